@@ -1,0 +1,21 @@
+//! Meshes for tetbench: one checked tetrahedral mesh model ([`TetMesh`]), readers for the
+//! formats the papers' data sets come in, deterministic generators, and a registry of named
+//! data sets resolved from a data directory.
+
+pub mod error;
+pub mod generate;
+pub mod load;
+pub mod mesh;
+pub mod mhd;
+pub mod plot3d;
+pub mod registry;
+pub mod toff;
+pub mod volume;
+pub mod vtk_legacy;
+pub mod vtk_xml;
+pub mod write_vtu;
+
+pub use error::{ErrorKind, LoadError, Location};
+pub use load::{Dataset, LoadOptions, Plot3dField};
+pub use mesh::{Aabb, BoundaryFace, QualityStats, RepairReport, TetMesh, UniqueFaces, NO_NEIGHBOUR, TET_FACES};
+pub use volume::VoxelGrid;

@@ -1,0 +1,347 @@
+//! The headless wgpu context every GPU algorithm shares, GPU timing by timestamp queries, memory
+//! accounting, readback, and splitting of large arrays across storage bindings.
+//!
+//! Runs on any backend: Vulkan through Mesa's lavapipe where there is no GPU (CI, developers'
+//! machines), Vulkan/Metal/DX12 on real hardware. Every result row records which.
+
+use std::sync::mpsc;
+use std::time::Instant;
+
+use anyhow::{anyhow, Context};
+use serde::{Deserialize, Serialize};
+
+use crate::image::Image;
+
+/// Who rendered: recorded in every result row.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AdapterDescription {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    pub driver_info: String,
+}
+
+/// The device, its queue and what it can do.
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub adapter: AdapterDescription,
+    pub features: wgpu::Features,
+    pub limits: wgpu::Limits,
+}
+
+/// Features used when present; none is required, each algorithm checks what it needs.
+fn wanted_features() -> wgpu::Features {
+    wgpu::Features::TIMESTAMP_QUERY
+        | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+        | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES
+        | wgpu::Features::SHADER_F64
+        | wgpu::Features::FLOAT32_FILTERABLE
+        | wgpu::Features::FLOAT32_BLENDABLE
+        | wgpu::Features::VERTEX_WRITABLE_STORAGE
+        | wgpu::Features::INDIRECT_FIRST_INSTANCE
+}
+
+impl Gpu {
+    /// Opens the first adapter (high-performance preferred; software adapters allowed).
+    pub fn new() -> anyhow::Result<Gpu> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            ..Default::default()
+        }))
+        .map_err(|e| {
+            anyhow!(
+                "no GPU adapter found ({e}). On a machine without a GPU install Mesa's software \
+                 Vulkan driver: apt-get install -y mesa-vulkan-drivers libvulkan1"
+            )
+        })?;
+        let info = adapter.get_info();
+        let features = adapter.features() & wanted_features();
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("tetbench"),
+            required_features: features,
+            required_limits: limits.clone(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .context("requesting the GPU device")?;
+        Ok(Gpu {
+            device,
+            queue,
+            adapter: AdapterDescription {
+                name: info.name.clone(),
+                backend: format!("{:?}", info.backend).to_lowercase(),
+                device_type: format!("{:?}", info.device_type),
+                driver: info.driver.clone(),
+                driver_info: info.driver_info.clone(),
+            },
+            features,
+            limits,
+        })
+    }
+
+    pub fn has_timestamps(&self) -> bool {
+        self.features.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
+    }
+
+    /// Largest storage buffer one binding may cover (128 MiB on lavapipe), rounded down to a
+    /// multiple of 256 bytes so chunks stay aligned for any element size up to 256.
+    pub fn max_storage_binding(&self) -> u64 {
+        let m = (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size);
+        m & !255
+    }
+
+    /// Blocks until all submitted work is done.
+    pub fn wait(&self) -> anyhow::Result<()> {
+        self.device
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
+            .map(|_| ())
+            .map_err(|e| anyhow!("waiting for the GPU: {e}"))
+    }
+
+    /// Loads a WGSL module; `source` is normally `include_str!("name.wgsl")` of a shader file
+    /// beside the algorithm's Rust.
+    pub fn shader(&self, label: &str, source: &str) -> wgpu::ShaderModule {
+        self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        })
+    }
+
+    /// Copies a buffer range to the host (blocking).
+    pub fn read_buffer(&self, buffer: &wgpu::Buffer, offset: u64, size: u64) -> anyhow::Result<Vec<u8>> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
+        self.queue.submit([enc.finish()]);
+        self.map_and_copy(&staging)
+    }
+
+    fn map_and_copy(&self, staging: &wgpu::Buffer) -> anyhow::Result<Vec<u8>> {
+        let (tx, rx) = mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait()?;
+        rx.recv()
+            .map_err(|_| anyhow!("readback callback dropped"))?
+            .map_err(|e| anyhow!("mapping readback buffer: {e}"))?;
+        let data = staging.get_mapped_range(..).map_err(|e| anyhow!("mapped range: {e:?}"))?.to_vec();
+        staging.unmap();
+        Ok(data)
+    }
+
+    /// Reads an `Rgba32Float` texture (premultiplied linear) into an [`Image`].
+    pub fn read_rgba32f(&self, texture: &wgpu::Texture) -> anyhow::Result<Image> {
+        let (w, h) = (texture.width(), texture.height());
+        let unpadded = w as u64 * 16;
+        let padded = unpadded.div_ceil(256) * 256;
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("image readback"),
+            size: padded * h as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded as u32),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+        self.queue.submit([enc.finish()]);
+        let bytes = self.map_and_copy(&staging)?;
+        let mut img = Image::new(w, h);
+        for y in 0..h as usize {
+            let row = &bytes[y * padded as usize..y * padded as usize + unpadded as usize];
+            let px: &[[f32; 4]] = bytemuck::cast_slice(row);
+            img.pixels[y * w as usize..(y + 1) * w as usize].copy_from_slice(px);
+        }
+        Ok(img)
+    }
+}
+
+/// Where an allocation belongs in the memory report.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Lifetime {
+    /// Lives as long as the mesh: counted in bytes/tet.
+    Persistent,
+    /// Scratch of one frame (k-buffers, sort buffers, render targets).
+    PerFrame,
+}
+
+/// Counts every buffer and texture an algorithm allocates.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MemoryLedger {
+    pub persistent: u64,
+    pub per_frame: u64,
+    pub entries: Vec<(String, Lifetime, u64)>,
+}
+
+impl MemoryLedger {
+    pub fn record(&mut self, label: &str, lifetime: Lifetime, bytes: u64) {
+        match lifetime {
+            Lifetime::Persistent => self.persistent += bytes,
+            Lifetime::PerFrame => self.per_frame += bytes,
+        }
+        self.entries.push((label.to_string(), lifetime, bytes));
+    }
+
+    /// Creates a buffer and records it.
+    pub fn buffer(
+        &mut self,
+        gpu: &Gpu,
+        label: &str,
+        lifetime: Lifetime,
+        size: u64,
+        usage: wgpu::BufferUsages,
+    ) -> wgpu::Buffer {
+        let size = size.max(16).div_ceil(4) * 4;
+        self.record(label, lifetime, size);
+        gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+    }
+
+    /// Creates a buffer holding `data` and records it.
+    pub fn buffer_init(
+        &mut self,
+        gpu: &Gpu,
+        label: &str,
+        lifetime: Lifetime,
+        data: &[u8],
+        usage: wgpu::BufferUsages,
+    ) -> wgpu::Buffer {
+        let buf = self.buffer(gpu, label, lifetime, data.len() as u64, usage | wgpu::BufferUsages::COPY_DST);
+        gpu.queue.write_buffer(&buf, 0, data);
+        buf
+    }
+
+    /// Creates a texture and records its size.
+    pub fn texture(&mut self, gpu: &Gpu, lifetime: Lifetime, desc: &wgpu::TextureDescriptor) -> wgpu::Texture {
+        let texel = desc.format.block_copy_size(None).unwrap_or(4) as u64;
+        let s = desc.size;
+        self.record(desc.label.unwrap_or("texture"), lifetime, texel * s.width as u64 * s.height as u64 * s.depth_or_array_layers as u64);
+        gpu.device.create_texture(desc)
+    }
+
+    pub fn total(&self) -> u64 {
+        self.persistent + self.per_frame
+    }
+}
+
+/// Splits `count` elements of `element_bytes` each into ranges that fit one storage binding.
+/// Large meshes (20 M tets = 320 MB of indices) are drawn chunk by chunk, never refused.
+pub fn chunk_ranges(count: u64, element_bytes: u64, max_binding: u64) -> Vec<std::ops::Range<u64>> {
+    let per = (max_binding / element_bytes).max(1);
+    (0..count.div_ceil(per)).map(|i| i * per..((i + 1) * per).min(count)).collect()
+}
+
+/// GPU time of a frame from two timestamps, and wall time from CPU clocks.
+pub struct FrameTimer {
+    query_set: Option<wgpu::QuerySet>,
+    resolve: Option<wgpu::Buffer>,
+    period_ns: f32,
+    started: Instant,
+}
+
+impl FrameTimer {
+    pub fn new(gpu: &Gpu) -> FrameTimer {
+        let (query_set, resolve) = if gpu.has_timestamps() {
+            let qs = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("frame timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            });
+            let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamp resolve"),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            (Some(qs), Some(buf))
+        } else {
+            (None, None)
+        };
+        FrameTimer { query_set, resolve, period_ns: gpu.queue.get_timestamp_period(), started: Instant::now() }
+    }
+
+    /// Restarts the wall clock (call at the start of the frame, before CPU work).
+    pub fn start_wall(&mut self) {
+        self.started = Instant::now();
+    }
+
+    /// Milliseconds since [`FrameTimer::start_wall`].
+    pub fn wall_ms(&self) -> f64 {
+        self.started.elapsed().as_secs_f64() * 1e3
+    }
+
+    /// Writes the "begin" timestamp into `encoder` (first command of the frame's GPU work).
+    pub fn begin(&self, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(qs) = &self.query_set {
+            encoder.write_timestamp(qs, 0);
+        }
+    }
+
+    /// Writes the "end" timestamp and resolves both (last commands of the frame's GPU work).
+    pub fn end(&self, encoder: &mut wgpu::CommandEncoder) {
+        if let (Some(qs), Some(buf)) = (&self.query_set, &self.resolve) {
+            encoder.write_timestamp(qs, 1);
+            encoder.resolve_query_set(qs, 0..2, buf, 0);
+        }
+    }
+
+    /// GPU milliseconds between begin and end (after the work was submitted; blocks).
+    pub fn gpu_ms(&self, gpu: &Gpu) -> anyhow::Result<Option<f64>> {
+        let Some(buf) = &self.resolve else { return Ok(None) };
+        let bytes = gpu.read_buffer(buf, 0, 16)?;
+        let t: &[u64] = bytemuck::cast_slice(&bytes);
+        Ok(Some(t[1].saturating_sub(t[0]) as f64 * self.period_ns as f64 * 1e-6))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunks_cover_everything_once() {
+        let r = chunk_ranges(1000, 16, 16 * 300);
+        assert_eq!(r, vec![0..300, 300..600, 600..900, 900..1000]);
+        assert_eq!(chunk_ranges(5, 16, 1 << 27), vec![0..5]);
+    }
+}
+
+#[cfg(test)]
+mod device_tests {
+    use super::*;
+
+    /// The headless device opens (lavapipe on machines without a GPU) and round-trips data.
+    #[test]
+    fn device_opens_and_reads_back() {
+        let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
+        let mut ledger = MemoryLedger::default();
+        let data: Vec<u32> = (0..1000).collect();
+        let buf = ledger.buffer_init(&gpu, "test", Lifetime::Persistent, bytemuck::cast_slice(&data), wgpu::BufferUsages::COPY_SRC);
+        let back = gpu.read_buffer(&buf, 0, 4000).unwrap();
+        assert_eq!(bytemuck::cast_slice::<u8, u32>(&back), &data[..]);
+        assert_eq!(ledger.persistent, 4000);
+        assert!(!gpu.adapter.name.is_empty());
+        eprintln!("adapter: {:?}, timestamps: {}", gpu.adapter, gpu.has_timestamps());
+    }
+}

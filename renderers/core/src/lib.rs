@@ -1,0 +1,19 @@
+//! What every tetbench renderer shares: scene and cameras, the transfer function and optical
+//! model, the headless GPU context with timing and memory accounting, the [`Renderer`] trait,
+//! and the CPU sorts used for visibility ordering.
+
+pub mod gpu;
+pub mod gpu_sort;
+pub mod image;
+pub mod preintegration;
+pub mod renderer;
+pub mod scene;
+pub mod sort;
+pub mod transfer;
+pub mod visibility;
+
+pub use gpu::{AdapterDescription, FrameTimer, Gpu, Lifetime, MemoryLedger};
+pub use image::Image;
+pub use renderer::{settings_string, FrameStats, Prepared, Renderer, Setting};
+pub use scene::{fixed_viewpoints, orbit_viewpoints, Camera, Projection, Ray, Viewpoint};
+pub use transfer::{Optics, TransferFunction};

@@ -1,0 +1,74 @@
+//! The one trait all five algorithms implement, and what they return.
+//!
+//! Data flows one way: mesh + [`Optics`] → [`Renderer::prepare`] (upload, persistent bytes) →
+//! [`Renderer::render`] per camera (timings) → [`Renderer::read_image`] (only when the harness
+//! wants the picture, so readback never pollutes the timings).
+
+use datasets::TetMesh;
+
+use crate::gpu::Gpu;
+use crate::image::Image;
+use crate::scene::Camera;
+use crate::transfer::Optics;
+
+/// One named knob of the paper, as it appears in result rows (`key=value`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Setting {
+    pub key: &'static str,
+    pub value: String,
+}
+
+impl Setting {
+    pub fn new(key: &'static str, value: impl ToString) -> Setting {
+        Setting { key, value: value.to_string() }
+    }
+}
+
+/// Renders settings as `key=value;key=value`, the `settings` column of the results.
+pub fn settings_string(settings: &[Setting]) -> String {
+    settings.iter().map(|s| format!("{}={}", s.key, s.value)).collect::<Vec<_>>().join(";")
+}
+
+/// What [`Renderer::prepare`] uploaded.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Prepared {
+    /// GPU bytes that live as long as the mesh (the papers' bytes/tet counts these).
+    pub persistent_bytes: u64,
+    /// Tets the renderer draws (after discarding nothing, normally the mesh's count).
+    pub tets: u64,
+}
+
+/// Timings and counters of one rendered frame.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FrameStats {
+    /// CPU work inside the frame: sorting, classification on the host, uploads (ms).
+    pub cpu_ms: f64,
+    /// GPU time from timestamp queries, or `None` when the adapter has none.
+    pub gpu_ms: Option<f64>,
+    /// Wall clock from the start of the frame until the GPU finished (ms).
+    pub total_ms: f64,
+    /// GPU bytes allocated for this frame only (per-frame buffers, k-buffers, sort scratch).
+    pub frame_bytes: u64,
+    /// Named stage timings (ms), e.g. `sort`, `classify`, `draw`, `drain`.
+    pub stages: Vec<(String, f64)>,
+    /// Named counters, e.g. `fragments`, `kbuffer_overflows`.
+    pub counters: Vec<(String, f64)>,
+}
+
+/// A volume renderer for tetrahedral meshes.
+pub trait Renderer {
+    /// Stable short name used in result rows and on the command line (`gator-pt`, `havs`…).
+    fn algorithm(&self) -> &'static str;
+
+    /// The paper's knobs with their values for this instance.
+    fn settings(&self) -> Vec<Setting>;
+
+    /// Uploads the mesh and every view-independent table.
+    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared>;
+
+    /// Renders one view into the renderer's own target and waits for the GPU.
+    fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats>;
+
+    /// Reads back the last rendered image (premultiplied linear RGBA, row 0 at the top).
+    fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image>;
+}
