@@ -1,0 +1,414 @@
+//! GPU LSD radix sort of (f32 key, u32 payload) pairs, in place in storage buffers the caller
+//! owns, so that HAVS (its "GPU sort" setting, issue 4 item 1) and fragment PT (its GPU-resident
+//! order, issue 5 item 2) can compute keys, sort and draw with no readback.
+//!
+//! Algorithm (`gpu_sort.wgsl`): four passes of 8 bits, each a per-tile histogram, a scan over
+//! tiles per digit, and a stable scatter. Keys are written by the caller as f32 (bits in a
+//! `u32`/`f32` storage array); the first pass maps them to ordered u32 (HAVS §5.1), the last maps
+//! them back, so afterwards the key buffer holds the sorted f32 keys and the value buffer the
+//! payloads in the same order. Four passes (an even number) leave the result in the caller's
+//! buffers; the ping-pong copies live in this struct.
+//!
+//! Limits: `n` ≤ `max_len`, and `max_len` keys must fit one storage binding
+//! (`Gpu::max_storage_binding() / 4`: 32 Mi keys at 128 MiB on lavapipe); larger arrays are not
+//! sorted in one piece (no chunking). Each [`GpuRadixSort::encode`] writes its pass parameters
+//! through the queue, so encode at most one sort per instance per submission.
+
+use anyhow::{bail, ensure};
+
+use crate::gpu::{Gpu, Lifetime, MemoryLedger};
+
+/// Keys per workgroup tile (256 threads × 16 sub-blocks); must match `TILE` in the shader.
+pub const TILE: u32 = 4096;
+const PASSES: usize = 4;
+/// Uniform offsets must be multiples of `min_uniform_buffer_offset_alignment` (≤ 256).
+const PARAM_STRIDE: u64 = 256;
+
+const MAP_IN: u32 = 1;
+const DESCENDING: u32 = 2;
+const UNMAP_OUT: u32 = 4;
+
+/// What a caller's key and value buffers need besides what the caller uses them for.
+pub const REQUIRED_USAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE;
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    n: u32,
+    shift: u32,
+    num_tiles: u32,
+    flags: u32,
+}
+
+/// A reusable GPU radix sorter for up to `max_len` pairs.
+pub struct GpuRadixSort {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    max_len: u32,
+    layout: wgpu::BindGroupLayout,
+    histogram: wgpu::ComputePipeline,
+    scan_tiles: wgpu::ComputePipeline,
+    scatter: wgpu::ComputePipeline,
+    params: wgpu::Buffer,
+    tmp_keys: wgpu::Buffer,
+    tmp_vals: wgpu::Buffer,
+    tile_hist: wgpu::Buffer,
+    digit_total: wgpu::Buffer,
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl GpuRadixSort {
+    /// Compiles the pipelines and allocates the scratch (recorded in `ledger` as per-frame sort
+    /// buffers: 8 bytes per key of ping-pong copies plus 1 KiB of histogram per tile).
+    pub fn new(gpu: &Gpu, max_len: u32, ledger: &mut MemoryLedger) -> anyhow::Result<GpuRadixSort> {
+        let max_len = max_len.max(1);
+        let binding = gpu.max_storage_binding();
+        if max_len as u64 * 4 > binding {
+            bail!(
+                "GPU radix sort of {max_len} keys: {} bytes exceed one storage binding ({binding} bytes); \
+                 at most {} keys",
+                max_len as u64 * 4,
+                binding / 4
+            );
+        }
+        let tiles = max_len.div_ceil(TILE);
+        ensure!(
+            tiles <= gpu.limits.max_compute_workgroups_per_dimension,
+            "too many tiles for one dispatch"
+        );
+        let device = &gpu.device;
+        let module = gpu.shader("gpu_sort.wgsl", include_str!("gpu_sort.wgsl"));
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("radix sort"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                storage_entry(1, true),
+                storage_entry(2, true),
+                storage_entry(3, false),
+                storage_entry(4, false),
+                storage_entry(5, false),
+                storage_entry(6, false),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("radix sort"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let storage = wgpu::BufferUsages::STORAGE;
+        Ok(GpuRadixSort {
+            device: gpu.device.clone(),
+            queue: gpu.queue.clone(),
+            max_len,
+            histogram: pipeline("histogram"),
+            scan_tiles: pipeline("scan_tiles"),
+            scatter: pipeline("scatter"),
+            layout,
+            params: ledger.buffer(
+                gpu,
+                "radix sort params",
+                Lifetime::PerFrame,
+                PARAM_STRIDE * PASSES as u64,
+                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            ),
+            tmp_keys: ledger.buffer(
+                gpu,
+                "radix sort keys (ping-pong)",
+                Lifetime::PerFrame,
+                max_len as u64 * 4,
+                storage,
+            ),
+            tmp_vals: ledger.buffer(
+                gpu,
+                "radix sort values (ping-pong)",
+                Lifetime::PerFrame,
+                max_len as u64 * 4,
+                storage,
+            ),
+            tile_hist: ledger.buffer(
+                gpu,
+                "radix sort tile histograms",
+                Lifetime::PerFrame,
+                tiles as u64 * 256 * 4,
+                storage,
+            ),
+            digit_total: ledger.buffer(
+                gpu,
+                "radix sort digit totals",
+                Lifetime::PerFrame,
+                256 * 4,
+                storage,
+            ),
+        })
+    }
+
+    /// The largest `n` this sorter takes.
+    pub fn max_len(&self) -> u32 {
+        self.max_len
+    }
+
+    /// Records the sort of the first `n` pairs of `keys` (f32) and `values` (u32) into `encoder`,
+    /// ascending or descending by key, stable (equal keys keep their order). Both buffers need
+    /// [`REQUIRED_USAGE`] and at least `4 n` bytes; callers normally fill them with their own
+    /// compute pass earlier in the same encoder (e.g. key = centroid distance, value = tet id).
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        keys: &wgpu::Buffer,
+        values: &wgpu::Buffer,
+        n: u32,
+        descending: bool,
+    ) -> anyhow::Result<()> {
+        ensure!(
+            n <= self.max_len,
+            "GPU radix sort: {n} keys exceed the sorter's capacity of {}",
+            self.max_len
+        );
+        ensure!(
+            keys.size() >= n as u64 * 4 && values.size() >= n as u64 * 4,
+            "GPU radix sort: key/value buffers hold fewer than {n} elements"
+        );
+        if n == 0 {
+            return Ok(());
+        }
+        let num_tiles = n.div_ceil(TILE);
+        let dir = if descending { DESCENDING } else { 0 };
+        let mut params = vec![0u8; PARAM_STRIDE as usize * PASSES];
+        for pass in 0..PASSES {
+            let mut flags = dir;
+            if pass == 0 {
+                flags |= MAP_IN;
+            }
+            if pass == PASSES - 1 {
+                flags |= UNMAP_OUT;
+            }
+            let p = Params {
+                n,
+                shift: 8 * pass as u32,
+                num_tiles,
+                flags,
+            };
+            let o = pass * PARAM_STRIDE as usize;
+            params[o..o + 16].copy_from_slice(bytemuck::bytes_of(&p));
+        }
+        self.queue.write_buffer(&self.params, 0, &params);
+        let bytes = wgpu::BufferSize::new(n as u64 * 4);
+        fn range(b: &wgpu::Buffer, size: Option<wgpu::BufferSize>) -> wgpu::BindingResource<'_> {
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: b,
+                offset: 0,
+                size,
+            })
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("radix sort"),
+            timestamp_writes: None,
+        });
+        for p in 0..PASSES {
+            // Even passes read the caller's buffers, odd passes the ping-pong copies.
+            let (ki, vi, ko, vo) = if p % 2 == 0 {
+                (keys, values, &self.tmp_keys, &self.tmp_vals)
+            } else {
+                (&self.tmp_keys, &self.tmp_vals, keys, values)
+            };
+            let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("radix sort pass"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &self.params,
+                            offset: p as u64 * PARAM_STRIDE,
+                            size: wgpu::BufferSize::new(16),
+                        }),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: range(ki, bytes),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: range(vi, bytes),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: range(ko, bytes),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: range(vo, bytes),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: self.tile_hist.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: self.digit_total.as_entire_binding(),
+                    },
+                ],
+            });
+            pass.set_bind_group(0, &bind, &[]);
+            pass.set_pipeline(&self.histogram);
+            pass.dispatch_workgroups(num_tiles, 1, 1);
+            pass.set_pipeline(&self.scan_tiles);
+            pass.dispatch_workgroups(256, 1, 1);
+            pass.set_pipeline(&self.scatter);
+            pass.dispatch_workgroups(num_tiles, 1, 1);
+        }
+        Ok(())
+    }
+
+    /// Uploads `keys`, sorts them with payload 0..n on the GPU, waits, and returns the sorted
+    /// keys and payloads (for tests and one-off timings; renderers keep everything on the GPU).
+    pub fn sort_pairs_blocking(
+        &self,
+        gpu: &Gpu,
+        keys: &[f32],
+        descending: bool,
+    ) -> anyhow::Result<(Vec<f32>, Vec<u32>)> {
+        let n = keys.len() as u32;
+        let mut ledger = MemoryLedger::default();
+        let usage = REQUIRED_USAGE | wgpu::BufferUsages::COPY_SRC;
+        let kbuf = ledger.buffer_init(
+            gpu,
+            "sort keys",
+            Lifetime::PerFrame,
+            bytemuck::cast_slice(keys),
+            usage,
+        );
+        let vals: Vec<u32> = (0..n).collect();
+        let vbuf = ledger.buffer_init(
+            gpu,
+            "sort values",
+            Lifetime::PerFrame,
+            bytemuck::cast_slice(&vals),
+            usage,
+        );
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        self.encode(&mut enc, &kbuf, &vbuf, n, descending)?;
+        gpu.queue.submit([enc.finish()]);
+        if n == 0 {
+            return Ok((Vec::new(), Vec::new()));
+        }
+        let k = gpu.read_buffer(&kbuf, 0, n as u64 * 4)?;
+        let v = gpu.read_buffer(&vbuf, 0, n as u64 * 4)?;
+        Ok((
+            bytemuck::cast_slice(&k).to_vec(),
+            bytemuck::cast_slice(&v).to_vec(),
+        ))
+    }
+}
+
+/// Sorts `keys` ascending on the GPU and returns the permutation (index of the smallest key
+/// first), like [`crate::sort::radix_sort_indices`]. Builds a sorter for this one call.
+pub fn sort_blocking(gpu: &Gpu, keys: &[f32]) -> anyhow::Result<Vec<u32>> {
+    let sorter = GpuRadixSort::new(gpu, keys.len() as u32, &mut MemoryLedger::default())?;
+    Ok(sorter.sort_pairs_blocking(gpu, keys, false)?.1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sort::{radix_sort_indices, radix_sort_indices_descending, RadixScratch};
+
+    fn xorshift_keys(n: usize, seed: u64) -> Vec<f32> {
+        let mut s = seed | 1;
+        (0..n)
+            .map(|i| {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                match i % 7 {
+                    // duplicates, both zeros, and negative keys mixed in
+                    0 => ((s >> 60) as f32) - 8.0,
+                    1 => {
+                        if s & 1 == 0 {
+                            0.0
+                        } else {
+                            -0.0
+                        }
+                    }
+                    _ => ((s >> 11) as f64 / (1u64 << 53) as f64 * 2e4 - 1e4) as f32,
+                }
+            })
+            .collect()
+    }
+
+    /// The GPU sort equals the CPU radix sort exactly (both are stable LSD sorts on the same
+    /// ordered-u32 images), for sizes around and off the tile size, ascending and descending.
+    #[test]
+    fn gpu_radix_sort_agrees_with_cpu() {
+        let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
+        let sorter = GpuRadixSort::new(&gpu, 100_000, &mut MemoryLedger::default()).unwrap();
+        let mut scratch = RadixScratch::default();
+        for (n, seed) in [
+            (0usize, 1u64),
+            (1, 2),
+            (255, 3),
+            (4096, 4),
+            (4097, 5),
+            (33_333, 6),
+            (100_000, 7),
+        ] {
+            let keys = xorshift_keys(n, seed);
+            for descending in [false, true] {
+                let (sorted, perm) = sorter.sort_pairs_blocking(&gpu, &keys, descending).unwrap();
+                let mut want = Vec::new();
+                if descending {
+                    radix_sort_indices_descending(&keys, &mut want, &mut scratch);
+                } else {
+                    radix_sort_indices(&keys, &mut want, &mut scratch);
+                }
+                assert_eq!(perm, want, "n = {n}, descending = {descending}");
+                let want_keys: Vec<u32> =
+                    want.iter().map(|&i| keys[i as usize].to_bits()).collect();
+                let got_keys: Vec<u32> = sorted.iter().map(|k| k.to_bits()).collect();
+                assert_eq!(got_keys, want_keys, "keys come back sorted, bit for bit");
+            }
+        }
+        assert_eq!(
+            sort_blocking(&gpu, &[3.0, -1.0, 2.0]).unwrap(),
+            vec![1, 2, 0]
+        );
+    }
+
+    #[test]
+    fn oversized_sort_is_an_error() {
+        let gpu = Gpu::new().expect("a wgpu adapter");
+        let too_many = (gpu.max_storage_binding() / 4 + 1).min(u32::MAX as u64) as u32;
+        assert!(GpuRadixSort::new(&gpu, too_many, &mut MemoryLedger::default()).is_err());
+    }
+}

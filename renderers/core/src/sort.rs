@@ -14,64 +14,475 @@ pub fn float_to_ordered_u32(f: f32) -> u32 {
 }
 
 /// Sorts `indices` so that `keys[indices[i]]` ascends, with an LSD radix sort over the ordered
-/// u32 images of the keys: 4 passes of 8 bits, stable. `scratch` is reused between frames.
+/// u32 images of the keys (HAVS §5.1): stable, one read of the keys builds every digit histogram,
+/// passes whose digit is the same for all keys are skipped. `scratch` is reused between frames.
 pub fn radix_sort_indices(keys: &[f32], indices: &mut Vec<u32>, scratch: &mut RadixScratch) {
-    let n = keys.len();
-    scratch.keys_a.clear();
-    scratch.keys_a.extend(keys.iter().map(|&k| float_to_ordered_u32(k)));
-    scratch.vals_a.clear();
-    scratch.vals_a.extend(0..n as u32);
-    scratch.keys_b.resize(n, 0);
-    scratch.vals_b.resize(n, 0);
-    // One read of the keys builds all four histograms.
-    let mut hist = [[0u32; 256]; 4];
-    for &k in &scratch.keys_a {
-        for (p, h) in hist.iter_mut().enumerate() {
-            h[((k >> (8 * p)) & 0xff) as usize] += 1;
-        }
-    }
-    let (mut ka, mut kb) = (&mut scratch.keys_a, &mut scratch.keys_b);
-    let (mut va, mut vb) = (&mut scratch.vals_a, &mut scratch.vals_b);
-    for (pass, h) in hist.iter().enumerate() {
-        // A pass where every key has the same digit changes nothing: skip it.
-        if h.iter().any(|&c| c as usize == n) {
-            continue;
-        }
-        let mut offset = [0u32; 256];
-        let mut sum = 0;
-        for d in 0..256 {
-            offset[d] = sum;
-            sum += h[d];
-        }
-        let shift = 8 * pass;
-        for i in 0..n {
-            let k = ka[i];
-            let d = ((k >> shift) & 0xff) as usize;
-            let o = offset[d] as usize;
-            offset[d] += 1;
-            kb[o] = k;
-            vb[o] = va[i];
-        }
-        std::mem::swap(&mut ka, &mut kb);
-        std::mem::swap(&mut va, &mut vb);
-    }
-    indices.clear();
-    indices.extend_from_slice(va);
+    radix_sort_packed::<RADIX_BITS>(keys, 0, indices, scratch);
 }
 
 /// Buffers the radix sort reuses from frame to frame.
 #[derive(Debug, Default, Clone)]
 pub struct RadixScratch {
-    keys_a: Vec<u32>,
-    keys_b: Vec<u32>,
-    vals_a: Vec<u32>,
-    vals_b: Vec<u32>,
+    a: Vec<u64>,
+    b: Vec<u64>,
 }
 
-/// Back-to-front order: indices sorted by descending key.
-pub fn radix_sort_indices_descending(keys: &[f32], indices: &mut Vec<u32>, scratch: &mut RadixScratch) {
-    radix_sort_indices(keys, indices, scratch);
-    indices.reverse();
+/// Back-to-front order: indices sorted by descending key (stable: equal keys keep ascending
+/// index order). The keys' ordered images are complemented, so it costs the same as ascending.
+pub fn radix_sort_indices_descending(
+    keys: &[f32],
+    indices: &mut Vec<u32>,
+    scratch: &mut RadixScratch,
+) {
+    radix_sort_packed::<RADIX_BITS>(keys, u32::MAX, indices, scratch);
+}
+
+/// Digit width of the CPU radix sort. HAVS §5.1 uses four 8-bit passes; 8 bits keep the 256
+/// scatter streams within the L1 cache and the write-combining buffers, which measured faster
+/// than three 11-bit passes on 1 M keys (benches/sort.rs).
+pub const RADIX_BITS: u32 = 8;
+
+/// LSD radix sort of `(ordered(key) ^ flip) << 32 | index` pairs packed in a u64, so that each
+/// scatter moves one 8-byte item instead of a key and a value in two arrays (one cache line
+/// stream per digit instead of two). The first pass reads the f32 keys directly and the last
+/// writes only the indices.
+pub fn radix_sort_packed<const BITS: u32>(
+    keys: &[f32],
+    flip: u32,
+    indices: &mut Vec<u32>,
+    scratch: &mut RadixScratch,
+) {
+    let n = keys.len();
+    let passes = 32u32.div_ceil(BITS) as usize;
+    let radix = 1usize << BITS;
+    let mask = (radix - 1) as u32;
+    indices.clear();
+    debug_assert!(n <= u32::MAX as usize);
+    // One read of the keys builds all histograms.
+    let mut hist = vec![0u32; passes * radix];
+    for &k in keys {
+        let u = float_to_ordered_u32(k) ^ flip;
+        for p in 0..passes {
+            hist[p * radix + ((u >> (BITS as usize * p)) & mask) as usize] += 1;
+        }
+    }
+    // A pass where every key has the same digit changes nothing: skip it.
+    let live: Vec<usize> = (0..passes)
+        .filter(|&p| {
+            !hist[p * radix..(p + 1) * radix]
+                .iter()
+                .any(|&c| c as usize == n)
+        })
+        .collect();
+    if live.is_empty() {
+        indices.extend(0..n as u32);
+        return;
+    }
+    scratch.a.resize(n, 0);
+    scratch.b.resize(n, 0);
+    let (mut a, mut b) = (&mut scratch.a, &mut scratch.b);
+    let mut offset = vec![0usize; radix];
+    for (li, &p) in live.iter().enumerate() {
+        let mut sum = 0usize;
+        for (o, &h) in offset.iter_mut().zip(&hist[p * radix..(p + 1) * radix]) {
+            *o = sum;
+            sum += h as usize;
+        }
+        let first = li == 0;
+        let last = li + 1 == live.len();
+        let key_shift = BITS as usize * p;
+        let shift = 32 + key_shift;
+        match (first, last) {
+            (true, true) => {
+                indices.resize(n, 0);
+                for (i, &k) in keys.iter().enumerate() {
+                    let d = (((float_to_ordered_u32(k) ^ flip) >> key_shift) & mask) as usize;
+                    indices[offset[d]] = i as u32;
+                    offset[d] += 1;
+                }
+            }
+            (true, false) => {
+                for (i, &k) in keys.iter().enumerate() {
+                    let u = float_to_ordered_u32(k) ^ flip;
+                    let d = ((u >> key_shift) & mask) as usize;
+                    a[offset[d]] = ((u as u64) << 32) | i as u64;
+                    offset[d] += 1;
+                }
+            }
+            (false, true) => {
+                indices.resize(n, 0);
+                for &x in a.iter() {
+                    let d = ((x >> shift) as u32 & mask) as usize;
+                    indices[offset[d]] = x as u32;
+                    offset[d] += 1;
+                }
+            }
+            (false, false) => {
+                for &x in a.iter() {
+                    let d = ((x >> shift) as u32 & mask) as usize;
+                    b[offset[d]] = x;
+                    offset[d] += 1;
+                }
+                std::mem::swap(&mut a, &mut b);
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The classic comparison sorts of HAVS Table 1 (Callahan et al. 2005 §5.1 compare shellsort,
+// heapsort, quicksort and radix sort on 1 M floats), plus the sorts of Marroquim et al. 2006 §4
+// (bucket sort while the camera moves, merge sort for still frames).
+//
+// They are written by hand on purpose: the point of Table 1 is to compare the textbook
+// algorithms themselves, which no crate exposes as such (std and rayon hide theirs behind one
+// `sort`). Each `*_sort_indices` wrapper sorts the same items: a key/index pair packed into a
+// u64, `(float_to_ordered_u32(key) << 32) | index`. Integer comparison of the packed pair is the
+// float order of the keys (HAVS §5.1's mapping), with ties broken by index, so every sort here
+// yields exactly the stable order of the radix sort, and the pair stays in one cache line slot.
+// ---------------------------------------------------------------------------------------------
+
+/// Packs keys and their indices as `ordered(key) << 32 | index` (ascending key order).
+fn packed_pairs(keys: &[f32], descending: bool) -> Vec<u64> {
+    let flip = if descending { u32::MAX } else { 0 };
+    keys.iter()
+        .enumerate()
+        .map(|(i, &k)| (((float_to_ordered_u32(k) ^ flip) as u64) << 32) | i as u64)
+        .collect()
+}
+
+fn unpack_indices(pairs: &[u64], indices: &mut Vec<u32>) {
+    indices.clear();
+    indices.extend(pairs.iter().map(|&p| p as u32));
+}
+
+/// Shellsort with Tokuda's gap sequence (h_k = ⌈(9^k − 4^k) / (5·4^(k−1))⌉: 1, 4, 9, 20, 46,
+/// 103, …), one of the best known empirically (Tokuda 1992; Ciura 2001's is similar but only
+/// tabulated up to 1750).
+pub fn shellsort<T: Copy>(v: &mut [T], less: impl Fn(&T, &T) -> bool) {
+    let n = v.len();
+    let mut gaps = Vec::new();
+    let mut k = 1u32;
+    loop {
+        let num = 9f64.powi(k as i32) - 4f64.powi(k as i32);
+        let h = (num / (5.0 * 4f64.powi(k as i32 - 1))).ceil() as usize;
+        if h >= n.max(2) {
+            break;
+        }
+        gaps.push(h);
+        k += 1;
+    }
+    for &gap in gaps.iter().rev() {
+        for i in gap..n {
+            let x = v[i];
+            let mut j = i;
+            while j >= gap && less(&x, &v[j - gap]) {
+                v[j] = v[j - gap];
+                j -= gap;
+            }
+            v[j] = x;
+        }
+    }
+}
+
+/// Heapsort (Williams 1964, Floyd's bottom-up heap construction): a max-heap, then repeated
+/// extraction of the maximum to the end.
+pub fn heapsort<T: Copy>(v: &mut [T], less: impl Fn(&T, &T) -> bool) {
+    let n = v.len();
+    // Moves v[root] down within v[..end] until the heap property holds.
+    let sift_down = |v: &mut [T], mut root: usize, end: usize| {
+        let x = v[root];
+        loop {
+            let mut child = 2 * root + 1;
+            if child >= end {
+                break;
+            }
+            if child + 1 < end && less(&v[child], &v[child + 1]) {
+                child += 1;
+            }
+            if !less(&x, &v[child]) {
+                break;
+            }
+            v[root] = v[child];
+            root = child;
+        }
+        v[root] = x;
+    };
+    for root in (0..n / 2).rev() {
+        sift_down(v, root, n);
+    }
+    for end in (1..n).rev() {
+        v.swap(0, end);
+        sift_down(v, 0, end);
+    }
+}
+
+/// Ranges this short are finished by insertion sort (quicksort's classic cut-off; Sedgewick).
+const QUICKSORT_CUTOFF: usize = 16;
+
+fn insertion_sort<T: Copy>(v: &mut [T], less: &impl Fn(&T, &T) -> bool) {
+    for i in 1..v.len() {
+        let x = v[i];
+        let mut j = i;
+        while j > 0 && less(&x, &v[j - 1]) {
+            v[j] = v[j - 1];
+            j -= 1;
+        }
+        v[j] = x;
+    }
+}
+
+/// Quicksort (Hoare 1962) with median-of-three pivots and insertion sort for short ranges; it
+/// recurses into the smaller part and loops on the larger, so the stack stays O(log n).
+pub fn quicksort<T: Copy>(v: &mut [T], less: impl Fn(&T, &T) -> bool) {
+    quicksort_rec(v, &less);
+}
+
+fn quicksort_rec<T: Copy>(mut v: &mut [T], less: &impl Fn(&T, &T) -> bool) {
+    while v.len() > QUICKSORT_CUTOFF {
+        let n = v.len();
+        let mid = n / 2;
+        // Median of three, left in v[mid]; v[0] ≤ v[mid] ≤ v[n−1] serve as sentinels.
+        if less(&v[mid], &v[0]) {
+            v.swap(mid, 0);
+        }
+        if less(&v[n - 1], &v[0]) {
+            v.swap(n - 1, 0);
+        }
+        if less(&v[n - 1], &v[mid]) {
+            v.swap(n - 1, mid);
+        }
+        let pivot = v[mid];
+        // Hoare partition.
+        let (mut i, mut j) = (0usize, n - 1);
+        loop {
+            while less(&v[i], &pivot) {
+                i += 1;
+            }
+            while less(&pivot, &v[j]) {
+                j -= 1;
+            }
+            if i >= j {
+                break;
+            }
+            v.swap(i, j);
+            i += 1;
+            j -= 1;
+        }
+        // v[..=j] ≤ pivot ≤ v[j+1..]
+        let (left, right) = v.split_at_mut(j + 1);
+        if left.len() < right.len() {
+            quicksort_rec(left, less);
+            v = right;
+        } else {
+            quicksort_rec(right, less);
+            v = left;
+        }
+    }
+    insertion_sort(v, less);
+}
+
+/// Stable bottom-up merge sort (von Neumann), ping-ponging between `v` and `scratch`. Runs of
+/// `QUICKSORT_CUTOFF` are first sorted by insertion sort.
+pub fn merge_sort<T: Copy>(v: &mut [T], scratch: &mut Vec<T>, less: impl Fn(&T, &T) -> bool) {
+    let n = v.len();
+    if n <= 1 {
+        return;
+    }
+    for run in v.chunks_mut(QUICKSORT_CUTOFF) {
+        insertion_sort(run, &less);
+    }
+    scratch.clear();
+    scratch.extend_from_slice(v);
+    let mut width = QUICKSORT_CUTOFF;
+    // `in_v`: the current runs are in `v` (else in `scratch`).
+    let mut in_v = true;
+    while width < n {
+        let (src, dst): (&[T], &mut [T]) = if in_v {
+            (&*v, &mut scratch[..])
+        } else {
+            (&scratch[..], &mut *v)
+        };
+        let mut lo = 0;
+        while lo < n {
+            let mid = (lo + width).min(n);
+            let hi = (lo + 2 * width).min(n);
+            let (mut a, mut b, mut o) = (lo, mid, lo);
+            while a < mid && b < hi {
+                // `<=` on the left run keeps equal items in input order (stability).
+                if less(&src[b], &src[a]) {
+                    dst[o] = src[b];
+                    b += 1;
+                } else {
+                    dst[o] = src[a];
+                    a += 1;
+                }
+                o += 1;
+            }
+            dst[o..o + (mid - a)].copy_from_slice(&src[a..mid]);
+            o += mid - a;
+            dst[o..o + (hi - b)].copy_from_slice(&src[b..hi]);
+            lo = hi;
+        }
+        in_v = !in_v;
+        width *= 2;
+    }
+    if !in_v {
+        v.copy_from_slice(scratch);
+    }
+}
+
+/// Indices sorted by ascending key with [`shellsort`].
+pub fn shellsort_indices(keys: &[f32], indices: &mut Vec<u32>) {
+    let mut p = packed_pairs(keys, false);
+    shellsort(&mut p, |a, b| a < b);
+    unpack_indices(&p, indices);
+}
+
+/// Indices sorted by ascending key with [`heapsort`].
+pub fn heapsort_indices(keys: &[f32], indices: &mut Vec<u32>) {
+    let mut p = packed_pairs(keys, false);
+    heapsort(&mut p, |a, b| a < b);
+    unpack_indices(&p, indices);
+}
+
+/// Indices sorted by ascending key with [`quicksort`].
+pub fn quicksort_indices(keys: &[f32], indices: &mut Vec<u32>) {
+    let mut p = packed_pairs(keys, false);
+    quicksort(&mut p, |a, b| a < b);
+    unpack_indices(&p, indices);
+}
+
+/// Indices sorted by ascending key (`descending`: by descending key) with [`merge_sort`]; ties
+/// keep ascending index order either way.
+pub fn merge_sort_indices(
+    keys: &[f32],
+    descending: bool,
+    indices: &mut Vec<u32>,
+    scratch: &mut Vec<u64>,
+) {
+    let mut p = packed_pairs(keys, descending);
+    merge_sort(&mut p, scratch, |a, b| a < b);
+    unpack_indices(&p, indices);
+}
+
+/// The baseline every user would write: the standard library's pattern-defeating quicksort,
+/// `sort_unstable_by` on (key, index) pairs with `f32::total_cmp`.
+pub fn std_sort_indices(keys: &[f32], indices: &mut Vec<u32>) {
+    let mut p: Vec<(f32, u32)> = keys
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| (k, i as u32))
+        .collect();
+    p.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    indices.clear();
+    indices.extend(p.iter().map(|x| x.1));
+}
+
+/// The default number of depth slabs of the bucket sort (Marroquim et al. 2006 §4: "about 20").
+pub const DEFAULT_SLABS: usize = 20;
+
+/// The slab of each key: `slabs` equal-width depth intervals between the smallest and the largest
+/// finite key (non-finite keys go to the nearest end).
+pub fn slab_of(key: f32, lo: f32, hi: f32, slabs: usize) -> usize {
+    if !(hi > lo) {
+        return 0;
+    }
+    let t = ((key - lo) / (hi - lo) * slabs as f32).floor();
+    if t.is_nan() || t < 0.0 {
+        0
+    } else {
+        (t as usize).min(slabs - 1)
+    }
+}
+
+/// Bucket sort into `slabs` depth slabs (Marroquim et al. 2006 §4, used while the camera moves):
+/// slabs ascend (`descending`: descend), and within a slab the input order is left as is. That
+/// partial order is the point: O(n) with one counting pass, at the price of ordering errors
+/// between nearby cells of one slab. Returns the `(lo, hi)` key range the slabs cover.
+pub fn bucket_sort_indices(
+    keys: &[f32],
+    slabs: usize,
+    descending: bool,
+    indices: &mut Vec<u32>,
+) -> (f32, f32) {
+    let slabs = slabs.max(1);
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    for &k in keys {
+        if k.is_finite() {
+            lo = lo.min(k);
+            hi = hi.max(k);
+        }
+    }
+    let mut count = vec![0u32; slabs + 1];
+    let slab = |k: f32| {
+        let s = slab_of(k, lo, hi, slabs);
+        if descending {
+            slabs - 1 - s
+        } else {
+            s
+        }
+    };
+    for &k in keys {
+        count[slab(k) + 1] += 1;
+    }
+    for s in 0..slabs {
+        count[s + 1] += count[s];
+    }
+    indices.clear();
+    indices.resize(keys.len(), 0);
+    for (i, &k) in keys.iter().enumerate() {
+        let s = slab(k);
+        indices[count[s] as usize] = i as u32;
+        count[s] += 1;
+    }
+    (lo, hi)
+}
+
+/// The CPU sorts compared in HAVS Table 1 (and the bucket/merge sorts of fragment PT), by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CpuSort {
+    Shell,
+    Heap,
+    Quick,
+    Radix,
+    Std,
+    Merge,
+}
+
+impl CpuSort {
+    /// The algorithms of HAVS Table 1, in the paper's row order, then the standard library's.
+    pub const TABLE1: [CpuSort; 5] = [
+        CpuSort::Shell,
+        CpuSort::Heap,
+        CpuSort::Quick,
+        CpuSort::Radix,
+        CpuSort::Std,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            CpuSort::Shell => "shellsort",
+            CpuSort::Heap => "heapsort",
+            CpuSort::Quick => "quicksort",
+            CpuSort::Radix => "radix sort",
+            CpuSort::Std => "std sort_unstable_by",
+            CpuSort::Merge => "merge sort",
+        }
+    }
+
+    /// Sorts indices by ascending key. `Std` is unstable on equal keys; all others give the
+    /// stable order.
+    pub fn sort_indices(self, keys: &[f32], indices: &mut Vec<u32>) {
+        match self {
+            CpuSort::Shell => shellsort_indices(keys, indices),
+            CpuSort::Heap => heapsort_indices(keys, indices),
+            CpuSort::Quick => quicksort_indices(keys, indices),
+            CpuSort::Radix => radix_sort_indices(keys, indices, &mut RadixScratch::default()),
+            CpuSort::Std => std_sort_indices(keys, indices),
+            CpuSort::Merge => merge_sort_indices(keys, false, indices, &mut Vec::new()),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -95,6 +506,117 @@ mod tests {
             let got: Vec<f32> = idx.iter().map(|&i| keys[i as usize]).collect();
             let want: Vec<f32> = expect.iter().map(|&i| keys[i as usize]).collect();
             prop_assert_eq!(got, want);
+        }
+    }
+    /// Keys with many duplicates, both zeros and negatives: what trips sorts up.
+    fn awkward_keys() -> impl Strategy<Value = Vec<f32>> {
+        proptest::collection::vec(
+            prop_oneof![
+                -1e6f32..1e6,
+                (-4i32..4).prop_map(|i| i as f32 * 0.5),
+                Just(0.0f32),
+                Just(-0.0f32),
+                Just(f32::MAX),
+                Just(f32::MIN),
+            ],
+            0..3000,
+        )
+    }
+
+    /// The stable ascending order by `total_cmp` (the reference).
+    fn stable_order(keys: &[f32]) -> Vec<u32> {
+        let mut expect: Vec<u32> = (0..keys.len() as u32).collect();
+        expect.sort_by(|&i, &j| keys[i as usize].total_cmp(&keys[j as usize]));
+        expect
+    }
+
+    fn is_permutation(idx: &[u32], n: usize) -> bool {
+        let mut seen = vec![false; n];
+        idx.len() == n
+            && idx
+                .iter()
+                .all(|&i| (i as usize) < n && !std::mem::replace(&mut seen[i as usize], true))
+    }
+
+    proptest! {
+        #[test]
+        fn classic_sorts_give_the_stable_order(keys in awkward_keys()) {
+            let expect = stable_order(&keys);
+            for s in [CpuSort::Shell, CpuSort::Heap, CpuSort::Quick, CpuSort::Radix, CpuSort::Merge] {
+                let mut idx = vec![7];
+                s.sort_indices(&keys, &mut idx);
+                prop_assert_eq!(&idx, &expect, "{}", s.name());
+            }
+            // The standard library's sort is unstable: same keys in the same order.
+            let mut idx = Vec::new();
+            std_sort_indices(&keys, &mut idx);
+            prop_assert!(is_permutation(&idx, keys.len()));
+            let got: Vec<u32> = idx.iter().map(|&i| float_to_ordered_u32(keys[i as usize])).collect();
+            let want: Vec<u32> = expect.iter().map(|&i| float_to_ordered_u32(keys[i as usize])).collect();
+            prop_assert_eq!(got, want);
+        }
+
+        #[test]
+        fn merge_sort_descending_is_stable(keys in awkward_keys()) {
+            let mut expect: Vec<u32> = (0..keys.len() as u32).collect();
+            expect.sort_by(|&i, &j| keys[j as usize].total_cmp(&keys[i as usize]));
+            let mut idx = Vec::new();
+            merge_sort_indices(&keys, true, &mut idx, &mut Vec::new());
+            prop_assert_eq!(idx, expect);
+        }
+
+        #[test]
+        fn generic_sorts_sort_plain_floats(mut v in proptest::collection::vec(-1e3f32..1e3, 0..500)) {
+            let mut want = v.clone();
+            want.sort_by(f32::total_cmp);
+            let mut a = v.clone();
+            shellsort(&mut a, |x, y| x < y);
+            let mut b = v.clone();
+            heapsort(&mut b, |x, y| x < y);
+            let mut c = v.clone();
+            quicksort(&mut c, |x, y| x < y);
+            merge_sort(&mut v, &mut Vec::new(), |x, y| x < y);
+            prop_assert_eq!(&a, &want);
+            prop_assert_eq!(&b, &want);
+            prop_assert_eq!(&c, &want);
+            prop_assert_eq!(&v, &want);
+        }
+
+        /// Bucket sort: a permutation whose slabs are in order; inside a slab the input order.
+        #[test]
+        fn bucket_sort_orders_slabs(keys in proptest::collection::vec(-50f32..50.0, 0..3000),
+                                    slabs in 1usize..40, descending: bool) {
+            let mut idx = Vec::new();
+            let (lo, hi) = bucket_sort_indices(&keys, slabs, descending, &mut idx);
+            prop_assert!(is_permutation(&idx, keys.len()));
+            let slab: Vec<usize> = idx.iter().map(|&i| slab_of(keys[i as usize], lo, hi, slabs)).collect();
+            for w in 0..idx.len().saturating_sub(1) {
+                let (a, b) = (slab[w], slab[w + 1]);
+                if descending { prop_assert!(a >= b); } else { prop_assert!(a <= b); }
+                if a == b { prop_assert!(idx[w] < idx[w + 1], "order inside a slab is the input order"); }
+                // Keys of a later slab are never on the wrong side of an earlier slab's keys.
+                let (ka, kb) = (keys[idx[w] as usize], keys[idx[w + 1] as usize]);
+                let in_order = if descending { ka > kb } else { ka < kb };
+                if a != b { prop_assert!(in_order); }
+            }
+        }
+    }
+
+    #[test]
+    fn sorts_handle_tiny_inputs() {
+        for keys in [vec![], vec![1.0f32], vec![2.0, 1.0], vec![1.0, 1.0, 1.0]] {
+            let expect = stable_order(&keys);
+            for s in CpuSort::TABLE1.into_iter().chain([CpuSort::Merge]) {
+                let mut idx = Vec::new();
+                s.sort_indices(&keys, &mut idx);
+                assert!(is_permutation(&idx, keys.len()));
+                if s != CpuSort::Std {
+                    assert_eq!(idx, expect, "{}", s.name());
+                }
+            }
+            let mut idx = Vec::new();
+            bucket_sort_indices(&keys, DEFAULT_SLABS, true, &mut idx);
+            assert!(is_permutation(&idx, keys.len()));
         }
     }
 }
