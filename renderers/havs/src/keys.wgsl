@@ -1,0 +1,35 @@
+// GPU sort variant of HAVS' object-space pass: one key per face, the distance from the eye to
+// the face's centroid (§5.1), or the distance along the viewing direction for orthographic
+// views. The keys and the face indices are then sorted by render_core's GPU radix sort.
+
+struct KeyUniforms {
+    // xyz: eye; w: 1 for perspective.
+    eye: vec4<f32>,
+    forward: vec4<f32>,
+    faces: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(0) @binding(0) var<uniform> ku: KeyUniforms;
+@group(0) @binding(1) var<storage, read> verts: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> faces: array<u32>;
+@group(0) @binding(3) var<storage, read_write> keys: array<f32>;
+@group(0) @binding(4) var<storage, read_write> ids: array<u32>;
+
+@compute @workgroup_size(256)
+fn face_keys(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
+    let f = g.x + g.y * nw.x * 256u;
+    if f >= ku.faces {
+        return;
+    }
+    let c = (verts[faces[3u * f]].xyz + verts[faces[3u * f + 1u]].xyz + verts[faces[3u * f + 2u]].xyz) / 3.0;
+    let rel = c - ku.eye.xyz;
+    var d = dot(rel, ku.forward.xyz);
+    if ku.eye.w > 0.5 {
+        d = length(rel);
+    }
+    keys[f] = d;
+    ids[f] = f;
+}
