@@ -50,6 +50,9 @@ pub enum ErrorKind {
     Unsupported(String),
     #[error("unrecognised file format: {0}")]
     UnknownFormat(String),
+    /// A named data set's file is absent from the data directory.
+    #[error("missing data file {file} (for data set {dataset}); public copy: {origin}")]
+    MissingDataFile { dataset: String, file: String, origin: String },
     #[error("{0}")]
     Invalid(String),
 }

@@ -1,0 +1,328 @@
+//! Named data sets usable on the command line: the papers' public data sets (resolved from a
+//! data directory), generator specs (`box:200k`, `shell:1m`, …) and plain file paths.
+//!
+//! The data directory is `--data-dir`, else the environment variable `TETBENCH_DATA`, else
+//! `../shared/datasets` relative to the current directory, else `shared/datasets` beside one
+//! of the executable's ancestor folders (a binary under `<root>/main/target/…` finds
+//! `<root>/shared/datasets`), else the same path relative to this crate's source.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{ErrorKind, LoadError};
+use crate::load::{Dataset, LoadOptions, Plot3dField};
+
+/// Where public copies of the files live (shown when one is missing).
+const VTK_DATA: &str =
+    "VTK's data repository, Data/ (e.g. https://github.com/pyvista/vtk-data/tree/master/Data)";
+const VISTRAILS: &str =
+    "the VisTrails examples (https://github.com/VisTrails/VisTrails, examples/data/spx.vtk)";
+
+/// One named data set.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Entry {
+    pub name: String,
+    pub description: String,
+    /// Files it needs, relative to the data directory (empty for generators).
+    pub files: Vec<String>,
+    /// All files present (always true for generators).
+    pub present: bool,
+    /// Which papers used it / what it stands in for.
+    pub paper: &'static str,
+}
+
+/// A named file data set.
+struct Named {
+    name: &'static str,
+    description: &'static str,
+    /// The file to load (PLOT3D: the XYZ file) and any companions (the Q file).
+    files: &'static [&'static str],
+    origin: &'static str,
+    paper: &'static str,
+    /// PLOT3D field used unless the caller asks for another.
+    field: Option<Plot3dField>,
+}
+
+const NAMED: &[Named] = &[
+    Named {
+        name: "bluntfin",
+        description: "Blunt Fin (NASA), PLOT3D 40×32×32 curvilinear grid, density: 40,960 points / 187,395 tets",
+        files: &["bluntfinxyz.bin", "bluntfinq.bin"],
+        origin: VTK_DATA,
+        paper: "the papers' Blunt Fin (187,395 tets)",
+        field: Some(Plot3dField::Density),
+    },
+    Named {
+        name: "comb",
+        description: "Combustion Chamber, PLOT3D 57×33×25, density: 47,025 points / 215,040 tets",
+        files: &["combxyz.bin", "combq.bin"],
+        origin: VTK_DATA,
+        paper: "the papers' Combustion Chamber (215,040 tets)",
+        field: Some(Plot3dField::Density),
+    },
+    Named {
+        name: "post",
+        description: "Liquid Oxygen Post, PLOT3D 38×76×38 with IBLANK, velocity magnitude (ρ = 1 everywhere): 109,744 points / 513,375 tets",
+        files: &["postxyz.bin", "postq.bin"],
+        origin: VTK_DATA,
+        paper: "the papers' LOx Post (513,375 tets)",
+        field: Some(Plot3dField::VelocityMagnitude),
+    },
+    Named {
+        name: "spx",
+        description: "SPX (Électricité de France), legacy VTK tets: 2,896 points / 12,936 tets, non-convex",
+        files: &["spx.vtk"],
+        origin: VISTRAILS,
+        paper: "SPX of the HAVS/ZSWEEP distributions",
+        field: None,
+    },
+    Named {
+        name: "tetramesh",
+        description: "VTK sample tet mesh (legacy ASCII): 55 points / 160 tets",
+        files: &["tetraMesh.vtk"],
+        origin: VTK_DATA,
+        paper: "VTK sample (reader test)",
+        field: None,
+    },
+    Named {
+        name: "tetrahedron",
+        description: "VTK sample (XML .vtu, raw appended, UInt64 header): 35 points / 96 tets",
+        files: &["Tetrahedron.vtu"],
+        origin: VTK_DATA,
+        paper: "VTK sample (reader test)",
+        field: None,
+    },
+    Named {
+        name: "ironprot",
+        description: "Iron protein, 68³ unsigned-char volume (legacy BINARY STRUCTURED_POINTS): 1,503,815 tets",
+        files: &["ironProt.vtk"],
+        origin: VTK_DATA,
+        paper: "regular volume (splatting comparisons)",
+        field: None,
+    },
+    Named {
+        name: "headmr",
+        description: "MR head, 48×62×42 unsigned-char MetaImage volume",
+        files: &["HeadMRVolume.mhd", "HeadMRVolume.raw"],
+        origin: VTK_DATA,
+        paper: "regular volume (splatting comparisons)",
+        field: None,
+    },
+];
+
+/// Generator specs listed by [`Registry::entries`] (any size works; these are examples).
+const GENERATED: &[(&str, &str)] = &[
+    (
+        "box:200k",
+        "stand-in for mid-size convex meshes (e.g. Blunt Fin class)",
+    ),
+    (
+        "shell:1m",
+        "non-convex stand-in (rays re-enter) for the unavailable F117/fighter class",
+    ),
+    ("tunnels:1m", "non-convex stand-in with many re-entries"),
+    (
+        "slivers:50k",
+        "sliver-rich mesh for the HAVS k-buffer analysis",
+    ),
+];
+
+fn is_data_dir(p: &Path) -> bool {
+    p.is_dir()
+}
+
+/// The default data directory (see the module documentation), if one exists.
+pub fn default_data_dir() -> Option<PathBuf> {
+    if let Some(v) = std::env::var_os("TETBENCH_DATA") {
+        return Some(PathBuf::from(v));
+    }
+    let rel = PathBuf::from("../shared/datasets");
+    if is_data_dir(&rel) {
+        return Some(rel);
+    }
+    if let Ok(exe) = std::env::current_exe() {
+        for anc in exe.ancestors().skip(1) {
+            let c = anc.join("shared/datasets");
+            if is_data_dir(&c) {
+                return Some(c);
+            }
+        }
+    }
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/datasets");
+    is_data_dir(&src).then_some(src)
+}
+
+/// Resolves names, specs and paths to data sets.
+#[derive(Debug, Clone, Default)]
+pub struct Registry {
+    pub data_dir: Option<PathBuf>,
+}
+
+impl Registry {
+    /// `None` uses [`default_data_dir`].
+    pub fn new(data_dir: Option<PathBuf>) -> Registry {
+        Registry {
+            data_dir: data_dir.or_else(default_data_dir),
+        }
+    }
+
+    fn file(&self, f: &str) -> Option<PathBuf> {
+        self.data_dir.as_ref().map(|d| d.join(f))
+    }
+
+    /// Every named data set and example generator spec, with whether its files are present.
+    pub fn entries(&self) -> Vec<Entry> {
+        let mut out: Vec<Entry> = NAMED
+            .iter()
+            .map(|n| Entry {
+                name: n.name.into(),
+                description: n.description.into(),
+                files: n.files.iter().map(|f| f.to_string()).collect(),
+                present: n
+                    .files
+                    .iter()
+                    .all(|f| self.file(f).is_some_and(|p| p.is_file())),
+                paper: n.paper,
+            })
+            .collect();
+        for (spec, paper) in GENERATED {
+            let kind = crate::generate::parse_spec(spec)
+                .map(|s| s.kind.description())
+                .unwrap_or_default();
+            out.push(Entry {
+                name: spec.to_string(),
+                description: format!("generated: {kind}"),
+                files: vec![],
+                present: true,
+                paper,
+            });
+        }
+        out
+    }
+
+    /// Loads a named data set (case-insensitive), a generator spec (`KIND:SIZE[:opts]`, seed 1
+    /// unless the spec says `seed=N`) or a file path.
+    pub fn resolve(&self, name_or_path: &str, options: &LoadOptions) -> Result<Dataset, LoadError> {
+        let key = name_or_path.trim();
+        if let Some(n) = NAMED.iter().find(|n| n.name.eq_ignore_ascii_case(key)) {
+            return self.load_named(n, options);
+        }
+        if crate::generate::is_spec(key) {
+            let mesh = crate::generate::from_spec(key, 1)?;
+            if let Some(want) = &options.scalar {
+                if *want != mesh.scalar_name {
+                    return Err(LoadError::new(
+                        key,
+                        ErrorKind::MissingArray {
+                            name: want.clone(),
+                            available: vec![mesh.scalar_name.clone()],
+                        },
+                    ));
+                }
+            }
+            return Ok(Dataset {
+                mesh,
+                volume: None,
+                source: key.to_string(),
+            });
+        }
+        let path = Path::new(key);
+        if path.exists() {
+            return crate::load::load(path, options);
+        }
+        // A bare file name may live in the data directory.
+        if let Some(p) = self
+            .file(key)
+            .filter(|p| p.is_file() && !path.is_absolute())
+        {
+            return crate::load::load(&p, options);
+        }
+        let known: Vec<&str> = NAMED.iter().map(|n| n.name).collect();
+        Err(LoadError::new(
+            key,
+            ErrorKind::Io(format!(
+                "no such file, named data set ({}) or generator spec (box|shell|tunnels|slivers:SIZE[:field=…][:seed=…])",
+                known.join(", ")
+            )),
+        ))
+    }
+
+    fn load_named(&self, n: &Named, options: &LoadOptions) -> Result<Dataset, LoadError> {
+        let missing = |file: &str, where_: String| {
+            LoadError::new(
+                where_,
+                ErrorKind::MissingDataFile {
+                    dataset: n.name.into(),
+                    file: file.into(),
+                    origin: n.origin.into(),
+                },
+            )
+        };
+        let Some(dir) = &self.data_dir else {
+            return Err(missing(
+                &n.files.join(" + "),
+                "(no data directory found: use --data-dir or set TETBENCH_DATA)".into(),
+            ));
+        };
+        for f in n.files {
+            let p = dir.join(f);
+            if !p.is_file() {
+                return Err(missing(f, p.display().to_string()));
+            }
+        }
+        let mut opts = options.clone();
+        if n.field.is_some() {
+            if opts.q_file.is_none() && n.files.len() > 1 {
+                opts.q_file = Some(dir.join(n.files[1]));
+            }
+            if opts.plot3d_field.is_none() && opts.scalar.is_none() {
+                opts.plot3d_field = n.field;
+            }
+        }
+        let mut ds = crate::load::load(&dir.join(n.files[0]), &opts)?;
+        ds.mesh.name = n.name.to_string();
+        Ok(ds)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn missing_file_names_it_and_its_origin() {
+        let dir = tempfile::tempdir().unwrap();
+        let reg = Registry::new(Some(dir.path().to_path_buf()));
+        let err = reg
+            .resolve("bluntfin", &LoadOptions::default())
+            .unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            matches!(&err.kind, ErrorKind::MissingDataFile { file, .. } if file == "bluntfinxyz.bin"),
+            "{msg}"
+        );
+        assert!(msg.contains("vtk-data"), "{msg}");
+        let err = reg.resolve("SPX", &LoadOptions::default()).unwrap_err();
+        assert!(err.to_string().contains("VisTrails"), "{err}");
+        let entries = reg.entries();
+        assert!(entries.iter().any(|e| e.name == "post" && !e.present));
+        assert!(entries.iter().any(|e| e.name == "shell:1m" && e.present));
+    }
+
+    #[test]
+    fn specs_and_unknown_names() {
+        let reg = Registry::new(None);
+        let ds = reg
+            .resolve("box:1k:field=linear", &LoadOptions::default())
+            .unwrap();
+        assert_eq!(ds.mesh.scalar_name, "linear");
+        assert_eq!(ds.source, "box:1k:field=linear");
+        let err = reg
+            .resolve("no-such-thing", &LoadOptions::default())
+            .unwrap_err();
+        assert!(matches!(err.kind, ErrorKind::Io(_)));
+        let err = reg
+            .resolve("box:lots", &LoadOptions::default())
+            .unwrap_err();
+        assert!(matches!(err.kind, ErrorKind::Syntax { .. }));
+    }
+}

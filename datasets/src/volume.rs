@@ -1,7 +1,13 @@
 //! Regular voxel volumes (for splatting, and the papers' regular data sets) and the conversion
 //! of structured (hexahedral) grids to conforming tets.
 
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+
+use crate::error::ErrorKind;
+use crate::mesh::{cross, dot, sub, TetMesh};
 
 /// A regular grid of values at the grid points (VTK "point data" layout: x fastest).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -22,6 +28,161 @@ impl VoxelGrid {
     pub fn num_voxels(&self) -> usize {
         self.dims.iter().product()
     }
+
+    /// Position of grid point (i, j, k).
+    pub fn point(&self, i: usize, j: usize, k: usize) -> [f64; 3] {
+        let ijk = [i, j, k];
+        [0, 1, 2].map(|a| self.origin[a] + ijk[a] as f64 * self.spacing[a])
+    }
+
+    /// The volume as a tet mesh: grid points become mesh points (same order, same values) and
+    /// each cell 5 tets ([`structured_tets`]); a 68³ volume gives 67³·5 = 1,503,815 tets.
+    pub fn to_tets(&self) -> Result<TetMesh, ErrorKind> {
+        let n = self.num_voxels();
+        if self.values.len() != n {
+            return Err(ErrorKind::CountMismatch {
+                what: "voxel values".into(),
+                expected: n as u64,
+                found: self.values.len() as u64,
+            });
+        }
+        if n > u32::MAX as usize {
+            return Err(ErrorKind::IndexOverflow {
+                what: "voxels".into(),
+                count: n as u64,
+            });
+        }
+        let [nx, ny, _] = self.dims;
+        let points: Vec<[f32; 3]> = (0..n)
+            .into_par_iter()
+            .map(|g| {
+                self.point(g % nx, (g / nx) % ny, g / (nx * ny))
+                    .map(|c| c as f32)
+            })
+            .collect();
+        TetMesh::new(
+            "volume",
+            points,
+            self.values.clone(),
+            self.scalar_name.clone(),
+            structured_tets(self.dims),
+        )
+    }
+
+    /// Samples `mesh` at the points of a regular grid of `dims` points spanning its bounding
+    /// box (for splatting renderers, which need a voxel grid). Each grid point takes the
+    /// barycentric (linear) interpolation of the tet containing it, so a field linear over
+    /// the mesh is reproduced exactly; points outside the mesh (holes, non-convex regions)
+    /// take the mesh's minimum scalar, i.e. "empty" under any transfer function ramp.
+    ///
+    /// Point location: every tet visits the grid points inside its bounding box and claims
+    /// those inside it with an atomic minimum of its index — the voxel grid itself serves as
+    /// the uniform bin structure, the work is O(tets + covered grid points) and parallel, and
+    /// the smallest containing tet wins, so the result is deterministic.
+    pub fn resample(mesh: &TetMesh, dims: [usize; 3]) -> VoxelGrid {
+        let dims = dims.map(|d| d.max(1));
+        let b = mesh.bounds();
+        let mut origin = b.min;
+        let mut spacing = [1.0; 3];
+        for a in 0..3 {
+            let e = b.max[a] - b.min[a];
+            if dims[a] > 1 {
+                spacing[a] = e / (dims[a] - 1) as f64;
+            } else {
+                origin[a] = 0.5 * (b.min[a] + b.max[a]);
+                spacing[a] = if e > 0.0 { e } else { 1.0 };
+            }
+        }
+        let n: usize = dims.iter().product();
+        let claim: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(u32::MAX)).collect();
+        let inv = |a: usize, x: f64| {
+            if spacing[a] > 0.0 {
+                (x - origin[a]) / spacing[a]
+            } else {
+                0.0
+            }
+        };
+        (0..mesh.num_tets()).into_par_iter().for_each(|t| {
+            let p = mesh.tet_points(t);
+            let bary = Barycentric::new(p);
+            let mut lo = [0usize; 3];
+            let mut hi = [0usize; 3];
+            for a in 0..3 {
+                let mn = p.iter().map(|q| q[a]).fold(f64::INFINITY, f64::min);
+                let mx = p.iter().map(|q| q[a]).fold(f64::NEG_INFINITY, f64::max);
+                let l = (inv(a, mn) - 1e-6).ceil().max(0.0);
+                let h = (inv(a, mx) + 1e-6).floor().min((dims[a] - 1) as f64);
+                if h < l {
+                    return;
+                }
+                lo[a] = l as usize;
+                hi[a] = h as usize;
+            }
+            for k in lo[2]..=hi[2] {
+                for j in lo[1]..=hi[1] {
+                    for i in lo[0]..=hi[0] {
+                        let q = [0, 1, 2].map(|a| origin[a] + [i, j, k][a] as f64 * spacing[a]);
+                        if bary.weights(q).iter().all(|&w| w >= -BARY_TOLERANCE) {
+                            claim[i + dims[0] * (j + dims[1] * k)]
+                                .fetch_min(t as u32, Ordering::Relaxed);
+                        }
+                    }
+                }
+            }
+        });
+        let outside = mesh.scalar_range().0;
+        let values: Vec<f32> = (0..n)
+            .into_par_iter()
+            .map(|g| {
+                let t = claim[g].load(Ordering::Relaxed);
+                if t == u32::MAX {
+                    return outside;
+                }
+                let q = [
+                    g % dims[0],
+                    (g / dims[0]) % dims[1],
+                    g / (dims[0] * dims[1]),
+                ];
+                let q = [0, 1, 2].map(|a| origin[a] + q[a] as f64 * spacing[a]);
+                let w = Barycentric::new(mesh.tet_points(t as usize)).weights(q);
+                let s = mesh.tets[t as usize].map(|v| mesh.scalars[v as usize] as f64);
+                (0..4).map(|c| w[c] * s[c]).sum::<f64>() as f32
+            })
+            .collect();
+        VoxelGrid {
+            dims,
+            spacing,
+            origin,
+            values,
+            scalar_name: mesh.scalar_name.clone(),
+        }
+    }
+}
+
+/// A point is in a tet when all its barycentric weights are ≥ −this (relative; absorbs the
+/// rounding of points on shared faces and on the mesh boundary).
+const BARY_TOLERANCE: f64 = 1e-7;
+
+/// Barycentric coordinates in one tet: λ₁..₃ = rows of the inverse edge matrix · (q − p₀).
+struct Barycentric {
+    p0: [f64; 3],
+    rows: [[f64; 3]; 3],
+}
+
+impl Barycentric {
+    fn new(p: [[f64; 3]; 4]) -> Barycentric {
+        let e = [sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0])];
+        let det = dot(e[0], cross(e[1], e[2]));
+        let inv = if det != 0.0 { 1.0 / det } else { 0.0 };
+        let rows =
+            [cross(e[1], e[2]), cross(e[2], e[0]), cross(e[0], e[1])].map(|r| r.map(|x| x * inv));
+        Barycentric { p0: p[0], rows }
+    }
+    fn weights(&self, q: [f64; 3]) -> [f64; 4] {
+        let d = sub(q, self.p0);
+        let l = self.rows.map(|r| dot(r, d));
+        [1.0 - l[0] - l[1] - l[2], l[0], l[1], l[2]]
+    }
 }
 
 /// The five tets of hexahedral cell (i, j, k) of a structured grid, as indices into the grid's
@@ -29,22 +190,37 @@ impl VoxelGrid {
 /// of i + j + k, so the diagonals of shared faces match and the mesh is conforming; this gives
 /// the papers' counts (Blunt Fin 39·31·31·5 = 187,395 tets).
 pub fn hex_cell_tets(dims: [usize; 3], i: usize, j: usize, k: usize) -> [[u32; 4]; 5] {
-    let idx = |di: usize, dj: usize, dk: usize| (i + di + dims[0] * ((j + dj) + dims[1] * (k + dk))) as u32;
+    let idx = |di: usize, dj: usize, dk: usize| {
+        (i + di + dims[0] * ((j + dj) + dims[1] * (k + dk))) as u32
+    };
     // Corners: c[b] with b = dx + 2 dy + 4 dz.
     let c: [u32; 8] = std::array::from_fn(|b| idx(b & 1, (b >> 1) & 1, (b >> 2) & 1));
     if (i + j + k) % 2 == 0 {
         // Central tet on corners 1, 2, 4, 7 (its edges are the face diagonals).
-        [[c[0], c[1], c[2], c[4]], [c[3], c[1], c[2], c[7]], [c[5], c[1], c[4], c[7]], [c[6], c[2], c[4], c[7]], [c[1], c[2], c[4], c[7]]]
+        [
+            [c[0], c[1], c[2], c[4]],
+            [c[3], c[1], c[2], c[7]],
+            [c[5], c[1], c[4], c[7]],
+            [c[6], c[2], c[4], c[7]],
+            [c[1], c[2], c[4], c[7]],
+        ]
     } else {
         // Mirror split: central tet on corners 0, 3, 5, 6.
-        [[c[1], c[0], c[3], c[5]], [c[2], c[0], c[3], c[6]], [c[4], c[0], c[5], c[6]], [c[7], c[3], c[5], c[6]], [c[0], c[3], c[5], c[6]]]
+        [
+            [c[1], c[0], c[3], c[5]],
+            [c[2], c[0], c[3], c[6]],
+            [c[4], c[0], c[5], c[6]],
+            [c[7], c[3], c[5], c[6]],
+            [c[0], c[3], c[5], c[6]],
+        ]
     }
 }
 
 /// All tets of a structured grid with `dims` points (orientation is fixed later by
 /// [`crate::TetMesh::new`]).
 pub fn structured_tets(dims: [usize; 3]) -> Vec<[u32; 4]> {
-    let mut tets = Vec::with_capacity(5 * dims.iter().map(|d| d.saturating_sub(1)).product::<usize>());
+    let mut tets =
+        Vec::with_capacity(5 * dims.iter().map(|d| d.saturating_sub(1)).product::<usize>());
     for k in 0..dims[2].saturating_sub(1) {
         for j in 0..dims[1].saturating_sub(1) {
             for i in 0..dims[0].saturating_sub(1) {
@@ -72,7 +248,8 @@ mod tests {
             }
         }
         let n = points.len();
-        let mesh = TetMesh::new("grid", points, vec![0.0; n], "zero", structured_tets(dims)).unwrap();
+        let mesh =
+            TetMesh::new("grid", points, vec![0.0; n], "zero", structured_tets(dims)).unwrap();
         assert_eq!(mesh.num_tets(), 3 * 2 * 4 * 5);
         assert_eq!(mesh.repair.degenerate_dropped, 0);
         // Conforming: boundary faces are exactly 2 triangles per boundary quad.
