@@ -15,7 +15,9 @@ use render_core::preintegration::Table3d;
 use render_core::sort::{radix_sort_indices, RadixScratch};
 use render_core::{Camera, Image};
 
-use crate::kbuffer::{composite_front_to_back, Fragment, KBuffer, Tag, TagScheme, EARLY_TERMINATION_ALPHA};
+use crate::kbuffer::{
+    composite_front_to_back, Fragment, KBuffer, Tag, TagScheme, EARLY_TERMINATION_ALPHA,
+};
 
 /// The vertices HAVS draws (xyz, normalised scalar + 2 on boundary copies) and its unique
 /// faces as indices into them; see [`crate::tagged_geometry`].
@@ -58,7 +60,11 @@ pub struct AFrag {
 
 impl AFrag {
     pub fn fragment(&self) -> Fragment {
-        Fragment { scalar: self.scalar, depth: self.depth, tag: self.tag }
+        Fragment {
+            scalar: self.scalar,
+            depth: self.depth,
+            tag: self.tag,
+        }
     }
 }
 
@@ -99,7 +105,11 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// Whether an edge with direction (dx, dy) (interior on its positive side) owns the pixel
@@ -125,7 +135,11 @@ pub fn for_each_band<R: Send>(
             .map(|p| {
                 let c = vp * glam::DVec4::new(p[0] as f64, p[1] as f64, p[2] as f64, 1.0);
                 let ndc = c.truncate() / c.w;
-                [(ndc.x + 1.0) * 0.5 * w as f64, (1.0 - ndc.y) * 0.5 * h as f64, c.w]
+                [
+                    (ndc.x + 1.0) * 0.5 * w as f64,
+                    (1.0 - ndc.y) * 0.5 * h as f64,
+                    c.w,
+                ]
             })
             .collect()
     };
@@ -217,18 +231,29 @@ pub fn for_each_band<R: Send>(
                         let w2 = dot(cross(sub(p0, hit), sub(p1, hit)), face.n);
                         let sum = w0 + w1 + w2;
                         let raw_v = if sum != 0.0 {
-                            (w0 * face.v[0] as f64 + w1 * face.v[1] as f64 + w2 * face.v[2] as f64) / sum
+                            (w0 * face.v[0] as f64 + w1 * face.v[1] as f64 + w2 * face.v[2] as f64)
+                                / sum
                         } else {
                             face.v[0] as f64
                         };
                         let (scalar, tag) = if face.boundary {
                             // Boundary faces are wound outward: seen from outside the ray enters.
-                            ((raw_v - 2.0).clamp(0.0, 1.0), if nd < 0.0 { Tag::Entry } else { Tag::Exit })
+                            (
+                                (raw_v - 2.0).clamp(0.0, 1.0),
+                                if nd < 0.0 { Tag::Entry } else { Tag::Exit },
+                            )
                         } else {
                             (raw_v.clamp(0.0, 1.0), Tag::Interior)
                         };
                         let local = (py as u32 - y0) * w + px as u32;
-                        raw.push((local, AFrag { depth: depth as f32, scalar: scalar as f32, tag }));
+                        raw.push((
+                            local,
+                            AFrag {
+                                depth: depth as f32,
+                                scalar: scalar as f32,
+                                tag,
+                            },
+                        ));
                     }
                 }
             }
@@ -242,13 +267,26 @@ pub fn for_each_band<R: Send>(
                 offsets[i + 1] += offsets[i];
             }
             let mut fill = offsets.clone();
-            let mut frags = vec![AFrag { depth: 0.0, scalar: 0.0, tag: Tag::Interior }; raw.len()];
+            let mut frags = vec![
+                AFrag {
+                    depth: 0.0,
+                    scalar: 0.0,
+                    tag: Tag::Interior
+                };
+                raw.len()
+            ];
             for (p, fr) in raw {
                 let slot = &mut fill[p as usize];
                 frags[*slot as usize] = fr;
                 *slot += 1;
             }
-            f(&Band { y0, rows: y1 - y0, width: w, offsets, frags })
+            f(&Band {
+                y0,
+                rows: y1 - y0,
+                width: w,
+                offsets,
+                frags,
+            })
         })
         .collect()
 }
@@ -296,7 +334,11 @@ pub fn kbuffer_stats(geom: &Geometry, camera: &Camera) -> KStats {
         }
         (s, map)
     });
-    let mut total = KStats { width: camera.width, height: camera.height, ..Default::default() };
+    let mut total = KStats {
+        width: camera.width,
+        height: camera.height,
+        ..Default::default()
+    };
     for (s, map) in bands {
         total.fragments += s.fragments;
         total.max_list = total.max_list.max(s.max_list);
@@ -381,6 +423,10 @@ fn shade(table: &Table3d, s: &crate::kbuffer::Segment, acc: &mut [f32; 4]) {
     if !s.inside {
         return;
     }
-    let c = table.sample(s.front.scalar as f64, s.back.scalar as f64, (s.back.depth - s.front.depth) as f64);
+    let c = table.sample(
+        s.front.scalar as f64,
+        s.back.scalar as f64,
+        (s.back.depth - s.front.depth) as f64,
+    );
     composite_front_to_back(acc, c.map(|x| x as f32));
 }

@@ -90,7 +90,13 @@ pub struct KBuffer {
 impl KBuffer {
     pub fn new(k: usize, scheme: TagScheme) -> KBuffer {
         assert!(k >= 1, "a k-buffer needs at least one entry");
-        KBuffer { k, scheme, entries: Vec::with_capacity(k), last_back: f32::NEG_INFINITY, out_of_order: 0 }
+        KBuffer {
+            k,
+            scheme,
+            entries: Vec::with_capacity(k),
+            last_back: f32::NEG_INFINITY,
+            out_of_order: 0,
+        }
     }
 
     pub fn k(&self) -> usize {
@@ -136,17 +142,27 @@ impl KBuffer {
             self.out_of_order += 1;
         }
         self.last_back = back.depth;
-        Segment { front, back, inside: self.scheme.composites(front.tag, back.tag) }
+        Segment {
+            front,
+            back,
+            inside: self.scheme.composites(front.tag, back.tag),
+        }
     }
 
     /// After the last face: pops the remaining entries in order (the screen pass).
     pub fn drain(&mut self, out: &mut Vec<Segment>) {
         while !self.entries.is_empty() {
-            let (i, _) = self
-                .entries
-                .iter()
-                .enumerate()
-                .fold((0, f32::INFINITY), |(bi, bd), (i, e)| if e.depth < bd { (i, e.depth) } else { (bi, bd) });
+            let (i, _) =
+                self.entries
+                    .iter()
+                    .enumerate()
+                    .fold((0, f32::INFINITY), |(bi, bd), (i, e)| {
+                        if e.depth < bd {
+                            (i, e.depth)
+                        } else {
+                            (bi, bd)
+                        }
+                    });
             let front = self.entries.swap_remove(i);
             match self.closest() {
                 Some(&back) => {
@@ -179,7 +195,11 @@ pub fn exact_segments(scheme: TagScheme, stream: &[Fragment]) -> Vec<Segment> {
     sorted.sort_by(|a, b| a.depth.total_cmp(&b.depth));
     sorted
         .windows(2)
-        .map(|w| Segment { front: w[0], back: w[1], inside: scheme.composites(w[0].tag, w[1].tag) })
+        .map(|w| Segment {
+            front: w[0],
+            back: w[1],
+            inside: scheme.composites(w[0].tag, w[1].tag),
+        })
         .collect()
 }
 
@@ -191,7 +211,11 @@ pub fn k_needed(depths: &[f32]) -> usize {
         return 1;
     }
     let mut by_rank: Vec<u32> = (0..depths.len() as u32).collect();
-    by_rank.sort_by(|&a, &b| depths[a as usize].total_cmp(&depths[b as usize]).then(a.cmp(&b)));
+    by_rank.sort_by(|&a, &b| {
+        depths[a as usize]
+            .total_cmp(&depths[b as usize])
+            .then(a.cmp(&b))
+    });
     let mut k = (by_rank[0] as usize).max(1);
     for (r, &pos) in by_rank.iter().enumerate().skip(1) {
         let pos = pos as usize;
@@ -221,14 +245,24 @@ mod tests {
     use proptest::prelude::*;
 
     fn frag(d: f32) -> Fragment {
-        Fragment { scalar: d / 100.0, depth: d, tag: Tag::Interior }
+        Fragment {
+            scalar: d / 100.0,
+            depth: d,
+            tag: Tag::Interior,
+        }
     }
 
     /// A sequence of `n` distinct depths in which each element of sorted rank r arrives at
     /// position ≤ r + max_delay: sort by the perturbed key r + u·max_delay·(1 − ε).
     fn nearly_sorted(n: usize, max_delay: usize, u: &[f64]) -> Vec<f32> {
-        let mut keyed: Vec<(f64, f32)> =
-            (0..n).map(|r| (r as f64 + u[r] * max_delay as f64 * 0.999, (r as f32 + 1.0) * 0.5)).collect();
+        let mut keyed: Vec<(f64, f32)> = (0..n)
+            .map(|r| {
+                (
+                    r as f64 + u[r] * max_delay as f64 * 0.999,
+                    (r as f32 + 1.0) * 0.5,
+                )
+            })
+            .collect();
         keyed.sort_by(|a, b| a.0.total_cmp(&b.0));
         keyed.into_iter().map(|(_, d)| d).collect()
     }

@@ -25,7 +25,9 @@ use rayon::prelude::*;
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::preintegration::Table3d;
 use render_core::sort::{radix_sort_indices, RadixScratch};
-use render_core::{Camera, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Setting};
+use render_core::{
+    Camera, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Setting,
+};
 
 pub use kbuffer::{Tag, TagScheme};
 
@@ -106,7 +108,11 @@ pub fn default_variants() -> Vec<Box<dyn Renderer>> {
     let mut v: Vec<Box<dyn Renderer>> = Vec::new();
     for sort in [SortMode::CpuRadix, SortMode::GpuRadix] {
         for k in [2, 6] {
-            v.push(Box::new(Havs::new(HavsSettings { k, sort, ..Default::default() })));
+            v.push(Box::new(Havs::new(HavsSettings {
+                k,
+                sort,
+                ..Default::default()
+            })));
         }
     }
     v
@@ -120,7 +126,10 @@ pub struct Havs {
 
 impl Havs {
     pub fn new(settings: HavsSettings) -> Havs {
-        Havs { settings, state: None }
+        Havs {
+            settings,
+            state: None,
+        }
     }
 
     /// Bytes of every allocation so far (persistent and per frame), for reports.
@@ -251,10 +260,18 @@ fn sort_key(eye: [f32; 3], forward: [f32; 3], perspective: bool, c: [f32; 3]) ->
 }
 
 fn shader_source(k: u32) -> String {
-    format!("const K: u32 = {k}u;\n{}\n{}", include_str!("havs.wgsl"), include_str!("kbuffer.wgsl"))
+    format!(
+        "const K: u32 = {k}u;\n{}\n{}",
+        include_str!("havs.wgsl"),
+        include_str!("kbuffer.wgsl")
+    )
 }
 
-fn storage_entry(binding: u32, read_only: bool, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+fn storage_entry(
+    binding: u32,
+    read_only: bool,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
@@ -277,7 +294,14 @@ impl Renderer for Havs {
         vec![
             Setting::new("k", s.k),
             Setting::new("sort", s.sort.name()),
-            Setting::new("tags", if s.tags == TagScheme::Two { "two" } else { "single" }),
+            Setting::new(
+                "tags",
+                if s.tags == TagScheme::Two {
+                    "two"
+                } else {
+                    "single"
+                },
+            ),
             Setting::new("mode", s.mode.name()),
             Setting::new("et", if s.early_termination { "on" } else { "off" }),
         ]
@@ -307,8 +331,20 @@ impl Renderer for Havs {
             );
         }
         let storage = wgpu::BufferUsages::STORAGE;
-        let verts_buf = ledger.buffer_init(gpu, "havs vertices", Lifetime::Persistent, bytemuck::cast_slice(&verts), storage);
-        let faces_buf = ledger.buffer_init(gpu, "havs faces", Lifetime::Persistent, bytemuck::cast_slice(&faces), storage);
+        let verts_buf = ledger.buffer_init(
+            gpu,
+            "havs vertices",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&verts),
+            storage,
+        );
+        let faces_buf = ledger.buffer_init(
+            gpu,
+            "havs faces",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&faces),
+            storage,
+        );
         let num_faces = faces.len() as u64;
         let centroids: Vec<[f32; 3]> = faces
             .par_iter()
@@ -321,14 +357,23 @@ impl Renderer for Havs {
         // The 3D pre-integrated table (s_front, s_back, length), lengths up to the longest
         // edge: no segment inside a tet is longer.
         let max_len = mesh.quality().max_edge.max(f64::MIN_POSITIVE);
-        let table = Table3d::build(optics, s.table_scalar as usize, s.table_length as usize, max_len);
+        let table = Table3d::build(
+            optics,
+            s.table_scalar as usize,
+            s.table_length as usize,
+            max_len,
+        );
         let (n_s, n_l) = (s.table_scalar, s.table_length);
         let tex = ledger.texture(
             gpu,
             Lifetime::Persistent,
             &wgpu::TextureDescriptor {
                 label: Some("havs preintegration table"),
-                size: wgpu::Extent3d { width: n_s, height: n_s, depth_or_array_layers: n_l },
+                size: wgpu::Extent3d {
+                    width: n_s,
+                    height: n_s,
+                    depth_or_array_layers: n_l,
+                },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D3,
@@ -340,12 +385,24 @@ impl Renderer for Havs {
         gpu.queue.write_texture(
             tex.as_image_copy(),
             bytemuck::cast_slice(&table.data),
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(n_s * 16), rows_per_image: Some(n_s) },
-            wgpu::Extent3d { width: n_s, height: n_s, depth_or_array_layers: n_l },
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(n_s * 16),
+                rows_per_image: Some(n_s),
+            },
+            wgpu::Extent3d {
+                width: n_s,
+                height: n_s,
+                depth_or_array_layers: n_l,
+            },
         );
         let table_view = tex.create_view(&Default::default());
         let filterable = gpu.features.contains(wgpu::Features::FLOAT32_FILTERABLE);
-        let filter = if filterable { wgpu::FilterMode::Linear } else { wgpu::FilterMode::Nearest };
+        let filter = if filterable {
+            wgpu::FilterMode::Linear
+        } else {
+            wgpu::FilterMode::Nearest
+        };
         let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("havs table sampler"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -390,111 +447,129 @@ impl Renderer for Havs {
             storage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
         );
 
-        let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let all =
+            wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let fc = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("havs layout"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: all,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
+        let layout = gpu
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("havs layout"),
+                entries: &[
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 0,
+                        visibility: all,
+                        ty: wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Uniform,
+                            has_dynamic_offset: false,
+                            min_binding_size: None,
+                        },
+                        count: None,
                     },
-                    count: None,
-                },
-                storage_entry(1, true, all),
-                storage_entry(2, true, all),
-                storage_entry(3, true, all),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: fc,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable },
-                        view_dimension: wgpu::TextureViewDimension::D3,
-                        multisampled: false,
+                    storage_entry(1, true, all),
+                    storage_entry(2, true, all),
+                    storage_entry(3, true, all),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 4,
+                        visibility: fc,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable },
+                            view_dimension: wgpu::TextureViewDimension::D3,
+                            multisampled: false,
+                        },
+                        count: None,
                     },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: fc,
-                    ty: wgpu::BindingType::Sampler(if filterable {
-                        wgpu::SamplerBindingType::Filtering
-                    } else {
-                        wgpu::SamplerBindingType::NonFiltering
-                    }),
-                    count: None,
-                },
-                storage_entry(6, false, fc),
-                storage_entry(7, false, fc),
-                storage_entry(8, false, fc),
-                storage_entry(9, false, fc),
-                storage_entry(10, false, fc),
-            ],
-        });
-        let pipeline_layout = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("havs pipeline layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 5,
+                        visibility: fc,
+                        ty: wgpu::BindingType::Sampler(if filterable {
+                            wgpu::SamplerBindingType::Filtering
+                        } else {
+                            wgpu::SamplerBindingType::NonFiltering
+                        }),
+                        count: None,
+                    },
+                    storage_entry(6, false, fc),
+                    storage_entry(7, false, fc),
+                    storage_entry(8, false, fc),
+                    storage_entry(9, false, fc),
+                    storage_entry(10, false, fc),
+                ],
+            });
+        let pipeline_layout = gpu
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("havs pipeline layout"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
         let module = gpu.shader("havs", &shader_source(s.k));
         let fs_entry = match s.mode {
             Mode::FragmentRace => "fs_kbuffer",
             Mode::RaceFree => "fs_append",
         };
-        let draw_pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("havs draw"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
+        let draw_pipeline = gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("havs draw"),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    front_face: wgpu::FrontFace::Ccw,
+                    // Every face is needed from both sides (entry and exit of a ray).
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(fs_entry),
+                    compilation_options: Default::default(),
+                    // wgpu needs an attachment; the k-buffer lives in storage, nothing is written.
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: wgpu::TextureFormat::R8Unorm,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::empty(),
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+        let drain_pipeline = gpu
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("havs drain"),
+                layout: Some(&pipeline_layout),
                 module: &module,
-                entry_point: Some("vs"),
+                entry_point: Some(match s.mode {
+                    Mode::FragmentRace => "drain",
+                    Mode::RaceFree => "resolve_lists",
+                }),
                 compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                front_face: wgpu::FrontFace::Ccw,
-                // Every face is needed from both sides (entry and exit of a ray).
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(fs_entry),
-                compilation_options: Default::default(),
-                // wgpu needs an attachment; the k-buffer lives in storage, nothing is written.
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: wgpu::TextureFormat::R8Unorm,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::empty(),
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let drain_pipeline = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("havs drain"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(match s.mode {
-                Mode::FragmentRace => "drain",
-                Mode::RaceFree => "resolve_lists",
-            }),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+                cache: None,
+            });
 
         let gpu_sort = match s.sort {
             SortMode::CpuRadix => None,
-            SortMode::GpuRadix => Some(GpuSortState::new(gpu, &mut ledger, &verts_buf, &faces_buf, num_faces)?),
+            SortMode::GpuRadix => Some(GpuSortState::new(
+                gpu,
+                &mut ledger,
+                &verts_buf,
+                &faces_buf,
+                num_faces,
+            )?),
         };
 
-        let prepared = Prepared { persistent_bytes: ledger.persistent, tets: mesh.num_tets() as u64 };
+        let prepared = Prepared {
+            persistent_bytes: ledger.persistent,
+            tets: mesh.num_tets() as u64,
+        };
         self.state = Some(State {
             ledger,
             verts: verts_buf,
@@ -526,14 +601,22 @@ impl Renderer for Havs {
 
     fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
         let settings = self.settings;
-        let st = self.state.as_mut().context("HAVS: render called before prepare")?;
+        let st = self
+            .state
+            .as_mut()
+            .context("HAVS: render called before prepare")?;
         let (w, h) = (camera.width, camera.height);
         st.ensure_target(gpu, settings, w, h, None)?;
         loop {
             let stats = st.frame(gpu, settings, camera)?;
             // Race-free mode: the node pool was too small for this view's fragments. Grow it
             // and render the frame again (the first frame of a new view pays this once).
-            let needed = stats.counters.iter().find(|(n, _)| n == "nodes").map(|c| c.1 as u64).unwrap_or(0);
+            let needed = stats
+                .counters
+                .iter()
+                .find(|(n, _)| n == "nodes")
+                .map(|c| c.1 as u64)
+                .unwrap_or(0);
             let cap = st.target.as_ref().map(|t| t.node_capacity).unwrap_or(0);
             if settings.mode == Mode::RaceFree && needed > cap {
                 st.ensure_target(gpu, settings, w, h, Some(needed + needed / 4))?;
@@ -544,8 +627,14 @@ impl Renderer for Havs {
     }
 
     fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image> {
-        let st = self.state.as_ref().context("HAVS: read_image before prepare")?;
-        let t = st.target.as_ref().context("HAVS: read_image before render")?;
+        let st = self
+            .state
+            .as_ref()
+            .context("HAVS: read_image before prepare")?;
+        let t = st
+            .target
+            .as_ref()
+            .context("HAVS: read_image before render")?;
         let n = t.width as u64 * t.height as u64;
         let bytes = gpu.read_buffer(&t.pixels, 0, n * 32)?;
         let px: &[[f32; 8]] = bytemuck::cast_slice(&bytes);
@@ -568,9 +657,23 @@ impl GpuSortState {
         if num_faces * 4 > gpu.max_storage_binding() {
             bail!("HAVS GPU sort: {num_faces} keys exceed one storage binding; use sort=cpu-radix");
         }
-        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let keys = ledger.buffer(gpu, "havs sort keys", Lifetime::PerFrame, num_faces * 4, usage);
-        let ids = ledger.buffer(gpu, "havs sort ids", Lifetime::PerFrame, num_faces * 4, usage);
+        let usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let keys = ledger.buffer(
+            gpu,
+            "havs sort keys",
+            Lifetime::PerFrame,
+            num_faces * 4,
+            usage,
+        );
+        let ids = ledger.buffer(
+            gpu,
+            "havs sort ids",
+            Lifetime::PerFrame,
+            num_faces * 4,
+            usage,
+        );
         let key_uniforms = ledger.buffer(
             gpu,
             "havs key uniforms",
@@ -579,27 +682,51 @@ impl GpuSortState {
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
         let module = gpu.shader("havs keys", include_str!("keys.wgsl"));
-        let key_pipeline = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("havs face keys"),
-            layout: None,
-            module: &module,
-            entry_point: Some("face_keys"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let key_pipeline = gpu
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("havs face keys"),
+                layout: None,
+                module: &module,
+                entry_point: Some("face_keys"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
         let key_bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("havs keys"),
             layout: &key_pipeline.get_bind_group_layout(0),
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: key_uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: verts.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: faces.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: keys.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: ids.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: key_uniforms.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: verts.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: faces.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: keys.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: ids.as_entire_binding(),
+                },
             ],
         });
         let sorter = render_core::gpu_sort::GpuRadixSort::new(gpu, num_faces as u32, ledger)?;
-        Ok(GpuSortState { sorter, keys, ids, key_uniforms, key_pipeline, key_bind_group })
+        Ok(GpuSortState {
+            sorter,
+            keys,
+            ids,
+            key_uniforms,
+            key_pipeline,
+            key_bind_group,
+        })
     }
 }
 
@@ -629,17 +756,43 @@ impl State {
         });
         let npx = w as u64 * h as u64;
         let max_binding = gpu.max_storage_binding();
-        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let pixels = self.ledger.buffer(gpu, "havs target pixels", Lifetime::PerFrame, npx * 32, usage);
+        let usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let pixels = self.ledger.buffer(
+            gpu,
+            "havs target pixels",
+            Lifetime::PerFrame,
+            npx * 32,
+            usage,
+        );
         let (kentries, heads, nodes_buf, node_capacity) = match s.mode {
             Mode::FragmentRace => {
                 let bytes = npx * s.k as u64 * 8;
                 if bytes > max_binding {
                     bail!("HAVS: a {w}x{h} k-buffer with k = {} needs {bytes} bytes, over one storage binding", s.k);
                 }
-                let kb = self.ledger.buffer(gpu, "havs target k-buffer", Lifetime::PerFrame, bytes, usage);
-                let heads = self.ledger.buffer(gpu, "havs target unused heads", Lifetime::PerFrame, 16, usage);
-                let nodes = self.ledger.buffer(gpu, "havs target unused nodes", Lifetime::PerFrame, 16, usage);
+                let kb = self.ledger.buffer(
+                    gpu,
+                    "havs target k-buffer",
+                    Lifetime::PerFrame,
+                    bytes,
+                    usage,
+                );
+                let heads = self.ledger.buffer(
+                    gpu,
+                    "havs target unused heads",
+                    Lifetime::PerFrame,
+                    16,
+                    usage,
+                );
+                let nodes = self.ledger.buffer(
+                    gpu,
+                    "havs target unused nodes",
+                    Lifetime::PerFrame,
+                    16,
+                    usage,
+                );
                 (kb, heads, nodes, 0)
             }
             Mode::RaceFree => {
@@ -652,9 +805,27 @@ impl State {
                         cap * 16
                     );
                 }
-                let kb = self.ledger.buffer(gpu, "havs target unused k-buffer", Lifetime::PerFrame, 16, usage);
-                let heads = self.ledger.buffer(gpu, "havs target list heads", Lifetime::PerFrame, npx * 4, usage);
-                let nodes = self.ledger.buffer(gpu, "havs target fragment lists", Lifetime::PerFrame, cap * 16, usage);
+                let kb = self.ledger.buffer(
+                    gpu,
+                    "havs target unused k-buffer",
+                    Lifetime::PerFrame,
+                    16,
+                    usage,
+                );
+                let heads = self.ledger.buffer(
+                    gpu,
+                    "havs target list heads",
+                    Lifetime::PerFrame,
+                    npx * 4,
+                    usage,
+                );
+                let nodes = self.ledger.buffer(
+                    gpu,
+                    "havs target fragment lists",
+                    Lifetime::PerFrame,
+                    cap * 16,
+                    usage,
+                );
                 (kb, heads, nodes, cap)
             }
         };
@@ -663,7 +834,11 @@ impl State {
             Lifetime::PerFrame,
             &wgpu::TextureDescriptor {
                 label: Some("havs target attachment"),
-                size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -682,24 +857,56 @@ impl State {
                     label: Some("havs bind group"),
                     layout: &self.layout,
                     entries: &[
-                        wgpu::BindGroupEntry { binding: 0, resource: ub.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 1, resource: self.verts.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 2, resource: self.faces.as_entire_binding() },
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: ub.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: self.verts.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: self.faces.as_entire_binding(),
+                        },
                         wgpu::BindGroupEntry {
                             binding: 3,
                             resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                                 buffer: &self.order,
                                 offset: range.start * 4,
-                                size: std::num::NonZeroU64::new((range.end - range.start).max(1) * 4),
+                                size: std::num::NonZeroU64::new(
+                                    (range.end - range.start).max(1) * 4,
+                                ),
                             }),
                         },
-                        wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&self.table_view) },
-                        wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::Sampler(&self.sampler) },
-                        wgpu::BindGroupEntry { binding: 6, resource: pixels.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 7, resource: kentries.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 8, resource: self.counters.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 9, resource: heads.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 10, resource: nodes_buf.as_entire_binding() },
+                        wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: wgpu::BindingResource::TextureView(&self.table_view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 5,
+                            resource: wgpu::BindingResource::Sampler(&self.sampler),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 6,
+                            resource: pixels.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 7,
+                            resource: kentries.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 8,
+                            resource: self.counters.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 9,
+                            resource: heads.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 10,
+                            resource: nodes_buf.as_entire_binding(),
+                        },
                     ],
                 })
             })
@@ -730,11 +937,13 @@ impl State {
         if s.sort == SortMode::CpuRadix {
             let cents = &self.centroids;
             self.keys.clear();
-            self.keys.par_extend(cents.par_iter().map(|&c| sort_key(eye, fwd, persp, c)));
+            self.keys
+                .par_extend(cents.par_iter().map(|&c| sort_key(eye, fwd, persp, c)));
             let tk = t0.elapsed().as_secs_f64() * 1e3;
             radix_sort_indices(&self.keys, &mut self.sorted, &mut self.scratch);
             let ts = t0.elapsed().as_secs_f64() * 1e3;
-            gpu.queue.write_buffer(&self.order, 0, bytemuck::cast_slice(&self.sorted));
+            gpu.queue
+                .write_buffer(&self.order, 0, bytemuck::cast_slice(&self.sorted));
             let tu = t0.elapsed().as_secs_f64() * 1e3;
             stages.push(("keys".to_string(), tk));
             stages.push(("sort".to_string(), ts - tk));
@@ -769,17 +978,26 @@ impl State {
                 faces: self.num_faces as u32,
                 _pad: [0; 3],
             };
-            gpu.queue.write_buffer(&gs.key_uniforms, 0, bytemuck::bytes_of(&ku));
+            gpu.queue
+                .write_buffer(&gs.key_uniforms, 0, bytemuck::bytes_of(&ku));
             {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("havs keys"), timestamp_writes: None });
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("havs keys"),
+                    timestamp_writes: None,
+                });
                 pass.set_pipeline(&gs.key_pipeline);
                 pass.set_bind_group(0, &gs.key_bind_group, &[]);
                 let groups = self.num_faces.div_ceil(256) as u32;
                 let max = gpu.limits.max_compute_workgroups_per_dimension;
-                let (gx, gy) = if groups <= max { (groups, 1) } else { (max, groups.div_ceil(max)) };
+                let (gx, gy) = if groups <= max {
+                    (groups, 1)
+                } else {
+                    (max, groups.div_ceil(max))
+                };
                 pass.dispatch_workgroups(gx, gy, 1);
             }
-            gs.sorter.encode(&mut enc, &gs.keys, &gs.ids, self.num_faces as u32, false)?;
+            gs.sorter
+                .encode(&mut enc, &gs.keys, &gs.ids, self.num_faces as u32, false)?;
             enc.copy_buffer_to_buffer(&gs.ids, 0, &self.order, 0, self.num_faces * 4);
         }
         enc.clear_buffer(&t.pixels, 0, None);
@@ -795,7 +1013,10 @@ impl State {
                     view: &t.dummy_view,
                     depth_slice: None,
                     resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Discard },
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Discard,
+                    },
                 })],
                 depth_stencil_attachment: None,
                 timestamp_writes: None,
@@ -810,7 +1031,10 @@ impl State {
             }
         }
         {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("havs drain"), timestamp_writes: None });
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("havs drain"),
+                timestamp_writes: None,
+            });
             pass.set_pipeline(&self.drain_pipeline);
             pass.set_bind_group(0, &t.bind_groups[0], &[]);
             pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
@@ -823,13 +1047,23 @@ impl State {
         let gpu_ms = self.timer.gpu_ms(gpu)?;
         let c = gpu.read_buffer(&self.counters, 0, 16)?;
         let c: &[u32] = bytemuck::cast_slice(&c);
-        let mut counters = vec![("fragments".to_string(), c[0] as f64), ("kbuffer_out_of_order".to_string(), c[1] as f64)];
+        let mut counters = vec![
+            ("fragments".to_string(), c[0] as f64),
+            ("kbuffer_out_of_order".to_string(), c[1] as f64),
+        ];
         if s.mode == Mode::RaceFree {
             counters.push(("lists_over_512".to_string(), c[2] as f64));
             counters.push(("nodes".to_string(), c[3] as f64));
         }
         counters.push(("faces".to_string(), self.num_faces as f64));
         let _ = self.tets;
-        Ok(FrameStats { cpu_ms, gpu_ms, total_ms, frame_bytes: self.ledger.per_frame, stages, counters })
+        Ok(FrameStats {
+            cpu_ms,
+            gpu_ms,
+            total_ms,
+            frame_bytes: self.ledger.per_frame,
+            stages,
+            counters,
+        })
     }
 }

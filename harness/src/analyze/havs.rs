@@ -1,0 +1,504 @@
+//! Reproductions of Callahan, Ikits, Comba and Silva (2005), "Hardware-assisted visibility
+//! sorting for unstructured volume rendering" (HAVS):
+//!
+//! * `tetbench analyze sort` — Table 1: sorting 1 M random floats with shellsort, heapsort,
+//!   quicksort, the LSD radix sort of §5.1 and the standard library's sort (ms, keys/s);
+//! * `tetbench analyze kbuffer --datasets spx,bluntfin,comb,post` — Table 2: the sorted faces
+//!   rasterised at 512² into an exact A-buffer (a CPU model): total fragments, longest
+//!   per-pixel list, largest k needed, pixels needing k > 2 and k > 6, maxima over the 14
+//!   viewpoints; and Fig. 6's maps of where k > 2 and k > 6 are needed;
+//! * `tetbench analyze havs-tables OUT` — Tables 3 and 4 from a finished `tetbench run` of
+//!   `havs` ([`tables_3_4`]).
+//!
+//! The paper's own figures: only its abstract was available to us ("between one and six million
+//! tetrahedral cells per second on an ATI Radeon 9800"); the numbers of its Tables 1–4 were not
+//! in any source we could search (see reports/papers/havs.md). The tables say "not found"
+//! rather than invent values.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Context as _;
+use rayon::prelude::*;
+use render_core::{fixed_viewpoints, Camera, Optics, Projection, TransferFunction};
+
+use crate::report::{aggregate, Aggregate};
+use crate::results::{ResultsFile, Row};
+
+/// What the paper reports that we could verify: its abstract's range of rates.
+pub const PAPER_RATE_RANGE_TETS_PER_SEC: (f64, f64) = (1.0e6, 6.0e6);
+const NOT_FOUND: &str = "not found";
+
+#[derive(Debug, clap::Args)]
+pub struct SortArgs {
+    /// Number of random float keys (the paper sorts 1 M).
+    #[arg(long, default_value_t = 1_000_000)]
+    pub keys: usize,
+    /// Timed repetitions per sort (the median is reported).
+    #[arg(long, default_value_t = 5)]
+    pub repeats: usize,
+    /// Where `havs_table1.csv` and `havs_table1.md` go.
+    #[arg(long, default_value = "tetbench-out")]
+    pub out: PathBuf,
+}
+
+/// One row of Table 1.
+#[derive(Debug, Clone)]
+pub struct SortRow {
+    pub name: &'static str,
+    pub ms: f64,
+    pub keys_per_sec: f64,
+}
+
+/// xorshift64*: deterministic keys without another dependency.
+fn random_keys(n: usize, seed: u64) -> Vec<f32> {
+    let mut x = seed.max(1);
+    (0..n)
+        .map(|_| {
+            x ^= x >> 12;
+            x ^= x << 25;
+            x ^= x >> 27;
+            let r = x.wrapping_mul(0x2545_f491_4f6c_dd1d);
+            // Distances as HAVS sorts them: positive, spread over a few orders of magnitude.
+            ((r >> 40) as f32 / (1u64 << 24) as f32) * 100.0 + 0.01
+        })
+        .collect()
+}
+
+/// Table 1: each sort orders the indices of `n` random keys, `repeats` times; median ms.
+pub fn table1(n: usize, repeats: usize) -> anyhow::Result<Vec<SortRow>> {
+    use render_core::sort::*;
+    let keys = random_keys(n, 0x5eed);
+    let mut expect: Vec<u32> = (0..n as u32).collect();
+    expect.sort_by(|&a, &b| keys[a as usize].total_cmp(&keys[b as usize]));
+    let sorted_keys: Vec<f32> = expect.iter().map(|&i| keys[i as usize]).collect();
+    type SortFn = Box<dyn Fn(&[f32], &mut Vec<u32>)>;
+    let radix = std::cell::RefCell::new(RadixScratch::default());
+    let sorts: Vec<(&'static str, SortFn)> = vec![
+        ("shellsort", Box::new(|k, i| shellsort_indices(k, i))),
+        ("heapsort", Box::new(|k, i| heapsort_indices(k, i))),
+        ("quicksort", Box::new(|k, i| quicksort_indices(k, i))),
+        (
+            "radix sort (HAVS §5.1)",
+            Box::new(move |k, i| radix_sort_indices(k, i, &mut radix.borrow_mut())),
+        ),
+        (
+            "std sort_unstable_by",
+            Box::new(|k, i| std_sort_indices(k, i)),
+        ),
+    ];
+    let mut rows = vec![];
+    for (name, sort) in sorts {
+        let mut times = vec![];
+        let mut idx = Vec::with_capacity(n);
+        for _ in 0..repeats.max(1) {
+            let t = Instant::now();
+            sort(&keys, &mut idx);
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+            let got: Vec<f32> = idx.iter().map(|&i| keys[i as usize]).collect();
+            anyhow::ensure!(got == sorted_keys, "{name} did not sort the keys");
+        }
+        times.sort_by(f64::total_cmp);
+        let ms = times[times.len() / 2];
+        rows.push(SortRow {
+            name,
+            ms,
+            keys_per_sec: n as f64 / (ms * 1e-3),
+        });
+    }
+    Ok(rows)
+}
+
+pub fn run_sort(args: SortArgs, _ctx: &super::Context) -> anyhow::Result<()> {
+    let rows = table1(args.keys, args.repeats)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let csv_path = args.out.join("havs_table1.csv");
+    let mut w = csv::Writer::from_path(&csv_path)
+        .with_context(|| format!("cannot create {}", csv_path.display()))?;
+    w.write_record(["sort", "keys", "ms", "keys_per_sec", "paper_ms"])?;
+    for r in &rows {
+        w.write_record([
+            r.name.to_string(),
+            args.keys.to_string(),
+            r.ms.to_string(),
+            r.keys_per_sec.to_string(),
+            String::new(),
+        ])?;
+    }
+    w.flush()?;
+    let mut md = format!(
+        "HAVS Table 1: sorting {} random floats (indices by key), median of {} runs, {} ({} cores).\n\n\
+         | sort | ms (ours) | M keys/s (ours) | ms (paper) |\n|---|---:|---:|---:|\n",
+        args.keys,
+        args.repeats,
+        cpu_name(),
+        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+    );
+    for r in &rows {
+        writeln!(
+            md,
+            "| {} | {:.1} | {:.1} | {NOT_FOUND} |",
+            r.name,
+            r.ms,
+            r.keys_per_sec / 1e6
+        )?;
+    }
+    md.push_str(
+        "\nThe paper's Table 1 figures were not available to us (reports/papers/havs.md).\n",
+    );
+    let md_path = args.out.join("havs_table1.md");
+    std::fs::write(&md_path, &md).with_context(|| format!("cannot write {}", md_path.display()))?;
+    println!("{md}");
+    Ok(())
+}
+
+fn cpu_name() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}
+
+#[derive(Debug, clap::Args)]
+pub struct KbufferArgs {
+    /// Data sets (registry names or files), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "spx,bluntfin,comb,post")]
+    pub datasets: Vec<String>,
+    /// Image size (square), 512 as in the paper.
+    #[arg(long, default_value_t = 512)]
+    pub resolution: u32,
+    /// Where `havs_table2.csv`, `havs_table2.md` and the Fig. 6 maps go.
+    #[arg(long, default_value = "tetbench-out")]
+    pub out: PathBuf,
+}
+
+/// Table 2 for one data set: maxima over the viewpoints.
+#[derive(Debug, Clone, Default)]
+pub struct KbufferRow {
+    pub dataset: String,
+    pub tets: u64,
+    pub faces: u64,
+    pub fragments: u64,
+    pub max_list: u32,
+    pub max_k: u32,
+    pub pixels_k_gt2: u64,
+    pub pixels_k_gt6: u64,
+    pub worst_viewpoint: String,
+}
+
+pub fn run_kbuffer(args: KbufferArgs, ctx: &super::Context) -> anyhow::Result<()> {
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let registry = datasets::registry::Registry::new(ctx.data_dir.clone());
+    let tf = TransferFunction::preset("low-opacity").context("low-opacity preset")?;
+    let csv_path = args.out.join("havs_table2.csv");
+    let mut w = csv::Writer::from_path(&csv_path)
+        .with_context(|| format!("cannot create {}", csv_path.display()))?;
+    w.write_record([
+        "dataset",
+        "viewpoint",
+        "width",
+        "height",
+        "tets",
+        "faces",
+        "fragments",
+        "max_list",
+        "max_k",
+        "pixels_k_gt2",
+        "pixels_k_gt6",
+        "covered_pixels",
+    ])?;
+    let mut table = vec![];
+    for spec in &args.datasets {
+        let dataset = registry
+            .resolve(spec, &datasets::LoadOptions::default())
+            .map_err(|e| anyhow::anyhow!("{e}"))
+            .with_context(|| format!("loading data set {spec:?}"))?;
+        let mesh = dataset.mesh;
+        let optics = Optics::for_mesh(tf.clone(), &mesh);
+        let geom = havs::tagged_geometry(&mesh, &optics);
+        let mut row = KbufferRow {
+            dataset: spec.clone(),
+            tets: mesh.num_tets() as u64,
+            faces: geom.faces.len() as u64,
+            ..Default::default()
+        };
+        let mut worst: Option<(u64, havs::abuffer::KStats)> = None;
+        let t0 = Instant::now();
+        for vp in fixed_viewpoints() {
+            let camera = Camera::fit(
+                &mesh.bounds(),
+                &vp,
+                Projection::default(),
+                args.resolution,
+                args.resolution,
+            );
+            let s = havs::abuffer::kbuffer_stats(&geom, &camera);
+            w.write_record([
+                spec.clone(),
+                vp.name.clone(),
+                s.width.to_string(),
+                s.height.to_string(),
+                row.tets.to_string(),
+                row.faces.to_string(),
+                s.fragments.to_string(),
+                s.max_list.to_string(),
+                s.max_k.to_string(),
+                s.pixels_k_gt2.to_string(),
+                s.pixels_k_gt6.to_string(),
+                s.covered_pixels.to_string(),
+            ])?;
+            w.flush()?;
+            row.fragments = row.fragments.max(s.fragments);
+            row.max_list = row.max_list.max(s.max_list);
+            row.max_k = row.max_k.max(s.max_k);
+            row.pixels_k_gt2 = row.pixels_k_gt2.max(s.pixels_k_gt2);
+            row.pixels_k_gt6 = row.pixels_k_gt6.max(s.pixels_k_gt6);
+            let score = s.pixels_k_gt2 * 1_000_000 + s.pixels_k_gt6;
+            if worst.as_ref().is_none_or(|(b, _)| score > *b) {
+                row.worst_viewpoint = vp.name.clone();
+                worst = Some((score, s));
+            }
+        }
+        if let Some((_, s)) = worst {
+            let path = args
+                .out
+                .join(format!("havs_fig6_{}.png", crate::run::slug(spec)));
+            s.k_map_image()
+                .save(&path)
+                .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+        }
+        eprintln!(
+            "{spec}: 14 viewpoints in {:.1} s",
+            t0.elapsed().as_secs_f64()
+        );
+        table.push(row);
+    }
+    let md = table2_markdown(&table, args.resolution);
+    let md_path = args.out.join("havs_table2.md");
+    std::fs::write(&md_path, &md).with_context(|| format!("cannot write {}", md_path.display()))?;
+    println!("{md}");
+    Ok(())
+}
+
+/// Table 2 in the paper's shape (one row per data set, maxima over the 14 viewpoints).
+pub fn table2_markdown(rows: &[KbufferRow], resolution: u32) -> String {
+    let mut md = format!(
+        "HAVS Table 2: k-buffer analysis, faces sorted by centroid distance and rasterised at \
+         {resolution}² into an exact A-buffer; maxima over the 14 viewpoints (6 axes, 8 diagonals). \
+         \"k needed\": smallest number of k-buffer entries that completes every pixel's sort \
+         exactly. Paper figures: {NOT_FOUND} (reports/papers/havs.md).\n\n\
+         | data set | tets | faces | fragments | max A-buffer list | max k needed | pixels k > 2 | pixels k > 6 | worst view (Fig. 6 map) | paper |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---|---|\n"
+    );
+    for r in rows {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {NOT_FOUND} |",
+            r.dataset,
+            r.tets,
+            r.faces,
+            r.fragments,
+            r.max_list,
+            r.max_k,
+            r.pixels_k_gt2,
+            r.pixels_k_gt6,
+            r.worst_viewpoint
+        );
+    }
+    md
+}
+
+#[derive(Debug, clap::Args)]
+pub struct TablesArgs {
+    /// Output directory of a `tetbench run --algorithms havs` (holds results.json).
+    pub out: PathBuf,
+}
+
+pub fn run_tables(args: TablesArgs, _ctx: &super::Context) -> anyhow::Result<()> {
+    let file = ResultsFile::read(&args.out)?;
+    let adapter = file
+        .machine
+        .adapter
+        .as_ref()
+        .map(|a| format!("{} ({})", a.name, a.backend))
+        .unwrap_or_default();
+    let md = format!(
+        "Adapter: {adapter}; {}×{}.\n\n{}",
+        file.run.width,
+        file.run.height,
+        tables_3_4(&file.rows)
+    );
+    let path = args.out.join("havs_tables_3_4.md");
+    std::fs::write(&path, &md).with_context(|| format!("cannot write {}", path.display()))?;
+    println!("{md}");
+    Ok(())
+}
+
+fn setting<'a>(settings: &'a str, key: &str) -> Option<&'a str> {
+    settings.split(';').find_map(|kv| {
+        kv.split_once('=')
+            .filter(|(k, _)| *k == key)
+            .map(|(_, v)| v)
+    })
+}
+
+fn cell(v: Option<f64>, digits: usize) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.digits$}"),
+        _ => "–".into(),
+    }
+}
+
+/// HAVS Tables 3 and 4 from result rows of `havs` (means over viewpoints):
+///
+/// * Table 3, GPU only: the GPU time of sorting (GPU-sort rows) or only drawing (CPU-sort rows)
+///   and drawing, as fps and tets/s, for k = 2 and k = 6;
+/// * Table 4, the whole frame with the paper's CPU sort: CPU ms (sort + upload), GPU ms,
+///   total ms, fps and tets/s for k = 2 and k = 6, with PSNR against the reference.
+pub fn tables_3_4(rows: &[Row]) -> String {
+    let havs_rows: Vec<Row> = rows
+        .iter()
+        .filter(|r| r.algorithm == "havs")
+        .cloned()
+        .collect();
+    let aggs = aggregate(&havs_rows);
+    let mut datasets: Vec<String> = vec![];
+    for a in &aggs {
+        if !datasets.contains(&a.dataset) {
+            datasets.push(a.dataset.clone());
+        }
+    }
+    let find = |ds: &str, k: &str, sort: &str| -> Option<&Aggregate> {
+        aggs.iter().find(|a| {
+            a.dataset == ds
+                && setting(&a.settings, "k") == Some(k)
+                && setting(&a.settings, "sort") == Some(sort)
+                && setting(&a.settings, "mode").is_none_or(|m| m == "fragment-race")
+        })
+    };
+    let mut md = String::from(
+        "HAVS Table 3: GPU time only (timestamp queries), means over viewpoints. \"draw\": faces \
+         sorted on the CPU, GPU time of drawing and draining; \"sort+draw\": faces sorted on the GPU too. \
+         Paper: its abstract gives 1–6 M tets/s on an ATI Radeon 9800; per-data-set figures not found.\n\n\
+         | data set | tets | k=2 draw fps | k=2 draw tets/s | k=2 sort+draw fps | k=2 sort+draw tets/s | k=6 draw fps | k=6 draw tets/s | k=6 sort+draw fps | k=6 sort+draw tets/s | paper |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
+    );
+    for ds in &datasets {
+        let mut cells = vec![];
+        let mut tets = 0;
+        for k in ["2", "6"] {
+            for sort in ["cpu-radix", "gpu-radix"] {
+                let a = find(ds, k, sort);
+                if let Some(a) = a {
+                    tets = a.tets;
+                }
+                let gpu_ms = a.and_then(|a| a.gpu_ms.map(|s| s.mean));
+                cells.push(cell(gpu_ms.map(|ms| 1e3 / ms), 1));
+                cells.push(
+                    cell(
+                        gpu_ms.and_then(|ms| a.map(|a| a.tets as f64 / (ms * 1e-3) / 1e6)),
+                        2,
+                    ) + " M",
+                );
+            }
+        }
+        let _ = writeln!(
+            md,
+            "| {ds} | {tets} | {} | {NOT_FOUND} |",
+            cells.join(" | ")
+        );
+    }
+    md.push_str(
+        "\nHAVS Table 4: whole frames with the CPU radix sort (CPU ms = key computation, sort and \
+         upload; GPU ms by timestamps; total = wall clock until the GPU finished), means over viewpoints.\n\n\
+         | data set | tets | k | CPU ms | GPU ms | total ms | fps | tets/s | PSNR dB | bytes/tet | paper |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
+    );
+    for ds in &datasets {
+        for k in ["2", "6"] {
+            if let Some(a) = find(ds, k, "cpu-radix") {
+                let _ = writeln!(
+                    md,
+                    "| {ds} | {} | {k} | {} | {} | {} | {} | {} M | {} | {} | {NOT_FOUND} |",
+                    a.tets,
+                    cell(a.cpu_ms.map(|s| s.mean), 1),
+                    cell(a.gpu_ms.map(|s| s.mean), 1),
+                    cell(a.total_ms.map(|s| s.mean), 1),
+                    cell(a.fps.map(|s| s.mean), 2),
+                    cell(a.tets_per_sec.map(|s| s.mean / 1e6), 3),
+                    cell(a.psnr_db.map(|s| s.mean), 1),
+                    cell(a.bytes_per_tet, 1),
+                );
+            }
+        }
+    }
+    md
+}
+
+/// The k-buffer statistics of several viewpoints in parallel (used by tests of the analysis).
+pub fn kbuffer_stats_views(
+    geom: &havs::abuffer::Geometry,
+    cameras: &[Camera],
+) -> Vec<havs::abuffer::KStats> {
+    cameras
+        .par_iter()
+        .map(|c| havs::abuffer::kbuffer_stats(geom, c))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table1_sorts_correctly_and_reports_rates() {
+        let rows = table1(20_000, 1).unwrap();
+        assert_eq!(rows.len(), 5);
+        assert!(rows.iter().all(|r| r.keys_per_sec > 0.0 && r.ms >= 0.0));
+    }
+
+    #[test]
+    fn kbuffer_stats_of_a_grid_count_every_fragment() {
+        // A 3×3×3-cell grid seen along an axis: every ray through the interior meets the
+        // same number of faces, and the table's bookkeeping adds up.
+        let dims = [4usize, 4, 4];
+        let mut points = vec![];
+        for k in 0..4 {
+            for j in 0..4 {
+                for i in 0..4 {
+                    points.push([i as f32, j as f32, k as f32]);
+                }
+            }
+        }
+        let n = points.len();
+        let mesh = datasets::TetMesh::new(
+            "g",
+            points,
+            vec![0.0; n],
+            "s",
+            datasets::volume::structured_tets(dims),
+        )
+        .unwrap();
+        let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+        let geom = havs::tagged_geometry(&mesh, &optics);
+        let cams: Vec<Camera> = fixed_viewpoints()
+            .iter()
+            .take(2)
+            .map(|vp| Camera::fit(&mesh.bounds(), vp, Projection::Orthographic, 48, 48))
+            .collect();
+        for s in kbuffer_stats_views(&geom, &cams) {
+            assert!(s.fragments > 0 && s.covered_pixels > 0);
+            assert!(s.max_k >= 1 && s.max_list >= 2);
+            assert!(s.pixels_k_gt6 <= s.pixels_k_gt2 && s.pixels_k_gt2 <= s.covered_pixels);
+            assert_eq!(s.k_map.len(), 48 * 48);
+        }
+    }
+}
