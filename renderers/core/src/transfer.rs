@@ -41,7 +41,11 @@ impl TransferFunction {
             return pts[pts.len() - 1].rgb;
         }
         let (a, b) = (pts[i - 1], pts[i]);
-        let t = if b.s > a.s { (s - a.s) / (b.s - a.s) } else { 0.0 };
+        let t = if b.s > a.s {
+            (s - a.s) / (b.s - a.s)
+        } else {
+            0.0
+        };
         [0, 1, 2].map(|k| a.rgb[k] + t * (b.rgb[k] - a.rgb[k]))
     }
 
@@ -56,14 +60,23 @@ impl TransferFunction {
             return pts[pts.len() - 1].kappa;
         }
         let (a, b) = (pts[i - 1], pts[i]);
-        let t = if b.s > a.s { (s - a.s) / (b.s - a.s) } else { 0.0 };
+        let t = if b.s > a.s {
+            (s - a.s) / (b.s - a.s)
+        } else {
+            0.0
+        };
         a.kappa + t * (b.kappa - a.kappa)
     }
 
     /// Every scalar value where c or κ has a kink, sorted and deduplicated: exact integration
     /// splits a segment there so that each piece is linear in s.
     pub fn breakpoints(&self) -> Vec<f64> {
-        let mut b: Vec<f64> = self.color.iter().map(|p| p.s).chain(self.kappa.iter().map(|p| p.s)).collect();
+        let mut b: Vec<f64> = self
+            .color
+            .iter()
+            .map(|p| p.s)
+            .chain(self.kappa.iter().map(|p| p.s))
+            .collect();
         b.sort_by(|x, y| x.total_cmp(y));
         b.dedup();
         b
@@ -73,6 +86,383 @@ impl TransferFunction {
     pub fn max_kappa(&self) -> f64 {
         self.kappa.iter().map(|p| p.kappa).fold(0.0, f64::max)
     }
+}
+
+/// Why a transfer function was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TransferError {
+    #[error("transfer function '{name}' has no {what} points")]
+    Empty { name: String, what: &'static str },
+    #[error("transfer function '{name}': {what} point {index} has a non-finite value")]
+    NonFinite {
+        name: String,
+        what: &'static str,
+        index: usize,
+    },
+    #[error("transfer function '{name}': {what} points are not sorted by s (point {index})")]
+    Unsorted {
+        name: String,
+        what: &'static str,
+        index: usize,
+    },
+    #[error("transfer function '{name}': extinction {value} at point {index} is negative")]
+    NegativeKappa {
+        name: String,
+        index: usize,
+        value: f64,
+    },
+    #[error("transfer function '{name}': colour {value} at point {index} is negative")]
+    NegativeColor {
+        name: String,
+        index: usize,
+        value: f64,
+    },
+}
+
+/// Names accepted by [`TransferFunction::preset`], the default first.
+pub const PRESET_NAMES: [&str; 2] = ["low-opacity", "high-opacity"];
+
+/// Default scale K of the ParaView opacity mapping κ = −ln(1 − o)·K (see
+/// [`TransferFunction::from_paraview_json`]): an opacity `o` is the opacity of a slab one tenth
+/// of the bounding-box diagonal thick.
+pub const PARAVIEW_OPACITY_SCALE: f64 = 10.0;
+
+/// ParaView opacities are clamped to this before the logarithm, so o = 1 maps to a finite κ
+/// (−ln(10⁻³)·K ≈ 6.9·K).
+const PARAVIEW_MAX_OPACITY: f64 = 0.999;
+
+/// Linear pieces each non-linear ParaView opacity interval (midpoint ≠ ½ or sharpness ≠ 0) is
+/// sampled into, so the function stays piecewise linear for exact pre-integration.
+const PARAVIEW_CURVE_PIECES: usize = 16;
+
+/// A rainbow from blue through cyan, green and yellow to red, as in the HAVS paper's figures.
+const RAINBOW: [(f64, [f64; 3]); 5] = [
+    (0.0, [0.10, 0.15, 0.90]),
+    (0.25, [0.05, 0.75, 0.90]),
+    (0.5, [0.15, 0.85, 0.20]),
+    (0.75, [0.95, 0.85, 0.10]),
+    (1.0, [0.95, 0.15, 0.05]),
+];
+
+impl TransferFunction {
+    /// A built-in transfer function by name (see [`PRESET_NAMES`]).
+    ///
+    /// * `low-opacity` (the default for runs): the HAVS tables were measured with a low-opacity
+    ///   map, so that most of the volume is seen through and every fragment matters. κ rises
+    ///   from 0.2 to 5 per diagonal: a ray crossing half the box at the median κ keeps about
+    ///   half of the light behind it.
+    /// * `high-opacity`: the same colours with ten times the extinction (2 … 50 per diagonal):
+    ///   rays saturate within a few cells, which exercises early ray termination.
+    pub fn preset(name: &str) -> Option<TransferFunction> {
+        let kappa_low = [(0.0, 0.2), (0.25, 0.8), (0.5, 1.5), (0.75, 3.0), (1.0, 5.0)];
+        let scale = match name {
+            "low-opacity" => 1.0,
+            "high-opacity" => 10.0,
+            _ => return None,
+        };
+        Some(TransferFunction {
+            name: name.to_string(),
+            color: RAINBOW
+                .iter()
+                .map(|&(s, rgb)| ColorPoint { s, rgb })
+                .collect(),
+            kappa: kappa_low
+                .iter()
+                .map(|&(s, k)| KappaPoint {
+                    s,
+                    kappa: k * scale,
+                })
+                .collect(),
+        })
+    }
+
+    /// Checks the invariants every integrator relies on: at least one point of each kind, all
+    /// values finite, points sorted by `s` (equal `s` allowed: a step), κ ≥ 0, colours ≥ 0.
+    pub fn validate(&self) -> Result<(), TransferError> {
+        let name = || self.name.clone();
+        if self.color.is_empty() {
+            return Err(TransferError::Empty {
+                name: name(),
+                what: "colour",
+            });
+        }
+        if self.kappa.is_empty() {
+            return Err(TransferError::Empty {
+                name: name(),
+                what: "extinction",
+            });
+        }
+        for (i, p) in self.color.iter().enumerate() {
+            if !p.s.is_finite() || p.rgb.iter().any(|v| !v.is_finite()) {
+                return Err(TransferError::NonFinite {
+                    name: name(),
+                    what: "colour",
+                    index: i,
+                });
+            }
+            if let Some(&v) = p.rgb.iter().find(|v| **v < 0.0) {
+                return Err(TransferError::NegativeColor {
+                    name: name(),
+                    index: i,
+                    value: v,
+                });
+            }
+            if i > 0 && p.s < self.color[i - 1].s {
+                return Err(TransferError::Unsorted {
+                    name: name(),
+                    what: "colour",
+                    index: i,
+                });
+            }
+        }
+        for (i, p) in self.kappa.iter().enumerate() {
+            if !p.s.is_finite() || !p.kappa.is_finite() {
+                return Err(TransferError::NonFinite {
+                    name: name(),
+                    what: "extinction",
+                    index: i,
+                });
+            }
+            if p.kappa < 0.0 {
+                return Err(TransferError::NegativeKappa {
+                    name: name(),
+                    index: i,
+                    value: p.kappa,
+                });
+            }
+            if i > 0 && p.s < self.kappa[i - 1].s {
+                return Err(TransferError::Unsorted {
+                    name: name(),
+                    what: "extinction",
+                    index: i,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// A preset name (see [`PRESET_NAMES`]) or a file: a ParaView colormap preset (`.json`, see
+    /// [`TransferFunction::from_paraview_json`]) or this type serialised as JSON (an object with
+    /// `color` and `kappa`). Errors name the file and what was wrong.
+    pub fn load(name_or_path: &str) -> anyhow::Result<TransferFunction> {
+        if let Some(tf) = TransferFunction::preset(name_or_path) {
+            return Ok(tf);
+        }
+        let path = std::path::Path::new(name_or_path);
+        if !path.is_file() {
+            anyhow::bail!(
+                "transfer function '{name_or_path}' is neither a preset ({}) nor a readable file",
+                PRESET_NAMES.join(", ")
+            );
+        }
+        TransferFunction::from_paraview_json(path)
+    }
+
+    /// Reads a ParaView colormap preset with the default opacity scale
+    /// [`PARAVIEW_OPACITY_SCALE`].
+    pub fn from_paraview_json(path: &std::path::Path) -> anyhow::Result<TransferFunction> {
+        TransferFunction::from_paraview_json_scaled(path, PARAVIEW_OPACITY_SCALE)
+    }
+
+    /// Reads a ParaView colormap preset: a JSON array of presets (the first one with
+    /// `RGBPoints` is used) or a single preset object. `RGBPoints` is `[x, r, g, b, …]`;
+    /// the optional `Points` is the opacity function `[x, o, midpoint, sharpness, …]`.
+    /// x is rescaled to [0, 1] over the range of the colour points.
+    ///
+    /// Colours are interpolated linearly in RGB (ParaView may interpolate in Lab or the
+    /// diverging Msh space; our optical model is piecewise linear in RGB, which exact
+    /// pre-integration needs). Opacity o becomes extinction κ = −ln(1 − min(o, 0.999))·K per
+    /// diagonal, with K = `opacity_scale`: o is then the opacity of a slab 1/K of the diagonal
+    /// thick. Intervals with ParaView's non-linear midpoint/sharpness shape (vtkPiecewiseFunction)
+    /// are sampled into 16 linear pieces; κ is linear between the resulting points. Without
+    /// `Points`, opacity ramps linearly from 0 to 1.
+    ///
+    /// A file holding this type serialised (object with `color` and `kappa`) is accepted too.
+    pub fn from_paraview_json_scaled(
+        path: &std::path::Path,
+        opacity_scale: f64,
+    ) -> anyhow::Result<TransferFunction> {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            anyhow::anyhow!("cannot read transfer function file {}: {e}", path.display())
+        })?;
+        let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+            anyhow::anyhow!(
+                "transfer function file {} is not valid JSON: {e}",
+                path.display()
+            )
+        })?;
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let tf = parse_transfer_json(&value, &stem, opacity_scale)
+            .map_err(|e| anyhow::anyhow!("transfer function file {}: {e}", path.display()))?;
+        tf.validate()
+            .map_err(|e| anyhow::anyhow!("transfer function file {}: {e}", path.display()))?;
+        Ok(tf)
+    }
+}
+
+/// Parses either ParaView preset JSON or a serialised [`TransferFunction`].
+fn parse_transfer_json(
+    value: &serde_json::Value,
+    stem: &str,
+    opacity_scale: f64,
+) -> Result<TransferFunction, String> {
+    use serde_json::Value;
+    if let Value::Object(m) = value {
+        if m.contains_key("color") && m.contains_key("kappa") {
+            return serde_json::from_value(value.clone())
+                .map_err(|e| format!("not a transfer function: {e}"));
+        }
+    }
+    let preset = match value {
+        Value::Array(items) => items
+            .iter()
+            .find(|v| v.get("RGBPoints").is_some())
+            .ok_or_else(|| "no preset with RGBPoints in the array".to_string())?,
+        Value::Object(_) => value,
+        _ => return Err("expected a ParaView preset object or an array of them".into()),
+    };
+    let numbers = |key: &str| -> Result<Option<Vec<f64>>, String> {
+        match preset.get(key) {
+            None | Some(Value::Null) => Ok(None),
+            Some(Value::Array(a)) => a
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    v.as_f64()
+                        .ok_or_else(|| format!("{key}[{i}] is not a number"))
+                })
+                .collect::<Result<Vec<f64>, String>>()
+                .map(Some),
+            Some(_) => Err(format!("{key} is not an array")),
+        }
+    };
+    let rgb = numbers("RGBPoints")?.ok_or_else(|| "preset has no RGBPoints".to_string())?;
+    if rgb.is_empty() || rgb.len() % 4 != 0 {
+        return Err(format!(
+            "RGBPoints has {} numbers, expected a non-zero multiple of 4",
+            rgb.len()
+        ));
+    }
+    if let Some(i) = rgb.iter().position(|v| !v.is_finite()) {
+        return Err(format!("RGBPoints[{i}] is not finite"));
+    }
+    let xs: Vec<f64> = rgb.chunks(4).map(|c| c[0]).collect();
+    let (x0, x1) = (xs[0], xs[xs.len() - 1]);
+    if let Some(i) = xs.windows(2).position(|w| w[1] < w[0]) {
+        return Err(format!(
+            "RGBPoints x values are not sorted (point {})",
+            i + 1
+        ));
+    }
+    let span = x1 - x0;
+    let rescale = |x: f64| {
+        if span > 0.0 {
+            ((x - x0) / span).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    };
+    let color: Vec<ColorPoint> = rgb
+        .chunks(4)
+        .map(|c| ColorPoint {
+            s: rescale(c[0]),
+            rgb: [c[1], c[2], c[3]],
+        })
+        .collect();
+    let kappa_of = |o: f64| -(1.0 - o.clamp(0.0, PARAVIEW_MAX_OPACITY)).ln() * opacity_scale;
+    let kappa = match numbers("Points")? {
+        None => vec![
+            KappaPoint {
+                s: 0.0,
+                kappa: kappa_of(0.0),
+            },
+            KappaPoint {
+                s: 1.0,
+                kappa: kappa_of(1.0),
+            },
+        ],
+        Some(p) => {
+            if p.is_empty() || p.len() % 4 != 0 {
+                return Err(format!(
+                    "Points has {} numbers, expected a non-zero multiple of 4",
+                    p.len()
+                ));
+            }
+            if let Some(i) = p.iter().position(|v| !v.is_finite()) {
+                return Err(format!("Points[{i}] is not finite"));
+            }
+            let nodes: Vec<[f64; 4]> = p.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+            if let Some(i) = nodes.windows(2).position(|w| w[1][0] < w[0][0]) {
+                return Err(format!("Points x values are not sorted (point {})", i + 1));
+            }
+            let mut out = vec![KappaPoint {
+                s: rescale(nodes[0][0]),
+                kappa: kappa_of(nodes[0][1]),
+            }];
+            for w in nodes.windows(2) {
+                let ([xa, ya, mid, sharp], [xb, yb, _, _]) = (w[0], w[1]);
+                let linear = (mid - 0.5).abs() < 1e-12 && sharp.abs() < 1e-12;
+                let pieces = if linear || xb <= xa {
+                    1
+                } else {
+                    PARAVIEW_CURVE_PIECES
+                };
+                for k in 1..=pieces {
+                    let t = k as f64 / pieces as f64;
+                    let o = if linear {
+                        ya + t * (yb - ya)
+                    } else {
+                        paraview_curve(ya, yb, mid, sharp, t)
+                    };
+                    out.push(KappaPoint {
+                        s: rescale(xa + t * (xb - xa)),
+                        kappa: kappa_of(o),
+                    });
+                }
+            }
+            out
+        }
+    };
+    let name = preset
+        .get("Name")
+        .and_then(|v| v.as_str())
+        .map(str::to_string)
+        .unwrap_or_else(|| stem.to_string());
+    Ok(TransferFunction { name, color, kappa })
+}
+
+/// vtkPiecewiseFunction's shape between two nodes (values `ya`, `yb`) at fraction `t`: the
+/// midpoint moves where the value is half-way, the sharpness bends the curve from linear (0)
+/// through a Hermite curve with flattened tangents towards a step (1).
+fn paraview_curve(ya: f64, yb: f64, mid: f64, sharp: f64, t: f64) -> f64 {
+    let mid = mid.clamp(1e-5, 1.0 - 1e-5);
+    let mut t = if t < mid {
+        0.5 * t / mid
+    } else {
+        0.5 + 0.5 * (t - mid) / (1.0 - mid)
+    };
+    if sharp > 0.99 {
+        return if t < 0.5 { ya } else { yb };
+    }
+    if sharp < 0.01 {
+        return ya + (yb - ya) * t;
+    }
+    t = if t < 0.5 {
+        0.5 * (2.0 * t).powf(1.0 + 10.0 * sharp)
+    } else {
+        1.0 - 0.5 * (2.0 * (1.0 - t)).powf(1.0 + 10.0 * sharp)
+    };
+    let (t2, t3) = (t * t, t * t * t);
+    let h1 = 2.0 * t3 - 3.0 * t2 + 1.0;
+    let h2 = -2.0 * t3 + 3.0 * t2;
+    let h3 = t3 - 2.0 * t2 + t;
+    let h4 = t3 - t2;
+    let slope = (yb - ya) * (1.0 - sharp);
+    let v = h1 * ya + h2 * yb + h3 * slope + h4 * slope;
+    v.clamp(ya.min(yb), ya.max(yb))
 }
 
 /// Everything view-independent a renderer needs to shade: the transfer function and how the
@@ -90,7 +480,12 @@ pub struct Optics {
 impl Optics {
     pub fn for_mesh(tf: TransferFunction, mesh: &datasets::TetMesh) -> Optics {
         let (lo, hi) = mesh.scalar_range();
-        Optics { tf, scalar_min: lo as f64, scalar_max: hi as f64, length_unit: mesh.bounds().diagonal() }
+        Optics {
+            tf,
+            scalar_min: lo as f64,
+            scalar_max: hi as f64,
+            length_unit: mesh.bounds().diagonal(),
+        }
     }
 
     /// Normalised scalar in [0, 1] (a constant field maps to 0).
@@ -101,5 +496,118 @@ impl Optics {
         } else {
             0.0
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fresh directory under the system temp dir (render-core has no tempfile dependency).
+    fn scratch_dir(tag: &str) -> std::path::PathBuf {
+        let d =
+            std::env::temp_dir().join(format!("tetbench-transfer-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn presets_are_valid_and_default_is_low_opacity() {
+        for name in PRESET_NAMES {
+            let tf = TransferFunction::preset(name).unwrap();
+            tf.validate().unwrap();
+            assert_eq!(tf.name, name);
+        }
+        assert_eq!(PRESET_NAMES[0], "low-opacity");
+        let lo = TransferFunction::preset("low-opacity").unwrap();
+        let hi = TransferFunction::preset("high-opacity").unwrap();
+        assert!(hi.max_kappa() > 5.0 * lo.max_kappa());
+        assert!(TransferFunction::preset("nope").is_none());
+    }
+
+    #[test]
+    fn validation_rejects_bad_functions() {
+        let mut tf = TransferFunction::preset("low-opacity").unwrap();
+        tf.kappa[1].kappa = -1.0;
+        assert!(matches!(
+            tf.validate(),
+            Err(TransferError::NegativeKappa { index: 1, .. })
+        ));
+        let mut tf = TransferFunction::preset("low-opacity").unwrap();
+        tf.color.swap(0, 2);
+        assert!(matches!(tf.validate(), Err(TransferError::Unsorted { .. })));
+        let mut tf = TransferFunction::preset("low-opacity").unwrap();
+        tf.kappa.clear();
+        assert!(matches!(tf.validate(), Err(TransferError::Empty { .. })));
+        let mut tf = TransferFunction::preset("low-opacity").unwrap();
+        tf.color[0].rgb[1] = f64::NAN;
+        assert!(matches!(
+            tf.validate(),
+            Err(TransferError::NonFinite { .. })
+        ));
+    }
+
+    #[test]
+    fn paraview_preset_is_read_rescaled_and_mapped() {
+        let dir = scratch_dir("pv");
+        let path = dir.join("cw.json");
+        std::fs::write(
+            &path,
+            r#"[{"ColorSpace":"Diverging","Name":"Cool to Warm","RGBPoints":[-2,0.23,0.299,0.754, 0,0.865,0.865,0.865, 2,0.706,0.016,0.15],
+                "Points":[-2,0,0.5,0, 2,0.5,0.5,0]}]"#,
+        )
+        .unwrap();
+        let tf = TransferFunction::load(path.to_str().unwrap()).unwrap();
+        assert_eq!(tf.name, "Cool to Warm");
+        assert_eq!(tf.color.len(), 3);
+        assert!((tf.color[1].s - 0.5).abs() < 1e-15 && (tf.color[2].s - 1.0).abs() < 1e-15);
+        // o = 0.5 at the top: κ = ln 2 · K.
+        assert!((tf.kappa_at(1.0) - 2f64.ln() * PARAVIEW_OPACITY_SCALE).abs() < 1e-12);
+        assert_eq!(tf.kappa_at(0.0), 0.0);
+        // A non-linear interval becomes 16 linear pieces that pass through the end values.
+        std::fs::write(
+            &path,
+            r#"{"RGBPoints":[0,1,1,1, 1,1,1,1], "Points":[0,0,0.3,0.5, 1,0.9,0.5,0]}"#,
+        )
+        .unwrap();
+        let tf = TransferFunction::from_paraview_json(&path).unwrap();
+        assert_eq!(tf.kappa.len(), 17);
+        assert!((tf.kappa_at(1.0) - -(0.1f64).ln() * PARAVIEW_OPACITY_SCALE).abs() < 1e-9);
+        tf.validate().unwrap();
+    }
+
+    #[test]
+    fn load_errors_name_the_file() {
+        let dir = scratch_dir("err");
+        let path = dir.join("broken.json");
+        std::fs::write(&path, r#"{"RGBPoints":[0,1,1]}"#).unwrap();
+        let err = TransferFunction::load(path.to_str().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("broken.json") && err.contains("multiple of 4"),
+            "{err}"
+        );
+        std::fs::write(&path, "not json").unwrap();
+        let err = TransferFunction::load(path.to_str().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("broken.json") && err.contains("JSON"), "{err}");
+        std::fs::write(&path, r#"{"RGBPoints":[1,1,1,1, 0,0,0,0]}"#).unwrap();
+        let err = TransferFunction::load(path.to_str().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("sorted"), "{err}");
+        let err = TransferFunction::load("/no/such/tf.json")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("/no/such/tf.json") && err.contains("low-opacity"),
+            "{err}"
+        );
+        // A serialised transfer function round-trips.
+        let tf = TransferFunction::preset("high-opacity").unwrap();
+        std::fs::write(&path, serde_json::to_string(&tf).unwrap()).unwrap();
+        assert_eq!(TransferFunction::load(path.to_str().unwrap()).unwrap(), tf);
     }
 }
