@@ -23,7 +23,6 @@ use rayon::prelude::*;
 
 use crate::error::{ErrorKind, LoadError};
 use crate::volume::structured_tets;
-use crate::vtk_xml::cell_to_tets;
 use crate::TetMesh;
 
 /// Largest accepted target (u32 indices and memory stay comfortable).
@@ -499,7 +498,7 @@ pub fn shell_cells(target_tets: usize) -> (usize, usize) {
 /// `shell`: hollow sphere. The cube [0,n]³'s surface lattice points are projected to the unit
 /// sphere (equiangular cubed-sphere map: each coordinate c ∈ [-1,1] warped by tan(πc/4)),
 /// repeated on m+1 radii; each surface quad × radial layer is a hexahedron split into 6 tets
-/// by [`cell_to_tets`], whose diagonal rule depends only on global point indices, so cells
+/// by [`hex_six_tets`], whose diagonal rule depends only on global point indices, so cells
 /// conform across the cube's face seams as well. 36·n²·m tets.
 fn shell_mesh(target: usize, f: &FieldEval) -> Result<TetMesh, ErrorKind> {
     let (n, m) = shell_cells(target);
@@ -562,12 +561,48 @@ fn shell_mesh(target: usize, f: &FieldEval) -> Result<TetMesh, ErrorKind> {
                     q[2] + b1,
                     q[3] + b1,
                 ];
-                cell_to_tets(12, &hex, &mut out).expect("8 points of a hexahedron");
+                hex_six_tets(hex, &mut out);
             }
             out
         })
         .collect();
     finish("shell", points, f, tets)
+}
+
+/// Faces of a VTK-ordered hexahedron (bottom ring 0..3, top ring 4..7 above it).
+const HEX_FACES: [[usize; 4]; 6] = [
+    [0, 3, 2, 1],
+    [4, 5, 6, 7],
+    [0, 1, 5, 4],
+    [1, 2, 6, 5],
+    [2, 3, 7, 6],
+    [3, 0, 4, 7],
+];
+
+/// Splits a convex hexahedron into exactly 6 tets: a cone from its vertex of smallest global
+/// index over the three faces not incident to it, each cut along the diagonal through *its*
+/// vertex of smallest global index (Dompierre et al. 1999's rule). The faces incident to the
+/// apex are cut through the apex, which is their smallest vertex too, so every face follows
+/// the same global rule and neighbouring cells conform. (The readers' split,
+/// [`crate::load::cell_to_tets`], uses the same rule but takes 5 tets when it can; the shell
+/// wants a fixed 6 per cell so its size is predictable: 36·n²·m.)
+fn hex_six_tets(v: [u32; 8], out: &mut Vec<[u32; 4]>) {
+    let apex = (0..8).min_by_key(|&i| v[i]).unwrap_or(0);
+    for f in HEX_FACES {
+        if f.contains(&apex) {
+            continue;
+        }
+        let q = f.map(|i| v[i]);
+        let m = (0..4).min_by_key(|&i| q[i]).unwrap_or(0);
+        let a = v[apex];
+        if m % 2 == 0 {
+            out.push([a, q[0], q[1], q[2]]);
+            out.push([a, q[0], q[2], q[3]]);
+        } else {
+            out.push([a, q[1], q[2], q[3]]);
+            out.push([a, q[1], q[3], q[0]]);
+        }
+    }
 }
 
 #[cfg(test)]
