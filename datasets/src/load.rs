@@ -218,6 +218,17 @@ bulk!(f32s, f32, 4);
 bulk!(f64s, f64, 8);
 bulk!(i32s, i32, 4);
 
+/// Whether the non-finite values of a block read in its declared byte order are better explained
+/// by a byte-order mix-up: read the other way the block has no non-finite value and fewer
+/// implausible magnitudes (non-zero below 1e-30 or above 1e30: what reversed bytes of ordinary
+/// floats give). A lone NaN in otherwise sane data stays a NaN.
+pub(crate) fn looks_byte_swapped(declared: &[f32], swapped: &[f32]) -> bool {
+    let implausible =
+        |v: &&f32| !v.is_finite() || (**v != 0.0 && (v.abs() < 1e-30 || v.abs() > 1e30));
+    swapped.iter().all(|v| v.is_finite())
+        && swapped.iter().filter(implausible).count() < declared.iter().filter(implausible).count()
+}
+
 // ---------------------------------------------------------------------------------------------
 // VTK cells → tets.
 

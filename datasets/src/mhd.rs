@@ -379,11 +379,8 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
         } else {
             ByteOrder::Big
         };
-        let kind = if convert(&raw, h.element, other)
-            .iter()
-            .all(|v| v.is_finite())
-        {
-            ErrorKind::ByteOrder(format!("voxel {i} is {} with the header's byte order ({:?}-endian) but every voxel is finite in the other order: fix BinaryDataByteOrderMSB", values[i], h.order))
+        let kind = if load::looks_byte_swapped(&values, &convert(&raw, h.element, other)) {
+            ErrorKind::ByteOrder(format!("voxel {i} is {} with the header's byte order ({:?}-endian) but the data reads as sane values in the other order: fix BinaryDataByteOrderMSB", values[i], h.order))
         } else {
             ErrorKind::NonFinite {
                 what: "voxel".into(),

@@ -345,7 +345,7 @@ fn block(b: &[u8], l: &Layout, at: usize, n: usize) -> Vec<f32> {
 }
 
 /// First non-finite value of a block, as an error: `ByteOrder` when the same bytes read in
-/// the other byte order are all finite (header and data disagree), else `NonFinite`.
+/// the other byte order look like sane data (header and data disagree), else `NonFinite`.
 fn check_finite(
     b: &[u8],
     l: &Layout,
@@ -365,15 +365,12 @@ fn check_finite(
         },
         ..*l
     };
-    if block(b, &other, at, values.len())
-        .iter()
-        .all(|v| v.is_finite())
-    {
+    if load::looks_byte_swapped(values, &block(b, &other, at, values.len())) {
         return Err(LoadError::at(
             path,
             Location::Byte((at + i * l.prec) as u64),
             ErrorKind::ByteOrder(format!(
-                "{what} {i} is {} read {:?}-endian as the header says, but every value is finite in the other byte order",
+                "{what} {i} is {} read {:?}-endian as the header says, but the data reads as sane values in the other byte order",
                 values[i], l.order
             )),
         ));
@@ -725,12 +722,22 @@ mod tests {
     #[test]
     fn data_in_the_other_byte_order_is_detected() {
         let (mut x, q) = pair(ByteOrder::Big, false, false);
-        // A value that is NaN big-endian (as the header says) but a finite denormal read
-        // little-endian, like every other coordinate of the block (small floats' bytes
-        // reversed are denormals).
-        x[12..16].copy_from_slice(&[0x7f, 0xc0, 0x00, 0x00]);
+        // Coordinates written little-endian under a big-endian header, one of them NaN when
+        // read big-endian (and a finite denormal little-endian).
+        for c in x[12..].chunks_exact_mut(4) {
+            c.reverse();
+        }
+        x[16..20].copy_from_slice(&[0x7f, 0xc0, 0x00, 0x00]);
         let err = load_pair(&x, &q, None).unwrap_err();
         assert!(matches!(err.kind, ErrorKind::ByteOrder(_)), "{err}");
-        assert_eq!(err.location, Some(Location::Byte(12)));
+        assert_eq!(err.location, Some(Location::Byte(16)));
+        // A lone NaN in sane big-endian data is a NaN, not a byte-order problem.
+        let (mut x, q) = pair(ByteOrder::Big, false, false);
+        x[16..20].copy_from_slice(&f32::NAN.to_be_bytes());
+        let err = load_pair(&x, &q, None).unwrap_err();
+        assert!(
+            matches!(err.kind, ErrorKind::NonFinite { index: 1, .. }),
+            "{err}"
+        );
     }
 }

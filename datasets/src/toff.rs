@@ -120,7 +120,7 @@ pub fn from_bytes(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<Da
     // Every value needs at least one character and a separator: check the counts against the
     // bytes present before allocating anything from them.
     let left = (bytes.len() - t.pos) as u64;
-    let need = (nv + nt) * 4 * 2 - 1;
+    let need = ((nv + nt) * 4 * 2).saturating_sub(1);
     if nv + nt > 0 && need > left {
         return Err(t.err(
             bytes.len(),
