@@ -1,0 +1,281 @@
+//! The `tetbench` command line (clap derive) and its dispatch.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use render_core::{Projection, TransferFunction};
+
+use crate::algorithms::{self, SettingsFilter};
+use crate::analyze::{self, AnalyzeCommand};
+use crate::datasets_cmd::{self, DatasetsCommand};
+use crate::run::{self, RunConfig};
+use crate::suite::{self, DEFAULT_SUITE};
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "tetbench",
+    version,
+    about = "Benchmarks GPU volume renderers for tetrahedral meshes against an exact CPU reference",
+    long_about = None
+)]
+pub struct Cli {
+    /// Directory of the real data sets (default: $TETBENCH_DATA, else ../shared/datasets).
+    #[arg(long, global = true, value_name = "DIR")]
+    pub data_dir: Option<PathBuf>,
+
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Measure algorithms over data sets and viewpoints; write results.csv, results.json,
+    /// images and index.html. With no options: the embedded default suite on generated meshes.
+    Run(RunArgs),
+    /// Inspect, list and convert data sets.
+    #[command(subcommand)]
+    Datasets(DatasetsCommand),
+    /// Analyses that reproduce the papers' tables.
+    #[command(subcommand)]
+    Analyze(AnalyzeCommand),
+    /// Re-render the report (charts, index.html) of an earlier run from its results.json.
+    Report {
+        /// The run's output directory.
+        out: PathBuf,
+    },
+}
+
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// Comma-separated algorithms (default: all).
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    pub algorithms: Vec<String>,
+    /// Comma-separated data set names, generator specs (box:200k, shell:1m) or files
+    /// (default: the embedded suite, box:20k and shell:20k).
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    pub datasets: Vec<String>,
+    /// `14` (the HAVS tables' fixed viewpoints), `axes`, `diagonals`, `orbit:N`, or names
+    /// such as `+x,-y,+x+y-z` (default 14; the default suite uses 4).
+    #[arg(long, value_name = "SPEC")]
+    pub viewpoints: Option<String>,
+    /// Square viewport size in pixels (default 512; the default suite uses 256).
+    #[arg(long, value_name = "PIXELS")]
+    pub resolution: Option<u32>,
+    /// Transfer function: a preset (low-opacity, high-opacity) or a ParaView colormap JSON file.
+    #[arg(long, value_name = "NAME|FILE", default_value = "low-opacity")]
+    pub tf: String,
+    /// Timed frames per viewpoint (default 10; the default suite uses 5).
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u32>,
+    /// Untimed warm-up frames before them (default 2; the default suite uses 1).
+    #[arg(long, value_name = "N")]
+    pub warmup: Option<u32>,
+    /// Output directory (results, images, report). Earlier results there are replaced.
+    #[arg(long, value_name = "DIR", default_value = "out")]
+    pub out: PathBuf,
+    /// Keep only variants whose settings match, e.g. `variant=linear` or `k=2|6;sort=radix`
+    /// (keys an algorithm lacks are ignored for it).
+    #[arg(long, value_name = "FILTER")]
+    pub settings: Option<String>,
+    /// Skip the reference and the error metrics (timing only).
+    #[arg(long)]
+    pub no_reference: bool,
+    /// Where reference images are cached (default: $TETBENCH_CACHE, else
+    /// $XDG_CACHE_HOME/tetbench, else ~/.cache/tetbench).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+    /// Orthographic instead of perspective (30° vertical field of view) projection.
+    #[arg(long)]
+    pub orthographic: bool,
+    /// Point array to use as the scalar (default: the file's first).
+    #[arg(long, value_name = "NAME")]
+    pub scalar: Option<String>,
+    /// Do not write the HTML report and charts.
+    #[arg(long)]
+    pub no_report: bool,
+}
+
+/// The reference cache: `--cache-dir`, `$TETBENCH_CACHE`, `$XDG_CACHE_HOME/tetbench`,
+/// `~/.cache/tetbench`, or (no home) `OUT/.reference-cache`.
+pub fn default_cache_dir(out: &std::path::Path) -> PathBuf {
+    let env = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    env("TETBENCH_CACHE")
+        .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("tetbench")))
+        .or_else(|| env("HOME").map(|d| d.join(".cache").join("tetbench")))
+        .unwrap_or_else(|| out.join(".reference-cache"))
+}
+
+impl RunArgs {
+    /// Checks the arguments and fills in defaults: the default suite's when no data set is
+    /// named, the papers' standard otherwise.
+    pub fn to_config(
+        &self,
+        data_dir: Option<PathBuf>,
+        command_line: Vec<String>,
+    ) -> anyhow::Result<RunConfig> {
+        let suite_mode = self.datasets.is_empty();
+        let datasets: Vec<String> = if suite_mode {
+            DEFAULT_SUITE
+                .datasets
+                .iter()
+                .map(|s| s.to_string())
+                .collect()
+        } else {
+            self.datasets
+                .iter()
+                .map(|s| s.trim().to_string())
+                .filter(|s| !s.is_empty())
+                .collect()
+        };
+        if datasets.is_empty() {
+            anyhow::bail!("--datasets is empty");
+        }
+        let pick = |given: Option<u32>, suite: u32, standard: u32| {
+            given.unwrap_or(if suite_mode { suite } else { standard })
+        };
+        let viewpoint_spec = self.viewpoints.clone().unwrap_or_else(|| {
+            if suite_mode {
+                DEFAULT_SUITE.viewpoints
+            } else {
+                suite::STANDARD_VIEWPOINTS
+            }
+            .to_string()
+        });
+        let viewpoints = suite::parse_viewpoints(&viewpoint_spec)?;
+        let resolution = pick(
+            self.resolution,
+            DEFAULT_SUITE.resolution,
+            suite::STANDARD_RESOLUTION,
+        );
+        if !(1..=16384).contains(&resolution) {
+            anyhow::bail!("--resolution {resolution}: must be between 1 and 16384 pixels");
+        }
+        let frames = pick(self.frames, DEFAULT_SUITE.frames, suite::STANDARD_FRAMES);
+        if frames == 0 {
+            anyhow::bail!("--frames must be at least 1");
+        }
+        let warmup = pick(self.warmup, DEFAULT_SUITE.warmup, suite::STANDARD_WARMUP);
+
+        let known = algorithms::names();
+        let algorithms: Vec<String> = if self.algorithms.is_empty() {
+            known.iter().map(|s| s.to_string()).collect()
+        } else {
+            self.algorithms
+                .iter()
+                .map(|s| s.trim().to_string())
+                .filter(|s| !s.is_empty())
+                .collect()
+        };
+        for a in &algorithms {
+            if !known.contains(&a.as_str()) {
+                anyhow::bail!(
+                    "--algorithms: unknown algorithm {a:?}; known: {}",
+                    known.join(", ")
+                );
+            }
+        }
+        if algorithms.is_empty() {
+            anyhow::bail!("--algorithms is empty; known: {}", known.join(", "));
+        }
+
+        let tf = TransferFunction::load(&self.tf)
+            .map_err(|e| anyhow::anyhow!("--tf {:?}: {e:#}", self.tf))?;
+        let settings_filter = SettingsFilter::parse(self.settings.as_deref().unwrap_or(""))?;
+        Ok(RunConfig {
+            algorithms,
+            datasets,
+            viewpoint_spec,
+            viewpoints,
+            width: resolution,
+            height: resolution,
+            frames,
+            warmup,
+            tf_spec: self.tf.clone(),
+            tf,
+            projection: if self.orthographic {
+                Projection::Orthographic
+            } else {
+                Projection::default()
+            },
+            cache_dir: self
+                .cache_dir
+                .clone()
+                .unwrap_or_else(|| default_cache_dir(&self.out)),
+            out: self.out.clone(),
+            data_dir,
+            reference: !self.no_reference,
+            settings_filter,
+            scalar: self.scalar.clone(),
+            command_line,
+            report: !self.no_report,
+        })
+    }
+}
+
+/// Parses `args` (program name first) and runs the command.
+pub fn main_with_args<I, T>(args: I) -> anyhow::Result<()>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let args: Vec<std::ffi::OsString> = args.into_iter().map(Into::into).collect();
+    let cli = Cli::try_parse_from(&args).unwrap_or_else(|e| e.exit());
+    let command_line = args
+        .iter()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
+    execute(cli, command_line)
+}
+
+pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Run(args) => {
+            let config = args.to_config(cli.data_dir, command_line)?;
+            let outcome = run::run(&config, &algorithms::variants)?;
+            println!(
+                "{} rows in {:.1} s; results in {} (open {})",
+                outcome.rows,
+                outcome.seconds,
+                config.out.join("results.csv").display(),
+                config.out.join("index.html").display()
+            );
+            if !outcome.all_ok() {
+                let mut msg = format!("{} of {} rows failed", outcome.failed_rows, outcome.rows);
+                for e in &outcome.errors {
+                    msg.push_str(&format!("\n  {e}"));
+                }
+                anyhow::bail!("{msg} (finished rows are in {})", config.out.display());
+            }
+            Ok(())
+        }
+        Command::Datasets(cmd) => datasets_cmd::run(cmd, cli.data_dir),
+        Command::Analyze(cmd) => analyze::run(
+            cmd,
+            &analyze::Context {
+                data_dir: cli.data_dir,
+            },
+        ),
+        Command::Report { out } => {
+            crate::report::rewrite(&out)
+                .with_context(|| format!("re-rendering the report in {}", out.display()))?;
+            println!("wrote {}", out.join("index.html").display());
+            Ok(())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cli_definition_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
+}

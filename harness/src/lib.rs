@@ -1,0 +1,14 @@
+//! The tetbench harness: the run loop over data sets × algorithm variants × viewpoints, image
+//! metrics against the exact reference, result files, reports and analyses. The `tetbench`
+//! binary (`src/main.rs`) is a thin wrapper around [`cli`].
+
+pub mod algorithms;
+pub mod analyze;
+pub mod cli;
+pub mod datasets_cmd;
+pub mod machine;
+pub mod metrics;
+pub mod report;
+pub mod results;
+pub mod run;
+pub mod suite;

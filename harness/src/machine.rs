@@ -1,0 +1,165 @@
+//! What a result was measured on: CPU, memory, OS, GPU adapter, tetbench version and commit,
+//! date. Recorded once per results file (and adapter/backend again in every row).
+
+use std::path::Path;
+use std::process::Command;
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use render_core::AdapterDescription;
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MachineInfo {
+    pub cpu_model: String,
+    /// Logical cores available to this process.
+    pub cpu_cores: usize,
+    pub memory_bytes: Option<u64>,
+    pub os: String,
+    pub kernel: Option<String>,
+    pub arch: String,
+    pub adapter: Option<AdapterDescription>,
+    pub git_commit: Option<String>,
+    /// Whether the working tree had uncommitted changes (`None` when git is unavailable).
+    pub git_dirty: Option<bool>,
+    /// When the run started, ISO 8601 UTC.
+    pub date_utc: String,
+    pub tetbench_version: String,
+}
+
+impl MachineInfo {
+    /// Gathers everything but the adapter (set by the caller once the GPU is opened).
+    pub fn collect() -> MachineInfo {
+        let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let git_commit = git(&repo, &["rev-parse", "HEAD"]);
+        let git_dirty =
+            git(&repo, &["status", "--porcelain", "--untracked-files=no"]).map(|s| !s.is_empty());
+        MachineInfo {
+            cpu_model: cpu_model().unwrap_or_else(|| "unknown".into()),
+            cpu_cores: std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1),
+            memory_bytes: memory_bytes(),
+            os: os_name(),
+            kernel: std::fs::read_to_string("/proc/sys/kernel/osrelease")
+                .ok()
+                .map(|s| s.trim().to_string()),
+            arch: std::env::consts::ARCH.to_string(),
+            adapter: None,
+            git_commit,
+            git_dirty,
+            date_utc: iso8601_utc(SystemTime::now()),
+            tetbench_version: env!("CARGO_PKG_VERSION").to_string(),
+        }
+    }
+}
+
+fn git(dir: &Path, args: &[&str]) -> Option<String> {
+    let out = Command::new("git")
+        .arg("-C")
+        .arg(dir)
+        .args(args)
+        .output()
+        .ok()?;
+    out.status
+        .success()
+        .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
+}
+
+fn cpu_model() -> Option<String> {
+    if let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") {
+        for key in ["model name", "Hardware", "Processor", "cpu model"] {
+            if let Some(v) = info
+                .lines()
+                .filter_map(|l| l.split_once(':'))
+                .find(|(k, _)| k.trim() == key)
+                .map(|(_, v)| v.trim().to_string())
+            {
+                return Some(v);
+            }
+        }
+    }
+    // macOS and the BSDs.
+    let out = Command::new("sysctl")
+        .args(["-n", "machdep.cpu.brand_string"])
+        .output()
+        .ok()?;
+    out.status
+        .success()
+        .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
+}
+
+fn memory_bytes() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok();
+    if let Some(info) = info {
+        let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
+        let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        return Some(kib * 1024);
+    }
+    let out = Command::new("sysctl")
+        .args(["-n", "hw.memsize"])
+        .output()
+        .ok()?;
+    String::from_utf8_lossy(&out.stdout).trim().parse().ok()
+}
+
+fn os_name() -> String {
+    if let Ok(rel) = std::fs::read_to_string("/etc/os-release") {
+        if let Some(name) = rel.lines().find_map(|l| l.strip_prefix("PRETTY_NAME=")) {
+            return name.trim_matches('"').to_string();
+        }
+    }
+    std::env::consts::OS.to_string()
+}
+
+/// `YYYY-MM-DDTHH:MM:SSZ` without a date crate: days since the epoch to a civil date by
+/// Howard Hinnant's `civil_from_days` (proleptic Gregorian calendar).
+pub fn iso8601_utc(t: SystemTime) -> String {
+    let secs = t
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_secs() as i64)
+        .unwrap_or(0);
+    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem / 60 % 60,
+        rem % 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    #[test]
+    fn iso_dates() {
+        assert_eq!(iso8601_utc(UNIX_EPOCH), "1970-01-01T00:00:00Z");
+        // 2000-02-29T12:34:56Z (a leap day in a century leap year).
+        assert_eq!(
+            iso8601_utc(UNIX_EPOCH + Duration::from_secs(951_827_696)),
+            "2000-02-29T12:34:56Z"
+        );
+        assert_eq!(
+            iso8601_utc(UNIX_EPOCH + Duration::from_secs(1_798_761_599)),
+            "2026-12-31T23:59:59Z"
+        );
+    }
+
+    #[test]
+    fn collects_something_sane() {
+        let m = MachineInfo::collect();
+        assert!(m.cpu_cores >= 1);
+        assert!(!m.os.is_empty());
+        assert_eq!(m.date_utc.len(), 20);
+    }
+}

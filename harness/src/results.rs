@@ -1,0 +1,354 @@
+//! Result rows and the two files that hold them: `results.csv` and `results.json`.
+//!
+//! Rows are written the moment they finish: the CSV gets a line and is flushed, and the JSON
+//! file is rewritten atomically (written beside, then renamed), so a run that is interrupted —
+//! killed, out of memory, power cut — keeps every finished row in both files.
+//!
+//! The CSV columns are the fields of [`Row`] in order. The first twenty are fixed by the
+//! measurement-core issue and are never renamed; later algorithms add columns at the end.
+
+use std::fs::File;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use serde::{Deserialize, Serialize};
+
+use crate::machine::MachineInfo;
+
+/// Bumped whenever a field changes meaning or is removed (adding a field does not bump it).
+pub const SCHEMA_VERSION: u32 = 1;
+
+pub const CSV_FILE: &str = "results.csv";
+pub const JSON_FILE: &str = "results.json";
+
+/// One (algorithm, settings, data set, viewpoint) measurement. Times in ms, rates per second,
+/// error metrics as defined in [`crate::metrics`]. `None` is an empty CSV cell / JSON null: no
+/// timestamp queries (gpu_ms), no reference (error metrics), or a failed row (`error` set).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    pub algorithm: String,
+    pub settings: String,
+    pub dataset: String,
+    pub tets: u64,
+    pub viewpoint: String,
+    pub width: u32,
+    pub height: u32,
+    pub total_ms: Option<f64>,
+    pub cpu_ms: Option<f64>,
+    pub gpu_ms: Option<f64>,
+    pub fps: Option<f64>,
+    pub tets_per_sec: Option<f64>,
+    pub gpu_bytes: Option<u64>,
+    pub bytes_per_tet: Option<f64>,
+    pub rmse: Option<f64>,
+    pub psnr_db: Option<f64>,
+    pub max_abs_error: Option<f64>,
+    pub bad_pixel_share: Option<f64>,
+    pub adapter: String,
+    pub backend: String,
+    // ---- extra columns (append new ones below, never rename the ones above) ----
+    pub total_ms_min: Option<f64>,
+    pub total_ms_max: Option<f64>,
+    pub cpu_ms_min: Option<f64>,
+    pub cpu_ms_max: Option<f64>,
+    pub gpu_ms_min: Option<f64>,
+    pub gpu_ms_max: Option<f64>,
+    /// Timed frames (after `warmup` untimed ones).
+    pub frames: u32,
+    pub warmup: u32,
+    /// GPU bytes that live as long as the mesh (bytes_per_tet = this / tets).
+    pub gpu_bytes_persistent: Option<u64>,
+    /// Largest per-frame allocation seen over the timed frames.
+    pub gpu_bytes_frame: Option<u64>,
+    /// Median stage timings, `name=ms;name=ms`.
+    pub stages: String,
+    /// Median counters, `name=value;…`.
+    pub counters: String,
+    pub covered_pixels: Option<u64>,
+    pub transfer_function: String,
+    pub projection: String,
+    pub device_type: String,
+    pub driver: String,
+    /// Paths relative to the output directory (empty when not written).
+    pub image: String,
+    pub reference_image: String,
+    pub heatmap: String,
+    /// Empty on success; otherwise what went wrong (the metrics are then empty).
+    pub error: String,
+}
+
+impl Row {
+    pub fn ok(&self) -> bool {
+        self.error.is_empty()
+    }
+}
+
+/// How the run was asked for, stored with the results so a report says what it shows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct RunDescription {
+    pub command_line: Vec<String>,
+    pub algorithms: Vec<String>,
+    pub datasets: Vec<String>,
+    pub viewpoints: String,
+    pub width: u32,
+    pub height: u32,
+    pub frames: u32,
+    pub warmup: u32,
+    pub transfer_function: String,
+    pub projection: String,
+    pub settings_filter: String,
+    pub reference: bool,
+}
+
+/// The whole of `results.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ResultsFile {
+    pub schema_version: u32,
+    pub machine: MachineInfo,
+    pub run: RunDescription,
+    /// ISO 8601 UTC; `None` while the run is still going (or was interrupted).
+    pub finished_utc: Option<String>,
+    pub rows: Vec<Row>,
+    /// Failures that are not one row: a data set that could not be loaded, a renderer that
+    /// could not be prepared (its rows are also recorded, with `error` set).
+    pub errors: Vec<String>,
+}
+
+impl ResultsFile {
+    pub fn read(dir: &Path) -> anyhow::Result<ResultsFile> {
+        let path = dir.join(JSON_FILE);
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let value: serde_json::Value = serde_json::from_str(&text)
+            .with_context(|| format!("{} is not JSON", path.display()))?;
+        let version = value.get("schema_version").and_then(|v| v.as_u64());
+        if version != Some(SCHEMA_VERSION as u64) {
+            anyhow::bail!(
+                "{}: schema_version {:?}, this tetbench reads version {SCHEMA_VERSION}",
+                path.display(),
+                version
+            );
+        }
+        serde_json::from_value(value)
+            .with_context(|| format!("{}: unexpected layout", path.display()))
+    }
+}
+
+/// Writes rows to `results.csv` and `results.json` as they finish.
+pub struct ResultsWriter {
+    dir: PathBuf,
+    csv: csv::Writer<File>,
+    pub file: ResultsFile,
+}
+
+impl ResultsWriter {
+    /// Starts fresh result files in `dir` (replacing earlier ones).
+    pub fn create(
+        dir: &Path,
+        machine: MachineInfo,
+        run: RunDescription,
+    ) -> anyhow::Result<ResultsWriter> {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let csv_path = dir.join(CSV_FILE);
+        let f = File::create(&csv_path)
+            .with_context(|| format!("cannot create {}", csv_path.display()))?;
+        let mut csv = csv::WriterBuilder::new().has_headers(false).from_writer(f);
+        // The header is written by hand so that a run with no rows still has it.
+        csv.write_record(csv_header())?;
+        csv.flush()?;
+        let w = ResultsWriter {
+            dir: dir.to_path_buf(),
+            csv,
+            file: ResultsFile {
+                schema_version: SCHEMA_VERSION,
+                machine,
+                run,
+                finished_utc: None,
+                rows: vec![],
+                errors: vec![],
+            },
+        };
+        w.write_json()?;
+        Ok(w)
+    }
+
+    /// Appends a row to both files; both are on disk when this returns.
+    pub fn push(&mut self, row: Row) -> anyhow::Result<()> {
+        self.csv.serialize(&row)?;
+        self.csv.flush().context("writing results.csv")?;
+        self.file.rows.push(row);
+        self.write_json()
+    }
+
+    pub fn push_error(&mut self, message: String) -> anyhow::Result<()> {
+        self.file.errors.push(message);
+        self.write_json()
+    }
+
+    pub fn finish(&mut self) -> anyhow::Result<()> {
+        self.file.finished_utc = Some(crate::machine::iso8601_utc(std::time::SystemTime::now()));
+        self.write_json()
+    }
+
+    fn write_json(&self) -> anyhow::Result<()> {
+        let path = self.dir.join(JSON_FILE);
+        let tmp = self.dir.join(format!(".{JSON_FILE}.tmp"));
+        let mut f =
+            File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
+        serde_json::to_writer_pretty(&mut f, &self.file)?;
+        f.write_all(b"\n")?;
+        f.sync_all().ok();
+        std::fs::rename(&tmp, &path).with_context(|| format!("cannot write {}", path.display()))
+    }
+}
+
+/// The CSV header: [`Row`]'s field names in order (taken from serde so they cannot drift).
+pub fn csv_header() -> Vec<String> {
+    let mut w = csv::Writer::from_writer(vec![]);
+    w.serialize(example_row()).expect("row serialises");
+    let bytes = w.into_inner().expect("in-memory writer");
+    let text = String::from_utf8(bytes).expect("utf-8");
+    text.lines()
+        .next()
+        .unwrap_or_default()
+        .split(',')
+        .map(str::to_string)
+        .collect()
+}
+
+fn example_row() -> Row {
+    Row {
+        algorithm: String::new(),
+        settings: String::new(),
+        dataset: String::new(),
+        tets: 0,
+        viewpoint: String::new(),
+        width: 0,
+        height: 0,
+        total_ms: None,
+        cpu_ms: None,
+        gpu_ms: None,
+        fps: None,
+        tets_per_sec: None,
+        gpu_bytes: None,
+        bytes_per_tet: None,
+        rmse: None,
+        psnr_db: None,
+        max_abs_error: None,
+        bad_pixel_share: None,
+        adapter: String::new(),
+        backend: String::new(),
+        total_ms_min: None,
+        total_ms_max: None,
+        cpu_ms_min: None,
+        cpu_ms_max: None,
+        gpu_ms_min: None,
+        gpu_ms_max: None,
+        frames: 0,
+        warmup: 0,
+        gpu_bytes_persistent: None,
+        gpu_bytes_frame: None,
+        stages: String::new(),
+        counters: String::new(),
+        covered_pixels: None,
+        transfer_function: String::new(),
+        projection: String::new(),
+        device_type: String::new(),
+        driver: String::new(),
+        image: String::new(),
+        reference_image: String::new(),
+        heatmap: String::new(),
+        error: String::new(),
+    }
+}
+
+/// The columns the measurement-core issue fixes, in order.
+pub const REQUIRED_COLUMNS: [&str; 20] = [
+    "algorithm",
+    "settings",
+    "dataset",
+    "tets",
+    "viewpoint",
+    "width",
+    "height",
+    "total_ms",
+    "cpu_ms",
+    "gpu_ms",
+    "fps",
+    "tets_per_sec",
+    "gpu_bytes",
+    "bytes_per_tet",
+    "rmse",
+    "psnr_db",
+    "max_abs_error",
+    "bad_pixel_share",
+    "adapter",
+    "backend",
+];
+
+#[cfg(test)]
+pub(crate) fn test_row(i: u32) -> Row {
+    Row {
+        algorithm: "test".into(),
+        settings: "variant=a;sort=radix".into(),
+        dataset: "box:1k".into(),
+        tets: 1000,
+        viewpoint: format!("v{i}"),
+        width: 8,
+        height: 8,
+        total_ms: Some(2.0),
+        tets_per_sec: Some(500_000.0),
+        adapter: "llvmpipe, \"quoted\"".into(),
+        backend: "vulkan".into(),
+        ..example_row()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn header_starts_with_the_required_columns() {
+        let h = csv_header();
+        assert_eq!(&h[..20], &REQUIRED_COLUMNS[..]);
+        assert_eq!(h.last().map(String::as_str), Some("error"));
+    }
+
+    /// Every row is on disk, in both files, as soon as `push` returns: an interrupted run
+    /// keeps what it finished.
+    #[test]
+    fn rows_are_on_disk_after_each_push() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut w = ResultsWriter::create(
+            dir.path(),
+            MachineInfo::collect(),
+            RunDescription::default(),
+        )
+        .unwrap();
+        assert_eq!(ResultsFile::read(dir.path()).unwrap().rows.len(), 0);
+        for i in 0..3 {
+            w.push(test_row(i)).unwrap();
+            let json = ResultsFile::read(dir.path()).unwrap();
+            assert_eq!(json.rows.len(), i as usize + 1);
+            assert_eq!(json.rows[i as usize], test_row(i));
+            assert_eq!(json.finished_utc, None);
+            let mut r = csv::Reader::from_path(dir.path().join(CSV_FILE)).unwrap();
+            let rows: Vec<Row> = r.deserialize().collect::<Result<_, _>>().unwrap();
+            assert_eq!(rows.len(), i as usize + 1);
+            assert_eq!(rows[i as usize], test_row(i));
+        }
+        // Dropping the writer without `finish` (as a crash would) leaves both files readable.
+        drop(w);
+        assert_eq!(ResultsFile::read(dir.path()).unwrap().rows.len(), 3);
+    }
+
+    #[test]
+    fn wrong_schema_version_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join(JSON_FILE), r#"{"schema_version": 999}"#).unwrap();
+        let e = ResultsFile::read(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("schema_version"), "{e}");
+    }
+}

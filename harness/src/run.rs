@@ -1,0 +1,634 @@
+//! The run loop: every data set × algorithm variant × viewpoint, measured and compared with the
+//! exact reference, each row written the moment it is done.
+//!
+//! Per data set the mesh is loaded once and each renderer prepares it once; per viewpoint the
+//! renderer draws `warmup` untimed frames, then `frames` timed ones, then its image is read back
+//! (outside the timing) and compared with the reference. A failure in one row (out of GPU
+//! memory, a device error, even a panic in a renderer) is recorded in that row and the run goes
+//! on; finished rows are never lost.
+
+use std::collections::HashMap;
+use std::io::IsTerminal;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{anyhow, Context};
+use datasets::TetMesh;
+use indicatif::{ProgressBar, ProgressStyle};
+use render_core::{
+    settings_string, Camera, FrameStats, Gpu, Image, Optics, Projection, Renderer,
+    TransferFunction, Viewpoint,
+};
+
+use crate::algorithms::SettingsFilter;
+use crate::machine::MachineInfo;
+use crate::metrics::{self, summarize};
+use crate::results::{ResultsWriter, Row, RunDescription};
+
+/// Everything a run needs, already parsed and checked.
+#[derive(Debug, Clone)]
+pub struct RunConfig {
+    pub algorithms: Vec<String>,
+    pub datasets: Vec<String>,
+    pub viewpoint_spec: String,
+    pub viewpoints: Vec<Viewpoint>,
+    pub width: u32,
+    pub height: u32,
+    pub frames: u32,
+    pub warmup: u32,
+    pub tf_spec: String,
+    pub tf: TransferFunction,
+    pub projection: Projection,
+    pub out: PathBuf,
+    pub data_dir: Option<PathBuf>,
+    /// Where reference images are cached between runs.
+    pub cache_dir: PathBuf,
+    /// Compare with the reference (and write heatmaps); off with `--no-reference`.
+    pub reference: bool,
+    pub settings_filter: SettingsFilter,
+    pub scalar: Option<String>,
+    pub command_line: Vec<String>,
+    /// Write the HTML report and charts at the end.
+    pub report: bool,
+}
+
+/// Makes the variants of an algorithm by name (normally [`crate::algorithms::variants`]; tests
+/// pass their own).
+pub type VariantFactory<'a> = &'a dyn Fn(&str) -> anyhow::Result<Vec<Box<dyn Renderer>>>;
+
+/// What a finished run produced.
+#[derive(Debug, Clone, Default)]
+pub struct RunOutcome {
+    pub rows: usize,
+    pub failed_rows: usize,
+    /// Failures that are not one row (a data set that did not load, a missing reference).
+    pub errors: Vec<String>,
+    pub seconds: f64,
+}
+
+impl RunOutcome {
+    pub fn all_ok(&self) -> bool {
+        self.failed_rows == 0 && self.errors.is_empty()
+    }
+}
+
+/// Turns a name into something safe for file names and URLs: `box:20k` → `box_20k`,
+/// `variant=linear;order=radix` → `variant_linear_order_radix`.
+pub fn slug(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            'a'..='z' | 'A'..='Z' | '0'..='9' | '.' | '-' => out.push(c),
+            _ => out.push('_'),
+        }
+    }
+    if out.chars().all(|c| c == '.') {
+        out.insert(0, '_');
+    }
+    out
+}
+
+/// A viewpoint's folder name: `+` → `p`, `-` → `m` (`+x-y` → `pxmy`), so that the names stay
+/// distinct and no folder starts with a dash.
+pub fn viewpoint_slug(name: &str) -> String {
+    slug(&name.replace('+', "p").replace('-', "m"))
+}
+
+fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        s.to_string()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".into()
+    }
+}
+
+/// Runs `f`, turning a panic into an error so one faulty row cannot end the run.
+fn guarded<T>(what: &str, f: impl FnOnce() -> anyhow::Result<T>) -> anyhow::Result<T> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(r) => r,
+        Err(p) => Err(anyhow!("{what} panicked: {}", panic_message(p))),
+    }
+}
+
+/// Progress bar on a terminal, plain log lines otherwise (CI logs, pipes).
+struct Progress {
+    bar: Option<ProgressBar>,
+    done: u64,
+    total: u64,
+}
+
+impl Progress {
+    fn new(total: u64) -> Progress {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let b = ProgressBar::new(total);
+            b.set_style(
+                ProgressStyle::with_template(
+                    "{elapsed_precise} [{bar:30}] {pos}/{len} rows  {msg}",
+                )
+                .expect("valid template")
+                .progress_chars("=> "),
+            );
+            b
+        });
+        Progress {
+            bar,
+            done: 0,
+            total,
+        }
+    }
+
+    fn status(&self, msg: &str) {
+        match &self.bar {
+            Some(b) => b.set_message(msg.to_string()),
+            None => eprintln!("tetbench: {msg}"),
+        }
+    }
+
+    fn log(&self, line: &str) {
+        match &self.bar {
+            Some(b) => b.println(line),
+            None => eprintln!("{line}"),
+        }
+    }
+
+    fn row(&mut self, line: &str) {
+        self.done += 1;
+        match &self.bar {
+            Some(b) => {
+                b.println(line);
+                b.inc(1);
+            }
+            None => eprintln!("[{}/{}] {line}", self.done, self.total),
+        }
+    }
+
+    fn skip(&mut self, n: u64) {
+        self.done += n;
+        if let Some(b) = &self.bar {
+            b.inc(n);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+/// A data set's label in rows: the name as given (`spx`, `box:20k`), or a file's name.
+fn dataset_label(spec: &str) -> String {
+    let p = Path::new(spec);
+    if spec.contains(std::path::MAIN_SEPARATOR) || spec.contains('/') {
+        p.file_name()
+            .map(|f| f.to_string_lossy().into_owned())
+            .unwrap_or_else(|| spec.to_string())
+    } else {
+        spec.to_string()
+    }
+}
+
+fn projection_name(p: &Projection) -> String {
+    match p {
+        Projection::Perspective { fovy_deg } => format!("perspective{fovy_deg}"),
+        Projection::Orthographic => "orthographic".into(),
+    }
+}
+
+/// The variants of every asked-for algorithm that pass the settings filter, checked before any
+/// work starts: unknown algorithms, unknown filter keys and filters that leave nothing are
+/// errors here, not after an hour of measuring.
+fn plan_variants(
+    config: &RunConfig,
+    factory: VariantFactory,
+) -> anyhow::Result<Vec<(String, usize)>> {
+    let mut all_settings = vec![];
+    let mut kept = vec![];
+    for name in &config.algorithms {
+        let variants = factory(name)?;
+        let n = variants
+            .iter()
+            .filter(|r| config.settings_filter.accepts(&r.settings()))
+            .count();
+        all_settings.extend(variants.iter().map(|r| r.settings()));
+        kept.push((name.clone(), n));
+    }
+    let unknown = config.settings_filter.unknown_keys(&all_settings);
+    if !unknown.is_empty() {
+        let mut keys: Vec<&str> = all_settings.iter().flatten().map(|s| s.key).collect();
+        keys.sort();
+        keys.dedup();
+        anyhow::bail!(
+            "--settings: no algorithm has the setting(s) {}; known: {}",
+            unknown.join(", "),
+            keys.join(", ")
+        );
+    }
+    if kept.iter().all(|(_, n)| *n == 0) {
+        anyhow::bail!(
+            "--settings {} leaves no variant of {} to run",
+            config.settings_filter,
+            config.algorithms.join(", ")
+        );
+    }
+    Ok(kept)
+}
+
+/// Runs the whole plan, writing `results.csv`, `results.json`, images and (if asked) the
+/// report into `config.out`.
+pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOutcome> {
+    let started = Instant::now();
+    let plan = plan_variants(config, factory)?;
+    let variants_total: usize = plan.iter().map(|(_, n)| n).sum();
+
+    let gpu = Gpu::new()?;
+    let mut machine = MachineInfo::collect();
+    machine.adapter = Some(gpu.adapter.clone());
+    let description = RunDescription {
+        command_line: config.command_line.clone(),
+        algorithms: config.algorithms.clone(),
+        datasets: config.datasets.clone(),
+        viewpoints: config.viewpoint_spec.clone(),
+        width: config.width,
+        height: config.height,
+        frames: config.frames,
+        warmup: config.warmup,
+        transfer_function: config.tf_spec.clone(),
+        projection: projection_name(&config.projection),
+        settings_filter: config.settings_filter.to_string(),
+        reference: config.reference,
+    };
+    let mut writer = ResultsWriter::create(&config.out, machine, description)?;
+    let mut progress =
+        Progress::new((config.datasets.len() * variants_total * config.viewpoints.len()) as u64);
+    progress.log(&format!(
+        "tetbench: {} on {} ({}, {}); writing {}",
+        config.algorithms.join(","),
+        gpu.adapter.name,
+        gpu.adapter.backend,
+        gpu.adapter.device_type,
+        config.out.display()
+    ));
+
+    let registry = datasets::registry::Registry::new(config.data_dir.clone());
+    let load_options = datasets::LoadOptions {
+        scalar: config.scalar.clone(),
+        ..Default::default()
+    };
+    let mut outcome = RunOutcome::default();
+
+    for spec in &config.datasets {
+        let label = dataset_label(spec);
+        progress.status(&format!("loading {label}"));
+        let t0 = Instant::now();
+        let dataset = match guarded("loading", || {
+            registry
+                .resolve(spec, &load_options)
+                .map_err(|e| anyhow!("{e}"))
+        }) {
+            Ok(d) => d,
+            Err(e) => {
+                let msg = format!("data set {spec:?} could not be loaded: {e:#}");
+                progress.log(&format!("ERROR: {msg}"));
+                writer.push_error(msg.clone())?;
+                outcome.errors.push(msg);
+                progress.skip((variants_total * config.viewpoints.len()) as u64);
+                continue;
+            }
+        };
+        let mesh = dataset.mesh;
+        progress.log(&format!(
+            "{label}: {} points, {} tets (loaded in {:.2} s)",
+            mesh.num_points(),
+            mesh.num_tets(),
+            t0.elapsed().as_secs_f64()
+        ));
+        let optics = Optics::for_mesh(config.tf.clone(), &mesh);
+        let mut ctx = DatasetContext {
+            config,
+            gpu: &gpu,
+            mesh: &mesh,
+            optics: &optics,
+            label: label.clone(),
+            references: HashMap::new(),
+        };
+        for (name, _) in &plan {
+            let variants = factory(name)?;
+            for mut renderer in variants
+                .into_iter()
+                .filter(|r| config.settings_filter.accepts(&r.settings()))
+            {
+                ctx.run_variant(renderer.as_mut(), &mut writer, &mut progress, &mut outcome)?;
+            }
+        }
+    }
+    progress.finish();
+    writer.finish()?;
+    outcome.rows = writer.file.rows.len();
+    if config.report {
+        crate::report::write(&config.out, &writer.file).context("writing the report")?;
+    }
+    outcome.seconds = started.elapsed().as_secs_f64();
+    Ok(outcome)
+}
+
+struct DatasetContext<'a> {
+    config: &'a RunConfig,
+    gpu: &'a Gpu,
+    mesh: &'a TetMesh,
+    optics: &'a Optics,
+    label: String,
+    /// Reference image per viewpoint (or why there is none), rendered on first need.
+    references: HashMap<String, Result<(Image, String), String>>,
+}
+
+/// The row's fixed parts, before measuring.
+fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Row {
+    let c = ctx.config;
+    let a = &ctx.gpu.adapter;
+    Row {
+        algorithm: renderer.algorithm().to_string(),
+        settings: settings_string(&renderer.settings()),
+        dataset: ctx.label.clone(),
+        tets: ctx.mesh.num_tets() as u64,
+        viewpoint: vp.name.clone(),
+        width: c.width,
+        height: c.height,
+        total_ms: None,
+        cpu_ms: None,
+        gpu_ms: None,
+        fps: None,
+        tets_per_sec: None,
+        gpu_bytes: None,
+        bytes_per_tet: None,
+        rmse: None,
+        psnr_db: None,
+        max_abs_error: None,
+        bad_pixel_share: None,
+        adapter: a.name.clone(),
+        backend: a.backend.clone(),
+        total_ms_min: None,
+        total_ms_max: None,
+        cpu_ms_min: None,
+        cpu_ms_max: None,
+        gpu_ms_min: None,
+        gpu_ms_max: None,
+        frames: c.frames,
+        warmup: c.warmup,
+        gpu_bytes_persistent: None,
+        gpu_bytes_frame: None,
+        stages: String::new(),
+        counters: String::new(),
+        covered_pixels: None,
+        transfer_function: c.tf_spec.clone(),
+        projection: projection_name(&c.projection),
+        device_type: a.device_type.clone(),
+        driver: format!("{} {}", a.driver, a.driver_info).trim().to_string(),
+        image: String::new(),
+        reference_image: String::new(),
+        heatmap: String::new(),
+        error: String::new(),
+    }
+}
+
+/// Median of each named value over the frames (`name=value;…`, in first-seen order).
+fn median_named(
+    frames: &[FrameStats],
+    pick: impl Fn(&FrameStats) -> &Vec<(String, f64)>,
+) -> String {
+    let mut names: Vec<String> = vec![];
+    for f in frames {
+        for (n, _) in pick(f) {
+            if !names.contains(n) {
+                names.push(n.clone());
+            }
+        }
+    }
+    names
+        .iter()
+        .map(|n| {
+            let v: Vec<f64> = frames
+                .iter()
+                .flat_map(|f| pick(f).iter().filter(|(m, _)| m == n).map(|(_, v)| *v))
+                .collect();
+            let m = summarize(&v).map(|s| s.median).unwrap_or(f64::NAN);
+            format!("{n}={}", trim_float(m))
+        })
+        .collect::<Vec<_>>()
+        .join(";")
+}
+
+fn trim_float(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        format!("{}", v as i64)
+    } else {
+        format!("{v:.4}")
+    }
+}
+
+impl DatasetContext<'_> {
+    fn images_dir(&self, vp: &Viewpoint) -> (PathBuf, String) {
+        let rel = format!("images/{}/{}", slug(&self.label), viewpoint_slug(&vp.name));
+        (self.config.out.join(&rel), rel)
+    }
+
+    /// The reference image for `vp` and its PNG's path relative to OUT (rendered or read from
+    /// the cache on first need, then kept for every variant).
+    fn reference(
+        &mut self,
+        vp: &Viewpoint,
+        camera: &Camera,
+        progress: &Progress,
+    ) -> Result<(Image, String), String> {
+        if let Some(r) = self.references.get(&vp.name) {
+            return r.clone();
+        }
+        progress.status(&format!("reference {} {}", self.label, vp.name));
+        let (dir, rel) = self.images_dir(vp);
+        let cache = &self.config.cache_dir;
+        let r = guarded("the reference renderer", || {
+            let img = reference::render_cached(self.mesh, self.optics, camera, cache)?;
+            std::fs::create_dir_all(&dir)
+                .with_context(|| format!("cannot create {}", dir.display()))?;
+            img.save_png(&dir.join("reference.png"))?;
+            Ok((img, format!("{rel}/reference.png")))
+        })
+        .map_err(|e| format!("reference for {} {}: {e:#}", self.label, vp.name));
+        self.references.insert(vp.name.clone(), r.clone());
+        r
+    }
+
+    fn run_variant(
+        &mut self,
+        renderer: &mut dyn Renderer,
+        writer: &mut ResultsWriter,
+        progress: &mut Progress,
+        outcome: &mut RunOutcome,
+    ) -> anyhow::Result<()> {
+        let c = self.config;
+        let what = format!(
+            "{} {} on {}",
+            renderer.algorithm(),
+            settings_string(&renderer.settings()),
+            self.label
+        );
+        progress.status(&format!("preparing {what}"));
+        let prepared = guarded("prepare", || {
+            renderer.prepare(self.gpu, self.mesh, self.optics)
+        });
+        let prepared = match prepared {
+            Ok(p) => p,
+            Err(e) => {
+                // Every viewpoint of this variant gets a row that says why it is empty.
+                for vp in &c.viewpoints {
+                    let mut row = base_row(self, renderer, vp);
+                    row.error = format!("prepare failed: {e:#}");
+                    progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
+                    writer.push(row)?;
+                    outcome.failed_rows += 1;
+                }
+                return Ok(());
+            }
+        };
+        for vp in &c.viewpoints {
+            let mut row = base_row(self, renderer, vp);
+            row.gpu_bytes_persistent = Some(prepared.persistent_bytes);
+            if let Err(e) = self.measure(renderer, &prepared, vp, &mut row, progress) {
+                row.error = format!("{e:#}");
+                outcome.failed_rows += 1;
+                progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
+            } else if !row.error.is_empty() {
+                // Measured, but without error metrics (the reference failed).
+                outcome.failed_rows += 1;
+                progress.row(&format!(
+                    "{what} {}: {:.2} ms, no reference: {}",
+                    vp.name,
+                    row.total_ms.unwrap_or(f64::NAN),
+                    row.error
+                ));
+            } else {
+                progress.row(&format!(
+                    "{what} {}: {:.2} ms, {:.3} M tets/s, PSNR {}",
+                    vp.name,
+                    row.total_ms.unwrap_or(f64::NAN),
+                    row.tets_per_sec.unwrap_or(f64::NAN) * 1e-6,
+                    row.psnr_db
+                        .map(|p| format!("{p:.2} dB"))
+                        .unwrap_or_else(|| "-".into())
+                ));
+            }
+            writer.push(row)?;
+        }
+        Ok(())
+    }
+
+    /// Times one viewpoint and fills `row`; images are written as PNGs beside the results.
+    fn measure(
+        &mut self,
+        renderer: &mut dyn Renderer,
+        prepared: &render_core::Prepared,
+        vp: &Viewpoint,
+        row: &mut Row,
+        progress: &Progress,
+    ) -> anyhow::Result<()> {
+        let c = self.config;
+        let camera = Camera::fit(&self.mesh.bounds(), vp, c.projection, c.width, c.height);
+        progress.status(&format!("{} {} {}", row.algorithm, self.label, vp.name));
+        for _ in 0..c.warmup {
+            guarded("render", || renderer.render(self.gpu, &camera))?;
+        }
+        let mut frames = Vec::with_capacity(c.frames as usize);
+        for _ in 0..c.frames {
+            frames.push(guarded("render", || renderer.render(self.gpu, &camera))?);
+        }
+        let image = guarded("read_image", || renderer.read_image(self.gpu))?;
+
+        let total = summarize(&frames.iter().map(|f| f.total_ms).collect::<Vec<_>>())
+            .ok_or_else(|| anyhow!("no timed frames (--frames must be at least 1)"))?;
+        let cpu = summarize(&frames.iter().map(|f| f.cpu_ms).collect::<Vec<_>>());
+        // GPU time only when every frame has it (timestamp queries supported).
+        let gpu_ms: Option<Vec<f64>> = frames.iter().map(|f| f.gpu_ms).collect();
+        let gpu = gpu_ms.as_deref().and_then(summarize);
+        let tets = row.tets as f64;
+        row.total_ms = Some(total.median);
+        row.total_ms_min = Some(total.min);
+        row.total_ms_max = Some(total.max);
+        row.cpu_ms = cpu.map(|s| s.median);
+        row.cpu_ms_min = cpu.map(|s| s.min);
+        row.cpu_ms_max = cpu.map(|s| s.max);
+        row.gpu_ms = gpu.map(|s| s.median);
+        row.gpu_ms_min = gpu.map(|s| s.min);
+        row.gpu_ms_max = gpu.map(|s| s.max);
+        if total.median > 0.0 {
+            row.fps = Some(1000.0 / total.median);
+            row.tets_per_sec = Some(tets / (total.median * 1e-3));
+        }
+        let frame_bytes = frames.iter().map(|f| f.frame_bytes).max().unwrap_or(0);
+        row.gpu_bytes_frame = Some(frame_bytes);
+        row.gpu_bytes = Some(prepared.persistent_bytes + frame_bytes);
+        if tets > 0.0 {
+            row.bytes_per_tet = Some(prepared.persistent_bytes as f64 / tets);
+        }
+        row.stages = median_named(&frames, |f| &f.stages);
+        row.counters = median_named(&frames, |f| &f.counters);
+
+        let (dir, rel) = self.images_dir(vp);
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("cannot create {}", dir.display()))?;
+        let stem = format!("{}__{}", slug(&row.algorithm), slug(&row.settings));
+        image.save_png(&dir.join(format!("{stem}.png")))?;
+        row.image = format!("{rel}/{stem}.png");
+
+        if c.reference {
+            match self.reference(vp, &camera, progress) {
+                Ok((reference, ref_path)) => {
+                    let e = metrics::compare(&image, &reference)?;
+                    row.rmse = Some(e.rmse);
+                    row.psnr_db = Some(e.psnr_db);
+                    row.max_abs_error = Some(e.max_abs_error);
+                    row.bad_pixel_share = Some(e.bad_pixel_share);
+                    row.covered_pixels = Some(e.covered_pixels);
+                    row.reference_image = ref_path;
+                    let heat = metrics::heatmap(&image, &reference)?;
+                    let path = dir.join(format!("{stem}.error.png"));
+                    heat.save(&path)
+                        .map_err(|e| anyhow!("cannot write {}: {e}", path.display()))?;
+                    row.heatmap = format!("{rel}/{stem}.error.png");
+                }
+                Err(msg) => {
+                    // The timing is still valid; the row stays, without error metrics.
+                    row.error = msg;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slugs_keep_viewpoints_distinct_and_paths_safe() {
+        assert_eq!(slug("box:20k"), "box_20k");
+        assert_eq!(viewpoint_slug("+x+y-z"), "pxpymz");
+        assert_ne!(viewpoint_slug("+x"), viewpoint_slug("-x"));
+        assert_eq!(slug("gator-pt"), "gator-pt");
+        assert_eq!(
+            slug("variant=linear;sort=radix"),
+            "variant_linear_sort_radix"
+        );
+        assert_eq!(slug("../etc"), ".._etc");
+        assert_eq!(slug(".."), "_..");
+    }
+
+    #[test]
+    fn labels() {
+        assert_eq!(dataset_label("spx"), "spx");
+        assert_eq!(dataset_label("/data/x/spx.vtk"), "spx.vtk");
+    }
+}

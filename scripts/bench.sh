@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Runs the tetbench default suite (or `tetbench run` with the arguments given) in a release
+# build: installs a Vulkan driver first if the machine has none. Results go to out/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+. scripts/common.sh
+ensure_prerequisites
+cargo build --release -p harness --bin tetbench
+exec target/release/tetbench run "$@"
