@@ -1,1 +1,896 @@
+//! GATOR-style projected tetrahedra (Wylie, Moreland, Fisk, Crossno 2002, "Tetrahedral
+//! projection using vertex shaders").
+//!
+//! Shirley–Tuchman projected tetrahedra done entirely in the vertex shader: every tet is drawn
+//! as the paper's *basis graph* (the 4 vertices plus the thick/phantom vertex) and every vertex
+//! invocation re-derives the projection's class from the tet's four vertices, read from
+//! storage buffers (`gator.wgsl`). wgpu has no triangle fans, so a tet is 4 triangles
+//! (12 invocations); for class-1 projections the fourth degenerates.
+//!
+//! Per frame the CPU only sorts: tet centroids by distance to the eye (HAVS §5.1's LSD radix
+//! sort on float keys), back to front, one buffer write of the tet order. The GPU draws the
+//! fans into an `Rgba32Float` target with premultiplied "over" blending.
+//!
+//! Two variants, the paper's Table 3: **constant** cells (colour and extinction of the tet's
+//! mean scalar) and **linear** cells (the average of the scalars where the eye ray enters and
+//! leaves, interpolated from the thick vertex; the paper's average-scalar approach, not
+//! pre-integration). Opacity α = 1 − exp(−κ(s̄)·l / length_unit) through a lookup table.
+//!
+//! [`classify_cpu`] is the f64 twin of the shader's classification; [`classify_gpu`] runs the
+//! shader's own function in a compute pass and reads the results back, so tests compare them.
 
+mod classify;
+
+use std::time::Instant;
+
+use anyhow::{anyhow, bail, Context};
+use datasets::TetMesh;
+use rayon::prelude::*;
+use render_core::gpu::chunk_ranges;
+use render_core::sort::{radix_sort_indices_descending, RadixScratch};
+use render_core::{
+    Camera, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics, Prepared, Renderer,
+    Setting,
+};
+
+pub use classify::{
+    classify_cpu, classify_tet, world_segment, Classification, ThickSegment, FAN_TRIANGLES,
+    MAPPING_TABLE,
+};
+
+/// Entries of the transfer-function table (rgb, κ over the normalised scalar).
+pub const TF_LUT_SIZE: u32 = 4096;
+/// Entries of the opacity table α(τ) = 1 − exp(−τ), τ ∈ [0, TAU_MAX].
+pub const EXP_LUT_SIZE: u32 = 4096;
+/// Optical depth where the opacity table ends (α = 1 − e⁻¹⁶ ≈ 1 − 1.1·10⁻⁷ beyond).
+pub const TAU_MAX: f32 = 16.0;
+/// Storage bindings for the tet array and the point array (see `gator.wgsl`): meshes up to
+/// 4 × 8 M tets and 3 × 8 M points at lavapipe's 128 MiB per binding.
+const MAX_TET_CHUNKS: usize = 4;
+const MAX_POINT_CHUNKS: usize = 3;
+
+const SHADER: &str = include_str!("gator.wgsl");
+
+/// The cell model of the paper's Table 3.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CellModel {
+    /// One colour and extinction per tet, from the mean of its four vertex scalars.
+    Constant,
+    /// Scalars interpolated linearly: the average of s_front and s_back along each ray.
+    Linear,
+}
+
+impl CellModel {
+    pub fn name(self) -> &'static str {
+        match self {
+            CellModel::Constant => "constant",
+            CellModel::Linear => "linear",
+        }
+    }
+}
+
+/// How the tets are put in back-to-front order each frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Order {
+    /// Centroid distance to the eye, LSD radix sort on float keys (HAVS §5.1).
+    CentroidRadix,
+}
+
+impl Order {
+    pub fn name(self) -> &'static str {
+        match self {
+            Order::CentroidRadix => "radix",
+        }
+    }
+}
+
+/// The GATOR renderer. Construct with [`GatorPt::new`], then [`Renderer::prepare`].
+pub struct GatorPt {
+    cells: CellModel,
+    order: Order,
+    /// Largest storage binding to use (defaults to the device's); tests lower it to exercise
+    /// chunking on small meshes.
+    max_binding: Option<u64>,
+    state: Option<State>,
+}
+
+/// The constant and linear variants, as the harness runs them.
+pub fn default_variants() -> Vec<Box<dyn Renderer>> {
+    vec![
+        Box::new(GatorPt::new(CellModel::Constant, Order::CentroidRadix)),
+        Box::new(GatorPt::new(CellModel::Linear, Order::CentroidRadix)),
+    ]
+}
+
+impl GatorPt {
+    pub fn new(cells: CellModel, order: Order) -> GatorPt {
+        GatorPt {
+            cells,
+            order,
+            max_binding: None,
+            state: None,
+        }
+    }
+
+    /// Splits the mesh arrays at `bytes` per storage binding instead of the device limit
+    /// (rounded down to 256). Only useful to test chunking on small meshes.
+    pub fn with_max_binding(mut self, bytes: u64) -> GatorPt {
+        self.max_binding = Some((bytes & !255).max(256));
+        self
+    }
+
+    pub fn cells(&self) -> CellModel {
+        self.cells
+    }
+
+    /// GPU memory of the prepared mesh (after [`Renderer::prepare`]).
+    pub fn ledger(&self) -> Option<&MemoryLedger> {
+        self.state.as_ref().map(|s| &s.ledger)
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    view_proj: [[f32; 4]; 4],
+    tets_per_chunk: u32,
+    points_per_chunk: u32,
+    num_tets: u32,
+    cells: u32,
+    inv_length_unit: f32,
+    tau_max: f32,
+    tf_size: u32,
+    exp_size: u32,
+}
+
+/// Layouts, pipelines and the mesh on the GPU (shared by the renderer and the debug path).
+struct MeshGpu {
+    g0_layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+    g0: wgpu::BindGroup,
+    params_host: Params,
+    num_tets: u32,
+}
+
+fn storage_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    read_only: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn lut_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D1,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A 1D float lookup table texture.
+fn lut_texture(
+    gpu: &Gpu,
+    ledger: &mut MemoryLedger,
+    label: &str,
+    format: wgpu::TextureFormat,
+    texels: u32,
+    data: &[u8],
+) -> wgpu::TextureView {
+    let texture = ledger.texture(
+        gpu,
+        Lifetime::Persistent,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: texels,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D1,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        },
+    );
+    gpu.queue.write_texture(
+        texture.as_image_copy(),
+        data,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(data.len() as u32),
+            rows_per_image: Some(1),
+        },
+        wgpu::Extent3d {
+            width: texels,
+            height: 1,
+            depth_or_array_layers: 1,
+        },
+    );
+    texture.create_view(&Default::default())
+}
+
+/// Transfer-function table: rgb = c(s), a = κ(s) per length unit, s = i/(n−1).
+fn tf_table(optics: &Optics) -> Vec<[f32; 4]> {
+    (0..TF_LUT_SIZE)
+        .map(|i| {
+            let s = i as f64 / (TF_LUT_SIZE - 1) as f64;
+            let c = optics.tf.color_at(s);
+            [
+                c[0] as f32,
+                c[1] as f32,
+                c[2] as f32,
+                optics.tf.kappa_at(s) as f32,
+            ]
+        })
+        .collect()
+}
+
+/// Opacity table: α(τ) = 1 − exp(−τ) for τ = i/(n−1)·TAU_MAX.
+fn exp_table() -> Vec<f32> {
+    (0..EXP_LUT_SIZE)
+        .map(|i| {
+            let tau = i as f64 / (EXP_LUT_SIZE - 1) as f64 * TAU_MAX as f64;
+            (-(-tau).exp_m1()) as f32
+        })
+        .collect()
+}
+
+impl MeshGpu {
+    /// Uploads points (xyz + scalar) and tets, split over storage bindings of at most
+    /// `max_binding` bytes, and the lookup tables.
+    fn new(
+        gpu: &Gpu,
+        ledger: &mut MemoryLedger,
+        points: &[[f32; 4]],
+        tets: &[[u32; 4]],
+        optics: Option<&Optics>,
+        max_binding: u64,
+    ) -> anyhow::Result<MeshGpu> {
+        let per = max_binding / 16;
+        let tet_ranges = chunk_ranges(tets.len() as u64, 16, max_binding);
+        let point_ranges = chunk_ranges(points.len() as u64, 16, max_binding);
+        if tet_ranges.len() > MAX_TET_CHUNKS || point_ranges.len() > MAX_POINT_CHUNKS {
+            bail!(
+                "gator-pt: mesh of {} tets / {} points needs {} + {} storage bindings of {} bytes; \
+                 at most {MAX_TET_CHUNKS} + {MAX_POINT_CHUNKS} are bound",
+                tets.len(),
+                points.len(),
+                tet_ranges.len(),
+                point_ranges.len(),
+                max_binding
+            );
+        }
+        if tets.len() as u64 * 12 > u32::MAX as u64 {
+            bail!(
+                "gator-pt: {} tets exceed the 32-bit vertex index range (12 vertices per tet)",
+                tets.len()
+            );
+        }
+        let usage = wgpu::BufferUsages::STORAGE;
+        let chunk_buffers = |ledger: &mut MemoryLedger,
+                             label: &str,
+                             bytes: &[u8],
+                             ranges: &[std::ops::Range<u64>],
+                             max: usize| {
+            let mut bufs: Vec<wgpu::Buffer> = ranges
+                .iter()
+                .map(|r| {
+                    ledger.buffer_init(
+                        gpu,
+                        label,
+                        Lifetime::Persistent,
+                        &bytes[(r.start * 16) as usize..(r.end * 16) as usize],
+                        usage,
+                    )
+                })
+                .collect();
+            // Unused bindings get a tiny placeholder buffer (counted: it is allocated).
+            while bufs.len() < max {
+                bufs.push(ledger.buffer(
+                    gpu,
+                    "gator unused binding",
+                    Lifetime::Persistent,
+                    16,
+                    usage,
+                ));
+            }
+            bufs
+        };
+        let tet_bufs = chunk_buffers(
+            ledger,
+            "gator tets",
+            bytemuck::cast_slice(tets),
+            &tet_ranges,
+            MAX_TET_CHUNKS,
+        );
+        let point_bufs = chunk_buffers(
+            ledger,
+            "gator points",
+            bytemuck::cast_slice(points),
+            &point_ranges,
+            MAX_POINT_CHUNKS,
+        );
+
+        let default_optics;
+        let optics = match optics {
+            Some(o) => o,
+            None => {
+                default_optics = Optics {
+                    tf: render_core::TransferFunction::preset("low-opacity")
+                        .ok_or_else(|| anyhow!("no low-opacity preset"))?,
+                    scalar_min: 0.0,
+                    scalar_max: 1.0,
+                    length_unit: 1.0,
+                };
+                &default_optics
+            }
+        };
+        let tf = tf_table(optics);
+        let tf_view = lut_texture(
+            gpu,
+            ledger,
+            "gator tf table",
+            wgpu::TextureFormat::Rgba32Float,
+            TF_LUT_SIZE,
+            bytemuck::cast_slice(&tf),
+        );
+        let ex = exp_table();
+        let exp_view = lut_texture(
+            gpu,
+            ledger,
+            "gator opacity table",
+            wgpu::TextureFormat::R32Float,
+            EXP_LUT_SIZE,
+            bytemuck::cast_slice(&ex),
+        );
+
+        let params_host = Params {
+            view_proj: [[0.0; 4]; 4],
+            tets_per_chunk: per as u32,
+            points_per_chunk: per as u32,
+            num_tets: tets.len() as u32,
+            cells: 1,
+            inv_length_unit: (1.0 / optics.length_unit.max(1e-300)) as f32,
+            tau_max: TAU_MAX,
+            tf_size: TF_LUT_SIZE,
+            exp_size: EXP_LUT_SIZE,
+        };
+        let params = ledger.buffer_init(
+            gpu,
+            "gator params",
+            Lifetime::Persistent,
+            bytemuck::bytes_of(&params_host),
+            wgpu::BufferUsages::UNIFORM,
+        );
+
+        let vc = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE;
+        let mut entries = vec![uniform_entry(
+            0,
+            wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        )];
+        for b in 1..=(MAX_TET_CHUNKS + MAX_POINT_CHUNKS) as u32 {
+            entries.push(storage_entry(b, vc, true));
+        }
+        entries.push(lut_entry(8));
+        entries.push(lut_entry(9));
+        let g0_layout = gpu
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("gator g0"),
+                entries: &entries,
+            });
+        let mut bind = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: params.as_entire_binding(),
+        }];
+        for (i, b) in tet_bufs.iter().chain(point_bufs.iter()).enumerate() {
+            bind.push(wgpu::BindGroupEntry {
+                binding: 1 + i as u32,
+                resource: b.as_entire_binding(),
+            });
+        }
+        bind.push(wgpu::BindGroupEntry {
+            binding: 8,
+            resource: wgpu::BindingResource::TextureView(&tf_view),
+        });
+        bind.push(wgpu::BindGroupEntry {
+            binding: 9,
+            resource: wgpu::BindingResource::TextureView(&exp_view),
+        });
+        let g0 = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gator g0"),
+            layout: &g0_layout,
+            entries: &bind,
+        });
+        Ok(MeshGpu {
+            g0_layout,
+            params,
+            g0,
+            params_host,
+            num_tets: tets.len() as u32,
+        })
+    }
+
+    fn write_params(&mut self, gpu: &Gpu, camera: &Camera, cells: CellModel) {
+        self.params_host.view_proj = camera.view_proj_f32();
+        self.params_host.cells = match cells {
+            CellModel::Constant => 0,
+            CellModel::Linear => 1,
+        };
+        gpu.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&self.params_host));
+    }
+}
+
+/// One order-buffer chunk of the draw.
+struct DrawChunk {
+    range: std::ops::Range<u64>,
+    bind_group: wgpu::BindGroup,
+}
+
+struct Target {
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    bytes: u64,
+}
+
+struct State {
+    ledger: MemoryLedger,
+    mesh: MeshGpu,
+    pipeline: wgpu::RenderPipeline,
+    order_buf: wgpu::Buffer,
+    chunks: Vec<DrawChunk>,
+    centroids: Vec<[f64; 3]>,
+    keys: Vec<f32>,
+    order: Vec<u32>,
+    scratch: RadixScratch,
+    timer: FrameTimer,
+    target: Option<Target>,
+}
+
+fn max_binding(gpu: &Gpu, over: Option<u64>) -> u64 {
+    let dev = gpu.max_storage_binding();
+    over.map_or(dev, |o| o.min(dev))
+}
+
+impl Renderer for GatorPt {
+    fn algorithm(&self) -> &'static str {
+        "gator-pt"
+    }
+
+    fn settings(&self) -> Vec<Setting> {
+        vec![
+            Setting::new("variant", self.cells.name()),
+            Setting::new("order", self.order.name()),
+        ]
+    }
+
+    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+        self.state = None;
+        if !gpu.features.contains(wgpu::Features::FLOAT32_BLENDABLE) {
+            bail!("gator-pt needs FLOAT32_BLENDABLE (blending into an Rgba32Float target); adapter {} lacks it", gpu.adapter.name);
+        }
+        let mb = max_binding(gpu, self.max_binding);
+        let mut ledger = MemoryLedger::default();
+        let points: Vec<[f32; 4]> = mesh
+            .points
+            .iter()
+            .zip(&mesh.scalars)
+            .map(|(p, &s)| [p[0], p[1], p[2], optics.normalise(s as f64) as f32])
+            .collect();
+        let meshgpu = MeshGpu::new(gpu, &mut ledger, &points, &mesh.tets, Some(optics), mb)
+            .with_context(|| format!("uploading mesh {}", mesh.name))?;
+
+        let shader = gpu.shader("gator.wgsl", SHADER);
+        let g1_layout = gpu
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("gator order"),
+                entries: &[
+                    storage_entry(0, wgpu::ShaderStages::VERTEX, true),
+                    uniform_entry(1, wgpu::ShaderStages::VERTEX),
+                ],
+            });
+        let layout = gpu
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("gator"),
+                bind_group_layouts: &[Some(&meshgpu.g0_layout), Some(&g1_layout)],
+                immediate_size: 0,
+            });
+        // Premultiplied "over", back to front: dst = src + (1 − src_α)·dst.
+        let over = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let pipeline = gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("gator"),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &shader,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &shader,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: wgpu::TextureFormat::Rgba32Float,
+                        blend: Some(wgpu::BlendState {
+                            color: over,
+                            alpha: over,
+                        }),
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+
+        let n = mesh.num_tets() as u64;
+        // The order is rewritten every frame: per-frame memory, not per mesh.
+        let order_buf = ledger.buffer(
+            gpu,
+            "gator order",
+            Lifetime::PerFrame,
+            n * 4,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
+        let mut chunks = Vec::new();
+        for range in chunk_ranges(n, 4, mb) {
+            let cp = [range.start as u32, 0, 0, 0];
+            let cbuf = ledger.buffer_init(
+                gpu,
+                "gator chunk params",
+                Lifetime::Persistent,
+                bytemuck::cast_slice(&cp),
+                wgpu::BufferUsages::UNIFORM,
+            );
+            let size = std::num::NonZeroU64::new(((range.end - range.start) * 4).max(4));
+            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("gator order chunk"),
+                layout: &g1_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &order_buf,
+                            offset: range.start * 4,
+                            size,
+                        }),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: cbuf.as_entire_binding(),
+                    },
+                ],
+            });
+            chunks.push(DrawChunk { range, bind_group });
+        }
+        let centroids: Vec<[f64; 3]> = (0..mesh.num_tets())
+            .into_par_iter()
+            .map(|t| {
+                let p = mesh.tet_points(t);
+                [0, 1, 2].map(|k| 0.25 * (p[0][k] + p[1][k] + p[2][k] + p[3][k]))
+            })
+            .collect();
+        let persistent = ledger.persistent;
+        self.state = Some(State {
+            ledger,
+            mesh: meshgpu,
+            pipeline,
+            order_buf,
+            chunks,
+            keys: vec![0.0; centroids.len()],
+            centroids,
+            order: Vec::with_capacity(n as usize),
+            scratch: RadixScratch::default(),
+            timer: FrameTimer::new(gpu),
+            target: None,
+        });
+        Ok(Prepared {
+            persistent_bytes: persistent,
+            tets: n,
+        })
+    }
+
+    fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
+        let cells = self.cells;
+        let st = self
+            .state
+            .as_mut()
+            .ok_or_else(|| anyhow!("gator-pt: render called before prepare"))?;
+        let (w, h) = (camera.width, camera.height);
+        if st
+            .target
+            .as_ref()
+            .is_none_or(|t| t.texture.width() != w || t.texture.height() != h)
+        {
+            let desc = wgpu::TextureDescriptor {
+                label: Some("gator target"),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Float,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            };
+            let texture = st.ledger.texture(gpu, Lifetime::PerFrame, &desc);
+            let view = texture.create_view(&Default::default());
+            st.target = Some(Target {
+                texture,
+                view,
+                bytes: w as u64 * h as u64 * 16,
+            });
+        }
+
+        // CPU part of the frame: sort keys, radix sort, one upload of the order.
+        st.timer.start_wall();
+        let t0 = Instant::now();
+        match self.order {
+            Order::CentroidRadix => {
+                st.keys
+                    .par_iter_mut()
+                    .zip(st.centroids.par_iter())
+                    .for_each(|(k, c)| *k = camera.sort_distance(*c) as f32);
+                // Descending distance: farthest first (back to front).
+                radix_sort_indices_descending(&st.keys, &mut st.order, &mut st.scratch);
+            }
+        }
+        let sort_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let t1 = Instant::now();
+        gpu.queue
+            .write_buffer(&st.order_buf, 0, bytemuck::cast_slice(&st.order));
+        st.mesh.write_params(gpu, camera, cells);
+        let upload_ms = t1.elapsed().as_secs_f64() * 1e3;
+
+        let target = st.target.as_ref().expect("target created above");
+        let mut enc = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("gator frame"),
+            });
+        st.timer.begin(&mut enc);
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("gator fans"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target.view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&st.pipeline);
+            pass.set_bind_group(0, &st.mesh.g0, &[]);
+            for chunk in &st.chunks {
+                if chunk.range.is_empty() {
+                    continue;
+                }
+                pass.set_bind_group(1, &chunk.bind_group, &[]);
+                pass.draw(
+                    (chunk.range.start * 12) as u32..(chunk.range.end * 12) as u32,
+                    0..1,
+                );
+            }
+        }
+        st.timer.end(&mut enc);
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait()?;
+        let total_ms = st.timer.wall_ms();
+        let gpu_ms = st.timer.gpu_ms(gpu)?;
+        let n = st.order.len() as f64;
+        let mut stages = vec![
+            ("sort".to_string(), sort_ms),
+            ("upload".to_string(), upload_ms),
+        ];
+        if let Some(g) = gpu_ms {
+            stages.push(("draw".to_string(), g));
+        }
+        Ok(FrameStats {
+            cpu_ms: sort_ms + upload_ms,
+            gpu_ms,
+            total_ms,
+            frame_bytes: st.order.len() as u64 * 4
+                + std::mem::size_of::<Params>() as u64
+                + target.bytes,
+            stages,
+            counters: vec![
+                ("tets".to_string(), n),
+                ("vertex_invocations".to_string(), 12.0 * n),
+            ],
+        })
+    }
+
+    fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image> {
+        let st = self
+            .state
+            .as_ref()
+            .ok_or_else(|| anyhow!("gator-pt: read_image called before prepare"))?;
+        let target = st
+            .target
+            .as_ref()
+            .ok_or_else(|| anyhow!("gator-pt: read_image called before render"))?;
+        gpu.read_rgba32f(&target.texture)
+    }
+}
+
+/// The GPU classification of one tet, as `gator.wgsl`'s `classify_debug` writes it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuClassification {
+    /// 1..=14 (see [`Classification::case`]).
+    pub case: u32,
+    /// 1 or 2; 0 when a vertex was behind the eye (the tet is not drawn).
+    pub class: u32,
+    /// Thick vertex in normalised device coordinates.
+    pub thick_vertex: [f32; 2],
+    /// |Δz| in NDC between the two ends of the thick segment (the paper's thickness).
+    pub ndc_thickness: f32,
+    /// World length of the thick segment (what the optical model uses).
+    pub length: f32,
+    pub s_front: f32,
+    pub s_back: f32,
+}
+
+/// Runs the vertex shader's classification (`project_and_classify` in `gator.wgsl`) on every
+/// tet in a compute pass and reads the results back. `scalars` are passed through unchanged
+/// (not normalised). Degenerate and inverted tets are accepted as they are.
+pub fn classify_gpu(
+    gpu: &Gpu,
+    points: &[[f32; 3]],
+    scalars: &[f32],
+    tets: &[[u32; 4]],
+    camera: &Camera,
+) -> anyhow::Result<Vec<GpuClassification>> {
+    if points.len() != scalars.len() {
+        bail!(
+            "classify_gpu: {} points but {} scalars",
+            points.len(),
+            scalars.len()
+        );
+    }
+    if let Some((t, bad)) = tets
+        .iter()
+        .enumerate()
+        .find(|(_, t)| t.iter().any(|&i| i as usize >= points.len()))
+    {
+        bail!(
+            "classify_gpu: tet {t} {bad:?} indexes past the {} points",
+            points.len()
+        );
+    }
+    let groups = (tets.len() as u64).div_ceil(64);
+    if groups > gpu.limits.max_compute_workgroups_per_dimension as u64 {
+        bail!(
+            "classify_gpu: {} tets exceed one dispatch ({} workgroups of 64)",
+            tets.len(),
+            gpu.limits.max_compute_workgroups_per_dimension
+        );
+    }
+    let mut ledger = MemoryLedger::default();
+    let xyzs: Vec<[f32; 4]> = points
+        .iter()
+        .zip(scalars)
+        .map(|(p, &s)| [p[0], p[1], p[2], s])
+        .collect();
+    let mut mesh = MeshGpu::new(
+        gpu,
+        &mut ledger,
+        &xyzs,
+        tets,
+        None,
+        gpu.max_storage_binding(),
+    )?;
+    mesh.write_params(gpu, camera, CellModel::Linear);
+    let shader = gpu.shader("gator.wgsl", SHADER);
+    let g1_layout = gpu
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gator debug out"),
+            entries: &[storage_entry(2, wgpu::ShaderStages::COMPUTE, false)],
+        });
+    let layout = gpu
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gator debug"),
+            bind_group_layouts: &[Some(&mesh.g0_layout), Some(&g1_layout)],
+            immediate_size: 0,
+        });
+    let pipeline = gpu
+        .device
+        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("gator classify debug"),
+            layout: Some(&layout),
+            module: &shader,
+            entry_point: Some("classify_debug"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+    let size = (tets.len().max(1) * std::mem::size_of::<GpuClassification>()) as u64;
+    let out = ledger.buffer(
+        gpu,
+        "gator debug out",
+        Lifetime::PerFrame,
+        size,
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+    );
+    let g1 = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("gator debug out"),
+        layout: &g1_layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 2,
+            resource: out.as_entire_binding(),
+        }],
+    });
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("gator classify"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &mesh.g0, &[]);
+        pass.set_bind_group(1, &g1, &[]);
+        pass.dispatch_workgroups(groups as u32, 1, 1);
+    }
+    gpu.queue.submit([enc.finish()]);
+    let bytes = gpu.read_buffer(&out, 0, size)?;
+    let mut v: Vec<GpuClassification> = bytemuck::cast_slice(&bytes).to_vec();
+    v.truncate(mesh.num_tets as usize);
+    Ok(v)
+}

@@ -1,0 +1,354 @@
+// GATOR-style projected tetrahedra (Wylie, Moreland, Fisk, Crossno 2002, "Tetrahedral
+// projection using vertex shaders").
+//
+// Every vertex-shader invocation reads its tet's four vertices from storage, projects them,
+// runs the paper's four tests (Fig. 5), picks the basis-graph mapping of Table 1 and emits one
+// node of the basis graph. wgpu has no triangle fans, so each tet is 4 triangles = 12 vertex
+// invocations (the fourth degenerates for class 1). `project_and_classify` is the single copy
+// of the classification: the vertex shader and the debug compute entry point both call it,
+// and classify.rs is its f64 twin (keep the two in step).
+
+struct Params {
+    view_proj: mat4x4<f32>,
+    // Elements per storage binding of the tet and point arrays (meshes larger than one
+    // binding are split across tets0..3 / points0..2).
+    tets_per_chunk: u32,
+    points_per_chunk: u32,
+    num_tets: u32,
+    // 0: constant cells (the tet's mean scalar), 1: linear cells (s_front, s_back).
+    cells: u32,
+    inv_length_unit: f32,
+    tau_max: f32,
+    tf_size: u32,
+    exp_size: u32,
+};
+
+struct ChunkParams {
+    // Sorted position of this chunk's first entry in `order`.
+    base: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+};
+
+// What the debug entry point records per tet (32 bytes; mirrored by `GpuClassification`).
+struct DebugRecord {
+    case_id: u32,
+    class_id: u32,
+    thick: vec2<f32>,
+    ndc_thickness: f32,
+    length: f32,
+    s_front: f32,
+    s_back: f32,
+};
+
+@group(0) @binding(0) var<uniform> P: Params;
+@group(0) @binding(1) var<storage, read> tets0: array<vec4<u32>>;
+@group(0) @binding(2) var<storage, read> tets1: array<vec4<u32>>;
+@group(0) @binding(3) var<storage, read> tets2: array<vec4<u32>>;
+@group(0) @binding(4) var<storage, read> tets3: array<vec4<u32>>;
+// xyz and the normalised scalar.
+@group(0) @binding(5) var<storage, read> points0: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> points1: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> points2: array<vec4<f32>>;
+// Lookup tables (the paper shades through tables): chromaticity rgb + extinction κ over the
+// normalised scalar, and α(τ) = 1 − exp(−τ) over τ ∈ [0, tau_max].
+@group(0) @binding(8) var tf_lut: texture_1d<f32>;
+@group(0) @binding(9) var exp_lut: texture_1d<f32>;
+
+// Back-to-front order of tet ids for this chunk of the draw.
+@group(1) @binding(0) var<storage, read> order: array<u32>;
+@group(1) @binding(1) var<uniform> C: ChunkParams;
+// Debug path only.
+@group(1) @binding(2) var<storage, read_write> debug_out: array<DebugRecord>;
+
+fn tet_at(id: u32) -> vec4<u32> {
+    let c = id / P.tets_per_chunk;
+    let i = id - c * P.tets_per_chunk;
+    switch c {
+        case 0u: { return tets0[i]; }
+        case 1u: { return tets1[i]; }
+        case 2u: { return tets2[i]; }
+        default: { return tets3[i]; }
+    }
+}
+
+fn point_at(id: u32) -> vec4<f32> {
+    let c = id / P.points_per_chunk;
+    let i = id - c * P.points_per_chunk;
+    switch c {
+        case 0u: { return points0[i]; }
+        case 1u: { return points1[i]; }
+        default: { return points2[i]; }
+    }
+}
+
+// The authors' MappingTable (gator.cg): input vertex in slots v0', v1', v2', v3' for
+// idx = 4·t1 + 2·t2 + t3. The hull is then v0', v3', v1', v2' (or v0', v3', v2' with v1'
+// inside).
+const MAPPING = array<vec4<u32>, 8>(
+    vec4<u32>(0u, 3u, 1u, 2u),
+    vec4<u32>(0u, 3u, 2u, 1u),
+    vec4<u32>(0u, 2u, 1u, 3u),
+    vec4<u32>(0u, 2u, 3u, 1u),
+    vec4<u32>(0u, 1u, 3u, 2u),
+    vec4<u32>(0u, 1u, 2u, 3u),
+    vec4<u32>(2u, 0u, 3u, 1u),
+    vec4<u32>(3u, 0u, 2u, 1u),
+);
+
+struct TetProjection {
+    // Screen (NDC) positions and scalars of the input vertices.
+    ndc: array<vec2<f32>, 4>,
+    scal: array<f32, 4>,
+    perm: vec4<u32>,
+    thick: vec2<f32>,
+    // World length of the eye-ray segment through the thick vertex (§3.5).
+    length: f32,
+    s_front: f32,
+    s_back: f32,
+    s_mean: f32,
+    ndc_thickness: f32,
+    case_id: u32,
+    class2: bool,
+    // false when a vertex is behind the eye (w <= 0): the tet is not drawn.
+    valid: bool,
+};
+
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+fn project_and_classify(tet_id: u32) -> TetProjection {
+    var r: TetProjection;
+    let t = tet_at(tet_id);
+    var world: array<vec3<f32>, 4>;
+    var ndcz: array<f32, 4>;
+    var w: array<f32, 4>;
+    r.valid = true;
+    for (var i = 0u; i < 4u; i++) {
+        let p = point_at(t[i]);
+        world[i] = p.xyz;
+        r.scal[i] = p.w;
+        let c = P.view_proj * vec4<f32>(p.xyz, 1.0);
+        if !(c.w > 0.0) {
+            r.valid = false;
+        }
+        let inv_w = 1.0 / max(c.w, 1e-30);
+        w[i] = max(c.w, 1e-30);
+        r.ndc[i] = c.xy * inv_w;
+        ndcz[i] = c.z * inv_w;
+    }
+    r.s_mean = 0.25 * (r.scal[0] + r.scal[1] + r.scal[2] + r.scal[3]);
+
+    // Tests 1-3 (Fig. 5; gator.cg tests123). A zero cross product counts as positive so ties
+    // (coincident or collinear points) still put a proper vertex into slot v1'.
+    let e1 = r.ndc[1] - r.ndc[0];
+    let e2 = r.ndc[2] - r.ndc[0];
+    let e3 = r.ndc[3] - r.ndc[0];
+    let a = cross2(e1, e2);
+    let b = cross2(e1, e3);
+    let c = cross2(e3, e2);
+    let t1 = (a >= 0.0) != (b >= 0.0);
+    let t2 = (a >= 0.0) != (c >= 0.0);
+    let t3 = a >= 0.0;
+    let idx = 4u * u32(t1) + 2u * u32(t2) + u32(t3);
+    var mapping = MAPPING;
+    let perm = mapping[idx];
+    r.perm = perm;
+    let q0 = r.ndc[perm.x];
+    let q1 = r.ndc[perm.y];
+    let q2 = r.ndc[perm.z];
+    let q3 = r.ndc[perm.w];
+
+    // Intersection of v0'v1' with v2'v3': 0 = C + α A − β B (gator.cg compute_intersection).
+    let av = q1 - q0;
+    let bv = q3 - q2;
+    let cv = q0 - q2;
+    let den = cross2(av, bv);
+    let alpha_num = cross2(bv, cv);
+    let beta_num = cross2(av, cv);
+
+    // Test 4: α < 1 → all four on the hull (class 2); never for idx 6, 7 (the two impossible
+    // rows: v0 strictly inside the other three).
+    var t4 = false;
+    if idx < 6u && den != 0.0 {
+        t4 = alpha_num / den < 1.0;
+    }
+    var beta = 0.0;
+    if den != 0.0 {
+        beta = clamp(beta_num / den, 0.0, 1.0);
+    }
+    // Projected-space weights (over input vertices) of the two ends of the thick segment.
+    var wa = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
+    var wb = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
+    if t4 {
+        let alpha = clamp(alpha_num / den, 0.0, 1.0);
+        wa[perm.x] += 1.0 - alpha;
+        wa[perm.y] += alpha;
+        wb[perm.z] += 1.0 - beta;
+        wb[perm.w] += beta;
+    } else {
+        // Class 1: thick vertex v1'; far end on face v0'v2'v3' at r = 1/α along v0' → I.
+        var rr = 0.0;
+        if alpha_num != 0.0 {
+            rr = clamp(den / alpha_num, 0.0, 1.0);
+        }
+        wa[perm.y] = 1.0;
+        wb[perm.x] += 1.0 - rr;
+        wb[perm.z] += rr * (1.0 - beta);
+        wb[perm.w] += rr * beta;
+    }
+    var thick = vec2<f32>(0.0);
+    var za = 0.0;
+    var zb = 0.0;
+    // World points: projected weights λ become world weights λᵢ/wᵢ, normalised
+    // (perspective-correct; exact because a projective map keeps lines straight).
+    var ga = 0.0;
+    var gb = 0.0;
+    var pa = vec3<f32>(0.0);
+    var pb = vec3<f32>(0.0);
+    var sa = 0.0;
+    var sb = 0.0;
+    for (var i = 0u; i < 4u; i++) {
+        thick += wa[i] * r.ndc[i];
+        za += wa[i] * ndcz[i];
+        zb += wb[i] * ndcz[i];
+        let gai = wa[i] / w[i];
+        let gbi = wb[i] / w[i];
+        ga += gai;
+        gb += gbi;
+        pa += gai * world[i];
+        pb += gbi * world[i];
+        sa += gai * r.scal[i];
+        sb += gbi * r.scal[i];
+    }
+    if !t4 {
+        thick = q1;
+    }
+    pa /= ga;
+    pb /= gb;
+    sa /= ga;
+    sb /= gb;
+    r.thick = thick;
+    r.length = length(pa - pb);
+    r.ndc_thickness = abs(za - zb);
+    if za <= zb {
+        r.s_front = sa;
+        r.s_back = sb;
+    } else {
+        r.s_front = sb;
+        r.s_back = sa;
+    }
+    r.class2 = t4;
+    if idx < 6u {
+        r.case_id = 2u * idx + 1u + u32(t4);
+    } else {
+        r.case_id = 13u + idx - 6u;
+    }
+    return r;
+}
+
+struct VsOut {
+    @builtin(position) pos: vec4<f32>,
+    // World thickness (0 on the silhouette), s_front, s_back: interpolated linearly on screen
+    // as in Shirley–Tuchman / GATOR (exact for orthographic views).
+    @location(0) @interpolate(linear) seg: vec3<f32>,
+};
+
+@vertex
+fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
+    let k = vi / 12u;
+    let corner = vi - 12u * k;
+    let tet_id = order[k - C.base];
+    var tp = project_and_classify(tet_id);
+    // Fan (node 0 = thick vertex; rim nodes 1..4 = v2', v0', v3', v1'|v2'):
+    // triangles (0,1,2) (0,2,3) (0,3,4) (0,4,1).
+    let tri = corner / 3u;
+    let j = corner - 3u * tri;
+    var node = 0u;
+    if j == 1u {
+        node = 1u + tri;
+    } else if j == 2u {
+        node = 1u + (tri + 1u) % 4u;
+    }
+    var out: VsOut;
+    if !tp.valid {
+        out.pos = vec4<f32>(0.0, 0.0, 0.5, 1.0);
+        out.seg = vec3<f32>(0.0);
+        return out;
+    }
+    var xy: vec2<f32>;
+    var seg: vec3<f32>;
+    if node == 0u {
+        xy = tp.thick;
+        seg = vec3<f32>(tp.length, tp.s_front, tp.s_back);
+    } else {
+        var slot = tp.perm.z;
+        if node == 2u {
+            slot = tp.perm.x;
+        } else if node == 3u {
+            slot = tp.perm.w;
+        } else if node == 4u && tp.class2 {
+            slot = tp.perm.y;
+        }
+        xy = tp.ndc[slot];
+        seg = vec3<f32>(0.0, tp.scal[slot], tp.scal[slot]);
+    }
+    if P.cells == 0u {
+        seg.y = tp.s_mean;
+        seg.z = tp.s_mean;
+    }
+    // w = 1: no perspective division of the attributes, no depth clipping (no depth test).
+    out.pos = vec4<f32>(xy, 0.5, 1.0);
+    out.seg = seg;
+    return out;
+}
+
+fn lut_tf(s: f32) -> vec4<f32> {
+    let x = clamp(s, 0.0, 1.0) * f32(P.tf_size - 1u);
+    let i0 = min(u32(floor(x)), P.tf_size - 1u);
+    let i1 = min(i0 + 1u, P.tf_size - 1u);
+    return mix(textureLoad(tf_lut, i0, 0), textureLoad(tf_lut, i1, 0), x - f32(i0));
+}
+
+fn lut_opacity(tau: f32) -> f32 {
+    let x = clamp(tau / P.tau_max, 0.0, 1.0) * f32(P.exp_size - 1u);
+    let i0 = min(u32(floor(x)), P.exp_size - 1u);
+    let i1 = min(i0 + 1u, P.exp_size - 1u);
+    return mix(textureLoad(exp_lut, i0, 0).x, textureLoad(exp_lut, i1, 0).x, x - f32(i0));
+}
+
+// Emission–absorption with the average scalar of the segment (the paper's shading):
+// colour c(s̄), opacity α = 1 − exp(−κ(s̄)·l / length_unit), premultiplied for "over".
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    let s = 0.5 * (in.seg.y + in.seg.z);
+    let tf = lut_tf(s);
+    let tau = max(tf.w, 0.0) * max(in.seg.x, 0.0) * P.inv_length_unit;
+    let alpha = lut_opacity(tau);
+    return vec4<f32>(tf.rgb * alpha, alpha);
+}
+
+// Debug: the classification of every tet, written to a buffer (tests compare it with
+// classify.rs).
+@compute @workgroup_size(64)
+fn classify_debug(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let id = gid.x;
+    if id >= P.num_tets {
+        return;
+    }
+    let tp = project_and_classify(id);
+    var rec: DebugRecord;
+    rec.case_id = tp.case_id;
+    rec.class_id = select(1u, 2u, tp.class2);
+    if !tp.valid {
+        rec.class_id = 0u;
+    }
+    rec.thick = tp.thick;
+    rec.ndc_thickness = tp.ndc_thickness;
+    rec.length = tp.length;
+    rec.s_front = tp.s_front;
+    rec.s_back = tp.s_back;
+    debug_out[id] = rec;
+}
