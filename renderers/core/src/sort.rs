@@ -17,7 +17,7 @@ pub fn float_to_ordered_u32(f: f32) -> u32 {
 /// u32 images of the keys (HAVS §5.1): stable, one read of the keys builds every digit histogram,
 /// passes whose digit is the same for all keys are skipped. `scratch` is reused between frames.
 pub fn radix_sort_indices(keys: &[f32], indices: &mut Vec<u32>, scratch: &mut RadixScratch) {
-    radix_sort_packed::<RADIX_BITS>(keys, 0, indices, scratch);
+    radix_sort_8bit(keys, 0, indices, scratch);
 }
 
 /// Buffers the radix sort reuses from frame to frame.
@@ -34,18 +34,104 @@ pub fn radix_sort_indices_descending(
     indices: &mut Vec<u32>,
     scratch: &mut RadixScratch,
 ) {
-    radix_sort_packed::<RADIX_BITS>(keys, u32::MAX, indices, scratch);
+    radix_sort_8bit(keys, u32::MAX, indices, scratch);
 }
 
-/// Digit width of the CPU radix sort. HAVS §5.1 uses four 8-bit passes; 8 bits keep the 256
-/// scatter streams within the L1 cache and the write-combining buffers, which measured faster
-/// than three 11-bit passes on 1 M keys (benches/sort.rs).
-pub const RADIX_BITS: u32 = 8;
+/// The radix sort behind [`radix_sort_indices`]: HAVS §5.1's four 8-bit passes over
+/// `(ordered(key) ^ flip) << 32 | index` pairs packed in a u64 (one 8-byte item per scatter
+/// instead of a key and a value in two arrays). The first pass reads the f32 keys directly, the
+/// last writes only the indices. Tuned for 1 M keys (benches/sort.rs):
+/// - the histograms are built in two interleaved copies: with real depth keys most keys share
+///   their top byte, and a single counter incremented key after key is a chain of dependent
+///   load-add-stores;
+/// - digits are taken as `u8`, so indexing the 256-entry tables needs no bounds check.
+fn radix_sort_8bit(keys: &[f32], flip: u32, indices: &mut Vec<u32>, scratch: &mut RadixScratch) {
+    let n = keys.len();
+    indices.clear();
+    debug_assert!(n <= u32::MAX as usize);
+    let mut h = [[[0u32; 256]; 4]; 2];
+    let mut pairs = keys.chunks_exact(2);
+    for c in &mut pairs {
+        let (u, v) = (
+            float_to_ordered_u32(c[0]) ^ flip,
+            float_to_ordered_u32(c[1]) ^ flip,
+        );
+        for p in 0..4 {
+            h[0][p][(u >> (8 * p)) as u8 as usize] += 1;
+            h[1][p][(v >> (8 * p)) as u8 as usize] += 1;
+        }
+    }
+    for &k in pairs.remainder() {
+        let u = float_to_ordered_u32(k) ^ flip;
+        for p in 0..4 {
+            h[0][p][(u >> (8 * p)) as u8 as usize] += 1;
+        }
+    }
+    let mut hist = [[0u32; 256]; 4];
+    for p in 0..4 {
+        for d in 0..256 {
+            hist[p][d] = h[0][p][d] + h[1][p][d];
+        }
+    }
+    // A pass where every key has the same digit changes nothing: skip it.
+    let live: Vec<usize> = (0..4)
+        .filter(|&p| !hist[p].iter().any(|&c| c as usize == n))
+        .collect();
+    if live.is_empty() {
+        indices.extend(0..n as u32);
+        return;
+    }
+    scratch.a.resize(n, 0);
+    scratch.b.resize(n, 0);
+    let (mut a, mut b) = (&mut scratch.a, &mut scratch.b);
+    let mut offset = [0usize; 256];
+    for (li, &p) in live.iter().enumerate() {
+        let mut sum = 0usize;
+        for (o, &c) in offset.iter_mut().zip(&hist[p]) {
+            *o = sum;
+            sum += c as usize;
+        }
+        let (first, last) = (li == 0, li + 1 == live.len());
+        let key_shift = 8 * p;
+        let shift = 32 + key_shift;
+        if first && last {
+            indices.resize(n, 0);
+            for (i, &k) in keys.iter().enumerate() {
+                let d = ((float_to_ordered_u32(k) ^ flip) >> key_shift) as u8 as usize;
+                indices[offset[d]] = i as u32;
+                offset[d] += 1;
+            }
+        } else if first {
+            for (i, &k) in keys.iter().enumerate() {
+                let u = float_to_ordered_u32(k) ^ flip;
+                let d = (u >> key_shift) as u8 as usize;
+                a[offset[d]] = ((u as u64) << 32) | i as u64;
+                offset[d] += 1;
+            }
+        } else if last {
+            indices.resize(n, 0);
+            for &x in a.iter() {
+                let d = (x >> shift) as u8 as usize;
+                indices[offset[d]] = x as u32;
+                offset[d] += 1;
+            }
+        } else {
+            for &x in a.iter() {
+                let d = (x >> shift) as u8 as usize;
+                b[offset[d]] = x;
+                offset[d] += 1;
+            }
+            std::mem::swap(&mut a, &mut b);
+        }
+    }
+}
 
 /// LSD radix sort of `(ordered(key) ^ flip) << 32 | index` pairs packed in a u64, so that each
 /// scatter moves one 8-byte item instead of a key and a value in two arrays (one cache line
 /// stream per digit instead of two). The first pass reads the f32 keys directly and the last
 /// writes only the indices.
+/// `BITS`-bit digits (e.g. 11: three passes, the alternative the issue suggests; the bench
+/// compares it with the 8-bit sort), otherwise as [`radix_sort_indices`].
 pub fn radix_sort_packed<const BITS: u32>(
     keys: &[f32],
     flip: u32,
@@ -385,7 +471,8 @@ pub const DEFAULT_SLABS: usize = 20;
 /// The slab of each key: `slabs` equal-width depth intervals between the smallest and the largest
 /// finite key (non-finite keys go to the nearest end).
 pub fn slab_of(key: f32, lo: f32, hi: f32, slabs: usize) -> usize {
-    if !(hi > lo) {
+    // No range (one key, all equal, or no finite key): everything in slab 0.
+    if !matches!(hi.partial_cmp(&lo), Some(std::cmp::Ordering::Greater)) {
         return 0;
     }
     let t = ((key - lo) / (hi - lo) * slabs as f32).floor();
@@ -554,6 +641,18 @@ mod tests {
             let got: Vec<u32> = idx.iter().map(|&i| float_to_ordered_u32(keys[i as usize])).collect();
             let want: Vec<u32> = expect.iter().map(|&i| float_to_ordered_u32(keys[i as usize])).collect();
             prop_assert_eq!(got, want);
+        }
+
+        #[test]
+        fn radix_variants_give_the_stable_order(keys in awkward_keys()) {
+            let mut scratch = RadixScratch::default();
+            let mut idx = Vec::new();
+            radix_sort_packed::<11>(&keys, 0, &mut idx, &mut scratch);
+            prop_assert_eq!(&idx, &stable_order(&keys));
+            let mut expect: Vec<u32> = (0..keys.len() as u32).collect();
+            expect.sort_by(|&i, &j| keys[j as usize].total_cmp(&keys[i as usize]));
+            radix_sort_indices_descending(&keys, &mut idx, &mut scratch);
+            prop_assert_eq!(&idx, &expect);
         }
 
         #[test]
