@@ -399,7 +399,8 @@ const HEX_FACES: [[usize; 4]; 6] = [
 
 /// The six diagonal planes of a hexahedron: the two faces they cut, the diagonal each cut needs
 /// (local ids, sorted), and the two prisms (bottom triangle, top triangle) on either side.
-const HEX_PLANES: [(usize, [usize; 2], usize, [usize; 2], [usize; 6], [usize; 6]); 6] = [
+type HexPlane = (usize, [usize; 2], usize, [usize; 2], [usize; 6], [usize; 6]);
+const HEX_PLANES: [HexPlane; 6] = [
     (5, [0, 7], 3, [1, 6], [0, 3, 7, 1, 2, 6], [0, 7, 4, 1, 6, 5]),
     (5, [3, 4], 3, [2, 5], [0, 3, 4, 1, 2, 5], [3, 7, 4, 2, 6, 5]),
     (2, [0, 5], 4, [3, 6], [0, 1, 5, 3, 2, 6], [0, 5, 4, 3, 6, 7]),
@@ -561,7 +562,7 @@ mod tests {
             }
             heap(k - 1, a, out);
             for i in 0..k - 1 {
-                if k % 2 == 0 {
+                if k.is_multiple_of(2) {
                     a.swap(i, k - 1);
                 } else {
                     a.swap(0, k - 1);

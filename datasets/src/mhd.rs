@@ -118,10 +118,8 @@ fn parse_header(b: &[u8], path: &Path) -> Result<Header, LoadError> {
             Ok(v)
         };
         match key.to_ascii_lowercase().as_str() {
-            "objecttype" => {
-                if !value.eq_ignore_ascii_case("image") {
+            "objecttype" if !value.eq_ignore_ascii_case("image") => {
                     return Err(err(ErrorKind::Unsupported(format!("MetaImage ObjectType {value} (only Image)"))));
-                }
             }
             "ndims" => {
                 let n: u32 = value.parse().map_err(|_| syntax("an integer"))?;
@@ -159,15 +157,11 @@ fn parse_header(b: &[u8], path: &Path) -> Result<Header, LoadError> {
                 order = if parse_bool(value).ok_or_else(|| syntax("True or False"))? { ByteOrder::Big } else { ByteOrder::Little }
             }
             "compresseddata" => compressed = parse_bool(value).ok_or_else(|| syntax("True or False"))?,
-            "binarydata" => {
-                if !parse_bool(value).ok_or_else(|| syntax("True or False"))? {
+            "binarydata" if !parse_bool(value).ok_or_else(|| syntax("True or False"))? => {
                     return Err(err(ErrorKind::Unsupported("BinaryData = False (ASCII MetaImage data)".into())));
-                }
             }
-            "elementnumberofchannels" => {
-                if value != "1" {
+            "elementnumberofchannels" if value != "1" => {
                     return Err(err(ErrorKind::Unsupported(format!("ElementNumberOfChannels = {value} (only scalar images)"))));
-                }
             }
             "headersize" => header_size = value.parse().map_err(|_| syntax("an integer"))?,
             "transformmatrix" | "rotation" | "orientation" => {

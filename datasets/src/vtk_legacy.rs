@@ -98,6 +98,17 @@ struct Array {
     non_finite: Option<(usize, usize, f64)>,
 }
 
+/// Values read as f32 and the first non-finite one (value index, byte offset, value).
+type Floats = (Vec<f32>, Option<(usize, usize, f64)>);
+
+/// Points, tets, cell count and (for STRUCTURED_POINTS) dims, origin and spacing.
+type Geometry = (
+    Vec<[f32; 3]>,
+    Vec<[u32; 4]>,
+    u64,
+    Option<([usize; 3], [f64; 3], [f64; 3])>,
+);
+
 /// Which attribute block arrays currently go to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Target {
@@ -335,12 +346,7 @@ impl<'a> Parser<'a> {
 
     /// Reads `n` values as f32. Non-finite values are recorded (not rejected: only the arrays
     /// actually used must be finite).
-    fn floats(
-        &mut self,
-        n: u64,
-        ty: DataType,
-        what: &str,
-    ) -> Result<(Vec<f32>, Option<(usize, usize, f64)>), LoadError> {
+    fn floats(&mut self, n: u64, ty: DataType, what: &str) -> Result<Floats, LoadError> {
         if self.binary {
             self.next_line();
         }
@@ -533,8 +539,7 @@ impl<'a> Parser<'a> {
 
         let mut f = VtkFile::default();
         let mut target = Target::Dataset;
-        loop {
-            let Some((at, kw)) = self.token() else { break };
+        while let Some((at, kw)) = self.token() {
             let k = kw.to_ascii_uppercase();
             match k.as_slice() {
                 b"DATASET" => {
@@ -947,12 +952,7 @@ impl VtkFile {
         let kind = self.kind.unwrap_or(Kind::Unstructured);
         let end = p.b.len();
         // Geometry: points, tets and (for STRUCTURED_POINTS) the voxel grid parameters.
-        let (points, tets, n_cells, regular): (
-            Vec<[f32; 3]>,
-            Vec<[u32; 4]>,
-            u64,
-            Option<([usize; 3], [f64; 3], [f64; 3])>,
-        ) = match kind {
+        let (points, tets, n_cells, regular): Geometry = match kind {
             Kind::Unstructured => {
                 let (pts, _) = self.points.as_ref().ok_or_else(|| {
                     p.err(
