@@ -7,9 +7,10 @@
 //! storage buffers (`gator.wgsl`). wgpu has no triangle fans, so a tet is 4 triangles
 //! (12 invocations); for class-1 projections the fourth degenerates.
 //!
-//! Per frame the CPU only sorts: tet centroids by distance to the eye (HAVS §5.1's LSD radix
-//! sort on float keys), back to front, one buffer write of the tet order. The GPU draws the
-//! fans into an `Rgba32Float` target with premultiplied "over" blending.
+//! Per frame the CPU only sorts, back to front, with one of the shared visibility orders
+//! (`render_core::visibility`; default: centroid distance to the eye, HAVS §5.1's LSD radix
+//! sort on float keys), then writes the tet order in one buffer write. The GPU draws the fans
+//! into an `Rgba32Float` target with premultiplied "over" blending.
 //!
 //! Two variants, the paper's Table 3: **constant** cells (colour and extinction of the tet's
 //! mean scalar) and **linear** cells (the average of the scalars where the eye ray enters and
@@ -25,9 +26,9 @@ use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context};
 use datasets::TetMesh;
-use rayon::prelude::*;
 use render_core::gpu::chunk_ranges;
-use render_core::sort::{radix_sort_indices_descending, RadixScratch};
+pub use render_core::visibility::VisibilityOrder;
+use render_core::visibility::VisibilitySorter;
 use render_core::{
     Camera, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics, Prepared, Renderer,
     Setting,
@@ -69,41 +70,35 @@ impl CellModel {
     }
 }
 
-/// How the tets are put in back-to-front order each frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Order {
-    /// Centroid distance to the eye, LSD radix sort on float keys (HAVS §5.1).
-    CentroidRadix,
-}
-
-impl Order {
-    pub fn name(self) -> &'static str {
-        match self {
-            Order::CentroidRadix => "radix",
-        }
-    }
-}
-
 /// The GATOR renderer. Construct with [`GatorPt::new`], then [`Renderer::prepare`].
 pub struct GatorPt {
     cells: CellModel,
-    order: Order,
+    order: VisibilityOrder,
     /// Largest storage binding to use (defaults to the device's); tests lower it to exercise
     /// chunking on small meshes.
     max_binding: Option<u64>,
     state: Option<State>,
 }
 
-/// The constant and linear variants, as the harness runs them.
+/// The constant and linear variants (the paper's Table 3) with the default visibility order
+/// (centroid radix sort), as the harness runs them.
 pub fn default_variants() -> Vec<Box<dyn Renderer>> {
-    vec![
-        Box::new(GatorPt::new(CellModel::Constant, Order::CentroidRadix)),
-        Box::new(GatorPt::new(CellModel::Linear, Order::CentroidRadix)),
-    ]
+    variants(&[VisibilityOrder::default()])
+}
+
+/// Both cell models with each of `orders` (constant first, then linear, for each order).
+pub fn variants(orders: &[VisibilityOrder]) -> Vec<Box<dyn Renderer>> {
+    orders
+        .iter()
+        .flat_map(|&o| {
+            [CellModel::Constant, CellModel::Linear]
+                .map(|c| Box::new(GatorPt::new(c, o)) as Box<dyn Renderer>)
+        })
+        .collect()
 }
 
 impl GatorPt {
-    pub fn new(cells: CellModel, order: Order) -> GatorPt {
+    pub fn new(cells: CellModel, order: VisibilityOrder) -> GatorPt {
         GatorPt {
             cells,
             order,
@@ -121,6 +116,10 @@ impl GatorPt {
 
     pub fn cells(&self) -> CellModel {
         self.cells
+    }
+
+    pub fn order(&self) -> VisibilityOrder {
+        self.order
     }
 
     /// GPU memory of the prepared mesh (after [`Renderer::prepare`]).
@@ -470,10 +469,10 @@ struct State {
     pipeline: wgpu::RenderPipeline,
     order_buf: wgpu::Buffer,
     chunks: Vec<DrawChunk>,
-    centroids: Vec<[f64; 3]>,
-    keys: Vec<f32>,
+    /// The mesh as prepared (the visibility sorter reads its centroids / face adjacency).
+    host_mesh: TetMesh,
+    sorter: VisibilitySorter,
     order: Vec<u32>,
-    scratch: RadixScratch,
     timer: FrameTimer,
     target: Option<Target>,
 }
@@ -491,7 +490,7 @@ impl Renderer for GatorPt {
     fn settings(&self) -> Vec<Setting> {
         vec![
             Setting::new("variant", self.cells.name()),
-            Setting::new("order", self.order.name()),
+            Setting::new("sort", self.order),
         ]
     }
 
@@ -609,13 +608,19 @@ impl Renderer for GatorPt {
             });
             chunks.push(DrawChunk { range, bind_group });
         }
-        let centroids: Vec<[f64; 3]> = (0..mesh.num_tets())
-            .into_par_iter()
-            .map(|t| {
-                let p = mesh.tet_points(t);
-                [0, 1, 2].map(|k| 0.25 * (p[0][k] + p[1][k] + p[2][k] + p[3][k]))
-            })
-            .collect();
+        // Per-mesh work of the visibility order (centroids; MPVONC's face planes) is done here,
+        // not in the first timed frame.
+        let mut sorter = VisibilitySorter::new(self.order);
+        let host_mesh = mesh.clone();
+        let mut order = Vec::with_capacity(n as usize);
+        let warm = Camera::fit(
+            &mesh.bounds(),
+            &render_core::fixed_viewpoints()[0],
+            Default::default(),
+            16,
+            16,
+        );
+        sorter.back_to_front(&host_mesh, &warm, &mut order);
         let persistent = ledger.persistent;
         self.state = Some(State {
             ledger,
@@ -623,10 +628,9 @@ impl Renderer for GatorPt {
             pipeline,
             order_buf,
             chunks,
-            keys: vec![0.0; centroids.len()],
-            centroids,
-            order: Vec::with_capacity(n as usize),
-            scratch: RadixScratch::default(),
+            host_mesh,
+            sorter,
+            order,
             timer: FrameTimer::new(gpu),
             target: None,
         });
@@ -674,16 +678,9 @@ impl Renderer for GatorPt {
         // CPU part of the frame: sort keys, radix sort, one upload of the order.
         st.timer.start_wall();
         let t0 = Instant::now();
-        match self.order {
-            Order::CentroidRadix => {
-                st.keys
-                    .par_iter_mut()
-                    .zip(st.centroids.par_iter())
-                    .for_each(|(k, c)| *k = camera.sort_distance(*c) as f32);
-                // Descending distance: farthest first (back to front).
-                radix_sort_indices_descending(&st.keys, &mut st.order, &mut st.scratch);
-            }
-        }
+        let sort = st
+            .sorter
+            .back_to_front(&st.host_mesh, camera, &mut st.order);
         let sort_ms = t0.elapsed().as_secs_f64() * 1e3;
         let t1 = Instant::now();
         gpu.queue
@@ -738,6 +735,9 @@ impl Renderer for GatorPt {
             ("sort".to_string(), sort_ms),
             ("upload".to_string(), upload_ms),
         ];
+        if sort.precompute_ms > 0.0 {
+            stages.push(("sort_precompute".to_string(), sort.precompute_ms));
+        }
         if let Some(g) = gpu_ms {
             stages.push(("draw".to_string(), g));
         }
@@ -752,6 +752,7 @@ impl Renderer for GatorPt {
             counters: vec![
                 ("tets".to_string(), n),
                 ("vertex_invocations".to_string(), 12.0 * n),
+                ("cycle_breaks".to_string(), sort.cycle_breaks as f64),
             ],
         })
     }

@@ -4,7 +4,7 @@
 //! projections), and chunked storage bindings drawing the same image as one binding.
 
 use datasets::TetMesh;
-use gator_pt::{classify_gpu, classify_tet, CellModel, GatorPt, Order};
+use gator_pt::{classify_gpu, classify_tet, CellModel, GatorPt, VisibilityOrder};
 use glam::DVec3;
 use render_core::transfer::{ColorPoint, KappaPoint};
 use render_core::{Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint};
@@ -415,7 +415,7 @@ fn constant_field_images_are_exact_even_for_degenerate_views() {
     let fine = box_mesh([11, 9, 7], [1.0, 0.8, 0.6]);
     let oblique = Viewpoint::new("oblique", [0.3, 0.5, 0.8]);
     for cells in [CellModel::Constant, CellModel::Linear] {
-        let mut r = GatorPt::new(cells, Order::CentroidRadix);
+        let mut r = GatorPt::new(cells, VisibilityOrder::CentroidRadix);
         r.prepare(&gpu, &coarse, &constant_optics(&coarse, kappa))
             .unwrap();
         let mut views = render_core::fixed_viewpoints();
@@ -478,12 +478,12 @@ fn chunked_bindings_draw_the_same_image() {
     for cells in [CellModel::Constant, CellModel::Linear] {
         let whole = render(
             &gpu,
-            &mut GatorPt::new(cells, Order::CentroidRadix),
+            &mut GatorPt::new(cells, VisibilityOrder::CentroidRadix),
             &mesh,
             &optics,
             &cam,
         );
-        let mut chunked = GatorPt::new(cells, Order::CentroidRadix).with_max_binding(256);
+        let mut chunked = GatorPt::new(cells, VisibilityOrder::CentroidRadix).with_max_binding(256);
         let split = render(&gpu, &mut chunked, &mesh, &optics, &cam);
         let ledger = chunked.ledger().unwrap();
         let tet_chunks = ledger
@@ -511,7 +511,7 @@ fn settings_and_variants() {
         .collect();
     assert_eq!(
         rows,
-        ["variant=constant;order=radix", "variant=linear;order=radix"]
+        ["variant=constant;sort=radix", "variant=linear;sort=radix"]
     );
     assert!(v.iter().all(|r| r.algorithm() == "gator-pt"));
 }
