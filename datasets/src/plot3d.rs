@@ -740,4 +740,29 @@ mod tests {
             "{err}"
         );
     }
+
+    // Quick stand-in for the PLOT3D fuzz target (datasets/fuzz) that CI runs every time:
+    // corrupted bytes (headers, markers, data) in every layout give a mesh or an error.
+    proptest::proptest! {
+        #[test]
+        fn corrupted_pairs_never_panic(
+            layout in 0usize..8,
+            field in 0usize..5,
+            edits in proptest::collection::vec((proptest::prelude::any::<bool>(), 0usize..64, proptest::prelude::any::<u8>()), 1..6),
+            cut in proptest::option::of(0usize..2000),
+        ) {
+            let (mut x, mut q) = pair(if layout & 1 == 0 { ByteOrder::Big } else { ByteOrder::Little }, layout & 2 != 0, layout & 4 != 0);
+            for (in_q, at, v) in edits {
+                // Mostly the headers and markers, where the sniffing decides.
+                let f = if in_q { &mut q } else { &mut x };
+                let i = at % f.len();
+                f[i] = v;
+            }
+            if let Some(c) = cut {
+                x.truncate(c.min(x.len()));
+            }
+            let opts = LoadOptions { plot3d_field: Some(Plot3dField::ALL[field]), ..Default::default() };
+            let _ = from_bytes(&x, &q, Path::new("axyz.bin"), Path::new("aq.bin"), &opts);
+        }
+    }
 }

@@ -278,4 +278,21 @@ mod tests {
         );
         assert_eq!(err.location, Some(Location::Line(5)));
     }
+
+    // Quick stand-in for the TOFF fuzz target (datasets/fuzz) that CI runs every time.
+    proptest::proptest! {
+        #[test]
+        fn random_and_corrupted_input_never_panics(
+            data in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..300),
+            edits in proptest::collection::vec((proptest::prelude::any::<usize>(), 0u8..128), 1..6),
+        ) {
+            let _ = from_bytes(&data, Path::new("r.toff"), &LoadOptions::default());
+            let mut b = TWO.as_bytes().to_vec();
+            for (at, v) in edits {
+                let i = at % b.len();
+                b[i] = v;
+            }
+            let _ = from_bytes(&b, Path::new("c.toff"), &LoadOptions::default());
+        }
+    }
 }

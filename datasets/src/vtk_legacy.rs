@@ -1523,4 +1523,32 @@ mod tests {
             .sum();
         assert!((total - (1.0 + 0.5 + 1.0 / 3.0)).abs() < 1e-6, "{total}");
     }
+
+    // The fuzz targets (datasets/fuzz) run for minutes; this is their quick stand-in that CI
+    // runs every time: random bytes and random corruptions of valid files (ASCII and BINARY,
+    // both cell layouts) give a mesh or a LoadError, never a panic.
+    proptest::proptest! {
+        #[test]
+        fn random_bytes_never_panic(data in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..600)) {
+            let mut with_header = b"# vtk DataFile Version 4.2\nx\nBINARY\nDATASET UNSTRUCTURED_GRID\n".to_vec();
+            with_header.extend_from_slice(&data);
+            let _ = parse(&data);
+            let _ = parse(&with_header);
+        }
+
+        #[test]
+        fn corrupted_files_never_panic(which in 0usize..4, edits in proptest::collection::vec((proptest::prelude::any::<usize>(), proptest::prelude::any::<u8>()), 1..6)) {
+            let mut b = match which {
+                0 => two_tets_ascii("4.2", false).into_bytes(),
+                1 => two_tets_ascii("5.1", true).into_bytes(),
+                2 => two_tets_binary(false),
+                _ => two_tets_binary(true),
+            };
+            for (at, v) in edits {
+                let i = at % b.len();
+                b[i] = v;
+            }
+            let _ = parse(&b);
+        }
+    }
 }
