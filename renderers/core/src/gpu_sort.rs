@@ -9,6 +9,10 @@
 //! payloads in the same order. Four passes (an even number) leave the result in the caller's
 //! buffers; the ping-pong copies live in this struct.
 //!
+//! Keys are usually computed on the device too: [`GpuCentroidKeys`] writes, per tet or face,
+//! the centroid's sort distance as key and the primitive id as value, so a frame is "key pass,
+//! sort, draw" in one encoder with nothing read back.
+//!
 //! Limits: `n` ≤ `max_len`, and `max_len` keys must fit one storage binding
 //! (`Gpu::max_storage_binding() / 4`: 32 Mi keys at 128 MiB on lavapipe); larger arrays are not
 //! sorted in one piece (no chunking). Each [`GpuRadixSort::encode`] writes its pass parameters
@@ -332,6 +336,171 @@ impl GpuRadixSort {
     }
 }
 
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct KeyParams {
+    eye: [f32; 3],
+    perspective: u32,
+    forward: [f32; 3],
+    count: u32,
+    point_stride: u32,
+    verts: u32,
+    value_base: u32,
+    pad: u32,
+}
+
+/// Computes sort keys on the GPU, the pass before [`GpuRadixSort::encode`]: for each primitive
+/// (tet: 4 vertex indices, face: 3) the centroid's [`crate::Camera::sort_distance`] (in f32) as
+/// key and the primitive's id as value. Points are read from a caller's f32 storage buffer with
+/// 3 (xyz) or 4 (xyz + scalar) floats per point.
+pub struct GpuCentroidKeys {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+    params: wgpu::Buffer,
+}
+
+impl GpuCentroidKeys {
+    pub fn new(gpu: &Gpu, ledger: &mut MemoryLedger) -> GpuCentroidKeys {
+        let device = &gpu.device;
+        let module = gpu.shader("gpu_sort.wgsl", include_str!("gpu_sort.wgsl"));
+        let uniform = wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("centroid keys"),
+            entries: &[
+                uniform,
+                storage_entry(1, true),
+                storage_entry(2, true),
+                storage_entry(3, false),
+                storage_entry(4, false),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("centroid keys"),
+            bind_group_layouts: &[None, Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("centroid_keys"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("centroid_keys"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let params = ledger.buffer(
+            gpu,
+            "centroid key params",
+            Lifetime::PerFrame,
+            std::mem::size_of::<KeyParams>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        GpuCentroidKeys {
+            device: gpu.device.clone(),
+            queue: gpu.queue.clone(),
+            layout,
+            pipeline,
+            params,
+        }
+    }
+
+    /// Records the key pass for `count` primitives of `verts` (3 or 4) indices each in `prims`,
+    /// writing `keys[p]` and `values[p] = value_base + p`. Like [`GpuRadixSort::encode`], it
+    /// writes its parameters through the queue: one key pass per instance per submission.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &crate::Camera,
+        points: &wgpu::Buffer,
+        point_stride: u32,
+        prims: &wgpu::Buffer,
+        verts: u32,
+        count: u32,
+        value_base: u32,
+        keys: &wgpu::Buffer,
+        values: &wgpu::Buffer,
+    ) -> anyhow::Result<()> {
+        ensure!(
+            verts == 3 || verts == 4,
+            "centroid keys: {verts} vertices per primitive (3 or 4)"
+        );
+        ensure!(
+            point_stride >= 3,
+            "centroid keys: point stride {point_stride} < 3 floats"
+        );
+        ensure!(
+            prims.size() >= count as u64 * verts as u64 * 4
+                && keys.size() >= count as u64 * 4
+                && values.size() >= count as u64 * 4,
+            "centroid keys: buffers hold fewer than {count} primitives"
+        );
+        if count == 0 {
+            return Ok(());
+        }
+        let p = KeyParams {
+            eye: camera.eye.map(|x| x as f32),
+            perspective: camera.is_perspective() as u32,
+            forward: camera.forward().map(|x| x as f32),
+            count,
+            point_stride,
+            verts,
+            value_base,
+            pad: 0,
+        };
+        self.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("centroid keys"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: points.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: prims.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: keys.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: values.as_entire_binding(),
+                },
+            ],
+        });
+        let groups = count.div_ceil(256);
+        // Two-dimensional grid when one dimension's 65,535 workgroups do not suffice.
+        let x = groups.min(65_535);
+        let y = groups.div_ceil(x);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("centroid keys"),
+            timestamp_writes: None,
+        });
+        pass.set_bind_group(1, &bind, &[]);
+        pass.set_pipeline(&self.pipeline);
+        pass.dispatch_workgroups(x, y, 1);
+        Ok(())
+    }
+}
+
 /// Sorts `keys` ascending on the GPU and returns the permutation (index of the smallest key
 /// first), like [`crate::sort::radix_sort_indices`]. Builds a sorter for this one call.
 pub fn sort_blocking(gpu: &Gpu, keys: &[f32]) -> anyhow::Result<Vec<u32>> {
@@ -403,6 +572,96 @@ mod tests {
             sort_blocking(&gpu, &[3.0, -1.0, 2.0]).unwrap(),
             vec![1, 2, 0]
         );
+    }
+
+    /// Keys computed on the GPU match the CPU's centroid distances, and key pass + sort give
+    /// the CPU's back-to-front centroid order (up to near-ties of f32 rounding).
+    #[test]
+    fn gpu_centroid_keys_then_sort_match_the_cpu() {
+        use crate::scene::{fixed_viewpoints, Camera, Projection};
+        let gpu = Gpu::new().expect("a wgpu adapter");
+        let dims = [9usize, 8, 7];
+        let mut pts = Vec::new();
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    pts.push([i as f32 * 0.3, j as f32 * 0.5 - 1.0, k as f32 * 0.4, 7.0]);
+                }
+            }
+        }
+        let tets = datasets::volume::structured_tets(dims);
+        let n = tets.len() as u32;
+        let mut ledger = MemoryLedger::default();
+        let storage = REQUIRED_USAGE | wgpu::BufferUsages::COPY_SRC;
+        let pbuf = ledger.buffer_init(
+            &gpu,
+            "points",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&pts),
+            storage,
+        );
+        let tbuf = ledger.buffer_init(
+            &gpu,
+            "tets",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&tets),
+            storage,
+        );
+        let kbuf = ledger.buffer(&gpu, "keys", Lifetime::PerFrame, n as u64 * 4, storage);
+        let vbuf = ledger.buffer(&gpu, "values", Lifetime::PerFrame, n as u64 * 4, storage);
+        let keys_pass = GpuCentroidKeys::new(&gpu, &mut ledger);
+        let sorter = GpuRadixSort::new(&gpu, n, &mut ledger).unwrap();
+        let bounds =
+            datasets::Aabb::of_points(&pts.iter().map(|p| [p[0], p[1], p[2]]).collect::<Vec<_>>());
+        for (vi, vp) in fixed_viewpoints().iter().enumerate().step_by(3) {
+            let proj = if vi % 2 == 0 {
+                Projection::default()
+            } else {
+                Projection::Orthographic
+            };
+            let cam = Camera::fit(&bounds, vp, proj, 64, 64);
+            let cpu_keys: Vec<f32> = tets
+                .iter()
+                .map(|t| {
+                    let c = [0, 1, 2]
+                        .map(|a| t.iter().map(|&v| pts[v as usize][a] as f64).sum::<f64>() / 4.0);
+                    cam.sort_distance(c) as f32
+                })
+                .collect();
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            keys_pass
+                .encode(&mut enc, &cam, &pbuf, 4, &tbuf, 4, n, 0, &kbuf, &vbuf)
+                .unwrap();
+            gpu.queue.submit([enc.finish()]);
+            let gk: Vec<f32> =
+                bytemuck::cast_slice(&gpu.read_buffer(&kbuf, 0, n as u64 * 4).unwrap()).to_vec();
+            let scale = cam.far;
+            for (g, c) in gk.iter().zip(&cpu_keys) {
+                assert!(
+                    ((g - c) as f64).abs() <= 1e-5 * scale,
+                    "GPU key {g} vs CPU {c}"
+                );
+            }
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            keys_pass
+                .encode(&mut enc, &cam, &pbuf, 4, &tbuf, 4, n, 0, &kbuf, &vbuf)
+                .unwrap();
+            sorter.encode(&mut enc, &kbuf, &vbuf, n, true).unwrap();
+            gpu.queue.submit([enc.finish()]);
+            let order: Vec<u32> =
+                bytemuck::cast_slice(&gpu.read_buffer(&vbuf, 0, n as u64 * 4).unwrap()).to_vec();
+            let mut seen = order.clone();
+            seen.sort_unstable();
+            assert_eq!(seen, (0..n).collect::<Vec<_>>());
+            // Back to front by the CPU keys, up to ties within the f32 rounding of the keys.
+            for w in order.windows(2) {
+                let (a, b) = (
+                    cpu_keys[w[0] as usize] as f64,
+                    cpu_keys[w[1] as usize] as f64,
+                );
+                assert!(a >= b - 2e-5 * scale, "{a} before {b}");
+            }
+        }
     }
 
     #[test]

@@ -178,3 +178,52 @@ fn scatter(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid
         workgroupBarrier();
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Sort keys computed on the GPU: for primitive p (a tet of 4 or a face of 3 vertex indices), key
+// = the visibility-sort distance of its centroid (Camera::sort_distance: distance from the eye
+// in perspective, depth along the view axis in orthographic projection), value = p. Callers that
+// sort on the device run this, then GpuRadixSort::encode, then draw, with no readback.
+// Group 1 so that its bindings never meet the sort's in one pipeline layout.
+
+struct KeyParams {
+    eye: vec3<f32>,
+    // 1: perspective (distance to `eye`), 0: orthographic (depth along `forward`).
+    perspective: u32,
+    forward: vec3<f32>,
+    count: u32,
+    // floats per point (3 for xyz, 4 for xyz + scalar)
+    point_stride: u32,
+    // vertex indices per primitive (3 or 4)
+    verts: u32,
+    // Added to the primitive index written as the value (chunked callers).
+    value_base: u32,
+    pad: u32,
+}
+
+@group(1) @binding(0) var<uniform> kp: KeyParams;
+@group(1) @binding(1) var<storage, read> key_points: array<f32>;
+@group(1) @binding(2) var<storage, read> key_prims: array<u32>;
+@group(1) @binding(3) var<storage, read_write> key_out: array<f32>;
+@group(1) @binding(4) var<storage, read_write> value_out: array<u32>;
+
+@compute @workgroup_size(256)
+fn centroid_keys(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let p = gid.x + gid.y * nwg.x * 256u;
+    if p >= kp.count {
+        return;
+    }
+    var c = vec3<f32>(0.0);
+    for (var v = 0u; v < kp.verts; v = v + 1u) {
+        let i = key_prims[p * kp.verts + v] * kp.point_stride;
+        c = c + vec3<f32>(key_points[i], key_points[i + 1u], key_points[i + 2u]);
+    }
+    c = c / f32(kp.verts);
+    let d = c - kp.eye;
+    var key = dot(d, kp.forward);
+    if kp.perspective != 0u {
+        key = length(d);
+    }
+    key_out[p] = key;
+    value_out[p] = kp.value_base + p;
+}
