@@ -30,6 +30,9 @@
 //! u = (s·(n−1) + ½)/n, which is linear interpolation between neighbouring entries; the CPU
 //! `sample` methods here do exactly that (with exact, not fixed-point, weights).
 
+// `!(x > 0.0)` is used on purpose: it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use rayon::prelude::*;
 
 use crate::transfer::{ColorPoint, KappaPoint, Optics, TransferFunction};
@@ -53,12 +56,12 @@ pub fn composite_front_to_back(acc: &mut Rgba, seg: Rgba) {
 /// Gauss–Legendre, 8 nodes on [−1, 1] (positive half; symmetric).
 const GL8_X: [f64; 4] = [
     0.183_434_642_495_649_8,
-    0.525_532_409_916_329_0,
+    0.525_532_409_916_329,
     0.796_666_477_413_626_7,
     0.960_289_856_497_536_3,
 ];
 const GL8_W: [f64; 4] = [
-    0.362_683_783_378_362_0,
+    0.362_683_783_378_362,
     0.313_706_645_877_887_3,
     0.222_381_034_453_374_5,
     0.101_228_536_290_376_3,
