@@ -1029,13 +1029,14 @@ impl VtkFile {
                 for c in 0..ncells {
                     let t = types[c];
                     let ids = &conn[cells.offsets[c]..cells.offsets[c + 1]];
-                    let at = p.value_pos(*tstart, c, DataType::I32);
+                    // Located only on error: finding an ASCII value's offset re-reads the block.
+                    let at = || p.value_pos(*tstart, c, DataType::I32);
                     let t32 = u32::try_from(t).unwrap_or(u32::MAX);
                     if load::vtk_cell_size(t32).is_none()
                         && p.binary
                         && swapped_i64_plausible(t, DataType::I32, 81)
                     {
-                        return Err(p.err(at, byte_order_error("cell type", t)));
+                        return Err(p.err(at(), byte_order_error("cell type", t)));
                     }
                     load::cell_to_tets(t32, ids, &mut tets).map_err(|k| {
                         let k = match k {
@@ -1056,7 +1057,7 @@ impl VtkFile {
                             },
                             k => k,
                         };
-                        p.err(at, k)
+                        p.err(at(), k)
                     })?;
                 }
                 if tets.len() > u32::MAX as usize {
