@@ -396,3 +396,26 @@ fn mpvonc_handles_a_second_mesh_and_order_switches() {
         }
     }
 }
+
+#[test]
+fn mpvonc_with_the_eye_inside_the_mesh() {
+    // No boundary face faces the eye, so no entry cell exists: every tet is reached from the
+    // fallback roots (decreasing centroid distance), and the order stays exact.
+    let mesh = random_delaunay(300, 11);
+    let c = mesh.bounds().center();
+    let mut cam = Camera::fit(
+        &mesh.bounds(),
+        &fixed_viewpoints()[8],
+        Projection::default(),
+        64,
+        64,
+    );
+    cam.eye = [c[0] + 0.01, c[1] - 0.02, c[2] + 0.03];
+    let mut sorter = VisibilitySorter::new(VisibilityOrder::Mpvonc);
+    let mut order = Vec::new();
+    let stats = sorter.back_to_front(&mesh, &cam, &mut order);
+    assert_eq!(stats.entry_faces, 0);
+    assert_eq!(stats.unreached, mesh.num_tets());
+    assert_eq!(stats.cycle_breaks, 0);
+    assert_eq!(violations(&mesh, &cam, &order).1, 0);
+}
