@@ -89,8 +89,19 @@ fn covered(img: &Image) -> usize {
 
 /// Checks reference against dense sampling for every given camera; returns the worst error.
 fn check(mesh: &TetMesh, optics: &Optics, cams: &[Camera], tol: f64) -> f64 {
+    check_with_step(mesh, optics, cams, tol, 3000.0)
+}
+
+/// [`check`] with dense-sampling steps of 1/`divisions` of the diagonal.
+fn check_with_step(
+    mesh: &TetMesh,
+    optics: &Optics,
+    cams: &[Camera],
+    tol: f64,
+    divisions: f64,
+) -> f64 {
     let prep = Prepared::new(mesh);
-    let step = mesh.bounds().diagonal() / 3000.0;
+    let step = mesh.bounds().diagonal() / divisions;
     let mut worst: f64 = 0.0;
     for cam in cams {
         let (img, stats) = prep.render(optics, cam);
@@ -305,4 +316,30 @@ fn cache_round_trip_and_damaged_files_are_recomputed() {
             .unwrap(),
         fresh
     );
+}
+
+/// SPX (the papers' non-convex tet mesh) against dense sampling, when the data sets exist.
+#[test]
+fn agrees_with_dense_sampling_on_spx() {
+    let Some(dir) = datasets::registry::default_data_dir().filter(|d| d.join("spx.vtk").is_file())
+    else {
+        eprintln!("SKIPPED: spx.vtk not found (set TETBENCH_DATA)");
+        return;
+    };
+    let registry = datasets::registry::Registry::new(Some(dir));
+    let mesh = registry
+        .resolve("spx", &datasets::LoadOptions::default())
+        .unwrap()
+        .mesh;
+    assert!(!mesh.is_convex());
+    let o = optics(&mesh, "low-opacity");
+    let vps = fixed_viewpoints();
+    let cams: Vec<Camera> = [3, 7, 12]
+        .iter()
+        .map(|&i| Camera::fit(&mesh.bounds(), &vps[i], Projection::default(), 16, 16))
+        .collect();
+    // SPX's scalar varies steeply: dense sampling needs 1/20000 of the diagonal per step to be
+    // within 1e-5 itself (at 1/3000 it is off by 2.3e-5 on some pixels; the reference is not).
+    let worst = check_with_step(&mesh, &o, &cams, 1e-5, 20000.0);
+    eprintln!("spx: worst {worst:e}");
 }
