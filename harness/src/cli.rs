@@ -52,20 +52,20 @@ pub struct RunArgs {
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     pub algorithms: Vec<String>,
     /// Comma-separated data set names, generator specs (box:200k, shell:1m) or files
-    /// (default: the embedded suite, box:20k and shell:20k).
+    /// (default: the embedded suite, box:10k and shell:10k).
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     pub datasets: Vec<String>,
     /// `14` (the HAVS tables' fixed viewpoints), `axes`, `diagonals`, `orbit:N`, or names
-    /// such as `+x,-y,+x+y-z` (default 14; the default suite uses 4).
+    /// such as `+x,-y,+x+y-z` (default 14; the default suite uses 3).
     #[arg(long, value_name = "SPEC")]
     pub viewpoints: Option<String>,
-    /// Square viewport size in pixels (default 512; the default suite uses 256).
+    /// Square viewport size in pixels (default 512; the default suite uses 128).
     #[arg(long, value_name = "PIXELS")]
     pub resolution: Option<u32>,
     /// Transfer function: a preset (low-opacity, high-opacity) or a ParaView colormap JSON file.
     #[arg(long, value_name = "NAME|FILE", default_value = "low-opacity")]
     pub tf: String,
-    /// Timed frames per viewpoint (default 10; the default suite uses 5).
+    /// Timed frames per viewpoint (default 10; the default suite uses 3).
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
     /// Untimed warm-up frames before them (default 2; the default suite uses 1).

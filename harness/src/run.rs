@@ -147,6 +147,13 @@ impl Progress {
         }
     }
 
+    /// Shows what is being measured on the bar only (log mode prints one line per row).
+    fn activity(&self, msg: &str) {
+        if let Some(b) = &self.bar {
+            b.set_message(msg.to_string());
+        }
+    }
+
     fn log(&self, line: &str) {
         match &self.bar {
             Some(b) => b.println(line),
@@ -475,7 +482,7 @@ impl DatasetContext<'_> {
             settings_string(&renderer.settings()),
             self.label
         );
-        progress.status(&format!("preparing {what}"));
+        progress.activity(&format!("preparing {what}"));
         let prepared = guarded("prepare", || {
             renderer.prepare(self.gpu, self.mesh, self.optics)
         });
@@ -536,7 +543,7 @@ impl DatasetContext<'_> {
     ) -> anyhow::Result<()> {
         let c = self.config;
         let camera = Camera::fit(&self.mesh.bounds(), vp, c.projection, c.width, c.height);
-        progress.status(&format!("{} {} {}", row.algorithm, self.label, vp.name));
+        progress.activity(&format!("{} {} {}", row.algorithm, self.label, vp.name));
         for _ in 0..c.warmup {
             guarded("render", || renderer.render(self.gpu, &camera))?;
         }
