@@ -165,7 +165,11 @@ pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
@@ -193,20 +197,35 @@ impl TetMesh {
             });
         }
         if points.len() > u32::MAX as usize {
-            return Err(ErrorKind::IndexOverflow { what: "points".into(), count: points.len() as u64 });
+            return Err(ErrorKind::IndexOverflow {
+                what: "points".into(),
+                count: points.len() as u64,
+            });
         }
         for (i, p) in points.iter().enumerate() {
             if let Some(v) = p.iter().find(|v| !v.is_finite()) {
-                return Err(ErrorKind::NonFinite { what: "point".into(), index: i as u64, value: *v as f64 });
+                return Err(ErrorKind::NonFinite {
+                    what: "point".into(),
+                    index: i as u64,
+                    value: *v as f64,
+                });
             }
         }
         if let Some((i, v)) = scalars.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(ErrorKind::NonFinite { what: "scalar of point".into(), index: i as u64, value: *v as f64 });
+            return Err(ErrorKind::NonFinite {
+                what: "scalar of point".into(),
+                index: i as u64,
+                value: *v as f64,
+            });
         }
         let n = points.len() as u64;
         for t in &tets {
             if let Some(&bad) = t.iter().find(|&&v| v as u64 >= n) {
-                return Err(ErrorKind::IndexOutOfRange { what: "point".into(), index: bad as u64, limit: n });
+                return Err(ErrorKind::IndexOutOfRange {
+                    what: "point".into(),
+                    index: bad as u64,
+                    limit: n,
+                });
             }
         }
         let mut repair = RepairReport::default();
@@ -359,7 +378,10 @@ impl TetMesh {
             for (t, a) in adj.iter().enumerate() {
                 for (f, &n) in a.iter().enumerate() {
                     if n == NO_NEIGHBOUR {
-                        out.push(BoundaryFace { tet: t as u32, face: f as u8 });
+                        out.push(BoundaryFace {
+                            tet: t as u32,
+                            face: f as u8,
+                        });
                     }
                 }
             }
@@ -443,7 +465,10 @@ impl TetMesh {
                     (lmin, lmax, lsum, aspect)
                 })
                 .collect();
-            let mut q = QualityStats { min_edge: f64::INFINITY, ..Default::default() };
+            let mut q = QualityStats {
+                min_edge: f64::INFINITY,
+                ..Default::default()
+            };
             let mut lsum = 0.0;
             let mut asum = 0.0;
             for &(lmin, lmax, ls, aspect) in &per_tet {
@@ -464,26 +489,66 @@ impl TetMesh {
         })
     }
 
-    /// Whether the boundary is convex: no boundary vertex lies in front of any boundary face's
-    /// plane. Equivalent for a closed surface to "every ray enters and leaves once".
+    /// Whether the boundary is convex. A closed, connected surface that is locally convex at
+    /// every edge is convex (Tietze's theorem), so it suffices to check, for each boundary edge,
+    /// that neither adjacent face's far vertex lies in front of the other face's plane, and
+    /// that the boundary is one connected surface (a hollow shell's inner sphere is a second
+    /// component). Linear in the boundary size, unlike the all-pairs face/vertex test.
     pub fn is_convex(&self) -> bool {
         *self.cache.convex.get_or_init(|| {
             let bfaces = self.boundary_faces();
-            let mut verts: Vec<u32> = bfaces.iter().flat_map(|f| f.vertices(self)).collect();
-            verts.sort_unstable();
-            verts.dedup();
-            let vpts: Vec<[f64; 3]> = verts.iter().map(|&v| self.points[v as usize].map(|c| c as f64)).collect();
+            let tris: Vec<[u32; 3]> = bfaces.iter().map(|f| f.vertices(self)).collect();
+            let mut edges: Vec<((u32, u32), u32)> = tris
+                .iter()
+                .enumerate()
+                .flat_map(|(i, t)| {
+                    (0..3).map(move |e| {
+                        (
+                            (t[e].min(t[(e + 1) % 3]), t[e].max(t[(e + 1) % 3])),
+                            i as u32,
+                        )
+                    })
+                })
+                .collect();
+            edges.par_sort_unstable();
             let tol = 1e-6 * self.bounds().diagonal();
-            bfaces.par_iter().all(|f| {
-                let [a, b, c] = f.vertices(self).map(|v| self.points[v as usize].map(|x| x as f64));
+            let point = |v: u32| self.points[v as usize].map(|c| c as f64);
+            let plane = |t: [u32; 3]| {
+                let [a, b, c] = t.map(point);
                 let n = cross(sub(b, a), sub(c, a));
                 let l = norm(n);
-                if l == 0.0 {
-                    return true;
+                (a, if l > 0.0 { n.map(|x| x / l) } else { [0.0; 3] })
+            };
+            let mut parent: Vec<u32> = (0..tris.len() as u32).collect();
+            fn find(parent: &mut [u32], mut x: u32) -> u32 {
+                while parent[x as usize] != x {
+                    parent[x as usize] = parent[parent[x as usize] as usize];
+                    x = parent[x as usize];
                 }
-                let n = n.map(|x| x / l);
-                vpts.iter().all(|&p| dot(sub(p, a), n) <= tol)
-            })
+                x
+            }
+            for pair in edges.chunk_by(|a, b| a.0 == b.0) {
+                // A boundary edge shared by other than two boundary faces: the boundary is not a
+                // simple closed surface (e.g. two blocks touching along an edge).
+                let [(edge, f1), (_, f2)] = pair else {
+                    return false;
+                };
+                for (f, g) in [(*f1, *f2), (*f2, *f1)] {
+                    let (a, n) = plane(tris[f as usize]);
+                    let far = tris[g as usize]
+                        .into_iter()
+                        .find(|&v| v != edge.0 && v != edge.1);
+                    if let Some(v) = far {
+                        if dot(sub(point(v), a), n) > tol {
+                            return false;
+                        }
+                    }
+                }
+                let (r1, r2) = (find(&mut parent, *f1), find(&mut parent, *f2));
+                parent[r1 as usize] = r2;
+            }
+            let root = find(&mut parent, 0);
+            (0..tris.len() as u32).all(|f| find(&mut parent, f) == root)
         })
     }
 
@@ -510,7 +575,11 @@ impl TetMesh {
 
     /// Replaces the point scalar (e.g. another PLOT3D Q field), keeping the geometry and the
     /// derived data that does not depend on the scalar.
-    pub fn with_scalars(mut self, name: impl Into<String>, scalars: Vec<f32>) -> Result<TetMesh, ErrorKind> {
+    pub fn with_scalars(
+        mut self,
+        name: impl Into<String>,
+        scalars: Vec<f32>,
+    ) -> Result<TetMesh, ErrorKind> {
         if scalars.len() != self.points.len() {
             return Err(ErrorKind::CountMismatch {
                 what: "point scalars".into(),
@@ -519,7 +588,11 @@ impl TetMesh {
             });
         }
         if let Some((i, v)) = scalars.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(ErrorKind::NonFinite { what: "scalar of point".into(), index: i as u64, value: *v as f64 });
+            return Err(ErrorKind::NonFinite {
+                what: "scalar of point".into(),
+                index: i as u64,
+                value: *v as f64,
+            });
         }
         self.scalars = scalars;
         self.scalar_name = name.into();
@@ -564,7 +637,13 @@ mod tests {
     use super::*;
 
     fn two_tets() -> TetMesh {
-        let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0],
+        ];
         let scalars = vec![0.0, 1.0, 2.0, 3.0, 4.0];
         // Second tet given inverted on purpose.
         TetMesh::new("t", points, scalars, "s", vec![[0, 1, 2, 3], [1, 3, 2, 4]]).unwrap()
@@ -580,7 +659,10 @@ mod tests {
             let c = [0, 1, 2].map(|a| p.iter().map(|q| q[a]).sum::<f64>() / 4.0);
             for (f, n) in m.face_normals()[t].iter().enumerate() {
                 let a = p[TET_FACES[f][0]];
-                assert!(dot(sub(a, c), n.map(|x| x as f64)) > 0.0, "face normal points inward");
+                assert!(
+                    dot(sub(a, c), n.map(|x| x as f64)) > 0.0,
+                    "face normal points inward"
+                );
             }
         }
     }
@@ -598,16 +680,28 @@ mod tests {
 
     #[test]
     fn degenerate_dropped_and_empty_is_error() {
-        let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 0.0, 0.0]];
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+        ];
         let err = TetMesh::new("d", points, vec![0.0; 4], "s", vec![[0, 1, 2, 3]]).unwrap_err();
         assert!(matches!(err, ErrorKind::EmptyMesh(_)));
     }
 
     #[test]
     fn gradient_of_linear_field_is_exact() {
-        let p = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 5.0]];
+        let p = [
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [0.0, 3.0, 0.0],
+            [0.0, 0.0, 5.0],
+        ];
         let f = |q: [f64; 3]| 1.0 + 2.0 * q[0] - 3.0 * q[1] + 0.5 * q[2];
         let g = linear_gradient(p, p.map(f));
-        assert!((g[0] - 2.0).abs() < 1e-12 && (g[1] + 3.0).abs() < 1e-12 && (g[2] - 0.5).abs() < 1e-12);
+        assert!(
+            (g[0] - 2.0).abs() < 1e-12 && (g[1] + 3.0).abs() < 1e-12 && (g[2] - 0.5).abs() < 1e-12
+        );
     }
 }
