@@ -17,6 +17,9 @@
 //! sub-simplex (face, edge, vertex) it lies on, continuing in the one the ray stays in longest.
 //! Only pieces shorter than 1e-12 of the bounding-box diagonal can be skipped that way.
 //!
+//! The eye must lie outside the mesh (cameras fitted with `Camera::fit` always do): rays start
+//! at the first boundary face they cross.
+//!
 //! [`dense_sampling`] is an independent brute-force integrator (point location at small steps)
 //! used only to test this one; [`render_cached`] keeps images on disk.
 
