@@ -11,6 +11,7 @@ type Variants = fn() -> Vec<Box<dyn Renderer>>;
 const TABLE: &[(&str, Variants)] = &[
     ("gator-pt", gator_pt::default_variants),
     ("havs", havs::default_variants),
+    ("fragment-pt", fragment_pt::default_variants),
 ];
 
 /// Every algorithm's name, in table order.

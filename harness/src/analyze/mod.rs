@@ -8,6 +8,7 @@ use std::path::PathBuf;
 
 use clap::Subcommand;
 
+pub mod fragment_pt;
 pub mod havs;
 pub mod summary;
 
@@ -24,6 +25,10 @@ pub enum AnalyzeCommand {
     /// Markdown table (the layout of the papers' timing tables: HAVS Tables 3–4, fragment PT
     /// Table 1).
     Summary(summary::Args),
+    /// Fragment PT (Marroquim et al. 2006) Tables 1 and 2 from a finished run, as Markdown.
+    FragmentPt(fragment_pt::TablesArgs),
+    /// Fragment PT Fig. 8: K tets/s against viewport size (one timing run per size), plotted.
+    Resolution(fragment_pt::ResolutionArgs),
     /// HAVS Table 1: sorting 1 M floats with shellsort, heapsort, quicksort, radix and std sort.
     Sort(havs::SortArgs),
     /// HAVS Table 2 and Fig. 6: exact A-buffer analysis of how large the k-buffer must be.
@@ -35,6 +40,8 @@ pub enum AnalyzeCommand {
 pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
     match cmd {
         AnalyzeCommand::Summary(args) => summary::run(args, ctx),
+        AnalyzeCommand::FragmentPt(args) => fragment_pt::run_tables(args, ctx),
+        AnalyzeCommand::Resolution(args) => fragment_pt::run_resolution(args, ctx),
         AnalyzeCommand::Sort(args) => havs::run_sort(args, ctx),
         AnalyzeCommand::Kbuffer(args) => havs::run_kbuffer(args, ctx),
         AnalyzeCommand::HavsTables(args) => havs::run_tables(args, ctx),

@@ -1,0 +1,596 @@
+//! Reproductions of Marroquim, Maximo, Farias and Esperança (2006), "GPU-based cell projection
+//! for interactive volume rendering":
+//!
+//! * `tetbench analyze fragment-pt OUT` — Table 1 (fps and K tets/s per data set for fragment
+//!   PT) and Table 2 (fragment PT beside GATOR and every other algorithm of the same run) from a
+//!   finished run's `results.json`, as Markdown (`OUT/fragment_pt_tables.md`);
+//! * `tetbench analyze resolution …` — Fig. 8: average K tets/s against viewport size (256²,
+//!   512², 768², 1024² by default), one `tetbench run` per size (timing only), plotted as
+//!   `fig8.png` / `fig8.svg` with `fig8.md` and `fig8.csv`.
+//!
+//! The paper's own figures go beside ours where we could find them. The per-data-set numbers of
+//! its Tables 1 and 2 and the curve of Fig. 8 were not available to us (the paper's text was not
+//! in any source we could search); its abstract states "over 2.0 M Tets/s" (GeForce 7900 GTX)
+//! and §3.1 about 20 bytes per tet for the model. The tables say so instead of inventing values.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+use anyhow::{anyhow, Context as _};
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+
+use crate::report::{aggregate, Aggregate};
+use crate::results::{ResultsFile, Row};
+
+/// The data sets of the paper's Table 1, in its order (names as the registry knows them).
+pub const TABLE1_DATASETS: [&str; 4] = ["spx", "bluntfin", "comb", "post"];
+
+/// What the paper states that we could verify; `None` where its figure was not available.
+pub struct PaperFigure {
+    pub dataset: &'static str,
+    pub fps: Option<f64>,
+    pub k_tets_per_sec: Option<f64>,
+}
+
+/// The paper's Table 1 figures per data set. None were available to us (see the module
+/// documentation); the table prints "n/a (not found)" rather than a guess.
+pub const PAPER_TABLE1: [PaperFigure; 4] = [
+    PaperFigure {
+        dataset: "spx",
+        fps: None,
+        k_tets_per_sec: None,
+    },
+    PaperFigure {
+        dataset: "bluntfin",
+        fps: None,
+        k_tets_per_sec: None,
+    },
+    PaperFigure {
+        dataset: "comb",
+        fps: None,
+        k_tets_per_sec: None,
+    },
+    PaperFigure {
+        dataset: "post",
+        fps: None,
+        k_tets_per_sec: None,
+    },
+];
+
+/// The paper's headline rate (abstract): "over 2.0 M Tets/s".
+pub const PAPER_PEAK_K_TETS_PER_SEC: f64 = 2000.0;
+/// The paper's model size (§3.1): about 20 bytes per tet (tet indices + vertices).
+pub const PAPER_BYTES_PER_TET: f64 = 20.0;
+
+fn fmt_opt(v: Option<f64>, digits: usize) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.digits$}"),
+        _ => "–".to_string(),
+    }
+}
+
+/// The `model_bytes_per_tet` counter fragment PT records (tet indices + vertices only).
+fn model_bytes_per_tet(rows: &[Row], a: &Aggregate) -> Option<f64> {
+    rows.iter()
+        .filter(|r| {
+            r.algorithm == a.algorithm && r.settings == a.settings && r.dataset == a.dataset
+        })
+        .find_map(|r| {
+            r.counters.split(';').find_map(|kv| {
+                let (k, v) = kv.split_once('=')?;
+                (k.trim() == "model_bytes_per_tet")
+                    .then(|| v.trim().parse::<f64>().ok())
+                    .flatten()
+            })
+        })
+}
+
+/// Orders data sets as the paper's Table 1, then any others in order of appearance.
+fn dataset_order(aggs: &[Aggregate]) -> Vec<String> {
+    let mut names: Vec<String> = vec![];
+    for d in TABLE1_DATASETS {
+        if aggs.iter().any(|a| a.dataset == d) {
+            names.push(d.to_string());
+        }
+    }
+    for a in aggs {
+        if !names.contains(&a.dataset) {
+            names.push(a.dataset.clone());
+        }
+    }
+    names
+}
+
+/// Table 1 (fragment PT: fps and K tets/s per data set and variant) and Table 2 (every
+/// algorithm of the run, same machine) as Markdown, from the rows of one run.
+pub fn tables_markdown(file: &ResultsFile) -> String {
+    let rows = &file.rows;
+    let aggs = aggregate(rows);
+    let adapter = file
+        .machine
+        .adapter
+        .as_ref()
+        .map(|a| format!("{} ({}, {})", a.name, a.backend, a.device_type))
+        .unwrap_or_else(|| "unknown adapter".into());
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "Means over viewpoints ({}) at {}×{}, {} timed frames each; adapter {adapter}.\n",
+        file.run.viewpoints, file.run.width, file.run.height, file.run.frames
+    );
+    let _ = writeln!(
+        md,
+        "### Table 1 — fragment PT per data set (Marroquim et al. 2006, Table 1)\n"
+    );
+    let _ = writeln!(
+        md,
+        "| data set | tets | settings | fps | K tets/s | CPU ms | GPU ms | model B/tet | all B/tet | PSNR dB | paper fps | paper K tets/s |"
+    );
+    let _ = writeln!(
+        md,
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    let datasets = dataset_order(&aggs);
+    let mut any = false;
+    for d in &datasets {
+        for a in aggs
+            .iter()
+            .filter(|a| a.algorithm == "fragment-pt" && &a.dataset == d)
+        {
+            any = true;
+            let paper = PAPER_TABLE1.iter().find(|p| p.dataset == d);
+            let paper_cell = |v: Option<f64>| match (paper, v) {
+                (Some(_), Some(x)) => format!("{x:.1}"),
+                (Some(_), None) => "n/a (not found)".into(),
+                (None, _) => "not in paper".into(),
+            };
+            let _ = writeln!(
+                md,
+                "| {d} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                a.tets,
+                a.settings,
+                fmt_opt(a.fps.map(|s| s.mean), 2),
+                fmt_opt(a.tets_per_sec.map(|s| s.mean / 1e3), 1),
+                fmt_opt(a.cpu_ms.map(|s| s.mean), 2),
+                fmt_opt(a.gpu_ms.map(|s| s.mean), 2),
+                fmt_opt(model_bytes_per_tet(rows, a), 1),
+                fmt_opt(a.bytes_per_tet, 1),
+                fmt_opt(a.psnr_db.map(|s| s.mean), 1),
+                paper_cell(paper.and_then(|p| p.fps)),
+                paper_cell(paper.and_then(|p| p.k_tets_per_sec)),
+            );
+        }
+    }
+    if !any {
+        let _ = writeln!(md, "| (no fragment-pt rows in this run) |||||||||||| ");
+    }
+    let _ = writeln!(
+        md,
+        "\nPaper: the per-data-set figures of Table 1 were not available to us; its abstract \
+         reports over {:.1} M tets/s and §3.1 about {PAPER_BYTES_PER_TET:.0} bytes/tet for the \
+         model (our `model B/tet` column: tet indices + vertices; `all B/tet` adds the shading \
+         tables).\n",
+        PAPER_PEAK_K_TETS_PER_SEC / 1e3
+    );
+
+    let _ = writeln!(
+        md,
+        "### Table 2 — algorithms compared on the same run (Marroquim et al. 2006, Table 2)\n"
+    );
+    let mut header = String::from("| algorithm | settings |");
+    let mut rule = String::from("|---|---|");
+    for d in &datasets {
+        let tets = aggs
+            .iter()
+            .find(|a| &a.dataset == d)
+            .map(|a| a.tets)
+            .unwrap_or(0);
+        let _ = write!(header, " {d} ({tets} tets) K tets/s | {d} PSNR dB |");
+        rule.push_str("---:|---:|");
+    }
+    header.push_str(" B/tet |");
+    rule.push_str("---:|");
+    let _ = writeln!(md, "{header}\n{rule}");
+    let mut series: Vec<(String, String)> = vec![];
+    for a in &aggs {
+        let k = (a.algorithm.clone(), a.settings.clone());
+        if !series.contains(&k) {
+            series.push(k);
+        }
+    }
+    for (alg, set) in &series {
+        let mut line = format!("| {alg} | {set} |");
+        let mut bpt = None;
+        for d in &datasets {
+            let a = aggs
+                .iter()
+                .find(|a| &a.algorithm == alg && &a.settings == set && &a.dataset == d);
+            let _ = write!(
+                line,
+                " {} | {} |",
+                fmt_opt(a.and_then(|a| a.tets_per_sec).map(|s| s.mean / 1e3), 1),
+                fmt_opt(a.and_then(|a| a.psnr_db).map(|s| s.mean), 1)
+            );
+            bpt = bpt.or(a.and_then(|a| a.bytes_per_tet));
+        }
+        let _ = write!(line, " {} |", fmt_opt(bpt, 1));
+        let _ = writeln!(md, "{line}");
+    }
+    let _ = writeln!(
+        md,
+        "\nPaper: Table 2 compares fragment PT with GATOR (Wylie et al. 2002) and other methods \
+         on the authors' GPU; its per-method figures were not available to us, so only this \
+         run's measurements are shown (same machine, same viewpoints, same transfer function)."
+    );
+    md
+}
+
+/// `tetbench analyze fragment-pt OUT`.
+#[derive(Debug, clap::Args)]
+pub struct TablesArgs {
+    /// Output directory of a `tetbench run` (holds results.json), e.g. of
+    /// `tetbench run --algorithms fragment-pt,gator-pt --datasets spx,bluntfin,comb,post`.
+    pub out: PathBuf,
+}
+
+pub fn run_tables(args: TablesArgs, _ctx: &super::Context) -> anyhow::Result<()> {
+    let file = ResultsFile::read(&args.out)?;
+    let md = tables_markdown(&file);
+    let path = args.out.join("fragment_pt_tables.md");
+    std::fs::write(&path, &md).with_context(|| format!("cannot write {}", path.display()))?;
+    print!("{md}");
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
+/// `tetbench analyze resolution`: Fig. 8, performance against viewport size.
+#[derive(Debug, clap::Args)]
+pub struct ResolutionArgs {
+    /// Comma-separated algorithms (default: fragment-pt).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "LIST",
+        default_value = "fragment-pt"
+    )]
+    pub algorithms: Vec<String>,
+    /// Comma-separated data sets (default: the paper's spx, bluntfin, comb, post).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "LIST",
+        default_value = "spx,bluntfin,comb,post"
+    )]
+    pub datasets: Vec<String>,
+    /// Square viewport sizes in pixels (the paper's Fig. 8: 256, 512, 768, 1024).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "LIST",
+        default_value = "256,512,768,1024"
+    )]
+    pub resolutions: Vec<u32>,
+    /// Viewpoints per size (as `tetbench run --viewpoints`).
+    #[arg(long, value_name = "SPEC", default_value = "14")]
+    pub viewpoints: String,
+    /// Timed frames per viewpoint.
+    #[arg(long, value_name = "N", default_value_t = 5)]
+    pub frames: u32,
+    /// Untimed warm-up frames.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub warmup: u32,
+    /// Keep only variants whose settings match (as `tetbench run --settings`).
+    #[arg(long, value_name = "FILTER")]
+    pub settings: Option<String>,
+    /// Transfer function preset or file.
+    #[arg(long, value_name = "NAME|FILE", default_value = "low-opacity")]
+    pub tf: String,
+    /// Output directory: one sub-directory per size, and the figure.
+    #[arg(long, value_name = "DIR", default_value = "out-resolution")]
+    pub out: PathBuf,
+}
+
+/// One point of Fig. 8: a series at one viewport size.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepPoint {
+    pub series: String,
+    pub resolution: u32,
+    /// Mean over data sets of the mean over viewpoints of tets/s, in K tets/s.
+    pub k_tets_per_sec: f64,
+    pub datasets: usize,
+}
+
+/// Averages one run's rows per series (algorithm + settings) over viewpoints, then data sets.
+pub fn sweep_points(rows: &[Row], resolution: u32) -> Vec<SweepPoint> {
+    let aggs = aggregate(rows);
+    let mut out: Vec<SweepPoint> = vec![];
+    for a in &aggs {
+        let Some(t) = a.tets_per_sec else { continue };
+        let series = a.series();
+        match out.iter_mut().find(|p| p.series == series) {
+            Some(p) => {
+                p.k_tets_per_sec += t.mean / 1e3;
+                p.datasets += 1;
+            }
+            None => out.push(SweepPoint {
+                series,
+                resolution,
+                k_tets_per_sec: t.mean / 1e3,
+                datasets: 1,
+            }),
+        }
+    }
+    for p in &mut out {
+        p.k_tets_per_sec /= p.datasets as f64;
+    }
+    out
+}
+
+pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Result<()> {
+    if args.resolutions.is_empty() {
+        anyhow::bail!("--resolutions is empty");
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let mut points: Vec<SweepPoint> = vec![];
+    let mut adapter = String::new();
+    for &res in &args.resolutions {
+        let run_args = crate::cli::RunArgs {
+            algorithms: args.algorithms.clone(),
+            datasets: args.datasets.clone(),
+            viewpoints: Some(args.viewpoints.clone()),
+            resolution: Some(res),
+            tf: args.tf.clone(),
+            frames: Some(args.frames),
+            warmup: Some(args.warmup),
+            out: args.out.join(format!("res-{res}")),
+            settings: args.settings.clone(),
+            // Fig. 8 is about speed: no reference images (they dominate at 1024²).
+            no_reference: true,
+            cache_dir: None,
+            orthographic: false,
+            scalar: None,
+            no_report: true,
+        };
+        let config = run_args.to_config(
+            ctx.data_dir.clone(),
+            vec!["tetbench analyze resolution".into()],
+        )?;
+        eprintln!("resolution sweep: {res}×{res}");
+        let outcome = crate::run::run(&config, &crate::algorithms::variants)?;
+        if !outcome.all_ok() {
+            eprintln!(
+                "WARNING: {} of {} rows failed at {res}²: {:?}",
+                outcome.failed_rows, outcome.rows, outcome.errors
+            );
+        }
+        let file = ResultsFile::read(&config.out)?;
+        if let Some(a) = &file.machine.adapter {
+            adapter = format!("{} ({})", a.name, a.backend);
+        }
+        points.extend(sweep_points(&file.rows, res));
+    }
+    write_fig8(&args.out, &points, &adapter)?;
+    let md = fig8_markdown(&points, &adapter);
+    std::fs::write(args.out.join("fig8.md"), &md)?;
+    let mut w = csv::Writer::from_path(args.out.join("fig8.csv"))?;
+    w.write_record(["series", "resolution", "k_tets_per_sec", "datasets"])?;
+    for p in &points {
+        w.write_record([
+            p.series.clone(),
+            p.resolution.to_string(),
+            p.k_tets_per_sec.to_string(),
+            p.datasets.to_string(),
+        ])?;
+    }
+    w.flush()?;
+    print!("{md}");
+    eprintln!("wrote {}", args.out.join("fig8.png").display());
+    Ok(())
+}
+
+/// Fig. 8 as a Markdown table: one row per series, one column per size.
+pub fn fig8_markdown(points: &[SweepPoint], adapter: &str) -> String {
+    let mut sizes: Vec<u32> = points.iter().map(|p| p.resolution).collect();
+    sizes.sort();
+    sizes.dedup();
+    let mut series: Vec<&str> = vec![];
+    for p in points {
+        if !series.contains(&p.series.as_str()) {
+            series.push(&p.series);
+        }
+    }
+    let mut md = format!(
+        "### Fig. 8 — average K tets/s against viewport size (Marroquim et al. 2006)\n\nAdapter {adapter}; \
+         mean over data sets of the mean over viewpoints. The paper's curve was not available to us.\n\n| series |"
+    );
+    for s in &sizes {
+        let _ = write!(md, " {s}² |");
+    }
+    md.push_str("\n|---|");
+    for _ in &sizes {
+        md.push_str("---:|");
+    }
+    md.push('\n');
+    for s in &series {
+        let _ = write!(md, "| {s} |");
+        for r in &sizes {
+            let v = points
+                .iter()
+                .find(|p| p.series == *s && p.resolution == *r)
+                .map(|p| p.k_tets_per_sec);
+            let _ = write!(md, " {} |", fmt_opt(v, 1));
+        }
+        md.push('\n');
+    }
+    md
+}
+
+const FONT: &str = "DejaVu Sans";
+
+/// Registers the embedded DejaVu Sans with plotters (as `report.rs` does; registering the
+/// same family twice is harmless).
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        let _ = plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
+    });
+}
+
+const COLORS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+];
+
+fn draw_fig8<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    points: &[SweepPoint],
+    adapter: &str,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing Fig. 8: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let xmax = points.iter().map(|p| p.resolution).max().unwrap_or(1024) as f64 * 1.08;
+    let xmin = points.iter().map(|p| p.resolution).min().unwrap_or(256) as f64 * 0.8;
+    let ymax = points
+        .iter()
+        .map(|p| p.k_tets_per_sec)
+        .fold(0.0, f64::max)
+        .max(1e-3)
+        * 1.15;
+    let caption = format!("Fig. 8 reproduction: K tets/s vs viewport ({adapter})");
+    let mut chart = ChartBuilder::on(root)
+        .caption(caption, (FONT, 20).into_font())
+        .margin(14)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(xmin..xmax, 0.0..ymax)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("viewport side (pixels; image is side²)")
+        .y_desc("K tets/s (mean over data sets)")
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 15))
+        .draw()
+        .map_err(err)?;
+    let mut series: Vec<&str> = vec![];
+    for p in points {
+        if !series.contains(&p.series.as_str()) {
+            series.push(&p.series);
+        }
+    }
+    for (i, s) in series.iter().enumerate() {
+        let color = COLORS[i % COLORS.len()];
+        let mut pts: Vec<(f64, f64)> = points
+            .iter()
+            .filter(|p| p.series == *s)
+            .map(|p| (p.resolution as f64, p.k_tets_per_sec))
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart
+            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+            .map_err(err)?
+            .label(s.to_string())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .label_font((FONT, 13))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// Writes `fig8.png` and `fig8.svg` (the SVG loads DejaVu Sans from `DejaVuSans.ttf` beside it).
+pub fn write_fig8(dir: &Path, points: &[SweepPoint], adapter: &str) -> anyhow::Result<()> {
+    register_font();
+    let size = (1000, 640);
+    let png = dir.join("fig8.png");
+    {
+        let root = BitMapBackend::new(&png, size).into_drawing_area();
+        draw_fig8(&root, points, adapter).with_context(|| format!("writing {}", png.display()))?;
+    }
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        draw_fig8(&root, points, adapter)?;
+    }
+    let style = format!("<style>@font-face {{ font-family: \"{FONT}\"; src: url(\"DejaVuSans.ttf\") format(\"truetype\"); }}</style>");
+    if let Some(end) = svg
+        .find("<svg")
+        .and_then(|i| svg[i..].find('>').map(|j| i + j + 1))
+    {
+        svg.insert_str(end, &style);
+    }
+    std::fs::write(dir.join("DejaVuSans.ttf"), dejavu::sans::regular())?;
+    let path = dir.join("fig8.svg");
+    std::fs::write(&path, svg).with_context(|| format!("cannot write {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fig8_plot_and_table_are_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let points = vec![
+            SweepPoint {
+                series: "fragment-pt shading=psi;sort=merge".into(),
+                resolution: 256,
+                k_tets_per_sec: 900.0,
+                datasets: 2,
+            },
+            SweepPoint {
+                series: "fragment-pt shading=psi;sort=merge".into(),
+                resolution: 512,
+                k_tets_per_sec: 600.0,
+                datasets: 2,
+            },
+            SweepPoint {
+                series: "fragment-pt shading=average;sort=gpu".into(),
+                resolution: 256,
+                k_tets_per_sec: 1200.0,
+                datasets: 2,
+            },
+        ];
+        write_fig8(dir.path(), &points, "test adapter").unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("fig8.svg")).unwrap();
+        assert!(svg.contains("@font-face") && svg.contains("K tets/s"));
+        assert!(
+            std::fs::metadata(dir.path().join("fig8.png"))
+                .unwrap()
+                .len()
+                > 1000
+        );
+        let md = fig8_markdown(&points, "test adapter");
+        assert!(
+            md.contains("| fragment-pt shading=psi;sort=merge | 900.0 | 600.0 |"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| fragment-pt shading=average;sort=gpu | 1200.0 | – |"),
+            "{md}"
+        );
+    }
+}
