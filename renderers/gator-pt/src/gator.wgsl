@@ -3,8 +3,9 @@
 //
 // Every vertex-shader invocation reads its tet's four vertices from storage, projects them,
 // runs the paper's four tests (Fig. 5), picks the basis-graph mapping of Table 1 and emits one
-// node of the basis graph. wgpu has no triangle fans, so each tet is 4 triangles = 12 vertex
-// invocations (the fourth degenerates for class 1). `project_and_classify` is the single copy
+// node of the basis graph (5 per tet). wgpu has no triangle fans, so an index buffer draws each
+// tet's fan as 4 triangles = 12 indices over its 5 nodes (the fourth triangle degenerates for
+// class 1). `project_and_classify` is the single copy
 // of the classification: the vertex shader and the debug compute entry point both call it,
 // and classify.rs is its f64 twin (keep the two in step).
 
@@ -98,9 +99,10 @@ const MAPPING = array<vec4<u32>, 8>(
 );
 
 struct TetProjection {
-    // Screen (NDC) positions and scalars of the input vertices.
-    ndc: array<vec2<f32>, 4>,
-    scal: array<f32, 4>,
+    // Per input vertex (lanes x, y, z, w = vertices 0..3): screen x, y (NDC) and scalar.
+    x: vec4<f32>,
+    y: vec4<f32>,
+    s: vec4<f32>,
     perm: vec4<u32>,
     thick: vec2<f32>,
     // World length of the eye-ray segment through the thick vertex (§3.5).
@@ -119,33 +121,42 @@ fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
     return a.x * b.y - a.y * b.x;
 }
 
+// 1 in the lane of vertex `i`, 0 elsewhere: selecting vertex i is a dot product with this
+// mask, as gator.cg's `multiplex` does (no dynamic indexing, which vertex pipelines handle
+// badly).
+fn lane(i: u32) -> vec4<f32> {
+    return select(vec4<f32>(0.0), vec4<f32>(1.0), vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(i));
+}
+
 fn project_and_classify(tet_id: u32) -> TetProjection {
     var r: TetProjection;
     let t = tet_at(tet_id);
-    var world: array<vec3<f32>, 4>;
-    var ndcz: array<f32, 4>;
-    var w: array<f32, 4>;
-    r.valid = true;
-    for (var i = 0u; i < 4u; i++) {
-        let p = point_at(t[i]);
-        world[i] = p.xyz;
-        r.scal[i] = p.w;
-        let c = P.view_proj * vec4<f32>(p.xyz, 1.0);
-        if !(c.w > 0.0) {
-            r.valid = false;
-        }
-        let inv_w = 1.0 / max(c.w, 1e-30);
-        w[i] = max(c.w, 1e-30);
-        r.ndc[i] = c.xy * inv_w;
-        ndcz[i] = c.z * inv_w;
-    }
-    r.s_mean = 0.25 * (r.scal[0] + r.scal[1] + r.scal[2] + r.scal[3]);
+    let p0 = point_at(t.x);
+    let p1 = point_at(t.y);
+    let p2 = point_at(t.z);
+    let p3 = point_at(t.w);
+    let c0 = P.view_proj * vec4<f32>(p0.xyz, 1.0);
+    let c1 = P.view_proj * vec4<f32>(p1.xyz, 1.0);
+    let c2 = P.view_proj * vec4<f32>(p2.xyz, 1.0);
+    let c3 = P.view_proj * vec4<f32>(p3.xyz, 1.0);
+    let w_raw = vec4<f32>(c0.w, c1.w, c2.w, c3.w);
+    r.valid = all(w_raw > vec4<f32>(0.0));
+    let w = max(w_raw, vec4<f32>(1e-30));
+    let inv_w = 1.0 / w;
+    let x = vec4<f32>(c0.x, c1.x, c2.x, c3.x) * inv_w;
+    let y = vec4<f32>(c0.y, c1.y, c2.y, c3.y) * inv_w;
+    let z = vec4<f32>(c0.z, c1.z, c2.z, c3.z) * inv_w;
+    let s = vec4<f32>(p0.w, p1.w, p2.w, p3.w);
+    r.x = x;
+    r.y = y;
+    r.s = s;
+    r.s_mean = 0.25 * (s.x + s.y + s.z + s.w);
 
     // Tests 1-3 (Fig. 5; gator.cg tests123). A zero cross product counts as positive so ties
     // (coincident or collinear points) still put a proper vertex into slot v1'.
-    let e1 = r.ndc[1] - r.ndc[0];
-    let e2 = r.ndc[2] - r.ndc[0];
-    let e3 = r.ndc[3] - r.ndc[0];
+    let e1 = vec2<f32>(x.y - x.x, y.y - y.x);
+    let e2 = vec2<f32>(x.z - x.x, y.z - y.x);
+    let e3 = vec2<f32>(x.w - x.x, y.w - y.x);
     let a = cross2(e1, e2);
     let b = cross2(e1, e3);
     let c = cross2(e3, e2);
@@ -156,10 +167,14 @@ fn project_and_classify(tet_id: u32) -> TetProjection {
     var mapping = MAPPING;
     let perm = mapping[idx];
     r.perm = perm;
-    let q0 = r.ndc[perm.x];
-    let q1 = r.ndc[perm.y];
-    let q2 = r.ndc[perm.z];
-    let q3 = r.ndc[perm.w];
+    let m0 = lane(perm.x);
+    let m1 = lane(perm.y);
+    let m2 = lane(perm.z);
+    let m3 = lane(perm.w);
+    let q0 = vec2<f32>(dot(m0, x), dot(m0, y));
+    let q1 = vec2<f32>(dot(m1, x), dot(m1, y));
+    let q2 = vec2<f32>(dot(m2, x), dot(m2, y));
+    let q3 = vec2<f32>(dot(m3, x), dot(m3, y));
 
     // Intersection of v0'v1' with v2'v3': 0 = C + α A − β B (gator.cg compute_intersection).
     let av = q1 - q0;
@@ -180,57 +195,35 @@ fn project_and_classify(tet_id: u32) -> TetProjection {
         beta = clamp(beta_num / den, 0.0, 1.0);
     }
     // Projected-space weights (over input vertices) of the two ends of the thick segment.
-    var wa = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
-    var wb = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
+    var wa: vec4<f32>;
+    var wb: vec4<f32>;
     if t4 {
         let alpha = clamp(alpha_num / den, 0.0, 1.0);
-        wa[perm.x] += 1.0 - alpha;
-        wa[perm.y] += alpha;
-        wb[perm.z] += 1.0 - beta;
-        wb[perm.w] += beta;
+        wa = m0 * (1.0 - alpha) + m1 * alpha;
+        wb = m2 * (1.0 - beta) + m3 * beta;
     } else {
         // Class 1: thick vertex v1'; far end on face v0'v2'v3' at r = 1/α along v0' → I.
         var rr = 0.0;
         if alpha_num != 0.0 {
             rr = clamp(den / alpha_num, 0.0, 1.0);
         }
-        wa[perm.y] = 1.0;
-        wb[perm.x] += 1.0 - rr;
-        wb[perm.z] += rr * (1.0 - beta);
-        wb[perm.w] += rr * beta;
+        wa = m1;
+        wb = m0 * (1.0 - rr) + m2 * (rr * (1.0 - beta)) + m3 * (rr * beta);
     }
-    var thick = vec2<f32>(0.0);
-    var za = 0.0;
-    var zb = 0.0;
+    r.thick = vec2<f32>(dot(wa, x), dot(wa, y));
+    let za = dot(wa, z);
+    let zb = dot(wb, z);
     // World points: projected weights λ become world weights λᵢ/wᵢ, normalised
     // (perspective-correct; exact because a projective map keeps lines straight).
-    var ga = 0.0;
-    var gb = 0.0;
-    var pa = vec3<f32>(0.0);
-    var pb = vec3<f32>(0.0);
-    var sa = 0.0;
-    var sb = 0.0;
-    for (var i = 0u; i < 4u; i++) {
-        thick += wa[i] * r.ndc[i];
-        za += wa[i] * ndcz[i];
-        zb += wb[i] * ndcz[i];
-        let gai = wa[i] / w[i];
-        let gbi = wb[i] / w[i];
-        ga += gai;
-        gb += gbi;
-        pa += gai * world[i];
-        pb += gbi * world[i];
-        sa += gai * r.scal[i];
-        sb += gbi * r.scal[i];
-    }
-    if !t4 {
-        thick = q1;
-    }
-    pa /= ga;
-    pb /= gb;
-    sa /= ga;
-    sb /= gb;
-    r.thick = thick;
+    let ga = wa * inv_w;
+    let gb = wb * inv_w;
+    let world = mat4x3<f32>(p0.xyz, p1.xyz, p2.xyz, p3.xyz);
+    let sum_a = dot(ga, vec4<f32>(1.0));
+    let sum_b = dot(gb, vec4<f32>(1.0));
+    let pa = (world * ga) / sum_a;
+    let pb = (world * gb) / sum_b;
+    let sa = dot(ga, s) / sum_a;
+    let sb = dot(gb, s) / sum_b;
     r.length = length(pa - pb);
     r.ndc_thickness = abs(za - zb);
     if za <= zb {
@@ -256,22 +249,16 @@ struct VsOut {
     @location(0) @interpolate(linear) seg: vec3<f32>,
 };
 
+// One invocation per basis-graph node: vertex 5k + j is node j of the k-th tet in the sorted
+// order. The index buffer lists each tet's fan as 4 triangles of these 5 nodes,
+// (0,1,2) (0,2,3) (0,3,4) (0,4,1); node 0 is the thick vertex, nodes 1..4 the rim
+// v2', v0', v3', then v1' (class 2) or v2' again (class 1: the fourth triangle degenerates).
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
-    let k = vi / 12u;
-    let corner = vi - 12u * k;
+    let k = vi / 5u;
+    let node = vi - 5u * k;
     let tet_id = order[k - C.base];
-    var tp = project_and_classify(tet_id);
-    // Fan (node 0 = thick vertex; rim nodes 1..4 = v2', v0', v3', v1'|v2'):
-    // triangles (0,1,2) (0,2,3) (0,3,4) (0,4,1).
-    let tri = corner / 3u;
-    let j = corner - 3u * tri;
-    var node = 0u;
-    if j == 1u {
-        node = 1u + tri;
-    } else if j == 2u {
-        node = 1u + (tri + 1u) % 4u;
-    }
+    let tp = project_and_classify(tet_id);
     var out: VsOut;
     if !tp.valid {
         out.pos = vec4<f32>(0.0, 0.0, 0.5, 1.0);
@@ -284,16 +271,18 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
         xy = tp.thick;
         seg = vec3<f32>(tp.length, tp.s_front, tp.s_back);
     } else {
-        var slot = tp.perm.z;
+        var v = tp.perm.z;
         if node == 2u {
-            slot = tp.perm.x;
+            v = tp.perm.x;
         } else if node == 3u {
-            slot = tp.perm.w;
+            v = tp.perm.w;
         } else if node == 4u && tp.class2 {
-            slot = tp.perm.y;
+            v = tp.perm.y;
         }
-        xy = tp.ndc[slot];
-        seg = vec3<f32>(0.0, tp.scal[slot], tp.scal[slot]);
+        let m = lane(v);
+        xy = vec2<f32>(dot(m, tp.x), dot(m, tp.y));
+        let sv = dot(m, tp.s);
+        seg = vec3<f32>(0.0, sv, sv);
     }
     if P.cells == 0u {
         seg.y = tp.s_mean;

@@ -4,8 +4,9 @@
 //! Shirley–Tuchman projected tetrahedra done entirely in the vertex shader: every tet is drawn
 //! as the paper's *basis graph* (the 4 vertices plus the thick/phantom vertex) and every vertex
 //! invocation re-derives the projection's class from the tet's four vertices, read from
-//! storage buffers (`gator.wgsl`). wgpu has no triangle fans, so a tet is 4 triangles
-//! (12 invocations); for class-1 projections the fourth degenerates.
+//! storage buffers (`gator.wgsl`). One vertex invocation per node of the basis graph (5 per
+//! tet); wgpu has no triangle fans, so a fixed index buffer draws each tet's fan as 4
+//! triangles (12 indices); for class-1 projections the fourth degenerates.
 //!
 //! Per frame the CPU only sorts, back to front, with one of the shared visibility orders
 //! (`render_core::visibility`; default: centroid distance to the eye, HAVS §5.1's LSD radix
@@ -40,7 +41,7 @@ pub use classify::{
 };
 
 /// Entries of the transfer-function table (rgb, κ over the normalised scalar).
-pub const TF_LUT_SIZE: u32 = 4096;
+pub const TF_LUT_SIZE: u32 = 1024;
 /// Entries of the opacity table α(τ) = 1 − exp(−τ), τ ∈ [0, TAU_MAX].
 pub const EXP_LUT_SIZE: u32 = 4096;
 /// Optical depth where the opacity table ends (α = 1 − e⁻¹⁶ ≈ 1 − 1.1·10⁻⁷ beyond).
@@ -51,6 +52,22 @@ const MAX_TET_CHUNKS: usize = 4;
 const MAX_POINT_CHUNKS: usize = 3;
 
 const SHADER: &str = include_str!("gator.wgsl");
+
+/// Nodes of the basis graph, i.e. vertex invocations per tet.
+const NODES: u32 = 5;
+/// The fan over the 5 nodes as a triangle list (see `vs_main` in gator.wgsl).
+const FAN_INDICES: [u16; 12] = [0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1];
+/// Tets per indexed draw: one 24 KB index buffer serves any mesh, each draw offset by
+/// `base_vertex` (u16 indices allow up to 13,107 tets per draw; fewer keep the buffer small
+/// against the mesh, which bytes/tet counts, at a cost of one draw call per 1,024 tets).
+const TETS_PER_DRAW: u64 = 1024;
+
+/// The index buffer: [`FAN_INDICES`] for tets 0..TETS_PER_DRAW, node indices 5k + j.
+fn fan_index_buffer() -> Vec<u16> {
+    (0..TETS_PER_DRAW as u16)
+        .flat_map(|k| FAN_INDICES.map(|j| k * NODES as u16 + j))
+        .collect()
+}
 
 /// The cell model of the paper's Table 3.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -289,9 +306,9 @@ impl MeshGpu {
                 max_binding
             );
         }
-        if tets.len() as u64 * 12 > u32::MAX as u64 {
+        if tets.len() as u64 * NODES as u64 > i32::MAX as u64 {
             bail!(
-                "gator-pt: {} tets exceed the 32-bit vertex index range (12 vertices per tet)",
+                "gator-pt: {} tets exceed the 32-bit vertex index range ({NODES} vertices per tet)",
                 tets.len()
             );
         }
@@ -468,6 +485,7 @@ struct State {
     mesh: MeshGpu,
     pipeline: wgpu::RenderPipeline,
     order_buf: wgpu::Buffer,
+    index_buf: wgpu::Buffer,
     chunks: Vec<DrawChunk>,
     /// The mesh as prepared (the visibility sorter reads its centroids / face adjacency).
     host_mesh: TetMesh,
@@ -577,6 +595,13 @@ impl Renderer for GatorPt {
             n * 4,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         );
+        let index_buf = ledger.buffer_init(
+            gpu,
+            "gator fan indices",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&fan_index_buffer()),
+            wgpu::BufferUsages::INDEX,
+        );
         let mut chunks = Vec::new();
         for range in chunk_ranges(n, 4, mb) {
             let cp = [range.start as u32, 0, 0, 0];
@@ -627,6 +652,7 @@ impl Renderer for GatorPt {
             mesh: meshgpu,
             pipeline,
             order_buf,
+            index_buf,
             chunks,
             host_mesh,
             sorter,
@@ -714,15 +740,16 @@ impl Renderer for GatorPt {
             });
             pass.set_pipeline(&st.pipeline);
             pass.set_bind_group(0, &st.mesh.g0, &[]);
+            pass.set_index_buffer(st.index_buf.slice(..), wgpu::IndexFormat::Uint16);
             for chunk in &st.chunks {
-                if chunk.range.is_empty() {
-                    continue;
-                }
                 pass.set_bind_group(1, &chunk.bind_group, &[]);
-                pass.draw(
-                    (chunk.range.start * 12) as u32..(chunk.range.end * 12) as u32,
-                    0..1,
-                );
+                let mut start = chunk.range.start;
+                while start < chunk.range.end {
+                    let len = (chunk.range.end - start).min(TETS_PER_DRAW);
+                    // Vertex index = fan index + base_vertex = 5·(sorted position) + node.
+                    pass.draw_indexed(0..(12 * len) as u32, (start * NODES as u64) as i32, 0..1);
+                    start += len;
+                }
             }
         }
         st.timer.end(&mut enc);
@@ -751,7 +778,7 @@ impl Renderer for GatorPt {
             stages,
             counters: vec![
                 ("tets".to_string(), n),
-                ("vertex_invocations".to_string(), 12.0 * n),
+                ("basis_graph_vertices".to_string(), NODES as f64 * n),
                 ("cycle_breaks".to_string(), sort.cycle_breaks as f64),
             ],
         })
