@@ -1,7 +1,9 @@
 //! Times GATOR on data sets at the 14 fixed viewpoints and prints tets/s, CPU/GPU/total ms and
 //! bytes/tet per variant: a quick check outside the harness (`tetbench run` is the real one).
 //!
-//! `cargo run --release -p gator-pt --example gator_timing -- FILE [FILE…] [--size 512] [--frames 5]`
+//! `cargo run --release -p gator-pt --example gator_timing -- FILE [FILE…] [--size 512] [--frames 5]
+//! [--sort radix|bucket|merge|mpvonc] [--psnr N]` (`--psnr N`: PSNR against the exact reference
+//! at the first N viewpoints, RGB over black as the harness reports it).
 
 use gator_pt::{CellModel, GatorPt, VisibilityOrder};
 use render_core::{fixed_viewpoints, Camera, Gpu, Optics, Projection, Renderer, TransferFunction};
@@ -21,6 +23,7 @@ fn main() -> anyhow::Result<()> {
     let mut size = 512u32;
     let mut frames = 5usize;
     let mut order = VisibilityOrder::default();
+    let mut psnr_views = 0usize;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -40,6 +43,12 @@ fn main() -> anyhow::Result<()> {
                 order = args
                     .next()
                     .ok_or_else(|| anyhow::anyhow!("--sort needs a value"))?
+                    .parse()?
+            }
+            "--psnr" => {
+                psnr_views = args
+                    .next()
+                    .ok_or_else(|| anyhow::anyhow!("--psnr needs a value"))?
                     .parse()?
             }
             _ => files.push(a),
@@ -70,6 +79,28 @@ fn main() -> anyhow::Result<()> {
                         gpu_ms.push(s.gpu_ms.unwrap_or(f64::NAN));
                     }
                 }
+            }
+            let mut psnrs = Vec::new();
+            for vp in fixed_viewpoints().iter().take(psnr_views) {
+                let cam = Camera::fit(&mesh.bounds(), vp, Projection::default(), size, size);
+                r.render(&gpu, &cam)?;
+                let img = r.read_image(&gpu)?;
+                let reference = reference::render(&mesh, &optics, &cam);
+                let mut se = 0.0;
+                for (p, q) in img.pixels.iter().zip(&reference.pixels) {
+                    for c in 0..3 {
+                        let d = p[c].clamp(0.0, 1.0) as f64 - q[c].clamp(0.0, 1.0) as f64;
+                        se += d * d;
+                    }
+                }
+                psnrs.push(format!(
+                    "{} {:.2} dB",
+                    vp.name,
+                    -10.0 * (se / (img.pixels.len() * 3) as f64).log10()
+                ));
+            }
+            if !psnrs.is_empty() {
+                println!("  PSNR vs reference: {}", psnrs.join(", "));
             }
             let t = median(&mut total);
             println!(

@@ -18,6 +18,12 @@
 //! leaves, interpolated from the thick vertex; the paper's average-scalar approach, not
 //! pre-integration). Opacity α = 1 − exp(−κ(s̄)·l / length_unit) through a lookup table.
 //!
+//! Thickness and scalars are interpolated linearly on screen from the thick vertex to the
+//! silhouette (Shirley–Tuchman, GATOR): exact for orthographic views, a first-order
+//! approximation in (tet depth / view distance) in perspective. The thick segment itself is
+//! computed exactly in world space (perspective-correct weights), so class boundaries and
+//! degenerate projections stay continuous.
+//!
 //! [`classify_cpu`] is the f64 twin of the shader's classification; [`classify_gpu`] runs the
 //! shader's own function in a compute pass and reads the results back, so tests compare them.
 
