@@ -10,7 +10,10 @@ pub fn data_dir() -> Option<PathBuf> {
     if dir.is_dir() {
         Some(dir)
     } else {
-        eprintln!("SKIPPED: data directory {} is absent (set TETBENCH_DATA)", dir.display());
+        eprintln!(
+            "SKIPPED: data directory {} is absent (set TETBENCH_DATA)",
+            dir.display()
+        );
         None
     }
 }

@@ -31,11 +31,23 @@ pub enum ErrorKind {
     #[error("expected {expected}, found {found:?}")]
     Syntax { expected: String, found: String },
     #[error("{what}: expected {expected}, found {found}")]
-    CountMismatch { what: String, expected: u64, found: u64 },
+    CountMismatch {
+        what: String,
+        expected: u64,
+        found: u64,
+    },
     #[error("{what} index {index} is out of range (only {limit} exist)")]
-    IndexOutOfRange { what: String, index: u64, limit: u64 },
+    IndexOutOfRange {
+        what: String,
+        index: u64,
+        limit: u64,
+    },
     #[error("{what} {index} is not finite ({value})")]
-    NonFinite { what: String, index: u64, value: f64 },
+    NonFinite {
+        what: String,
+        index: u64,
+        value: f64,
+    },
     #[error("unsupported cell type {0}")]
     UnknownCellType(String),
     #[error("mesh has no tetrahedra{0}")]
@@ -45,14 +57,21 @@ pub enum ErrorKind {
     #[error("byte order: {0}")]
     ByteOrder(String),
     #[error("no array named {name:?} (available: {available:?})")]
-    MissingArray { name: String, available: Vec<String> },
+    MissingArray {
+        name: String,
+        available: Vec<String>,
+    },
     #[error("unsupported: {0}")]
     Unsupported(String),
     #[error("unrecognised file format: {0}")]
     UnknownFormat(String),
     /// A named data set's file is absent from the data directory.
     #[error("missing data file {file} (for data set {dataset}); public copy: {origin}")]
-    MissingDataFile { dataset: String, file: String, origin: String },
+    MissingDataFile {
+        dataset: String,
+        file: String,
+        origin: String,
+    },
     #[error("{0}")]
     Invalid(String),
 }
@@ -67,10 +86,18 @@ pub struct LoadError {
 
 impl LoadError {
     pub fn new(path: impl Into<PathBuf>, kind: ErrorKind) -> Self {
-        LoadError { path: path.into(), location: None, kind }
+        LoadError {
+            path: path.into(),
+            location: None,
+            kind,
+        }
     }
     pub fn at(path: impl Into<PathBuf>, location: Location, kind: ErrorKind) -> Self {
-        LoadError { path: path.into(), location: Some(location), kind }
+        LoadError {
+            path: path.into(),
+            location: Some(location),
+            kind,
+        }
     }
 }
 

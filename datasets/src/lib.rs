@@ -17,5 +17,7 @@ pub mod write_vtu;
 
 pub use error::{ErrorKind, LoadError, Location};
 pub use load::{Dataset, LoadOptions, Plot3dField};
-pub use mesh::{Aabb, BoundaryFace, QualityStats, RepairReport, TetMesh, UniqueFaces, NO_NEIGHBOUR, TET_FACES};
+pub use mesh::{
+    Aabb, BoundaryFace, QualityStats, RepairReport, TetMesh, UniqueFaces, NO_NEIGHBOUR, TET_FACES,
+};
 pub use volume::VoxelGrid;

@@ -242,7 +242,10 @@ impl TetMesh {
                     }
                 }
                 let lmax3 = lmax2 * lmax2.sqrt();
-                if !(v6.abs() / 6.0 > DEGENERATE_RELATIVE_VOLUME * lmax3) {
+                // Written so that a NaN volume also counts as degenerate.
+                #[allow(clippy::neg_cmp_op_on_partial_ord)]
+                let degenerate = !(v6.abs() / 6.0 > DEGENERATE_RELATIVE_VOLUME * lmax3);
+                if degenerate {
                     None
                 } else if v6 < 0.0 {
                     Some([t[0], t[2], t[1], t[3]])

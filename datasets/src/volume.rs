@@ -195,7 +195,7 @@ pub fn hex_cell_tets(dims: [usize; 3], i: usize, j: usize, k: usize) -> [[u32; 4
     };
     // Corners: c[b] with b = dx + 2 dy + 4 dz.
     let c: [u32; 8] = std::array::from_fn(|b| idx(b & 1, (b >> 1) & 1, (b >> 2) & 1));
-    if (i + j + k) % 2 == 0 {
+    if (i + j + k).is_multiple_of(2) {
         // Central tet on corners 1, 2, 4, 7 (its edges are the face diagonals).
         [
             [c[0], c[1], c[2], c[4]],

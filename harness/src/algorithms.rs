@@ -69,7 +69,7 @@ impl SettingsFilter {
         self.terms
             .iter()
             .all(|(k, values)| match settings.iter().find(|s| s.key == k) {
-                Some(s) => values.iter().any(|v| *v == s.value),
+                Some(s) => values.contains(&s.value),
                 None => true,
             })
     }

@@ -473,14 +473,14 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
         (Some(c), _) => c.clone(),
         _ => "unknown".into(),
     };
-    let _ = write!(
+    let _ = writeln!(
         h,
         "<h2>Machine and run</h2><dl>\
          <dt>GPU adapter</dt><dd>{}</dd><dt>CPU</dt><dd>{} ({} logical cores)</dd><dt>memory</dt><dd>{}</dd>\
          <dt>OS</dt><dd>{} {}</dd><dt>tetbench</dt><dd>{} at commit {}</dd><dt>started</dt><dd>{}</dd>\
          <dt>finished</dt><dd>{}</dd><dt>command</dt><dd><code>{}</code></dd>\
          <dt>viewpoints</dt><dd>{}</dd><dt>viewport</dt><dd>{}×{}, {}</dd><dt>frames</dt><dd>{} timed after {} warm-up</dd>\
-         <dt>transfer function</dt><dd>{}</dd></dl>\n",
+         <dt>transfer function</dt><dd>{}</dd></dl>",
         esc(&adapter),
         esc(&m.cpu_model),
         m.cpu_cores,
@@ -558,12 +558,12 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
     }
     h.push_str("</table>\n");
 
-    let _ = write!(
+    let _ = writeln!(
         h,
         "<h2>Images</h2><p>Each rendering beside its error heatmap (largest channel error per pixel: black ≤ 1/255, \
          then a log scale up to ≥ {HEATMAP_MAX_ERROR} in pale yellow); the exact reference first. PSNR over \
          premultiplied linear RGB, capped at {PSNR_CAP_DB} dB; “bad” pixels are covered pixels off by more than \
-         1/255 ({ONE_STEP:.4}) in any channel.</p>\n"
+         1/255 ({ONE_STEP:.4}) in any channel.</p>"
     );
     let mut views: Vec<(String, String)> = vec![];
     for row in &file.rows {

@@ -76,17 +76,14 @@ pub fn table1(n: usize, repeats: usize) -> anyhow::Result<Vec<SortRow>> {
     type SortFn = Box<dyn Fn(&[f32], &mut Vec<u32>)>;
     let radix = std::cell::RefCell::new(RadixScratch::default());
     let sorts: Vec<(&'static str, SortFn)> = vec![
-        ("shellsort", Box::new(|k, i| shellsort_indices(k, i))),
-        ("heapsort", Box::new(|k, i| heapsort_indices(k, i))),
-        ("quicksort", Box::new(|k, i| quicksort_indices(k, i))),
+        ("shellsort", Box::new(shellsort_indices)),
+        ("heapsort", Box::new(heapsort_indices)),
+        ("quicksort", Box::new(quicksort_indices)),
         (
             "radix sort (HAVS §5.1)",
             Box::new(move |k, i| radix_sort_indices(k, i, &mut radix.borrow_mut())),
         ),
-        (
-            "std sort_unstable_by",
-            Box::new(|k, i| std_sort_indices(k, i)),
-        ),
+        ("std sort_unstable_by", Box::new(std_sort_indices)),
     ];
     let mut rows = vec![];
     for (name, sort) in sorts {

@@ -46,7 +46,8 @@ fn wanted_features() -> wgpu::Features {
 impl Gpu {
     /// Opens the first adapter (high-performance preferred; software adapters allowed).
     pub fn new() -> anyhow::Result<Gpu> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,
@@ -87,20 +88,28 @@ impl Gpu {
     }
 
     pub fn has_timestamps(&self) -> bool {
-        self.features.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
+        self.features.contains(
+            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
+        )
     }
 
     /// Largest storage buffer one binding may cover (128 MiB on lavapipe), rounded down to a
     /// multiple of 256 bytes so chunks stay aligned for any element size up to 256.
     pub fn max_storage_binding(&self) -> u64 {
-        let m = (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size);
+        let m = self
+            .limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size);
         m & !255
     }
 
     /// Blocks until all submitted work is done.
     pub fn wait(&self) -> anyhow::Result<()> {
         self.device
-            .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
+            .poll(wgpu::PollType::Wait {
+                submission_index: None,
+                timeout: None,
+            })
             .map(|_| ())
             .map_err(|e| anyhow!("waiting for the GPU: {e}"))
     }
@@ -108,14 +117,20 @@ impl Gpu {
     /// Loads a WGSL module; `source` is normally `include_str!("name.wgsl")` of a shader file
     /// beside the algorithm's Rust.
     pub fn shader(&self, label: &str, source: &str) -> wgpu::ShaderModule {
-        self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(label),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        })
+        self.device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(label),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            })
     }
 
     /// Copies a buffer range to the host (blocking).
-    pub fn read_buffer(&self, buffer: &wgpu::Buffer, offset: u64, size: u64) -> anyhow::Result<Vec<u8>> {
+    pub fn read_buffer(
+        &self,
+        buffer: &wgpu::Buffer,
+        offset: u64,
+        size: u64,
+    ) -> anyhow::Result<Vec<u8>> {
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size,
@@ -137,7 +152,10 @@ impl Gpu {
         rx.recv()
             .map_err(|_| anyhow!("readback callback dropped"))?
             .map_err(|e| anyhow!("mapping readback buffer: {e}"))?;
-        let data = staging.get_mapped_range(..).map_err(|e| anyhow!("mapped range: {e:?}"))?.to_vec();
+        let data = staging
+            .get_mapped_range(..)
+            .map_err(|e| anyhow!("mapped range: {e:?}"))?
+            .to_vec();
         staging.unmap();
         Ok(data)
     }
@@ -164,7 +182,11 @@ impl Gpu {
                     rows_per_image: Some(h),
                 },
             },
-            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
         );
         self.queue.submit([enc.finish()]);
         let bytes = self.map_and_copy(&staging)?;
@@ -215,7 +237,12 @@ impl MemoryLedger {
     ) -> wgpu::Buffer {
         let size = size.max(16).div_ceil(4) * 4;
         self.record(label, lifetime, size);
-        gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+        gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage,
+            mapped_at_creation: false,
+        })
     }
 
     /// Creates a buffer holding `data` and records it.
@@ -227,16 +254,31 @@ impl MemoryLedger {
         data: &[u8],
         usage: wgpu::BufferUsages,
     ) -> wgpu::Buffer {
-        let buf = self.buffer(gpu, label, lifetime, data.len() as u64, usage | wgpu::BufferUsages::COPY_DST);
+        let buf = self.buffer(
+            gpu,
+            label,
+            lifetime,
+            data.len() as u64,
+            usage | wgpu::BufferUsages::COPY_DST,
+        );
         gpu.queue.write_buffer(&buf, 0, data);
         buf
     }
 
     /// Creates a texture and records its size.
-    pub fn texture(&mut self, gpu: &Gpu, lifetime: Lifetime, desc: &wgpu::TextureDescriptor) -> wgpu::Texture {
+    pub fn texture(
+        &mut self,
+        gpu: &Gpu,
+        lifetime: Lifetime,
+        desc: &wgpu::TextureDescriptor,
+    ) -> wgpu::Texture {
         let texel = desc.format.block_copy_size(None).unwrap_or(4) as u64;
         let s = desc.size;
-        self.record(desc.label.unwrap_or("texture"), lifetime, texel * s.width as u64 * s.height as u64 * s.depth_or_array_layers as u64);
+        self.record(
+            desc.label.unwrap_or("texture"),
+            lifetime,
+            texel * s.width as u64 * s.height as u64 * s.depth_or_array_layers as u64,
+        );
         gpu.device.create_texture(desc)
     }
 
@@ -249,7 +291,9 @@ impl MemoryLedger {
 /// Large meshes (20 M tets = 320 MB of indices) are drawn chunk by chunk, never refused.
 pub fn chunk_ranges(count: u64, element_bytes: u64, max_binding: u64) -> Vec<std::ops::Range<u64>> {
     let per = (max_binding / element_bytes).max(1);
-    (0..count.div_ceil(per)).map(|i| i * per..((i + 1) * per).min(count)).collect()
+    (0..count.div_ceil(per))
+        .map(|i| i * per..((i + 1) * per).min(count))
+        .collect()
 }
 
 /// GPU time of a frame from two timestamps, and wall time from CPU clocks.
@@ -278,7 +322,12 @@ impl FrameTimer {
         } else {
             (None, None)
         };
-        FrameTimer { query_set, resolve, period_ns: gpu.queue.get_timestamp_period(), started: Instant::now() }
+        FrameTimer {
+            query_set,
+            resolve,
+            period_ns: gpu.queue.get_timestamp_period(),
+            started: Instant::now(),
+        }
     }
 
     /// Restarts the wall clock (call at the start of the frame, before CPU work).
@@ -308,10 +357,14 @@ impl FrameTimer {
 
     /// GPU milliseconds between begin and end (after the work was submitted; blocks).
     pub fn gpu_ms(&self, gpu: &Gpu) -> anyhow::Result<Option<f64>> {
-        let Some(buf) = &self.resolve else { return Ok(None) };
+        let Some(buf) = &self.resolve else {
+            return Ok(None);
+        };
         let bytes = gpu.read_buffer(buf, 0, 16)?;
         let t: &[u64] = bytemuck::cast_slice(&bytes);
-        Ok(Some(t[1].saturating_sub(t[0]) as f64 * self.period_ns as f64 * 1e-6))
+        Ok(Some(
+            t[1].saturating_sub(t[0]) as f64 * self.period_ns as f64 * 1e-6,
+        ))
     }
 }
 
@@ -337,11 +390,21 @@ mod device_tests {
         let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
         let mut ledger = MemoryLedger::default();
         let data: Vec<u32> = (0..1000).collect();
-        let buf = ledger.buffer_init(&gpu, "test", Lifetime::Persistent, bytemuck::cast_slice(&data), wgpu::BufferUsages::COPY_SRC);
+        let buf = ledger.buffer_init(
+            &gpu,
+            "test",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&data),
+            wgpu::BufferUsages::COPY_SRC,
+        );
         let back = gpu.read_buffer(&buf, 0, 4000).unwrap();
         assert_eq!(bytemuck::cast_slice::<u8, u32>(&back), &data[..]);
         assert_eq!(ledger.persistent, 4000);
         assert!(!gpu.adapter.name.is_empty());
-        eprintln!("adapter: {:?}, timestamps: {}", gpu.adapter, gpu.has_timestamps());
+        eprintln!(
+            "adapter: {:?}, timestamps: {}",
+            gpu.adapter,
+            gpu.has_timestamps()
+        );
     }
 }

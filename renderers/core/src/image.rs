@@ -12,7 +12,11 @@ pub struct Image {
 
 impl Image {
     pub fn new(width: u32, height: u32) -> Image {
-        Image { width, height, pixels: vec![[0.0; 4]; (width * height) as usize] }
+        Image {
+            width,
+            height,
+            pixels: vec![[0.0; 4]; (width * height) as usize],
+        }
     }
     pub fn get(&self, x: u32, y: u32) -> [f32; 4] {
         self.pixels[(y * self.width + x) as usize]
@@ -27,7 +31,8 @@ impl Image {
         for (i, p) in self.pixels.iter().enumerate() {
             let x = i as u32 % self.width;
             let y = i as u32 / self.width;
-            let c = [p[0], p[1], p[2]].map(|v| (linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8);
+            let c =
+                [p[0], p[1], p[2]].map(|v| (linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8);
             out.put_pixel(x, y, image::Rgba([c[0], c[1], c[2], 255]));
         }
         out

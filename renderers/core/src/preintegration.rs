@@ -580,9 +580,9 @@ mod tests {
     #[test]
     fn psi_closed_forms_and_limits() {
         assert!((psi(0.0, 0.0) - 1.0).abs() < 1e-15);
-        for a in [1e-6, 0.01, 0.5, 1.0, 3.0, 15.9, 16.1, 100.0, 1e4] {
+        for a in [1e-6f64, 0.01, 0.5, 1.0, 3.0, 15.9, 16.1, 100.0, 1e4] {
             // Constant extinction: ψ = (1 − e^(−a))/a.
-            let exact = -(-a as f64).exp_m1() / a;
+            let exact = -(-a).exp_m1() / a;
             assert!(
                 (psi(a, a) - exact).abs() < 1e-14,
                 "a={a}: {} vs {exact}",
@@ -634,7 +634,7 @@ mod tests {
             (1.0, 0.0, 1e-4),
             (0.2, 0.9, 20.0),
         ] {
-            let alpha = 1.0 - (-3.0 * l as f64).exp();
+            let alpha = 1.0 - (-3.0f64 * l).exp();
             let got = integrate_segment(&tf, sf, sb, l);
             let want = [0.25 * alpha, 0.5 * alpha, alpha, alpha];
             assert!(max_diff(got, want) < 1e-14, "{got:?} vs {want:?}");

@@ -20,13 +20,20 @@ pub struct Setting {
 
 impl Setting {
     pub fn new(key: &'static str, value: impl ToString) -> Setting {
-        Setting { key, value: value.to_string() }
+        Setting {
+            key,
+            value: value.to_string(),
+        }
     }
 }
 
 /// Renders settings as `key=value;key=value`, the `settings` column of the results.
 pub fn settings_string(settings: &[Setting]) -> String {
-    settings.iter().map(|s| format!("{}={}", s.key, s.value)).collect::<Vec<_>>().join(";")
+    settings
+        .iter()
+        .map(|s| format!("{}={}", s.key, s.value))
+        .collect::<Vec<_>>()
+        .join(";")
 }
 
 /// What [`Renderer::prepare`] uploaded.

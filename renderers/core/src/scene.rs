@@ -12,7 +12,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Projection {
     /// Vertical field of view in degrees (30° by default, as for the HAVS tables).
-    Perspective { fovy_deg: f64 },
+    Perspective {
+        fovy_deg: f64,
+    },
     Orthographic,
 }
 
@@ -34,7 +36,10 @@ pub struct Viewpoint {
 impl Viewpoint {
     pub fn new(name: impl Into<String>, direction: [f64; 3]) -> Viewpoint {
         let d = DVec3::from(direction).normalize();
-        Viewpoint { name: name.into(), direction: d.into() }
+        Viewpoint {
+            name: name.into(),
+            direction: d.into(),
+        }
     }
 }
 
@@ -45,14 +50,20 @@ pub fn fixed_viewpoints() -> Vec<Viewpoint> {
         for sign in [1.0, -1.0] {
             let mut d = [0.0; 3];
             d[axis] = sign;
-            v.push(Viewpoint::new(format!("{}{name}", if sign > 0.0 { '+' } else { '-' }), d));
+            v.push(Viewpoint::new(
+                format!("{}{name}", if sign > 0.0 { '+' } else { '-' }),
+                d,
+            ));
         }
     }
     for sx in [1.0, -1.0] {
         for sy in [1.0, -1.0] {
             for sz in [1.0, -1.0] {
                 let s = |x: f64| if x > 0.0 { '+' } else { '-' };
-                v.push(Viewpoint::new(format!("{}x{}y{}z", s(sx), s(sy), s(sz)), [sx, sy, sz]));
+                v.push(Viewpoint::new(
+                    format!("{}x{}y{}z", s(sx), s(sy), s(sz)),
+                    [sx, sy, sz],
+                ));
             }
         }
     }
@@ -66,7 +77,11 @@ pub fn orbit_viewpoints(n: usize) -> Vec<Viewpoint> {
     (0..n)
         .map(|i| {
             let a = std::f64::consts::TAU * i as f64 / n as f64;
-            let d = [elevation.cos() * a.sin(), elevation.sin(), elevation.cos() * a.cos()];
+            let d = [
+                elevation.cos() * a.sin(),
+                elevation.sin(),
+                elevation.cos() * a.cos(),
+            ];
             Viewpoint::new(format!("orbit{:03}of{n}", i), d)
         })
         .collect()
@@ -97,7 +112,13 @@ pub struct Ray {
 
 impl Camera {
     /// Fits the mesh's bounding sphere into the view from `viewpoint`.
-    pub fn fit(bounds: &Aabb, viewpoint: &Viewpoint, projection: Projection, width: u32, height: u32) -> Camera {
+    pub fn fit(
+        bounds: &Aabb,
+        viewpoint: &Viewpoint,
+        projection: Projection,
+        width: u32,
+        height: u32,
+    ) -> Camera {
         let center = DVec3::from(bounds.center());
         let radius = 0.5 * bounds.diagonal().max(1e-30);
         let dir = DVec3::from(viewpoint.direction).normalize();
@@ -113,7 +134,11 @@ impl Camera {
             Projection::Orthographic => (2.0 * radius, radius * (1.0f64).max(1.0 / aspect)),
         };
         let eye = center + dir * distance;
-        let up = if dir.y.abs() > 0.99 { DVec3::Z } else { DVec3::Y };
+        let up = if dir.y.abs() > 0.99 {
+            DVec3::Z
+        } else {
+            DVec3::Y
+        };
         Camera {
             eye: eye.into(),
             target: center.into(),
@@ -166,7 +191,9 @@ impl Camera {
 
     /// Unit vector along which the camera looks.
     pub fn forward(&self) -> [f64; 3] {
-        (DVec3::from(self.target) - DVec3::from(self.eye)).normalize().into()
+        (DVec3::from(self.target) - DVec3::from(self.eye))
+            .normalize()
+            .into()
     }
 
     /// The ray through the image point (`px`, `py`) in pixels (pixel centres at +½).
@@ -181,8 +208,15 @@ impl Camera {
         let a = unproject(0.0);
         let b = unproject(1.0);
         let dir = (b - a).normalize();
-        let origin = if self.is_perspective() { DVec3::from(self.eye) } else { a };
-        Ray { origin: origin.into(), dir: dir.into() }
+        let origin = if self.is_perspective() {
+            DVec3::from(self.eye)
+        } else {
+            a
+        };
+        Ray {
+            origin: origin.into(),
+            dir: dir.into(),
+        }
     }
 
     /// The ray through the centre of pixel (`x`, `y`).
@@ -206,7 +240,11 @@ impl Camera {
     pub fn project_to_pixel(&self, p: [f64; 3]) -> [f64; 3] {
         let c = self.view_proj() * DVec4::new(p[0], p[1], p[2], 1.0);
         let ndc = c.truncate() / c.w;
-        [(ndc.x + 1.0) * 0.5 * self.width as f64, (1.0 - ndc.y) * 0.5 * self.height as f64, ndc.z]
+        [
+            (ndc.x + 1.0) * 0.5 * self.width as f64,
+            (1.0 - ndc.y) * 0.5 * self.height as f64,
+            ndc.z,
+        ]
     }
 }
 
@@ -226,7 +264,10 @@ mod tests {
 
     #[test]
     fn centre_pixel_ray_hits_target_and_projection_inverts() {
-        let b = Aabb { min: [-1.0, -2.0, 0.0], max: [3.0, 1.0, 2.0] };
+        let b = Aabb {
+            min: [-1.0, -2.0, 0.0],
+            max: [3.0, 1.0, 2.0],
+        };
         for vp in fixed_viewpoints() {
             for proj in [Projection::default(), Projection::Orthographic] {
                 let cam = Camera::fit(&b, &vp, proj, 64, 48);
@@ -243,7 +284,14 @@ mod tests {
                 for c in 0..8 {
                     let p = [0, 1, 2].map(|a| if c >> a & 1 == 1 { b.max[a] } else { b.min[a] });
                     let q = cam.project_to_pixel(p);
-                    assert!(q[0] >= 0.0 && q[0] <= 64.0 && q[1] >= 0.0 && q[1] <= 48.0 && q[2] > 0.0 && q[2] < 1.0);
+                    assert!(
+                        q[0] >= 0.0
+                            && q[0] <= 64.0
+                            && q[1] >= 0.0
+                            && q[1] <= 48.0
+                            && q[2] > 0.0
+                            && q[2] < 1.0
+                    );
                 }
             }
         }
