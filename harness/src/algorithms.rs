@@ -1,5 +1,6 @@
-//! The algorithms `tetbench run` knows: name → constructor of its default variants (one
-//! renderer per combination of the paper's settings that the tables compare).
+//! The algorithms `tetbench run` knows: name → constructors of its default variants (one
+//! renderer per combination of the paper's settings that the tables compare) and of every
+//! variant it offers (what `--settings` selects from).
 //!
 //! To add an algorithm, add one line to [`TABLE`].
 
@@ -7,24 +8,70 @@ use render_core::Renderer;
 
 type Variants = fn() -> Vec<Box<dyn Renderer>>;
 
-/// Name on the command line and in result rows → its variants, in the order they are run.
-const TABLE: &[(&str, Variants)] = &[
-    ("gator-pt", gator_pt::default_variants),
-    ("havs", havs::default_variants),
-    ("fragment-pt", fragment_pt::default_variants),
+/// Name on the command line and in result rows → (default variants, every variant), each in
+/// the order they are run.
+const TABLE: &[(&str, Variants, Variants)] = &[
+    ("gator-pt", gator_pt::default_variants, all_gator_variants),
+    ("havs", havs::default_variants, havs::all_variants),
+    (
+        "fragment-pt",
+        fragment_pt::default_variants,
+        fragment_pt::all_variants,
+    ),
 ];
+
+fn all_gator_variants() -> Vec<Box<dyn Renderer>> {
+    gator_pt::variants(&render_core::visibility::VisibilityOrder::ALL)
+}
 
 /// Every algorithm's name, in table order.
 pub fn names() -> Vec<&'static str> {
-    TABLE.iter().map(|(n, _)| *n).collect()
+    TABLE.iter().map(|(n, _, _)| *n).collect()
+}
+
+fn entry(name: &str) -> anyhow::Result<&'static (&'static str, Variants, Variants)> {
+    TABLE
+        .iter()
+        .find(|(n, _, _)| *n == name)
+        .ok_or_else(|| anyhow::anyhow!("unknown algorithm {name:?}; known: {}", names().join(", ")))
 }
 
 /// The default variants of `name`, or an error listing the known names.
 pub fn variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
-    match TABLE.iter().find(|(n, _)| *n == name) {
-        Some((_, make)) => Ok(make()),
-        None => anyhow::bail!("unknown algorithm {name:?}; known: {}", names().join(", ")),
+    Ok((entry(name)?.1)())
+}
+
+/// The variants of `name` that `filter` selects. Drawn from every variant the algorithm offers:
+/// a setting the filter names must take one of the listed values; a setting it does not name
+/// keeps the values the default variants use. So no filter gives exactly the defaults,
+/// `sort=mpvonc` gives GATOR's two cell models with the exact order, and `k=8` gives HAVS k = 8
+/// with both sorts and otherwise default settings.
+pub fn selected_variants(
+    name: &str,
+    filter: &SettingsFilter,
+) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+    let (_, defaults, all) = entry(name)?;
+    let defaults = defaults();
+    if filter.is_empty() {
+        return Ok(defaults);
     }
+    let default_settings: Vec<Vec<render_core::Setting>> =
+        defaults.iter().map(|r| r.settings()).collect();
+    let default_has = |s: &render_core::Setting| {
+        default_settings
+            .iter()
+            .flatten()
+            .any(|d| d.key == s.key && d.value == s.value)
+    };
+    Ok(all()
+        .into_iter()
+        .filter(|r| {
+            r.settings().iter().all(|s| match filter.values(s.key) {
+                Some(values) => values.contains(&s.value),
+                None => default_has(s),
+            })
+        })
+        .collect())
 }
 
 /// A `--settings` filter: `key=value;key=value`, where a value may list alternatives
@@ -62,6 +109,14 @@ impl SettingsFilter {
 
     pub fn is_empty(&self) -> bool {
         self.terms.is_empty()
+    }
+
+    /// The values asked for `key`, if the filter names it.
+    pub fn values(&self, key: &str) -> Option<&[String]> {
+        self.terms
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_slice())
     }
 
     /// Whether a renderer with these settings passes the filter.
@@ -122,6 +177,52 @@ mod tests {
         assert!(SettingsFilter::parse("=x").is_err());
         assert!(SettingsFilter::parse("").unwrap().is_empty());
         assert_eq!(f.to_string(), "variant=linear;k=2|6");
+    }
+
+    fn settings_of(name: &str, filter: &str) -> Vec<String> {
+        let f = SettingsFilter::parse(filter).unwrap();
+        selected_variants(name, &f)
+            .unwrap()
+            .iter()
+            .map(|r| {
+                r.settings()
+                    .iter()
+                    .map(|s| format!("{}={}", s.key, s.value))
+                    .collect::<Vec<_>>()
+                    .join(";")
+            })
+            .collect()
+    }
+
+    #[test]
+    fn filters_select_beyond_the_defaults_and_keep_other_defaults() {
+        // No filter: exactly the defaults.
+        for name in names() {
+            assert_eq!(
+                selected_variants(name, &SettingsFilter::default())
+                    .unwrap()
+                    .len(),
+                variants(name).unwrap().len()
+            );
+        }
+        assert_eq!(
+            settings_of("gator-pt", "sort=mpvonc|bucket"),
+            [
+                "variant=constant;sort=bucket",
+                "variant=linear;sort=bucket",
+                "variant=constant;sort=mpvonc",
+                "variant=linear;sort=mpvonc"
+            ]
+        );
+        let havs = settings_of("havs", "k=8|16");
+        assert_eq!(havs.len(), 4, "{havs:?}");
+        assert!(havs
+            .iter()
+            .all(|s| s.contains("tags=two") && s.contains("mode=") && s.contains("et=on")));
+        let race = settings_of("havs", "k=6;sort=cpu-radix;mode=race-free");
+        assert_eq!(race.len(), 1, "{race:?}");
+        let frag = settings_of("fragment-pt", "sort=mpvonc");
+        assert_eq!(frag.len(), 2, "{frag:?}");
     }
 
     #[test]

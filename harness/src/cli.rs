@@ -236,7 +236,10 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
     match cli.command {
         Command::Run(args) => {
             let config = args.to_config(cli.data_dir, command_line)?;
-            let outcome = run::run(&config, &algorithms::variants)?;
+            let filter = config.settings_filter.clone();
+            let outcome = run::run(&config, &|name: &str| {
+                algorithms::selected_variants(name, &filter)
+            })?;
             println!(
                 "{} rows in {:.1} s; results in {} (open {})",
                 outcome.rows,

@@ -53,8 +53,8 @@ pub struct RunConfig {
     pub report: bool,
 }
 
-/// Makes the variants of an algorithm by name (normally [`crate::algorithms::variants`]; tests
-/// pass their own).
+/// Makes the variants of an algorithm by name (normally
+/// [`crate::algorithms::selected_variants`] with the run's filter; tests pass their own).
 pub type VariantFactory<'a> = &'a dyn Fn(&str) -> anyhow::Result<Vec<Box<dyn Renderer>>>;
 
 /// What a finished run produced.
@@ -221,6 +221,10 @@ fn plan_variants(
             .filter(|r| config.settings_filter.accepts(&r.settings()))
             .count();
         all_settings.extend(variants.iter().map(|r| r.settings()));
+        // The filter may have selected nothing of this algorithm; its keys still exist.
+        if let Ok(defaults) = crate::algorithms::variants(name) {
+            all_settings.extend(defaults.iter().map(|r| r.settings()));
+        }
         kept.push((name.clone(), n));
     }
     let unknown = config.settings_filter.unknown_keys(&all_settings);
@@ -321,6 +325,7 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
             optics: &optics,
             label: label.clone(),
             references: HashMap::new(),
+            reference_mesh: None,
         };
         for (name, _) in &plan {
             let variants = factory(name)?;
@@ -350,6 +355,9 @@ struct DatasetContext<'a> {
     label: String,
     /// Reference image per viewpoint (or why there is none), rendered on first need.
     references: HashMap<String, Result<(Image, String), String>>,
+    /// The reference renderer's per-mesh data (planes, boundary bins), built on the first
+    /// cache miss and shared by every viewpoint (0.3 s per view saved on Blunt Fin).
+    reference_mesh: Option<reference::Prepared<'a>>,
 }
 
 /// The row's fixed parts, before measuring.
@@ -456,8 +464,15 @@ impl DatasetContext<'_> {
         progress.status(&format!("reference {} {}", self.label, vp.name));
         let (dir, rel) = self.images_dir(vp);
         let cache = &self.config.cache_dir;
+        let (mesh, optics) = (self.mesh, self.optics);
+        let prepared = &mut self.reference_mesh;
         let r = guarded("the reference renderer", || {
-            let img = reference::render_cached(self.mesh, self.optics, camera, cache)?;
+            let img = match reference::read_cached(mesh, optics, camera, cache) {
+                Some(img) => img,
+                None => prepared
+                    .get_or_insert_with(|| reference::Prepared::new(mesh))
+                    .render_cached(optics, camera, cache)?,
+            };
             std::fs::create_dir_all(&dir)
                 .with_context(|| format!("cannot create {}", dir.display()))?;
             img.save_png(&dir.join("reference.png"))?;

@@ -359,7 +359,10 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
             vec!["tetbench analyze resolution".into()],
         )?;
         eprintln!("resolution sweep: {res}×{res}");
-        let outcome = crate::run::run(&config, &crate::algorithms::variants)?;
+        let filter = config.settings_filter.clone();
+        let outcome = crate::run::run(&config, &|name: &str| {
+            crate::algorithms::selected_variants(name, &filter)
+        })?;
         if !outcome.all_ok() {
             eprintln!(
                 "WARNING: {} of {} rows failed at {res}²: {:?}",

@@ -118,6 +118,32 @@ pub fn default_variants() -> Vec<Box<dyn Renderer>> {
     v
 }
 
+/// Every combination the paper's analysis and this harness vary, from which `tetbench run
+/// --settings …` selects: k ∈ {2, 3, 4, 5, 6, 8, 16} × sort × tag scheme × race mode × early
+/// termination (the table sizes stay at their defaults).
+pub fn all_variants() -> Vec<Box<dyn Renderer>> {
+    let mut v: Vec<Box<dyn Renderer>> = Vec::new();
+    for sort in [SortMode::CpuRadix, SortMode::GpuRadix] {
+        for k in [2, 3, 4, 5, 6, 8, 16] {
+            for tags in [TagScheme::Two, TagScheme::Single] {
+                for mode in [Mode::FragmentRace, Mode::RaceFree] {
+                    for early_termination in [true, false] {
+                        v.push(Box::new(Havs::new(HavsSettings {
+                            k,
+                            sort,
+                            tags,
+                            mode,
+                            early_termination,
+                            ..Default::default()
+                        })));
+                    }
+                }
+            }
+        }
+    }
+    v
+}
+
 /// The HAVS renderer.
 pub struct Havs {
     pub settings: HavsSettings,

@@ -671,6 +671,22 @@ pub fn render_cached(
     Ok(img)
 }
 
+/// The cached reference image for these inputs, if a valid one exists (nothing is rendered).
+pub fn read_cached(
+    mesh: &TetMesh,
+    optics: &Optics,
+    camera: &Camera,
+    cache_dir: &Path,
+) -> Option<Image> {
+    let key = cache_key(mesh, optics, camera);
+    read_cache(
+        &cache_path(cache_dir, &key),
+        &key,
+        camera.width,
+        camera.height,
+    )
+}
+
 /// Where [`render_cached`] keeps the image for these inputs.
 pub fn cache_file(mesh: &TetMesh, optics: &Optics, camera: &Camera, cache_dir: &Path) -> PathBuf {
     cache_path(cache_dir, &cache_key(mesh, optics, camera))
