@@ -488,16 +488,7 @@ impl Renderer for FragmentPt {
         );
 
         let m1 = gpu.shader("fragment-pt pass 1", include_str!("pass1.wgsl"));
-        let pass1 = gpu
-            .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("fragment-pt pass 1"),
-                layout: None,
-                module: &m1,
-                entry_point: Some("classify"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
+        let pass1 = gpu.compute_pipeline("fragment-pt pass 1", None, &m1, "classify");
         let pass1_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("fragment-pt pass 1"),
             layout: &pass1.get_bind_group_layout(0),
@@ -551,38 +542,17 @@ impl Renderer for FragmentPt {
                 bind_group_layouts: &[Some(&pass2_layout)],
                 immediate_size: 0,
             });
-        let pass2 = gpu
-            .device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("fragment-pt pass 2"),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &m2,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &m2,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: wgpu::TextureFormat::Rgba32Float,
-                        // Back to front, premultiplied: dst = src + (1 − src.a) · dst.
-                        blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
+        // Back to front, premultiplied: dst = src + (1 − src.a) · dst.
+        let pass2 = gpu.triangle_pipeline(
+            "fragment-pt pass 2",
+            &pipeline_layout,
+            &m2,
+            "vs_main",
+            fs,
+            wgpu::TextureFormat::Rgba32Float,
+            Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+            wgpu::ColorWrites::ALL,
+        );
         let pass2_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("fragment-pt pass 2"),
             layout: &pass2_layout,

@@ -552,45 +552,16 @@ impl Renderer for GatorPt {
                 immediate_size: 0,
             });
         // Premultiplied "over", back to front: dst = src + (1 − src_α)·dst.
-        let over = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let pipeline = gpu
-            .device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("gator"),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &shader,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &shader,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: wgpu::TextureFormat::Rgba32Float,
-                        blend: Some(wgpu::BlendState {
-                            color: over,
-                            alpha: over,
-                        }),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
+        let pipeline = gpu.triangle_pipeline(
+            "gator",
+            &layout,
+            &shader,
+            "vs_main",
+            "fs_main",
+            wgpu::TextureFormat::Rgba32Float,
+            Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+            wgpu::ColorWrites::ALL,
+        );
 
         let n = mesh.num_tets() as u64;
         // The order is rewritten every frame: per-frame memory, not per mesh.
@@ -885,16 +856,12 @@ pub fn classify_gpu(
             bind_group_layouts: &[Some(&mesh.g0_layout), Some(&g1_layout)],
             immediate_size: 0,
         });
-    let pipeline = gpu
-        .device
-        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("gator classify debug"),
-            layout: Some(&layout),
-            module: &shader,
-            entry_point: Some("classify_debug"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+    let pipeline = gpu.compute_pipeline(
+        "gator classify debug",
+        Some(&layout),
+        &shader,
+        "classify_debug",
+    );
     let size = (tets.len().max(1) * std::mem::size_of::<GpuClassification>()) as u64;
     let out = ledger.buffer(
         gpu,

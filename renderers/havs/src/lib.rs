@@ -533,53 +533,27 @@ impl Renderer for Havs {
             Mode::FragmentRace => "fs_kbuffer",
             Mode::RaceFree => "fs_append",
         };
-        let draw_pipeline = gpu
-            .device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("havs draw"),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    front_face: wgpu::FrontFace::Ccw,
-                    // Every face is needed from both sides (entry and exit of a ray).
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(fs_entry),
-                    compilation_options: Default::default(),
-                    // wgpu needs an attachment; the k-buffer lives in storage, nothing is written.
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: wgpu::TextureFormat::R8Unorm,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::empty(),
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
-        let drain_pipeline = gpu
-            .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("havs drain"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(match s.mode {
-                    Mode::FragmentRace => "drain",
-                    Mode::RaceFree => "resolve_lists",
-                }),
-                compilation_options: Default::default(),
-                cache: None,
-            });
+        // Every face is needed from both sides (entry and exit of a ray). wgpu needs an attachment;
+        // the k-buffer lives in storage, so nothing is written to it.
+        let draw_pipeline = gpu.triangle_pipeline(
+            "havs draw",
+            &pipeline_layout,
+            &module,
+            "vs",
+            fs_entry,
+            wgpu::TextureFormat::R8Unorm,
+            None,
+            wgpu::ColorWrites::empty(),
+        );
+        let drain_pipeline = gpu.compute_pipeline(
+            "havs drain",
+            Some(&pipeline_layout),
+            &module,
+            match s.mode {
+                Mode::FragmentRace => "drain",
+                Mode::RaceFree => "resolve_lists",
+            },
+        );
 
         let gpu_sort = match s.sort {
             SortMode::CpuRadix => None,
@@ -708,16 +682,7 @@ impl GpuSortState {
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
         let module = gpu.shader("havs keys", include_str!("keys.wgsl"));
-        let key_pipeline = gpu
-            .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("havs face keys"),
-                layout: None,
-                module: &module,
-                entry_point: Some("face_keys"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
+        let key_pipeline = gpu.compute_pipeline("havs face keys", None, &module, "face_keys");
         let key_bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("havs keys"),
             layout: &key_pipeline.get_bind_group_layout(0),
