@@ -29,8 +29,13 @@ apt_install() {
 # A Vulkan driver: any installed ICD (a GPU's, or Mesa's lavapipe software rasteriser) plus the
 # Vulkan loader. On a machine with neither, Mesa's drivers give lavapipe.
 have_vulkan_icd() {
-    ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json /usr/local/share/vulkan/icd.d/*.json \
-        >/dev/null 2>&1
+    # Any one manifest will do (`ls a b c` would fail as soon as one directory has none).
+    local f
+    for f in /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json \
+        /usr/local/share/vulkan/icd.d/*.json; do
+        [ -e "$f" ] && return 0
+    done
+    return 1
 }
 have_vulkan_loader() {
     ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1' || ls /usr/lib/*/libvulkan.so.1 >/dev/null 2>&1
