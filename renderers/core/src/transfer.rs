@@ -68,6 +68,23 @@ impl TransferFunction {
         a.kappa + t * (b.kappa - a.kappa)
     }
 
+    /// The lookup table shaders sample: `entries` rows of (rgb = c(s), a = κ(s) per length
+    /// unit) at s = i / (entries − 1).
+    pub fn rgb_kappa_table(&self, entries: usize) -> Vec<[f32; 4]> {
+        (0..entries)
+            .map(|i| {
+                let s = i as f64 / (entries.max(2) - 1) as f64;
+                let c = self.color_at(s);
+                [
+                    c[0] as f32,
+                    c[1] as f32,
+                    c[2] as f32,
+                    self.kappa_at(s) as f32,
+                ]
+            })
+            .collect()
+    }
+
     /// Every scalar value where c or κ has a kink, sorted and deduplicated: exact integration
     /// splits a segment there so that each piece is linear in s.
     pub fn breakpoints(&self) -> Vec<f64> {

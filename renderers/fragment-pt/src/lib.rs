@@ -335,22 +335,6 @@ fn storage(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     }
 }
 
-/// The transfer function sampled for pass 2: rgb chromaticity and κ per length unit.
-fn tf_table(optics: &Optics) -> Vec<[f32; 4]> {
-    (0..TF_ENTRIES)
-        .map(|i| {
-            let s = i as f64 / (TF_ENTRIES - 1) as f64;
-            let c = optics.tf.color_at(s);
-            [
-                c[0] as f32,
-                c[1] as f32,
-                c[2] as f32,
-                optics.tf.kappa_at(s) as f32,
-            ]
-        })
-        .collect()
-}
-
 /// Shirley & Tuchman's exponential table: e^(−x) at x = i / (n − 1) · EXP_MAX_TAU.
 fn exp_table() -> Vec<f32> {
     (0..EXP_ENTRIES)
@@ -427,7 +411,7 @@ impl Renderer for FragmentPt {
             gpu,
             "fragment-pt transfer function",
             Lifetime::Persistent,
-            bytemuck::cast_slice(&tf_table(optics)),
+            bytemuck::cast_slice(&optics.tf.rgb_kappa_table(TF_ENTRIES)),
             storage_use,
         );
         let expt = ledger.buffer_init(

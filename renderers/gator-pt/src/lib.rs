@@ -261,22 +261,6 @@ fn lut_texture(
     texture.create_view(&Default::default())
 }
 
-/// Transfer-function table: rgb = c(s), a = κ(s) per length unit, s = i/(n−1).
-fn tf_table(optics: &Optics) -> Vec<[f32; 4]> {
-    (0..TF_LUT_SIZE)
-        .map(|i| {
-            let s = i as f64 / (TF_LUT_SIZE - 1) as f64;
-            let c = optics.tf.color_at(s);
-            [
-                c[0] as f32,
-                c[1] as f32,
-                c[2] as f32,
-                optics.tf.kappa_at(s) as f32,
-            ]
-        })
-        .collect()
-}
-
 /// Opacity table: α(τ) = 1 − exp(−τ) for τ = i/(n−1)·TAU_MAX.
 fn exp_table() -> Vec<f32> {
     (0..EXP_LUT_SIZE)
@@ -377,7 +361,7 @@ impl MeshGpu {
                 &default_optics
             }
         };
-        let tf = tf_table(optics);
+        let tf = optics.tf.rgb_kappa_table(TF_LUT_SIZE as usize);
         let tf_view = lut_texture(
             gpu,
             ledger,
