@@ -2,18 +2,15 @@
 
 use std::path::PathBuf;
 
-/// The data directory of the papers' data sets, or `None` (and a printed reason) when absent.
+/// The data directory of the papers' data sets, or `None` (and a printed reason) when absent;
+/// with `TETBENCH_REQUIRE_DATA=1` a missing directory fails the test instead
+/// (`datasets::registry::test_data_file`).
 pub fn data_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("TETBENCH_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/datasets"));
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "SKIPPED: data directory {} is absent (set TETBENCH_DATA)",
-            dir.display()
-        );
-        None
-    }
+    datasets::registry::test_data_file("MANIFEST.md").and_then(|p| p.parent().map(PathBuf::from))
+}
+
+/// One file of the data directory, or `None` with a printed skip (a failure under
+/// `TETBENCH_REQUIRE_DATA=1`).
+pub fn data_file(name: &str) -> Option<PathBuf> {
+    datasets::registry::test_data_file(name)
 }

@@ -129,14 +129,9 @@ fn fragment_pt_on_a_grid_is_within_bounds_of_the_reference() {
 
 #[test]
 fn fragment_pt_on_spx_is_within_bounds_of_the_reference() {
-    let Some(dir) = tetbench_tests::data_dir() else {
+    let Some(path) = tetbench_tests::data_file("spx.vtk") else {
         return;
     };
-    let path = dir.join("spx.vtk");
-    if !path.is_file() {
-        eprintln!("SKIPPED: {} is absent", path.display());
-        return;
-    }
     let mesh = datasets::load::load(&path, &Default::default())
         .unwrap()
         .mesh;

@@ -151,6 +151,26 @@ pub fn default_data_dir() -> Option<PathBuf> {
     is_data_dir(&src).then_some(src)
 }
 
+/// A file from the data directory, for tests and benches: `Some(path)` when it exists; else a
+/// printed `SKIPPED` line and `None` — or a panic naming the file when the environment sets
+/// `TETBENCH_REQUIRE_DATA=1` (CI, where the data directory is always laid out, so a missing file
+/// is a failure rather than a quiet pass).
+pub fn test_data_file(name: &str) -> Option<PathBuf> {
+    let found = default_data_dir()
+        .map(|d| d.join(name))
+        .filter(|p| p.is_file());
+    if found.is_none() {
+        let where_ = default_data_dir()
+            .map(|d| d.display().to_string())
+            .unwrap_or_else(|| "no data directory (set TETBENCH_DATA)".into());
+        if std::env::var("TETBENCH_REQUIRE_DATA").is_ok_and(|v| v == "1") {
+            panic!("TETBENCH_REQUIRE_DATA=1 but data file {name} is absent ({where_})");
+        }
+        eprintln!("SKIPPED: data file {name} is absent ({where_})");
+    }
+    found
+}
+
 /// Resolves names, specs and paths to data sets.
 #[derive(Debug, Clone, Default)]
 pub struct Registry {

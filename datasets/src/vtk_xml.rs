@@ -1572,13 +1572,7 @@ mod tests {
     use crate::write_vtu::{vtu_bytes, VtuFormat, VtuOptions};
 
     fn data_file(name: &str) -> Option<std::path::PathBuf> {
-        let p = crate::registry::default_data_dir()?.join(name);
-        if p.is_file() {
-            Some(p)
-        } else {
-            eprintln!("SKIPPED: {} is absent", p.display());
-            None
-        }
+        crate::registry::test_data_file(name)
     }
 
     fn parse(text: &str) -> Result<Dataset, LoadError> {

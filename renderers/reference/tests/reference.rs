@@ -321,9 +321,9 @@ fn cache_round_trip_and_damaged_files_are_recomputed() {
 /// SPX (the papers' non-convex tet mesh) against dense sampling, when the data sets exist.
 #[test]
 fn agrees_with_dense_sampling_on_spx() {
-    let Some(dir) = datasets::registry::default_data_dir().filter(|d| d.join("spx.vtk").is_file())
+    let Some(dir) = datasets::registry::test_data_file("spx.vtk")
+        .and_then(|p| p.parent().map(std::path::PathBuf::from))
     else {
-        eprintln!("SKIPPED: spx.vtk not found (set TETBENCH_DATA)");
         return;
     };
     let registry = datasets::registry::Registry::new(Some(dir));
