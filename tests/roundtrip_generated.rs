@@ -160,12 +160,13 @@ fn generated_sizes_are_exact_and_near_the_target() {
             m.num_tets()
         );
     }
-    for (spec, target) in [("shell:2k", 2_000), ("shell:50k", 50_000)] {
+    // The shell puts cell shape before count (tests/generator_quality.rs has the bounds).
+    for (spec, target, tolerance) in [("shell:2k", 2_000, 0.25), ("shell:50k", 50_000, 0.10)] {
         let m = from_spec(spec, 1).unwrap();
         let (n, l) = shell_cells(target);
         assert_eq!(m.num_tets(), 36 * n * n * l, "{spec}");
         assert!(
-            (m.num_tets() as f64 / target as f64 - 1.0).abs() < 0.05,
+            (m.num_tets() as f64 / target as f64 - 1.0).abs() < tolerance,
             "{spec}: {}",
             m.num_tets()
         );

@@ -12,6 +12,11 @@
 //! | `shell` | hollow sphere r ∈ [0.5, 1] (cubed-sphere grid, 6 tets per cell): rays through the middle cross the boundary 4 times | blobs |
 //! | `tunnels` | cube pierced by 3×2×2 square tunnels along the axes: rays leave and re-enter up to 6 times | Marschner–Lobb |
 //! | `slivers` | cube whose z layers are thin at random (0.5–4 % of a cell) and whose points are jittered: many flat tets (aspect ratio > 10), still valid and conforming | blobs |
+//! | `onion` | the shell's radii with one cell per cube face and N/36 radial layers: a cube-shaped onion of nested sliver layers (aspect ratio ≫ 10), a stress case for HAVS's k-buffer | blobs |
+//!
+//! Quality: every kind except `slivers` and `onion` keeps each tet's aspect ratio (longest edge
+//! over 2·√6·inradius, [`crate::QualityStats`]) at most [`MAX_ASPECT`] at every size from 1 k to
+//! 20 M tets, so none is a sliver; the generator tests sweep the sizes.
 //!
 //! Everything is a pure function of (spec, seed): random numbers come from a counter-based
 //! SplitMix64 hash of (seed, stream, index), so parallel generation is deterministic and does
@@ -35,16 +40,32 @@ pub enum Kind {
     Shell,
     Tunnels,
     Slivers,
+    Onion,
 }
 
+/// Largest tet aspect ratio of the quality generators (`box`, `shell`, `tunnels`) at any size.
+/// Measured maxima from 1 k to 1 M tets (tests/generator_quality.rs): box 1.86 (the 5-tet split
+/// of cells whose axes differ by up to 2×), tunnels 1.86 (the same cells), shell 4.15 (at 1 k,
+/// the coarsest cubed-sphere cells, which the equiangular map skews most at the cube's corners).
+/// The rules that bound them (box axes within 2×, shell cells 1–2.5× as thick as wide) do not
+/// depend on the size.
+pub const MAX_ASPECT: f64 = 5.0;
+
 impl Kind {
-    pub const ALL: [Kind; 4] = [Kind::Box, Kind::Shell, Kind::Tunnels, Kind::Slivers];
+    pub const ALL: [Kind; 5] = [
+        Kind::Box,
+        Kind::Shell,
+        Kind::Tunnels,
+        Kind::Slivers,
+        Kind::Onion,
+    ];
     pub fn name(self) -> &'static str {
         match self {
             Kind::Box => "box",
             Kind::Shell => "shell",
             Kind::Tunnels => "tunnels",
             Kind::Slivers => "slivers",
+            Kind::Onion => "onion",
         }
     }
     pub fn description(self) -> &'static str {
@@ -53,12 +74,13 @@ impl Kind {
             Kind::Shell => "hollow sphere r in [0.5,1] (cubed-sphere grid, 6 tets/cell), non-convex: rays cross 4 times",
             Kind::Tunnels => "cube with 12 square tunnels along the axes, non-convex: rays leave and re-enter",
             Kind::Slivers => "cube with randomly thin layers and jittered points: many flat tets (aspect > 10)",
+            Kind::Onion => "hollow sphere r in [0.5,1] with one cell per cube face and N/36 radial layers: nested sliver shells (HAVS k-buffer stress case)",
         }
     }
     fn default_field(self) -> Field {
         match self {
             Kind::Box | Kind::Tunnels => Field::MarschnerLobb,
-            Kind::Shell | Kind::Slivers => Field::Blobs,
+            Kind::Shell | Kind::Slivers | Kind::Onion => Field::Blobs,
         }
     }
 }
@@ -133,7 +155,7 @@ pub fn parse_spec(spec: &str) -> Result<Spec, ErrorKind> {
         .into_iter()
         .find(|k| k.name() == head)
         .ok_or_else(|| ErrorKind::Syntax {
-            expected: "a generator kind (box, shell, tunnels, slivers)".into(),
+            expected: "a generator kind (box, shell, tunnels, slivers, onion)".into(),
             found: head.clone(),
         })?;
     let size = parts.next().unwrap_or("");
@@ -187,7 +209,8 @@ pub fn generate(spec: &Spec, seed: u64) -> Result<TetMesh, ErrorKind> {
     let f = FieldEval::new(spec.field, seed);
     match spec.kind {
         Kind::Box => box_mesh(spec.target_tets, &f),
-        Kind::Shell => shell_mesh(spec.target_tets, &f),
+        Kind::Shell => shell_mesh(shell_cells(spec.target_tets), "shell", &f),
+        Kind::Onion => shell_mesh(onion_cells(spec.target_tets), "onion", &f),
         Kind::Tunnels => tunnels_mesh(spec.target_tets, &f),
         Kind::Slivers => slivers_mesh(spec.target_tets, &f, seed),
     }
@@ -385,25 +408,47 @@ fn slivers_mesh(target: usize, f: &FieldEval, seed: u64) -> Result<TetMesh, Erro
 }
 
 /// Tunnels of the `tunnels` mesh: square holes of half-width 1/8 through the cube along each
-/// axis, at the four positions (±0.45, ±0.45) of the other two coordinates.
-fn in_tunnel(c: [f64; 3]) -> bool {
+/// axis, at the four positions (±0.45, ±0.45) of the other two coordinates. A cell is cut
+/// away when its centre lies within the half-width of a tunnel's axis line — or, on grids
+/// coarser than the tunnels (cells wider than 1/4, below ≈ 2 k tets), within half a cell, so
+/// that the cells the line runs through are removed and every tunnel stays open at every size.
+fn in_tunnel(c: [f64; 3], cell: [f64; 3]) -> bool {
     const HALF: f64 = 0.125;
     const POS: [f64; 2] = [-0.45, 0.45];
     (0..3).any(|axis| {
-        let (u, v) = (c[(axis + 1) % 3], c[(axis + 2) % 3]);
-        POS.iter().any(|&pu| (u - pu).abs() < HALF) && POS.iter().any(|&pv| (v - pv).abs() < HALF)
+        let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+        let near = |x: f64, p: f64, h: f64| (x - p).abs() < HALF.max(0.5 * h);
+        POS.iter().any(|&pu| near(c[a], pu, cell[a]))
+            && POS.iter().any(|&pv| near(c[b], pv, cell[b]))
     })
+}
+
+/// The tunnels' axis lines: (axis, u, v) with u, v the other two coordinates in axis order.
+pub const TUNNEL_LINES: [(usize, f64, f64); 12] = {
+    let mut out = [(0, 0.0, 0.0); 12];
+    let pos = [-0.45, 0.45];
+    let mut i = 0;
+    while i < 12 {
+        out[i] = (i / 4, pos[(i / 2) % 2], pos[i % 2]);
+        i += 1;
+    }
+    out
+};
+
+fn cell_size(cells: [usize; 3]) -> [f64; 3] {
+    cells.map(|c| 2.0 / c as f64)
 }
 
 /// Number of cells outside the tunnels.
 fn tunnel_kept(cells: [usize; 3]) -> usize {
+    let h = cell_size(cells);
     (0..cells[2])
         .into_par_iter()
         .map(|k| {
             let mut kept = 0;
             for j in 0..cells[1] {
                 for i in 0..cells[0] {
-                    if !in_tunnel(cell_center(cells, i, j, k)) {
+                    if !in_tunnel(cell_center(cells, i, j, k), h) {
                         kept += 1;
                     }
                 }
@@ -435,7 +480,7 @@ fn tunnels_mesh(target: usize, f: &FieldEval) -> Result<TetMesh, ErrorKind> {
     for k in 0..cells[2] {
         for j in 0..cells[1] {
             for i in 0..cells[0] {
-                if !in_tunnel(cell_center(cells, i, j, k)) {
+                if !in_tunnel(cell_center(cells, i, j, k), cell_size(cells)) {
                     tets.extend_from_slice(&crate::volume::hex_cell_tets(d, i, j, k));
                 }
             }
@@ -468,40 +513,63 @@ fn tunnels_mesh(target: usize, f: &FieldEval) -> Result<TetMesh, ErrorKind> {
 pub const SHELL_RADII: (f64, f64) = (0.5, 1.0);
 
 /// (n, m): n cells along each edge of the cubed sphere, m radial layers; 36·n²·m tets.
-/// Cells are kept roughly isotropic (radial size within 0.5–2× the tangential size).
+///
+/// The cells' shape comes first, the count second: among the (n, m) whose radial size
+/// 0.5/m is 1 to 2.5 times the tangential size at mid-radius, 0.75·(π/2)/n (cells a little
+/// thicker than wide, so small meshes spend their tets on angular resolution — a curved outer
+/// surface and a real cavity — rather than on layers), the one closest to the target. Only when
+/// no such pair is within 25 % of the target (never from 1 k tets up) does the count win, with
+/// the shape mismatch as a cost. So `shell:10k` is 10×10 cells per cube face × 3 layers =
+/// 10,800 tets with 2,400 boundary faces, not 1 cell × 278 layers of slivers.
 pub fn shell_cells(target_tets: usize) -> (usize, usize) {
     let t = target_tets as f64;
     let mut best = (1, 1);
-    let mut best_err = f64::INFINITY;
+    let mut best_cost = f64::INFINITY;
     for n in 1..=2000usize {
         let per_layer = 36.0 * (n * n) as f64;
         if per_layer > 4.0 * t && n > 1 {
             break;
         }
-        let m = ((t / per_layer).round() as usize).max(1);
-        // Tangential size at mid-radius ≈ 0.75·(π/2)/n, radial 0.5/m.
-        let ratio = (0.5 / m as f64) / (0.75 * PI / 2.0 / n as f64);
-        let shape_penalty = if (0.5..=2.0).contains(&ratio) {
-            0.0
-        } else {
-            0.05
-        };
-        let err = ((per_layer * m as f64) - t).abs() / t + shape_penalty;
-        if err < best_err {
-            best_err = err;
-            best = (n, m);
+        let m0 = (t / per_layer).max(1.0);
+        for m in [m0.floor().max(1.0) as usize, m0.ceil() as usize] {
+            let ratio = (0.5 / m as f64) / (0.75 * PI / 2.0 / n as f64);
+            let size_err = ((per_layer * m as f64) - t).abs() / t;
+            let shape_err = if ratio < 1.0 {
+                (1.0 / ratio).ln()
+            } else if ratio > 2.5 {
+                (ratio / 2.5).ln()
+            } else {
+                0.0
+            };
+            // A shape outside the band costs more than any size error up to 25 %.
+            let cost = size_err
+                + if shape_err > 0.0 {
+                    0.25 + shape_err
+                } else {
+                    0.0
+                };
+            if cost < best_cost {
+                best_cost = cost;
+                best = (n, m);
+            }
         }
     }
     best
+}
+
+/// (1, m) with m = target/36 layers: the `onion` stress case (what `shell` used to generate at
+/// 1 k and 10 k tets, before shape came first). Each layer is 0.5/m thick and ≈ 1.2 wide.
+pub fn onion_cells(target_tets: usize) -> (usize, usize) {
+    (1, ((target_tets as f64 / 36.0).round() as usize).max(1))
 }
 
 /// `shell`: hollow sphere. The cube [0,n]³'s surface lattice points are projected to the unit
 /// sphere (equiangular cubed-sphere map: each coordinate c ∈ [-1,1] warped by tan(πc/4)),
 /// repeated on m+1 radii; each surface quad × radial layer is a hexahedron split into 6 tets
 /// by [`hex_six_tets`], whose diagonal rule depends only on global point indices, so cells
-/// conform across the cube's face seams as well. 36·n²·m tets.
-fn shell_mesh(target: usize, f: &FieldEval) -> Result<TetMesh, ErrorKind> {
-    let (n, m) = shell_cells(target);
+/// conform across the cube's face seams as well. 36·n²·m tets for `cells` = (n, m).
+fn shell_mesh(cells: (usize, usize), name: &str, f: &FieldEval) -> Result<TetMesh, ErrorKind> {
+    let (n, m) = cells;
     let (r0, r1) = SHELL_RADII;
     let side = n + 1;
     // Dense index of surface lattice points.
@@ -566,7 +634,7 @@ fn shell_mesh(target: usize, f: &FieldEval) -> Result<TetMesh, ErrorKind> {
             out
         })
         .collect();
-    finish("shell", points, f, tets)
+    finish(name, points, f, tets)
 }
 
 /// Faces of a VTK-ordered hexahedron (bottom ring 0..3, top ring 4..7 above it).
@@ -644,11 +712,17 @@ mod tests {
                 "{t}: {c:?} gives {n}"
             );
         }
-        for t in [1_000, 10_000, 1_000_000, 20_000_000] {
+        // Shape first, then count: within 25 % below 10 k tets, 10 % below 100 k, else 5 %.
+        for (t, tolerance) in [
+            (1_000, 0.25),
+            (10_000, 0.10),
+            (1_000_000, 0.05),
+            (20_000_000, 0.05),
+        ] {
             let (n, m) = shell_cells(t);
             let got = 36 * n * n * m;
             assert!(
-                ((got as f64) - t as f64).abs() / (t as f64) < 0.05,
+                ((got as f64) - t as f64).abs() / (t as f64) < tolerance,
                 "{t}: ({n},{m}) gives {got}"
             );
         }
