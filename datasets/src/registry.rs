@@ -171,6 +171,13 @@ pub fn test_data_file(name: &str) -> Option<PathBuf> {
     found
 }
 
+/// What a name resolves to, before anything is loaded.
+enum Source {
+    Named(&'static Named),
+    Generated,
+    File(PathBuf),
+}
+
 /// Resolves names, specs and paths to data sets.
 #[derive(Debug, Clone, Default)]
 pub struct Registry {
@@ -223,50 +230,70 @@ impl Registry {
     /// unless the spec says `seed=N`) or a file path.
     pub fn resolve(&self, name_or_path: &str, options: &LoadOptions) -> Result<Dataset, LoadError> {
         let key = name_or_path.trim();
+        match self.locate(key)? {
+            Source::Named(n) => self.load_named(n, options),
+            Source::Generated => {
+                let mesh = crate::generate::from_spec(key, 1)?;
+                if let Some(want) = &options.scalar {
+                    if *want != mesh.scalar_name {
+                        return Err(LoadError::new(
+                            key,
+                            ErrorKind::MissingArray {
+                                name: want.clone(),
+                                available: vec![mesh.scalar_name.clone()],
+                            },
+                        ));
+                    }
+                }
+                Ok(Dataset {
+                    mesh,
+                    volume: None,
+                    source: key.to_string(),
+                })
+            }
+            Source::File(p) => crate::load::load(&p, options),
+        }
+    }
+
+    /// Checks, without loading anything, that `name_or_path` names something [`Self::resolve`]
+    /// can load: a named data set whose files are all in the data directory, a generator spec
+    /// that parses, or an existing file. Lets a run refuse a typo before measuring anything.
+    pub fn check(&self, name_or_path: &str) -> Result<(), LoadError> {
+        self.locate(name_or_path.trim()).map(|_| ())
+    }
+
+    fn locate(&self, key: &str) -> Result<Source, LoadError> {
         if let Some(n) = NAMED.iter().find(|n| n.name.eq_ignore_ascii_case(key)) {
-            return self.load_named(n, options);
+            self.named_files(n)?;
+            return Ok(Source::Named(n));
         }
         if crate::generate::is_spec(key) {
-            let mesh = crate::generate::from_spec(key, 1)?;
-            if let Some(want) = &options.scalar {
-                if *want != mesh.scalar_name {
-                    return Err(LoadError::new(
-                        key,
-                        ErrorKind::MissingArray {
-                            name: want.clone(),
-                            available: vec![mesh.scalar_name.clone()],
-                        },
-                    ));
-                }
-            }
-            return Ok(Dataset {
-                mesh,
-                volume: None,
-                source: key.to_string(),
-            });
+            crate::generate::parse_spec(key).map_err(|k| LoadError::new(key, k))?;
+            return Ok(Source::Generated);
         }
         let path = Path::new(key);
         if path.exists() {
-            return crate::load::load(path, options);
+            return Ok(Source::File(path.to_path_buf()));
         }
         // A bare file name may live in the data directory.
         if let Some(p) = self
             .file(key)
             .filter(|p| p.is_file() && !path.is_absolute())
         {
-            return crate::load::load(&p, options);
+            return Ok(Source::File(p));
         }
         let known: Vec<&str> = NAMED.iter().map(|n| n.name).collect();
         Err(LoadError::new(
             key,
             ErrorKind::Io(format!(
-                "no such file, named data set ({}) or generator spec (box|shell|tunnels|slivers:SIZE[:field=…][:seed=…])",
+                "no such file, named data set ({}) or generator spec (box|shell|tunnels|slivers|onion:SIZE[:field=…][:seed=…]); `tetbench datasets list` shows them",
                 known.join(", ")
             )),
         ))
     }
 
-    fn load_named(&self, n: &Named, options: &LoadOptions) -> Result<Dataset, LoadError> {
+    /// The paths of a named data set's files, or which one is missing and where it comes from.
+    fn named_files(&self, n: &Named) -> Result<Vec<PathBuf>, LoadError> {
         let missing = |file: &str, where_: String| {
             LoadError::new(
                 where_,
@@ -283,22 +310,31 @@ impl Registry {
                 "(no data directory found: use --data-dir or set TETBENCH_DATA)".into(),
             ));
         };
-        for f in n.files {
-            let p = dir.join(f);
-            if !p.is_file() {
-                return Err(missing(f, p.display().to_string()));
-            }
-        }
+        n.files
+            .iter()
+            .map(|f| {
+                let p = dir.join(f);
+                if p.is_file() {
+                    Ok(p)
+                } else {
+                    Err(missing(f, p.display().to_string()))
+                }
+            })
+            .collect()
+    }
+
+    fn load_named(&self, n: &Named, options: &LoadOptions) -> Result<Dataset, LoadError> {
+        let files = self.named_files(n)?;
         let mut opts = options.clone();
         if n.field.is_some() {
-            if opts.q_file.is_none() && n.files.len() > 1 {
-                opts.q_file = Some(dir.join(n.files[1]));
+            if opts.q_file.is_none() && files.len() > 1 {
+                opts.q_file = Some(files[1].clone());
             }
             if opts.plot3d_field.is_none() && opts.scalar.is_none() {
                 opts.plot3d_field = n.field;
             }
         }
-        let mut ds = crate::load::load(&dir.join(n.files[0]), &opts)?;
+        let mut ds = crate::load::load(&files[0], &opts)?;
         ds.mesh.name = n.name.to_string();
         Ok(ds)
     }

@@ -36,6 +36,11 @@ fn entry(name: &str) -> anyhow::Result<&'static (&'static str, Variants, Variant
         .ok_or_else(|| anyhow::anyhow!("unknown algorithm {name:?}; known: {}", names().join(", ")))
 }
 
+/// Every variant `name` offers (what `--settings` selects from).
+pub fn all_variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+    Ok((entry(name)?.2)())
+}
+
 /// The default variants of `name`, or an error listing the known names.
 pub fn variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
     Ok((entry(name)?.1)())

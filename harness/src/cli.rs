@@ -94,6 +94,10 @@ pub struct RunArgs {
     /// Do not write the HTML report and charts.
     #[arg(long)]
     pub no_report: bool,
+    /// Exit non-zero when a row is suspect (its PSNR far below the best algorithm's on the same
+    /// image, or below 20 dB); without it suspect rows are flagged and the run still succeeds.
+    #[arg(long)]
+    pub strict: bool,
 }
 
 /// The reference cache: `--cache-dir`, `$TETBENCH_CACHE`, `$XDG_CACHE_HOME/tetbench`,
@@ -213,6 +217,7 @@ impl RunArgs {
             scalar: self.scalar.clone(),
             command_line,
             report: !self.no_report,
+            strict: self.strict,
         })
     }
 }
@@ -247,12 +252,32 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
                 config.out.join("results.csv").display(),
                 config.out.join("index.html").display()
             );
+            if !outcome.suspect_rows.is_empty() {
+                eprintln!(
+                    "{} suspect row(s) — image error far out of line with the other algorithms \
+                     on the same image (see the `suspect` column and {}):",
+                    outcome.suspect_rows.len(),
+                    config.out.join("index.html").display()
+                );
+                for s in &outcome.suspect_rows {
+                    eprintln!("  {s}");
+                }
+            }
+            if outcome.rows == 0 && !outcome.errors.is_empty() {
+                anyhow::bail!("nothing was measured:\n  {}", outcome.errors.join("\n  "));
+            }
             if !outcome.all_ok() {
                 let mut msg = format!("{} of {} rows failed", outcome.failed_rows, outcome.rows);
                 for e in &outcome.errors {
                     msg.push_str(&format!("\n  {e}"));
                 }
                 anyhow::bail!("{msg} (finished rows are in {})", config.out.display());
+            }
+            if config.strict && !outcome.suspect_rows.is_empty() {
+                anyhow::bail!(
+                    "--strict: {} suspect row(s) (listed above)",
+                    outcome.suspect_rows.len()
+                );
             }
             Ok(())
         }

@@ -63,6 +63,8 @@ pub struct Aggregate {
     pub tets: u64,
     pub rows: usize,
     pub failed: usize,
+    /// Rows flagged by [`crate::suspect`].
+    pub suspect: usize,
     pub total_ms: Option<Spread>,
     pub cpu_ms: Option<Spread>,
     pub gpu_ms: Option<Spread>,
@@ -111,6 +113,7 @@ pub fn aggregate(rows: &[Row]) -> Vec<Aggregate> {
                 tets: g[0].tets,
                 rows: g.len(),
                 failed: g.iter().filter(|r| !r.ok()).count(),
+                suspect: g.iter().filter(|r| !r.suspect.is_empty()).count(),
                 total_ms: spread(g.iter().filter_map(|r| r.total_ms)),
                 cpu_ms: spread(g.iter().filter_map(|r| r.cpu_ms)),
                 gpu_ms: spread(g.iter().filter_map(|r| r.gpu_ms)),
@@ -442,6 +445,8 @@ table {{ border-collapse: collapse; font-size: 13px; margin: 0.5em 0 1.5em; }}
 th, td {{ border: 1px solid #ccc; padding: 2px 6px; text-align: right; }}
 th {{ background: #eee; }} td.l, th.l {{ text-align: left; }}
 tr.failed td {{ background: #fdd; }}
+tr.suspect td {{ background: #ffe4b3; }}
+.suspect figure {{ border: 2px solid #e69500; padding: 3px; }}
 dl {{ display: grid; grid-template-columns: max-content auto; gap: 2px 12px; font-size: 14px; }}
 dt {{ font-weight: bold; }} dd {{ margin: 0; }}
 .charts img {{ max-width: 100%; border: 1px solid #ddd; margin-bottom: 8px; }}
@@ -506,6 +511,42 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
             let _ = write!(h, "<li>{}</li>", esc(e));
         }
         h.push_str("</ul>\n");
+    }
+
+    let suspects: Vec<&Row> = file.rows.iter().filter(|r| !r.suspect.is_empty()).collect();
+    if !suspects.is_empty() {
+        let _ = write!(
+            h,
+            "<h2>Suspect rows ({})</h2><p>Image error far out of line with the other algorithms on \
+             the same image: probably a renderer defect, or a mesh the method cannot handle. \
+             Heatmap first, then the rendering and the reference.</p><div class=\"strip suspect\">",
+            suspects.len()
+        );
+        for row in suspects {
+            let _ = write!(h, "<figure><div class=pair>");
+            for (path, alt) in [
+                (&row.heatmap, "error heatmap"),
+                (&row.image, "image"),
+                (&row.reference_image, "reference"),
+            ] {
+                if !path.is_empty() {
+                    let _ = write!(
+                        h,
+                        "<a href=\"{0}\"><img src=\"{0}\" alt=\"{alt}\" loading=lazy></a>",
+                        esc(path)
+                    );
+                }
+            }
+            let _ = write!(
+                h,
+                "</div><figcaption>{} on {} {}<br>{}</figcaption></figure>",
+                esc(&series_label(&row.algorithm, &row.settings)),
+                esc(&row.dataset),
+                esc(&row.viewpoint),
+                esc(&row.suspect)
+            );
+        }
+        h.push_str("</div>\n");
     }
 
     h.push_str(
@@ -634,7 +675,13 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
             "<tr{}><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td>{}</td><td>{}</td>\
              <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
              <td class=l>{}</td><td class=l>{}</td></tr>",
-            if row.ok() { "" } else { " class=failed" },
+            if !row.ok() {
+                " class=failed"
+            } else if !row.suspect.is_empty() {
+                " class=suspect"
+            } else {
+                ""
+            },
             esc(&row.algorithm),
             esc(&row.settings),
             esc(&row.dataset),
@@ -651,7 +698,11 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
             opt(row.max_abs_error, 4),
             opt(row.bad_pixel_share.map(|v| v * 100.0), 2),
             esc(&row.stages),
-            esc(&row.error),
+            if row.suspect.is_empty() {
+                esc(&row.error)
+            } else {
+                esc(&format!("SUSPECT: {}", row.suspect))
+            },
         );
     }
     h.push_str("</table>\n<p>Raw data: <a href=\"results.csv\">results.csv</a>, <a href=\"results.json\">results.json</a>.</p>\n</body></html>\n");
@@ -687,6 +738,17 @@ pub fn markdown_summary(aggs: &[Aggregate]) -> String {
                 .unwrap_or_else(|| "–".into()),
             opt(a.bytes_per_tet, 1),
         );
+    }
+    let suspect: Vec<&Aggregate> = aggs.iter().filter(|a| a.suspect > 0).collect();
+    if !suspect.is_empty() {
+        s.push_str("\n**Suspect** (PSNR far below the best algorithm on the same image; see `suspect` in results.csv):\n\n");
+        for a in suspect {
+            let _ = writeln!(
+                s,
+                "- {} {} on {}: {} of {} views",
+                a.algorithm, a.settings, a.dataset, a.suspect, a.rows
+            );
+        }
     }
     s
 }

@@ -74,6 +74,10 @@ pub struct Row {
     pub image: String,
     pub reference_image: String,
     pub heatmap: String,
+    /// Empty, or why the row's image error is out of line with the other algorithms on the
+    /// same image ([`crate::suspect`]). Absent in files written before it existed.
+    #[serde(default)]
+    pub suspect: String,
     /// Empty on success; otherwise what went wrong (the metrics are then empty).
     pub error: String,
 }
@@ -186,6 +190,22 @@ impl ResultsWriter {
         self.write_json()
     }
 
+    /// Rewrites both files from `self.file.rows`, for columns only known once every row is in
+    /// (the final `suspect` flags).
+    pub fn rewrite_rows(&mut self) -> anyhow::Result<()> {
+        let csv_path = self.dir.join(CSV_FILE);
+        let f = File::create(&csv_path)
+            .with_context(|| format!("cannot create {}", csv_path.display()))?;
+        let mut csv = csv::WriterBuilder::new().has_headers(false).from_writer(f);
+        csv.write_record(csv_header())?;
+        for row in &self.file.rows {
+            csv.serialize(row)?;
+        }
+        csv.flush().context("writing results.csv")?;
+        self.csv = csv;
+        self.write_json()
+    }
+
     pub fn finish(&mut self) -> anyhow::Result<()> {
         self.file.finished_utc = Some(crate::machine::iso8601_utc(std::time::SystemTime::now()));
         self.write_json()
@@ -259,6 +279,7 @@ fn example_row() -> Row {
         image: String::new(),
         reference_image: String::new(),
         heatmap: String::new(),
+        suspect: String::new(),
         error: String::new(),
     }
 }

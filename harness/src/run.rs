@@ -51,6 +51,8 @@ pub struct RunConfig {
     pub command_line: Vec<String>,
     /// Write the HTML report and charts at the end.
     pub report: bool,
+    /// Make suspect rows ([`crate::suspect`]) an error (non-zero exit), for CI.
+    pub strict: bool,
 }
 
 /// Makes the variants of an algorithm by name (normally
@@ -62,6 +64,9 @@ pub type VariantFactory<'a> = &'a dyn Fn(&str) -> anyhow::Result<Vec<Box<dyn Ren
 pub struct RunOutcome {
     pub rows: usize,
     pub failed_rows: usize,
+    /// Rows whose image error is out of line with the others on the same image
+    /// ([`crate::suspect`]): measured, but probably a renderer defect.
+    pub suspect_rows: Vec<String>,
     /// Failures that are not one row (a data set that did not load, a missing reference).
     pub errors: Vec<String>,
     pub seconds: f64,
@@ -238,6 +243,49 @@ fn plan_variants(
             keys.join(", ")
         );
     }
+    // A value no variant of an asked-for algorithm has is a typo that would silently drop the
+    // algorithm from the run (issue 18): refuse it, naming what the algorithm offers. An
+    // algorithm without the key at all keeps its defaults.
+    for (name, n) in &kept {
+        let Ok(all) = crate::algorithms::all_variants(name) else {
+            continue; // not in the table (tests pass their own factories)
+        };
+        let offered: Vec<render_core::Setting> = all.iter().flat_map(|r| r.settings()).collect();
+        for (key, values) in &config.settings_filter.terms {
+            let mut has: Vec<&str> = vec![];
+            for s in offered.iter().filter(|s| s.key == key) {
+                if !has.contains(&s.value.as_str()) {
+                    has.push(&s.value);
+                }
+            }
+            if has.is_empty() {
+                continue;
+            }
+            let unknown: Vec<&str> = values
+                .iter()
+                .map(String::as_str)
+                .filter(|v| !has.contains(v))
+                .collect();
+            if !unknown.is_empty() {
+                anyhow::bail!(
+                    "--settings {key}={}: {name} has no variant with {key}={}; it offers {key}={}",
+                    values.join("|"),
+                    unknown.join("|"),
+                    has.join("|")
+                );
+            }
+        }
+        if *n == 0 {
+            let variants: Vec<String> =
+                all.iter().map(|r| settings_string(&r.settings())).collect();
+            anyhow::bail!(
+                "--settings {} leaves no variant of {name} to run: each value exists, but no \
+                 variant combines them; its variants are:\n  {}",
+                config.settings_filter,
+                variants.join("\n  ")
+            );
+        }
+    }
     if kept.iter().all(|(_, n)| *n == 0) {
         anyhow::bail!(
             "--settings {} leaves no variant of {} to run",
@@ -248,11 +296,34 @@ fn plan_variants(
     Ok(kept)
 }
 
+/// Checks every data set name before anything is measured, so that a typo fails at once with
+/// what to do instead of after the other data sets' rows.
+fn check_datasets(config: &RunConfig) -> anyhow::Result<()> {
+    let registry = datasets::registry::Registry::new(config.data_dir.clone());
+    let problems: Vec<String> = config
+        .datasets
+        .iter()
+        .filter_map(|spec| registry.check(spec).err().map(|e| format!("  {spec}: {e}")))
+        .collect();
+    if !problems.is_empty() {
+        anyhow::bail!(
+            "--datasets: {} of {} cannot be used, nothing was measured:\n{}\n\
+             (`tetbench datasets list` shows the named data sets and generators; named ones are \
+             read from the data directory: --data-dir DIR or TETBENCH_DATA)",
+            problems.len(),
+            config.datasets.len(),
+            problems.join("\n")
+        );
+    }
+    Ok(())
+}
+
 /// Runs the whole plan, writing `results.csv`, `results.json`, images and (if asked) the
 /// report into `config.out`.
 pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOutcome> {
     let started = Instant::now();
     let plan = plan_variants(config, factory)?;
+    check_datasets(config)?;
     let variants_total: usize = plan.iter().map(|(_, n)| n).sum();
 
     let gpu = Gpu::new()?;
@@ -338,6 +409,21 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         }
     }
     progress.finish();
+    if crate::suspect::mark_all(&mut writer.file.rows) > 0 {
+        writer.rewrite_rows()?;
+    }
+    outcome.suspect_rows = writer
+        .file
+        .rows
+        .iter()
+        .filter(|r| !r.suspect.is_empty())
+        .map(|r| {
+            format!(
+                "{} {} on {} {}: {}",
+                r.algorithm, r.settings, r.dataset, r.viewpoint, r.suspect
+            )
+        })
+        .collect();
     writer.finish()?;
     outcome.rows = writer.file.rows.len();
     if config.report {
@@ -405,6 +491,7 @@ fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Ro
         image: String::new(),
         reference_image: String::new(),
         heatmap: String::new(),
+        suspect: String::new(),
         error: String::new(),
     }
 }
@@ -532,14 +619,21 @@ impl DatasetContext<'_> {
                     row.error
                 ));
             } else {
+                // Against the rows so far; the final flags are set once every row is in.
+                row.suspect = crate::suspect::reason(&row, &writer.file.rows).unwrap_or_default();
                 progress.row(&format!(
-                    "{what} {}: {:.2} ms, {:.3} M tets/s, PSNR {}",
+                    "{what} {}: {:.2} ms, {:.3} M tets/s, PSNR {}{}",
                     vp.name,
                     row.total_ms.unwrap_or(f64::NAN),
                     row.tets_per_sec.unwrap_or(f64::NAN) * 1e-6,
                     row.psnr_db
                         .map(|p| format!("{p:.2} dB"))
-                        .unwrap_or_else(|| "-".into())
+                        .unwrap_or_else(|| "-".into()),
+                    if row.suspect.is_empty() {
+                        String::new()
+                    } else {
+                        format!("  SUSPECT: {}", row.suspect)
+                    }
                 ));
             }
             writer.push(row)?;

@@ -224,7 +224,7 @@ fn missing_dataset_is_a_clear_error() {
     let err = run_err(&[
         "run",
         "--datasets",
-        "no-such-dataset-xyz",
+        "box:1k,no-such-dataset-xyz",
         "--resolution",
         "16",
         "--frames",
@@ -234,14 +234,98 @@ fn missing_dataset_is_a_clear_error() {
         "--no-reference",
     ]);
     assert!(err.contains("no-such-dataset-xyz"), "{err}");
+    assert!(err.contains("tetbench datasets list"), "{err}");
+    assert!(err.contains("nothing was measured"), "{err}");
+    assert!(!err.contains("rows failed"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
-    // The failure is also on record in the results.
+    // Refused before anything ran: not even box:1k was measured.
+    assert!(!out.join("results.json").exists());
+}
+
+/// Issue 18: a `--settings` value that no variant of an asked-for algorithm has is an error
+/// naming the algorithm, the key, the value and what it offers — never a silently dropped
+/// algorithm.
+#[test]
+fn a_settings_typo_never_drops_an_algorithm() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().to_str().unwrap();
+    for args in [
+        &[
+            "run",
+            "--datasets",
+            "box:1k",
+            "--algorithms",
+            "havs,gator-pt",
+            "--settings",
+            "k=7",
+            "--out",
+            o,
+        ][..],
+        &["run", "--settings", "k=abc", "--out", o][..],
+        &[
+            "run",
+            "--datasets",
+            "box:1k",
+            "--algorithms",
+            "havs",
+            "--settings",
+            "k=2|7",
+            "--out",
+            o,
+        ][..],
+    ] {
+        let err = run_err(args);
+        assert!(
+            err.contains("havs has no variant with k="),
+            "{args:?}: {err}"
+        );
+        assert!(
+            err.contains("it offers k=2|3|4|5|6|8|16"),
+            "{args:?}: {err}"
+        );
+        assert!(!err.contains("rows failed"), "{args:?}: {err}");
+        assert!(
+            !dir.path().join("results.json").exists(),
+            "{args:?} ran rows"
+        );
+    }
+}
+
+/// Issue 18: an allocation past the adapter's limits fails its rows with the bytes needed and
+/// the limit (checked before wgpu sees it), and the run exits non-zero.
+#[test]
+fn an_oversized_viewport_fails_rows_with_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    let err = run_err(&[
+        "run",
+        "--resolution",
+        "9000",
+        "--algorithms",
+        "havs",
+        "--settings",
+        "k=2;sort=cpu-radix",
+        "--datasets",
+        "box:1k",
+        "--viewpoints",
+        "+x",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--no-reference",
+        "--no-report",
+        "--out",
+        o,
+    ]);
+    assert!(err.contains("1 of 1 rows failed"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
     let json = ResultsFile::read(&out).unwrap();
-    assert!(json.rows.is_empty());
-    assert!(json
-        .errors
-        .iter()
-        .any(|e| e.contains("no-such-dataset-xyz")));
+    let e = &json.rows[0].error;
+    assert!(e.contains("needs 2592000000 bytes"), "{e}");
+    assert!(e.contains("the adapter allows"), "{e}");
+    assert!(!e.contains("panicked") && !e.contains("Validation"), "{e}");
 }
 
 /// A run killed in the middle (as by a crash or Ctrl-C) keeps every finished row, in both

@@ -106,21 +106,25 @@ fn time_gpu_sort() {
     radix_sort_indices(&keys, &mut want, &mut RadixScratch::default());
     assert_eq!(perm, want, "GPU sort disagrees with the CPU radix sort");
     let usage = wgpu::BufferUsages::STORAGE;
-    let kbuf = ledger.buffer_init(
-        &gpu,
-        "keys",
-        render_core::Lifetime::PerFrame,
-        bytemuck::cast_slice(&keys),
-        usage,
-    );
+    let kbuf = ledger
+        .buffer_init(
+            &gpu,
+            "keys",
+            render_core::Lifetime::PerFrame,
+            bytemuck::cast_slice(&keys),
+            usage,
+        )
+        .expect("GPU buffer");
     let vals: Vec<u32> = (0..N as u32).collect();
-    let vbuf = ledger.buffer_init(
-        &gpu,
-        "values",
-        render_core::Lifetime::PerFrame,
-        bytemuck::cast_slice(&vals),
-        usage,
-    );
+    let vbuf = ledger
+        .buffer_init(
+            &gpu,
+            "values",
+            render_core::Lifetime::PerFrame,
+            bytemuck::cast_slice(&vals),
+            usage,
+        )
+        .expect("GPU buffer");
     gpu.wait().unwrap();
     let mut best = f64::INFINITY;
     for _ in 0..3 {

@@ -103,6 +103,58 @@ impl Gpu {
         m & !255
     }
 
+    /// Checks a buffer of `size` bytes against the adapter's `max_buffer_size`, so that an
+    /// oversized allocation fails its row with the figures instead of a wgpu validation panic.
+    pub fn check_buffer(&self, label: &str, size: u64) -> anyhow::Result<()> {
+        let max = self.limits.max_buffer_size;
+        if size > max {
+            anyhow::bail!(
+                "needs {size} bytes ({:.1} MiB) for buffer {label:?}, the adapter allows {max} \
+                 bytes ({:.1} MiB) per buffer (max_buffer_size); a smaller viewport or mesh, or a \
+                 split of this buffer into {} parts, would fit",
+                size as f64 / 1048576.0,
+                max as f64 / 1048576.0,
+                size.div_ceil(max.max(1))
+            );
+        }
+        Ok(())
+    }
+
+    /// Checks a texture's extent against the adapter's dimension limits (2D or 3D).
+    pub fn check_texture(&self, desc: &wgpu::TextureDescriptor) -> anyhow::Result<()> {
+        let s = desc.size;
+        let label = desc.label.unwrap_or("texture");
+        let (max, limit) = match desc.dimension {
+            wgpu::TextureDimension::D3 => (
+                self.limits.max_texture_dimension_3d,
+                "max_texture_dimension_3d",
+            ),
+            wgpu::TextureDimension::D2 => (
+                self.limits.max_texture_dimension_2d,
+                "max_texture_dimension_2d",
+            ),
+            wgpu::TextureDimension::D1 => (
+                self.limits.max_texture_dimension_1d,
+                "max_texture_dimension_1d",
+            ),
+        };
+        let depth = if desc.dimension == wgpu::TextureDimension::D3 {
+            s.depth_or_array_layers
+        } else {
+            1
+        };
+        if s.width > max || s.height > max || depth > max {
+            anyhow::bail!(
+                "needs a {}×{}×{} texture for {label:?}, the adapter allows {max} texels per side \
+                 ({limit})",
+                s.width,
+                s.height,
+                s.depth_or_array_layers
+            );
+        }
+        Ok(())
+    }
+
     /// Blocks until all submitted work is done.
     pub fn wait(&self) -> anyhow::Result<()> {
         self.device
@@ -294,7 +346,8 @@ impl MemoryLedger {
         self.entries.push((label.to_string(), lifetime, bytes));
     }
 
-    /// Creates a buffer and records it.
+    /// Creates a buffer and records it; fails, naming the buffer, the bytes it needs and the
+    /// adapter's limit, where wgpu would raise a validation error.
     pub fn buffer(
         &mut self,
         gpu: &Gpu,
@@ -302,15 +355,16 @@ impl MemoryLedger {
         lifetime: Lifetime,
         size: u64,
         usage: wgpu::BufferUsages,
-    ) -> wgpu::Buffer {
+    ) -> anyhow::Result<wgpu::Buffer> {
         let size = size.max(16).div_ceil(4) * 4;
+        gpu.check_buffer(label, size)?;
         self.record(label, lifetime, size);
-        gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        Ok(gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size,
             usage,
             mapped_at_creation: false,
-        })
+        }))
     }
 
     /// Creates a buffer holding `data` and records it.
@@ -321,25 +375,26 @@ impl MemoryLedger {
         lifetime: Lifetime,
         data: &[u8],
         usage: wgpu::BufferUsages,
-    ) -> wgpu::Buffer {
+    ) -> anyhow::Result<wgpu::Buffer> {
         let buf = self.buffer(
             gpu,
             label,
             lifetime,
             data.len() as u64,
             usage | wgpu::BufferUsages::COPY_DST,
-        );
+        )?;
         gpu.queue.write_buffer(&buf, 0, data);
-        buf
+        Ok(buf)
     }
 
-    /// Creates a texture and records its size.
+    /// Creates a texture and records its size; fails on sizes the adapter does not allow.
     pub fn texture(
         &mut self,
         gpu: &Gpu,
         lifetime: Lifetime,
         desc: &wgpu::TextureDescriptor,
-    ) -> wgpu::Texture {
+    ) -> anyhow::Result<wgpu::Texture> {
+        gpu.check_texture(desc)?;
         let texel = desc.format.block_copy_size(None).unwrap_or(4) as u64;
         let s = desc.size;
         self.record(
@@ -347,7 +402,7 @@ impl MemoryLedger {
             lifetime,
             texel * s.width as u64 * s.height as u64 * s.depth_or_array_layers as u64,
         );
-        gpu.device.create_texture(desc)
+        Ok(gpu.device.create_texture(desc))
     }
 
     pub fn total(&self) -> u64 {
@@ -452,19 +507,67 @@ mod tests {
 mod device_tests {
     use super::*;
 
+    /// An allocation past the adapter's limits fails with the figures, before wgpu sees it.
+    #[test]
+    fn oversized_buffers_and_textures_are_refused_with_the_limit() {
+        let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
+        let mut ledger = MemoryLedger::default();
+        let max = gpu.limits.max_buffer_size;
+        let too_big = (max + 4).div_ceil(4) * 4;
+        let e = ledger
+            .buffer(
+                &gpu,
+                "k-buffer",
+                Lifetime::PerFrame,
+                too_big,
+                wgpu::BufferUsages::STORAGE,
+            )
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(&format!("needs {too_big} bytes")), "{e}");
+        assert!(e.contains("\"k-buffer\""), "{e}");
+        assert!(e.contains(&format!("allows {max} bytes")), "{e}");
+        assert_eq!(ledger.total(), 0, "nothing was allocated");
+        let side = gpu.limits.max_texture_dimension_2d + 1;
+        let e = ledger
+            .texture(
+                &gpu,
+                Lifetime::PerFrame,
+                &wgpu::TextureDescriptor {
+                    label: Some("target"),
+                    size: wgpu::Extent3d {
+                        width: side,
+                        height: 8,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba32Float,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                    view_formats: &[],
+                },
+            )
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("max_texture_dimension_2d"), "{e}");
+    }
+
     /// The headless device opens (lavapipe on machines without a GPU) and round-trips data.
     #[test]
     fn device_opens_and_reads_back() {
         let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
         let mut ledger = MemoryLedger::default();
         let data: Vec<u32> = (0..1000).collect();
-        let buf = ledger.buffer_init(
-            &gpu,
-            "test",
-            Lifetime::Persistent,
-            bytemuck::cast_slice(&data),
-            wgpu::BufferUsages::COPY_SRC,
-        );
+        let buf = ledger
+            .buffer_init(
+                &gpu,
+                "test",
+                Lifetime::Persistent,
+                bytemuck::cast_slice(&data),
+                wgpu::BufferUsages::COPY_SRC,
+            )
+            .unwrap();
         let back = gpu.read_buffer(&buf, 0, 4000).unwrap();
         assert_eq!(bytemuck::cast_slice::<u8, u32>(&back), &data[..]);
         assert_eq!(ledger.persistent, 4000);

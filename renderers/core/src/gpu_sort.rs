@@ -145,35 +145,35 @@ impl GpuRadixSort {
                 Lifetime::PerFrame,
                 PARAM_STRIDE * PASSES as u64,
                 wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            ),
+            )?,
             tmp_keys: ledger.buffer(
                 gpu,
                 "radix sort keys (ping-pong)",
                 Lifetime::PerFrame,
                 max_len as u64 * 4,
                 storage,
-            ),
+            )?,
             tmp_vals: ledger.buffer(
                 gpu,
                 "radix sort values (ping-pong)",
                 Lifetime::PerFrame,
                 max_len as u64 * 4,
                 storage,
-            ),
+            )?,
             tile_hist: ledger.buffer(
                 gpu,
                 "radix sort tile histograms",
                 Lifetime::PerFrame,
                 tiles as u64 * 256 * 4,
                 storage,
-            ),
+            )?,
             digit_total: ledger.buffer(
                 gpu,
                 "radix sort digit totals",
                 Lifetime::PerFrame,
                 256 * 4,
                 storage,
-            ),
+            )?,
         })
     }
 
@@ -312,7 +312,7 @@ impl GpuRadixSort {
             Lifetime::PerFrame,
             bytemuck::cast_slice(keys),
             usage,
-        );
+        )?;
         let vals: Vec<u32> = (0..n).collect();
         let vbuf = ledger.buffer_init(
             gpu,
@@ -320,7 +320,7 @@ impl GpuRadixSort {
             Lifetime::PerFrame,
             bytemuck::cast_slice(&vals),
             usage,
-        );
+        )?;
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         self.encode(&mut enc, &kbuf, &vbuf, n, descending)?;
         gpu.queue.submit([enc.finish()]);
@@ -362,7 +362,7 @@ pub struct GpuCentroidKeys {
 }
 
 impl GpuCentroidKeys {
-    pub fn new(gpu: &Gpu, ledger: &mut MemoryLedger) -> GpuCentroidKeys {
+    pub fn new(gpu: &Gpu, ledger: &mut MemoryLedger) -> anyhow::Result<GpuCentroidKeys> {
         let device = &gpu.device;
         let module = gpu.shader("gpu_sort.wgsl", include_str!("gpu_sort.wgsl"));
         let uniform = wgpu::BindGroupLayoutEntry {
@@ -404,14 +404,14 @@ impl GpuCentroidKeys {
             Lifetime::PerFrame,
             std::mem::size_of::<KeyParams>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        );
-        GpuCentroidKeys {
+        )?;
+        Ok(GpuCentroidKeys {
             device: gpu.device.clone(),
             queue: gpu.queue.clone(),
             layout,
             pipeline,
             params,
-        }
+        })
     }
 
     /// Records the key pass for `count` primitives of `verts` (3 or 4) indices each in `prims`,
@@ -577,7 +577,7 @@ mod tests {
     /// Keys computed on the GPU match the CPU's centroid distances, and key pass + sort give
     /// the CPU's back-to-front centroid order (up to near-ties of f32 rounding).
     #[test]
-    fn gpu_centroid_keys_then_sort_match_the_cpu() {
+    fn gpu_centroid_keys_then_sort_match_the_cpu() -> anyhow::Result<()> {
         use crate::scene::{fixed_viewpoints, Camera, Projection};
         let gpu = Gpu::new().expect("a wgpu adapter");
         let dims = [9usize, 8, 7];
@@ -599,17 +599,17 @@ mod tests {
             Lifetime::Persistent,
             bytemuck::cast_slice(&pts),
             storage,
-        );
+        )?;
         let tbuf = ledger.buffer_init(
             &gpu,
             "tets",
             Lifetime::Persistent,
             bytemuck::cast_slice(&tets),
             storage,
-        );
-        let kbuf = ledger.buffer(&gpu, "keys", Lifetime::PerFrame, n as u64 * 4, storage);
-        let vbuf = ledger.buffer(&gpu, "values", Lifetime::PerFrame, n as u64 * 4, storage);
-        let keys_pass = GpuCentroidKeys::new(&gpu, &mut ledger);
+        )?;
+        let kbuf = ledger.buffer(&gpu, "keys", Lifetime::PerFrame, n as u64 * 4, storage)?;
+        let vbuf = ledger.buffer(&gpu, "values", Lifetime::PerFrame, n as u64 * 4, storage)?;
+        let keys_pass = GpuCentroidKeys::new(&gpu, &mut ledger).unwrap();
         let sorter = GpuRadixSort::new(&gpu, n, &mut ledger).unwrap();
         let bounds =
             datasets::Aabb::of_points(&pts.iter().map(|p| [p[0], p[1], p[2]]).collect::<Vec<_>>());
@@ -662,6 +662,7 @@ mod tests {
                 assert!(a >= b - 2e-5 * scale, "{a} before {b}");
             }
         }
+        Ok(())
     }
 
     #[test]

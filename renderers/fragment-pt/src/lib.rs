@@ -390,14 +390,14 @@ impl Renderer for FragmentPt {
             Lifetime::Persistent,
             bytemuck::cast_slice(&verts),
             storage_use,
-        );
+        )?;
         let tet_buf = ledger.buffer_init(
             gpu,
             "fragment-pt tets",
             Lifetime::Persistent,
             bytemuck::cast_slice(&tets),
             storage_use,
-        );
+        )?;
         let model_bytes = ledger.persistent;
         // View-independent tables (small; counted as persistent too).
         let table = ledger.buffer_init(
@@ -406,21 +406,21 @@ impl Renderer for FragmentPt {
             Lifetime::Persistent,
             bytemuck::cast_slice(&packed_table()),
             storage_use,
-        );
+        )?;
         let tf = ledger.buffer_init(
             gpu,
             "fragment-pt transfer function",
             Lifetime::Persistent,
             bytemuck::cast_slice(&optics.tf.rgb_kappa_table(TF_ENTRIES)),
             storage_use,
-        );
+        )?;
         let expt = ledger.buffer_init(
             gpu,
             "fragment-pt exp table",
             Lifetime::Persistent,
             bytemuck::cast_slice(&exp_table()),
             storage_use,
-        );
+        )?;
         let psi_values: Vec<f32> = match self.settings.shading {
             Shading::Psi => render_core::preintegration::PsiTable::build(PSI_SIDE).data,
             // The average mode never reads ψ; bind a minimal buffer.
@@ -432,7 +432,7 @@ impl Renderer for FragmentPt {
             Lifetime::Persistent,
             bytemuck::cast_slice(&psi_values),
             storage_use,
-        );
+        )?;
         // Per-frame buffers written by pass 1 and the sort.
         let records = ledger.buffer(
             gpu,
@@ -440,21 +440,21 @@ impl Renderer for FragmentPt {
             Lifetime::PerFrame,
             n * RECORD_BYTES,
             storage_use | wgpu::BufferUsages::COPY_SRC,
-        );
+        )?;
         let depths = ledger.buffer(
             gpu,
             "fragment-pt centroid depths",
             Lifetime::PerFrame,
             n * 4,
             storage_use | wgpu::BufferUsages::COPY_SRC,
-        );
+        )?;
         let order = ledger.buffer(
             gpu,
             "fragment-pt order",
             Lifetime::PerFrame,
             n * 4,
             storage_use | wgpu::BufferUsages::COPY_DST,
-        );
+        )?;
         let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         let pass1_params = ledger.buffer(
             gpu,
@@ -462,14 +462,14 @@ impl Renderer for FragmentPt {
             Lifetime::PerFrame,
             std::mem::size_of::<Pass1Params>() as u64,
             uniform,
-        );
+        )?;
         let pass2_params = ledger.buffer(
             gpu,
             "fragment-pt pass-2 params",
             Lifetime::PerFrame,
             std::mem::size_of::<Pass2Params>() as u64,
             uniform,
-        );
+        )?;
 
         let m1 = gpu.shader("fragment-pt pass 1", include_str!("pass1.wgsl"));
         let pass1 = gpu.compute_pipeline("fragment-pt pass 1", None, &m1, "classify");
@@ -649,7 +649,7 @@ impl Renderer for FragmentPt {
                     usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
                     view_formats: &[],
                 },
-            );
+            )?;
             let view = tex.create_view(&Default::default());
             st.target = Some((tex, view));
         }

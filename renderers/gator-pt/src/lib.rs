@@ -225,7 +225,7 @@ fn lut_texture(
     format: wgpu::TextureFormat,
     texels: u32,
     data: &[u8],
-) -> wgpu::TextureView {
+) -> anyhow::Result<wgpu::TextureView> {
     let texture = ledger.texture(
         gpu,
         Lifetime::Persistent,
@@ -243,7 +243,7 @@ fn lut_texture(
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         },
-    );
+    )?;
     gpu.queue.write_texture(
         texture.as_image_copy(),
         data,
@@ -258,7 +258,7 @@ fn lut_texture(
             depth_or_array_layers: 1,
         },
     );
-    texture.create_view(&Default::default())
+    Ok(texture.create_view(&Default::default()))
 }
 
 /// Opacity table: α(τ) = 1 − exp(−τ) for τ = i/(n−1)·TAU_MAX.
@@ -307,7 +307,8 @@ impl MeshGpu {
                              label: &str,
                              bytes: &[u8],
                              ranges: &[std::ops::Range<u64>],
-                             max: usize| {
+                             max: usize|
+         -> anyhow::Result<Vec<wgpu::Buffer>> {
             let mut bufs: Vec<wgpu::Buffer> = ranges
                 .iter()
                 .map(|r| {
@@ -319,7 +320,7 @@ impl MeshGpu {
                         usage,
                     )
                 })
-                .collect();
+                .collect::<anyhow::Result<_>>()?;
             // Unused bindings get a tiny placeholder buffer (counted: it is allocated).
             while bufs.len() < max {
                 bufs.push(ledger.buffer(
@@ -328,9 +329,9 @@ impl MeshGpu {
                     Lifetime::Persistent,
                     16,
                     usage,
-                ));
+                )?);
             }
-            bufs
+            Ok(bufs)
         };
         let tet_bufs = chunk_buffers(
             ledger,
@@ -338,14 +339,14 @@ impl MeshGpu {
             bytemuck::cast_slice(tets),
             &tet_ranges,
             MAX_TET_CHUNKS,
-        );
+        )?;
         let point_bufs = chunk_buffers(
             ledger,
             "gator points",
             bytemuck::cast_slice(points),
             &point_ranges,
             MAX_POINT_CHUNKS,
-        );
+        )?;
 
         let default_optics;
         let optics = match optics {
@@ -369,7 +370,7 @@ impl MeshGpu {
             wgpu::TextureFormat::Rgba32Float,
             TF_LUT_SIZE,
             bytemuck::cast_slice(&tf),
-        );
+        )?;
         let ex = exp_table();
         let exp_view = lut_texture(
             gpu,
@@ -378,7 +379,7 @@ impl MeshGpu {
             wgpu::TextureFormat::R32Float,
             EXP_LUT_SIZE,
             bytemuck::cast_slice(&ex),
-        );
+        )?;
 
         let params_host = Params {
             view_proj: [[0.0; 4]; 4],
@@ -397,7 +398,7 @@ impl MeshGpu {
             Lifetime::Persistent,
             bytemuck::bytes_of(&params_host),
             wgpu::BufferUsages::UNIFORM,
-        );
+        )?;
 
         let vc = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![uniform_entry(
@@ -555,14 +556,14 @@ impl Renderer for GatorPt {
             Lifetime::PerFrame,
             n * 4,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        );
+        )?;
         let index_buf = ledger.buffer_init(
             gpu,
             "gator fan indices",
             Lifetime::Persistent,
             bytemuck::cast_slice(&fan_index_buffer()),
             wgpu::BufferUsages::INDEX,
-        );
+        )?;
         let mut chunks = Vec::new();
         for range in chunk_ranges(n, 4, mb) {
             let cp = [range.start as u32, 0, 0, 0];
@@ -572,7 +573,7 @@ impl Renderer for GatorPt {
                 Lifetime::Persistent,
                 bytemuck::cast_slice(&cp),
                 wgpu::BufferUsages::UNIFORM,
-            );
+            )?;
             let size = std::num::NonZeroU64::new(((range.end - range.start) * 4).max(4));
             let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("gator order chunk"),
@@ -653,7 +654,7 @@ impl Renderer for GatorPt {
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
                 view_formats: &[],
             };
-            let texture = st.ledger.texture(gpu, Lifetime::PerFrame, &desc);
+            let texture = st.ledger.texture(gpu, Lifetime::PerFrame, &desc)?;
             let view = texture.create_view(&Default::default());
             st.target = Some(Target {
                 texture,
@@ -853,7 +854,7 @@ pub fn classify_gpu(
         Lifetime::PerFrame,
         size,
         wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-    );
+    )?;
     let g1 = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("gator debug out"),
         layout: &g1_layout,

@@ -363,14 +363,14 @@ impl Renderer for Havs {
             Lifetime::Persistent,
             bytemuck::cast_slice(&verts),
             storage,
-        );
+        )?;
         let faces_buf = ledger.buffer_init(
             gpu,
             "havs faces",
             Lifetime::Persistent,
             bytemuck::cast_slice(&faces),
             storage,
-        );
+        )?;
         let num_faces = faces.len() as u64;
         let centroids: Vec<[f32; 3]> = faces
             .par_iter()
@@ -407,7 +407,7 @@ impl Renderer for Havs {
                 usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
                 view_formats: &[],
             },
-        );
+        )?;
         gpu.queue.write_texture(
             tex.as_image_copy(),
             bytemuck::cast_slice(&table.data),
@@ -452,7 +452,7 @@ impl Renderer for Havs {
             Lifetime::PerFrame,
             num_faces * 4,
             storage | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        );
+        )?;
         let uniforms: Vec<wgpu::Buffer> = chunks
             .iter()
             .map(|_| {
@@ -464,14 +464,14 @@ impl Renderer for Havs {
                     wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 )
             })
-            .collect();
+            .collect::<anyhow::Result<_>>()?;
         let counters = ledger.buffer(
             gpu,
             "havs counters",
             Lifetime::PerFrame,
             16,
             storage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-        );
+        )?;
 
         let all =
             wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
@@ -666,21 +666,21 @@ impl GpuSortState {
             Lifetime::PerFrame,
             num_faces * 4,
             usage,
-        );
+        )?;
         let ids = ledger.buffer(
             gpu,
             "havs sort ids",
             Lifetime::PerFrame,
             num_faces * 4,
             usage,
-        );
+        )?;
         let key_uniforms = ledger.buffer(
             gpu,
             "havs key uniforms",
             Lifetime::PerFrame,
             std::mem::size_of::<KeyUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        );
+        )?;
         let module = gpu.shader("havs keys", include_str!("keys.wgsl"));
         let key_pipeline = gpu.compute_pipeline("havs face keys", None, &module, "face_keys");
         let key_bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -756,7 +756,7 @@ impl State {
             Lifetime::PerFrame,
             npx * 32,
             usage,
-        );
+        )?;
         let (kentries, heads, nodes_buf, node_capacity) = match s.mode {
             Mode::FragmentRace => {
                 let bytes = npx * s.k as u64 * 8;
@@ -769,21 +769,21 @@ impl State {
                     Lifetime::PerFrame,
                     bytes,
                     usage,
-                );
+                )?;
                 let heads = self.ledger.buffer(
                     gpu,
                     "havs target unused heads",
                     Lifetime::PerFrame,
                     16,
                     usage,
-                );
+                )?;
                 let nodes = self.ledger.buffer(
                     gpu,
                     "havs target unused nodes",
                     Lifetime::PerFrame,
                     16,
                     usage,
-                );
+                )?;
                 (kb, heads, nodes, 0)
             }
             Mode::RaceFree => {
@@ -802,21 +802,21 @@ impl State {
                     Lifetime::PerFrame,
                     16,
                     usage,
-                );
+                )?;
                 let heads = self.ledger.buffer(
                     gpu,
                     "havs target list heads",
                     Lifetime::PerFrame,
                     npx * 4,
                     usage,
-                );
+                )?;
                 let nodes = self.ledger.buffer(
                     gpu,
                     "havs target fragment lists",
                     Lifetime::PerFrame,
                     cap * 16,
                     usage,
-                );
+                )?;
                 (kb, heads, nodes, cap)
             }
         };
@@ -837,7 +837,7 @@ impl State {
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
                 view_formats: &[],
             },
-        );
+        )?;
         let dummy_view = dummy.create_view(&Default::default());
         let bind_groups = self
             .chunks
