@@ -353,6 +353,8 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
             orthographic: false,
             scalar: None,
             no_report: true,
+            shard: None,
+            no_calibrate: false,
         };
         let config = run_args.to_config(
             ctx.data_dir.clone(),
