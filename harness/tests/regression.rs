@@ -65,7 +65,7 @@ fn merged_shards_equal_one_run_and_compare_finds_no_change() {
             "--datasets",
             "box:1k,shell:1k",
             "--viewpoints",
-            "+x,-y+z",
+            "+x,-x-y+z",
             "--resolution",
             "16",
             "--frames",
