@@ -110,9 +110,11 @@ pub fn cache_path(cache_dir: &Path, gpu: &Gpu, machine: &MachineInfo) -> PathBuf
         machine.cpu_cores
     );
     let hex = blake3::hash(key.as_bytes()).to_hex();
-    cache_dir
-        .join("calibration")
-        .join(format!("{}-{}.json", crate::run::slug(&gpu.adapter.name), &hex[..16]))
+    cache_dir.join("calibration").join(format!(
+        "{}-{}.json",
+        crate::run::slug(&gpu.adapter.name),
+        &hex[..16]
+    ))
 }
 
 /// The cached calibration if there is one for this backend, else a fresh measurement (then
@@ -135,8 +137,7 @@ pub fn cached_or_measure(
     }
     let c = measure(gpu, machine)?;
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create {}", dir.display()))?;
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     std::fs::write(&path, serde_json::to_string_pretty(&c)?)
         .with_context(|| format!("cannot write {}", path.display()))?;
@@ -230,10 +231,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
     let tri_s = best_seconds(|| draw(&tri, &tri_view, (TRIANGLES * 3) as u32, 1))?;
 
     // 2. Fill: the float format the algorithms composite into, when it blends here.
-    let fill_format = if gpu
-        .features
-        .contains(wgpu::Features::FLOAT32_BLENDABLE)
-    {
+    let fill_format = if gpu.features.contains(wgpu::Features::FLOAT32_BLENDABLE) {
         wgpu::TextureFormat::Rgba32Float
     } else {
         wgpu::TextureFormat::Rgba16Float
@@ -341,7 +339,9 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         Ok(())
     })?;
     anyhow::ensure!(
-        indices.windows(2).all(|w| keys[w[0] as usize] <= keys[w[1] as usize]),
+        indices
+            .windows(2)
+            .all(|w| keys[w[0] as usize] <= keys[w[1] as usize]),
         "the calibration's radix sort did not sort"
     );
 
@@ -354,8 +354,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         date_utc: crate::machine::iso8601_utc(std::time::SystemTime::now()),
         seconds: started.elapsed().as_secs_f64(),
         triangles_per_sec: TRIANGLES as f64 / tri_s,
-        fill_fragments_per_sec: (FILL_SIZE as u64 * FILL_SIZE as u64 * FILL_LAYERS) as f64
-            / fill_s,
+        fill_fragments_per_sec: (FILL_SIZE as u64 * FILL_SIZE as u64 * FILL_LAYERS) as f64 / fill_s,
         fill_format: format!("{fill_format:?}"),
         compute_gflops: (FMA_INVOCATIONS * FMA_ITERS * 4 * 4 * 2) as f64 / fma_s * 1e-9,
         copy_bytes_per_sec: (2 * copy_bytes) as f64 / copy_s,

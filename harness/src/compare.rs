@@ -198,7 +198,11 @@ fn adapter_of(f: &ResultsFile) -> String {
     f.machine
         .adapter
         .as_ref()
-        .map(|a| format!("{} ({} {})", a.name, a.driver, a.driver_info).trim().to_string())
+        .map(|a| {
+            format!("{} ({} {})", a.name, a.driver, a.driver_info)
+                .trim()
+                .to_string()
+        })
         .unwrap_or_else(|| "unknown adapter".into())
 }
 
@@ -234,7 +238,11 @@ fn metric_samples(r: &Row, metric: &str, normalised: bool) -> anyhow::Result<Vec
 }
 
 /// Compares two result directories; writes nothing (see [`write_outputs`]).
-pub fn compare(base_dir: &Path, new_dir: &Path, opt: &CompareOptions) -> anyhow::Result<Comparison> {
+pub fn compare(
+    base_dir: &Path,
+    new_dir: &Path,
+    opt: &CompareOptions,
+) -> anyhow::Result<Comparison> {
     let base = ResultsFile::read(base_dir)?;
     let new = ResultsFile::read(new_dir)?;
     let (ba, na) = (adapter_of(&base), adapter_of(&new));
@@ -401,7 +409,11 @@ fn compare_rows(
     out.image = Some(img);
     for (what, bv, nv) in [
         ("gpu_bytes", b.gpu_bytes, n.gpu_bytes),
-        ("gpu_bytes_persistent", b.gpu_bytes_persistent, n.gpu_bytes_persistent),
+        (
+            "gpu_bytes_persistent",
+            b.gpu_bytes_persistent,
+            n.gpu_bytes_persistent,
+        ),
         ("gpu_bytes_frame", b.gpu_bytes_frame, n.gpu_bytes_frame),
     ] {
         if let (Some(bv), Some(nv)) = (bv, nv) {
@@ -472,8 +484,10 @@ fn image_change(
         if !b.image_hash.is_empty() && !n.image_hash.is_empty() {
             c.pixels_changed = Some(b.image_hash != n.image_hash);
         }
-        if let (Some(bp), Some(np)) = (samples::row_image(base_dir, b), samples::row_image(new_dir, n))
-        {
+        if let (Some(bp), Some(np)) = (
+            samples::row_image(base_dir, b),
+            samples::row_image(new_dir, n),
+        ) {
             let (bi, ni) = (samples::read_f32_image(&bp)?, samples::read_f32_image(&np)?);
             let d = crate::compare_plot::image_difference(&bi, &ni)?;
             c.changed_pixels = Some(d.changed_pixels);
@@ -523,10 +537,9 @@ fn group_tests(
     let mut out = vec![];
     for (algorithm, settings, dataset) in groups {
         let (mut bs, mut ns, mut views) = (vec![], vec![], 0);
-        for b in base
-            .iter()
-            .filter(|r| (&r.algorithm, &r.settings, &r.dataset) == (&algorithm, &settings, &dataset))
-        {
+        for b in base.iter().filter(|r| {
+            (&r.algorithm, &r.settings, &r.dataset) == (&algorithm, &settings, &dataset)
+        }) {
             let Some(n) = new.iter().find(|n| key(n) == key(b)) else {
                 continue;
             };
@@ -572,10 +585,7 @@ pub fn run_command(base: &Path, new: &Path, opt: &CompareOptions) -> anyhow::Res
         .with_context(|| format!("cannot create {}", opt.out.display()))?;
     print!("{}", crate::compare_report::terminal(&cmp));
     crate::compare_report::write_outputs(&cmp, &opt.out)?;
-    println!(
-        "wrote {}/compare.{{md,json,html}}",
-        opt.out.display()
-    );
+    println!("wrote {}/compare.{{md,json,html}}", opt.out.display());
     Ok(match opt.fail_on {
         FailOn::Never => false,
         FailOn::Regression => !cmp.regressions.is_empty(),
@@ -653,10 +663,16 @@ mod tests {
     fn a_one_pixel_image_change_is_reported() {
         let tmp = tempfile::tempdir().unwrap();
         let mut img = render_core::Image::new(16, 16);
-        img.pixels.iter_mut().for_each(|p| *p = [0.2, 0.3, 0.4, 0.5]);
+        img.pixels
+            .iter_mut()
+            .for_each(|p| *p = [0.2, 0.3, 0.4, 0.5]);
         let mut changed = img.clone();
         changed.pixels[37][2] = f32::from_bits(changed.pixels[37][2].to_bits() + 1);
-        let (a, b, c) = (tmp.path().join("a"), tmp.path().join("b"), tmp.path().join("c"));
+        let (a, b, c) = (
+            tmp.path().join("a"),
+            tmp.path().join("b"),
+            tmp.path().join("c"),
+        );
         results_dir(&a, &img, 10.0);
         results_dir(&b, &img, 10.0);
         results_dir(&c, &changed, 10.0);
@@ -681,7 +697,12 @@ mod tests {
         // fail-on change gates it; the outputs name the heatmap.
         assert!(run_command(&a, &c, &opt("ac")).unwrap());
         assert!(tmp.path().join("ac").join(&image.heatmap).is_file());
-        for f in ["compare.md", "compare.json", "compare.html", "charts/ratio_rows.png"] {
+        for f in [
+            "compare.md",
+            "compare.json",
+            "compare.html",
+            "charts/ratio_rows.png",
+        ] {
             assert!(tmp.path().join("ac").join(f).is_file(), "{f}");
         }
     }

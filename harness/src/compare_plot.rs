@@ -89,7 +89,10 @@ where
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing a ratio plot: {e:?}");
     root.fill(&WHITE).map_err(err)?;
-    let all = strips.iter().flat_map(|s| s.base.iter().chain(&s.new)).copied();
+    let all = strips
+        .iter()
+        .flat_map(|s| s.base.iter().chain(&s.new))
+        .copied();
     let (mut lo, mut hi) = (1.0 / threshold, threshold);
     for v in all.filter(|v| v.is_finite() && *v > 0.0) {
         lo = lo.min(v);
@@ -121,7 +124,10 @@ where
         .draw_series([
             line(1.0, BLACK.stroke_width(1)),
             line(threshold, RGBColor(214, 39, 40).mix(0.5).stroke_width(1)),
-            line(1.0 / threshold, RGBColor(44, 160, 44).mix(0.5).stroke_width(1)),
+            line(
+                1.0 / threshold,
+                RGBColor(44, 160, 44).mix(0.5).stroke_width(1),
+            ),
         ])
         .map_err(err)?;
     let text = TextStyle::from((FONT, 12).into_font()).pos(Pos::new(HPos::Right, VPos::Center));
@@ -140,7 +146,11 @@ where
             )
             .map_err(err)?;
         chart
-            .draw_series(s.new.iter().map(|&x| Circle::new((x, y - 0.18), 3, colour.filled())))
+            .draw_series(
+                s.new
+                    .iter()
+                    .map(|&x| Circle::new((x, y - 0.18), 3, colour.filled())),
+            )
             .map_err(err)?;
         let (_, py) = chart.backend_coord(&(1.0, y));
         labels
@@ -169,7 +179,8 @@ pub fn ratio_plot(
     let png = dir.join(format!("{stem}.png"));
     {
         let root = BitMapBackend::new(&png, size).into_drawing_area();
-        draw(&root, title, strips, threshold).with_context(|| format!("writing {}", png.display()))?;
+        draw(&root, title, strips, threshold)
+            .with_context(|| format!("writing {}", png.display()))?;
     }
     let mut svg = String::new();
     {

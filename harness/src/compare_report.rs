@@ -10,7 +10,12 @@ use crate::compare::{fmt_p, Comparison, RowComparison, TimeTest};
 use crate::compare_plot::{ratio_plot, Strip};
 
 fn header(c: &Comparison) -> Vec<String> {
-    let commit = |c: &Option<String>| c.as_deref().map(|s| &s[..s.len().min(10)]).unwrap_or("?").to_string();
+    let commit = |c: &Option<String>| {
+        c.as_deref()
+            .map(|s| &s[..s.len().min(10)])
+            .unwrap_or("?")
+            .to_string()
+    };
     vec![
         format!("BASE {} — {} (commit {})", c.base, c.base_adapter, commit(&c.base_commit)),
         format!("NEW  {} — {} (commit {})", c.new, c.new_adapter, commit(&c.new_commit)),
@@ -37,7 +42,12 @@ fn header(c: &Comparison) -> Vec<String> {
 
 fn time_cell(t: Option<&TimeTest>) -> String {
     match t {
-        Some(t) => format!("×{:.3} p={} {}", t.ratio, fmt_p(t.p_value), t.verdict.label()),
+        Some(t) => format!(
+            "×{:.3} p={} {}",
+            t.ratio,
+            fmt_p(t.p_value),
+            t.verdict.label()
+        ),
         None => "-".into(),
     }
 }
@@ -58,11 +68,7 @@ pub fn terminal(c: &Comparison) -> String {
         .unwrap_or(10);
     for g in &c.groups {
         let name = format!("{} {} @ {}", g.algorithm, g.settings, g.dataset);
-        let _ = writeln!(
-            s,
-            "  {name:<w$}  {}",
-            time_cell(Some(&g.total))
-        );
+        let _ = writeln!(s, "  {name:<w$}  {}", time_cell(Some(&g.total)));
     }
     let notable: Vec<&RowComparison> = c.rows.iter().filter(|r| r.status != "no change").collect();
     let _ = writeln!(
@@ -139,7 +145,9 @@ fn markdown(c: &Comparison) -> String {
             img.and_then(|i| i.psnr_delta_db)
                 .map(|d| format!("{d:+.3}"))
                 .unwrap_or_else(|| "-".into()),
-            img.and_then(|i| i.changed_pixels.map(|p| p.to_string()).or(i.pixels_changed.map(|b| if b { "yes".into() } else { "0".into() })))
+            img.and_then(|i| i.changed_pixels.map(|p| p.to_string()).or(i
+                .pixels_changed
+                .map(|b| if b { "yes".into() } else { "0".into() })))
                 .unwrap_or_else(|| "-".into()),
             r.memory
                 .iter()
@@ -153,7 +161,9 @@ fn markdown(c: &Comparison) -> String {
 }
 
 fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 fn html(c: &Comparison) -> String {
@@ -191,7 +201,13 @@ fn html(c: &Comparison) -> String {
         let img = r.image.as_ref();
         let heat = img
             .filter(|i| !i.heatmap.is_empty())
-            .map(|i| format!("<a href=\"{0}\"><img src=\"{0}\" width=64></a> {1} px", esc(&i.heatmap), i.changed_pixels.unwrap_or(0)))
+            .map(|i| {
+                format!(
+                    "<a href=\"{0}\"><img src=\"{0}\" width=64></a> {1} px",
+                    esc(&i.heatmap),
+                    i.changed_pixels.unwrap_or(0)
+                )
+            })
             .unwrap_or_else(|| img.map(|i| i.verdict.clone()).unwrap_or_default());
         let _ = write!(
             s,
@@ -224,7 +240,8 @@ pub fn write_outputs(c: &Comparison, out: &Path) -> anyhow::Result<()> {
     write("compare.md", markdown(c))?;
     write("compare.json", serde_json::to_string_pretty(c)? + "\n")?;
     let charts = out.join("charts");
-    std::fs::create_dir_all(&charts).with_context(|| format!("cannot create {}", charts.display()))?;
+    std::fs::create_dir_all(&charts)
+        .with_context(|| format!("cannot create {}", charts.display()))?;
     let groups: Vec<Strip> = c
         .groups
         .iter()
@@ -235,20 +252,35 @@ pub fn write_outputs(c: &Comparison, out: &Path) -> anyhow::Result<()> {
             verdict: g.total.verdict,
         })
         .collect();
-    ratio_plot(&charts, "ratio_groups", "total_ms per group", &groups, c.threshold)?;
+    ratio_plot(
+        &charts,
+        "ratio_groups",
+        "total_ms per group",
+        &groups,
+        c.threshold,
+    )?;
     let rows: Vec<Strip> = c
         .rows
         .iter()
         .filter_map(|r| {
             let t = metric(r, "total_ms")?;
             Some(Strip {
-                label: format!("{} {} @ {} {}", r.algorithm, r.settings, r.dataset, r.viewpoint),
+                label: format!(
+                    "{} {} @ {} {}",
+                    r.algorithm, r.settings, r.dataset, r.viewpoint
+                ),
                 base: t.base_ratios.clone(),
                 new: t.new_ratios.clone(),
                 verdict: t.verdict,
             })
         })
         .collect();
-    ratio_plot(&charts, "ratio_rows", "total_ms per row", &rows, c.threshold)?;
+    ratio_plot(
+        &charts,
+        "ratio_rows",
+        "total_ms per row",
+        &rows,
+        c.threshold,
+    )?;
     write("compare.html", html(c))
 }

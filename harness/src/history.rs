@@ -74,7 +74,9 @@ pub fn history(dirs: &[PathBuf], threshold: f64, alpha: f64) -> anyhow::Result<H
             format!(
                 "{} {}",
                 &c[..c.len().min(7)],
-                d.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
+                d.file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default()
             )
         })
         .collect();
@@ -172,7 +174,10 @@ fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<(
     root.fill(&WHITE).map_err(err)?;
     let n = h.runs.len().max(2);
     let mut c = ChartBuilder::on(&root)
-        .caption(format!("{alg} on {dataset}: total ms per run"), (FONT, 18).into_font())
+        .caption(
+            format!("{alg} on {dataset}: total ms per run"),
+            (FONT, 18).into_font(),
+        )
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(60)
@@ -196,7 +201,8 @@ fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<(
         .map_err(err)?;
     for (k, s) in series.iter().enumerate() {
         let col = crate::report::palette(k);
-        let mut band: Vec<(f64, f64)> = s.points.iter().map(|p| (p.run as f64, p.band_hi)).collect();
+        let mut band: Vec<(f64, f64)> =
+            s.points.iter().map(|p| (p.run as f64, p.band_hi)).collect();
         band.extend(s.points.iter().rev().map(|p| (p.run as f64, p.band_lo)));
         c.draw_series(std::iter::once(Polygon::new(band, col.mix(0.15))))
             .map_err(err)?;
@@ -236,10 +242,13 @@ fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<(
 pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> anyhow::Result<()> {
     let h = history(dirs, threshold, alpha)?;
     let charts = out.join("charts");
-    std::fs::create_dir_all(&charts).with_context(|| format!("cannot create {}", charts.display()))?;
+    std::fs::create_dir_all(&charts)
+        .with_context(|| format!("cannot create {}", charts.display()))?;
     let mut md = String::from("# tetbench history\n\nRuns: ");
     md.push_str(&h.runs.join(" → "));
-    md.push_str("\n\n| algorithm | settings | data set | ms per run (changes) |\n|---|---|---|---|\n");
+    md.push_str(
+        "\n\n| algorithm | settings | data set | ms per run (changes) |\n|---|---|---|---|\n",
+    );
     let mut html = String::from("<!doctype html><html><head><meta charset=\"utf-8\"><title>tetbench history</title></head><body style=\"font-family:sans-serif\"><h1>tetbench history</h1>");
     let _ = write!(html, "<p>Runs: {}</p>", h.runs.join(" → "));
     let mut pairs: Vec<(String, String)> = vec![];
@@ -255,14 +264,25 @@ pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> 
                 }
             })
             .collect();
-        let _ = writeln!(md, "| {} | {} | {} | {} |", s.algorithm, s.settings, s.dataset, cells.join(" → "));
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} |",
+            s.algorithm,
+            s.settings,
+            s.dataset,
+            cells.join(" → ")
+        );
         let k = (s.algorithm.clone(), s.dataset.clone());
         if !pairs.contains(&k) {
             pairs.push(k);
         }
     }
     for (alg, ds) in &pairs {
-        let name = format!("history_{}_{}.png", crate::run::slug(alg), crate::run::slug(ds));
+        let name = format!(
+            "history_{}_{}.png",
+            crate::run::slug(alg),
+            crate::run::slug(ds)
+        );
         chart(&charts.join(&name), &h, alg, ds)?;
         let _ = write!(html, "<h2>{alg} on {ds}</h2><img src=\"charts/{name}\">");
     }

@@ -156,7 +156,9 @@ impl ResultsFile {
         let value: serde_json::Value = serde_json::from_str(&text)
             .with_context(|| format!("{} is not JSON", path.display()))?;
         let version = value.get("schema_version").and_then(|v| v.as_u64());
-        if !version.is_some_and(|v| (OLDEST_READABLE_SCHEMA as u64..=SCHEMA_VERSION as u64).contains(&v)) {
+        if !version
+            .is_some_and(|v| (OLDEST_READABLE_SCHEMA as u64..=SCHEMA_VERSION as u64).contains(&v))
+        {
             anyhow::bail!(
                 "{}: schema_version {:?}, this tetbench reads versions \
                  {OLDEST_READABLE_SCHEMA} to {SCHEMA_VERSION}",

@@ -281,9 +281,9 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         None => None,
     };
     let in_shard = |label: &str, alg: &str, settings: &str| {
-        shard_units.as_ref().is_none_or(|u| {
-            u.contains(&(label.to_string(), alg.to_string(), settings.to_string()))
-        })
+        shard_units
+            .as_ref()
+            .is_none_or(|u| u.contains(&(label.to_string(), alg.to_string(), settings.to_string())))
     };
     let description = RunDescription {
         command_line: config.command_line.clone(),

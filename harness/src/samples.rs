@@ -204,14 +204,22 @@ pub fn read_f32_image(path: &Path) -> anyhow::Result<Image> {
         .read_to_end(&mut planes)
         .map_err(|e| bad(&format!("corrupt data: {e}")))?;
     if planes.len() != n {
-        return Err(bad(&format!("{} bytes of pixels, expected {n}", planes.len())));
+        return Err(bad(&format!(
+            "{} bytes of pixels, expected {n}",
+            planes.len()
+        )));
     }
     let q = n / 4;
     let mut img = Image::new(w, h);
     for (i, px) in img.pixels.iter_mut().enumerate() {
         for (c, v) in px.iter_mut().enumerate() {
             let j = i * 4 + c;
-            *v = f32::from_le_bytes([planes[j], planes[q + j], planes[2 * q + j], planes[3 * q + j]]);
+            *v = f32::from_le_bytes([
+                planes[j],
+                planes[q + j],
+                planes[2 * q + j],
+                planes[3 * q + j],
+            ]);
         }
     }
     Ok(img)
@@ -238,9 +246,8 @@ mod tests {
         let path = dir.path().join(format!("a.{IMAGE_EXTENSION}"));
         write_f32_image(&path, &img).unwrap();
         let back = read_f32_image(&path).unwrap();
-        let bits = |i: &Image| -> Vec<u32> {
-            i.pixels.iter().flatten().map(|v| v.to_bits()).collect()
-        };
+        let bits =
+            |i: &Image| -> Vec<u32> { i.pixels.iter().flatten().map(|v| v.to_bits()).collect() };
         assert_eq!((back.width, back.height), (7, 5));
         assert_eq!(bits(&back), bits(&img));
         assert_eq!(image_hash(&back), image_hash(&img));

@@ -120,7 +120,10 @@ fn row_key(r: &Row) -> (String, String, String, String, u32, u32, String) {
 /// Merges the results in `dirs` into one set written to `out` (results, samples, copied
 /// images), ordered as one unsharded run would order them, machines side by side.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> anyhow::Result<ResultsFile> {
-    anyhow::ensure!(!dirs.is_empty(), "report --merge needs at least one directory");
+    anyhow::ensure!(
+        !dirs.is_empty(),
+        "report --merge needs at least one directory"
+    );
     let files: Vec<ResultsFile> = dirs
         .iter()
         .map(|d| ResultsFile::read(d))
@@ -173,7 +176,10 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> anyhow::Result<ResultsFile> {
     let mut run = matrix;
     run.command_line = first.run.command_line.clone();
     run.merged_from = merged_from;
-    let finished = files.iter().map(|f| f.finished_utc.clone()).collect::<Option<Vec<_>>>();
+    let finished = files
+        .iter()
+        .map(|f| f.finished_utc.clone())
+        .collect::<Option<Vec<_>>>();
     let merged = ResultsFile {
         schema_version: results::SCHEMA_VERSION,
         machine: first.machine.clone(),
@@ -208,7 +214,11 @@ fn copy_file(from: &Path, to: &Path, rel: &str) -> anyhow::Result<()> {
 /// order), viewpoint, then adapter.
 pub fn sort_like_a_run(rows: &mut [Row], run: &RunDescription) {
     let pos = |list: &[String], x: &str| list.iter().position(|s| s == x).unwrap_or(usize::MAX);
-    let labels: Vec<String> = run.datasets.iter().map(|d| crate::run::dataset_label(d)).collect();
+    let labels: Vec<String> = run
+        .datasets
+        .iter()
+        .map(|d| crate::run::dataset_label(d))
+        .collect();
     let viewpoints: Vec<String> = crate::suite::parse_viewpoints(&run.viewpoints)
         .map(|v| v.into_iter().map(|v| v.name).collect())
         .unwrap_or_default();
@@ -218,7 +228,11 @@ pub fn sort_like_a_run(rows: &mut [Row], run: &RunDescription) {
         let order = filter
             .as_ref()
             .and_then(|f| crate::algorithms::selected_variants(a, f).ok())
-            .map(|v| v.iter().map(|r| render_core::settings_string(&r.settings())).collect())
+            .map(|v| {
+                v.iter()
+                    .map(|r| render_core::settings_string(&r.settings()))
+                    .collect()
+            })
             .unwrap_or_default();
         variant_order.insert(a.clone(), order);
     }

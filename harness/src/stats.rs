@@ -59,7 +59,9 @@ pub fn mann_whitney_p(a: &[f64], b: &[f64]) -> Option<f64> {
     let mut tie_term = 0.0;
     let mut i = 0;
     while i < all.len() {
-        let j = (i..all.len()).find(|&j| all[j] != all[i]).unwrap_or(all.len());
+        let j = (i..all.len())
+            .find(|&j| all[j] != all[i])
+            .unwrap_or(all.len());
         let t = (j - i) as f64;
         tie_term += t * t * t - t;
         i = j;

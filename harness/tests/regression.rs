@@ -123,16 +123,11 @@ fn merged_shards_equal_one_run_and_compare_finds_no_change() {
 
     // compare: identical images and memory (timings may differ on a busy machine; the gate
     // here is on images and memory, which are exact).
-    let text = ok(&[
-        "compare",
-        &p("full"),
-        &p("merged"),
-        "--out",
-        &p("cmp"),
-    ]);
-    let cmp: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(tmp.path().join("cmp/compare.json")).unwrap())
-            .unwrap();
+    let text = ok(&["compare", &p("full"), &p("merged"), "--out", &p("cmp")]);
+    let cmp: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(tmp.path().join("cmp/compare.json")).unwrap(),
+    )
+    .unwrap();
     for row in cmp["rows"].as_array().unwrap() {
         assert_eq!(row["image"]["changed_pixels"], 0, "{text}");
         assert!(row["memory"].as_array().unwrap().is_empty(), "{text}");
