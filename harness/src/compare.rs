@@ -548,7 +548,7 @@ fn group_tests(
                 metric_samples(n, "total_ms", opt.normalised)?,
             );
             let m = median(&bv);
-            if bv.is_empty() || nv.is_empty() || !(m > 0.0) {
+            if bv.is_empty() || nv.is_empty() || m.is_nan() || m <= 0.0 {
                 continue;
             }
             views += 1;
