@@ -39,11 +39,71 @@ pub enum Command {
     /// Analyses that reproduce the papers' tables.
     #[command(subcommand)]
     Analyze(AnalyzeCommand),
-    /// Re-render the report (charts, index.html) of an earlier run from its results.json.
+    /// Re-render the report (charts, index.html) of an earlier run from its results.json, or
+    /// merge shards / runs of several machines: `report --merge DIR… --out OUT`.
     Report {
-        /// The run's output directory.
-        out: PathBuf,
+        /// The run's output directory (not with --merge).
+        #[arg(required_unless_present = "merge", conflicts_with = "merge")]
+        dir: Option<PathBuf>,
+        /// Result directories to merge (shards of one run, or one run on several machines).
+        #[arg(long, num_args = 1.., value_name = "DIR", requires = "out")]
+        merge: Vec<PathBuf>,
+        /// Where the merged results and report go.
+        #[arg(long, value_name = "OUT")]
+        out: Option<PathBuf>,
     },
+    /// Compare two runs: faster / slower / no change per row and group (Mann–Whitney U and a
+    /// factor threshold), image and memory changes; writes compare.{md,json,html}.
+    Compare(CompareArgs),
+    /// Measure the backend (triangle setup, fill, compute, storage copy, CPU radix sort) in
+    /// under a minute; cached per adapter and driver, recorded in every run.
+    Calibrate {
+        /// Where the calibration is cached (default: the reference cache directory).
+        #[arg(long, value_name = "DIR")]
+        cache_dir: Option<PathBuf>,
+        /// Measure even when a cached calibration exists.
+        #[arg(long)]
+        force: bool,
+        /// Print JSON instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Metrics over a series of runs (in commit order, e.g. the baselines) per algorithm × data
+    /// set, with the noise band and the changes `compare` finds.
+    History {
+        /// Result directories, oldest first.
+        #[arg(required = true, value_name = "DIR")]
+        dirs: Vec<PathBuf>,
+        /// Output directory for history.{md,html,json} and the charts.
+        #[arg(long, value_name = "DIR", default_value = "history")]
+        out: PathBuf,
+        /// Factor a median must move by to count as a change.
+        #[arg(long, default_value_t = 1.10)]
+        threshold: f64,
+    },
+}
+
+#[derive(Debug, Clone, clap::Args)]
+pub struct CompareArgs {
+    /// The reference run's output directory (e.g. reports/baselines/ADAPTER-DATE).
+    pub base: PathBuf,
+    /// The run to judge.
+    pub new: PathBuf,
+    /// Factor the median must move by (and p < alpha) to count as slower / faster.
+    #[arg(long, default_value_t = 1.10)]
+    pub threshold: f64,
+    /// Significance level of the Mann–Whitney U test.
+    #[arg(long, default_value_t = 0.05)]
+    pub alpha: f64,
+    /// Exit with status 1 on a regression (or on any change).
+    #[arg(long, value_enum, default_value = "never")]
+    pub fail_on: crate::compare::FailOn,
+    /// Compare runs from different adapters on calibration-normalised times.
+    #[arg(long)]
+    pub normalised: bool,
+    /// Output directory (default: NEW/compare).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, clap::Args)]
@@ -98,6 +158,13 @@ pub struct RunArgs {
     /// image, or below 20 dB); without it suspect rows are flagged and the run still succeeds.
     #[arg(long)]
     pub strict: bool,
+    /// Run only the i-th of N disjoint parts of the run matrix (e.g. 2/4), for CI matrices and
+    /// job arrays; merge the parts with `report --merge`.
+    #[arg(long, value_name = "i/N")]
+    pub shard: Option<String>,
+    /// Skip the backend calibration (and the rows' roofline columns).
+    #[arg(long)]
+    pub no_calibrate: bool,
 }
 
 /// The reference cache: `--cache-dir`, `$TETBENCH_CACHE`, `$XDG_CACHE_HOME/tetbench`,
@@ -218,6 +285,8 @@ impl RunArgs {
             command_line,
             report: !self.no_report,
             strict: self.strict,
+            shard: self.shard.as_deref().map(str::parse).transpose()?,
+            calibrate: !self.no_calibrate,
         })
     }
 }
@@ -288,12 +357,54 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
                 data_dir: cli.data_dir,
             },
         ),
-        Command::Report { out } => {
+        Command::Report { dir, merge, out } => {
+            if !merge.is_empty() {
+                let out = out.context("report --merge needs --out OUT")?;
+                let merged = crate::shard::merge(&merge, &out)?;
+                crate::report::write(&out, &merged)
+                    .with_context(|| format!("writing the report in {}", out.display()))?;
+                println!(
+                    "merged {} rows from {} directories into {}",
+                    merged.rows.len(),
+                    merge.len(),
+                    out.join("results.json").display()
+                );
+                return Ok(());
+            }
+            let out = dir.context("tetbench report needs a directory")?;
             crate::report::rewrite(&out)
                 .with_context(|| format!("re-rendering the report in {}", out.display()))?;
             println!("wrote {}", out.join("index.html").display());
             Ok(())
         }
+        Command::Compare(args) => {
+            let opt = crate::compare::CompareOptions {
+                threshold: args.threshold,
+                alpha: args.alpha,
+                normalised: args.normalised,
+                fail_on: args.fail_on,
+                out: args.out.clone().unwrap_or_else(|| args.new.join("compare")),
+            };
+            anyhow::ensure!(args.threshold >= 1.0, "--threshold must be at least 1");
+            if crate::compare::run_command(&args.base, &args.new, &opt)? {
+                // The documented CI gate: status 1 without an error message.
+                std::process::exit(1);
+            }
+            Ok(())
+        }
+        Command::Calibrate {
+            cache_dir,
+            force,
+            json,
+        } => {
+            let cache = cache_dir.unwrap_or_else(|| default_cache_dir(std::path::Path::new(".")));
+            crate::calibrate::run_command(&cache, force, json)
+        }
+        Command::History {
+            dirs,
+            out,
+            threshold,
+        } => crate::history::run_command(&dirs, &out, threshold, 0.05),
     }
 }
 

@@ -4,12 +4,20 @@
 
 pub mod algorithms;
 pub mod analyze;
+pub mod calibrate;
 pub mod cli;
+pub mod compare;
+pub mod compare_plot;
+pub mod compare_report;
 pub mod datasets_cmd;
+pub mod history;
 pub mod machine;
 pub mod metrics;
 pub mod report;
 pub mod results;
 pub mod run;
+pub mod samples;
+pub mod shard;
+pub mod stats;
 pub mod suite;
 pub mod suspect;

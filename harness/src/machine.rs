@@ -24,6 +24,10 @@ pub struct MachineInfo {
     /// When the run started, ISO 8601 UTC.
     pub date_utc: String,
     pub tetbench_version: String,
+    /// The backend's micro-benchmark figures (`tetbench calibrate`); `None` with
+    /// `--no-calibrate` and in files of schema 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<crate::calibrate::Calibration>,
 }
 
 impl MachineInfo {
@@ -49,6 +53,7 @@ impl MachineInfo {
             git_dirty,
             date_utc: iso8601_utc(SystemTime::now()),
             tetbench_version: env!("CARGO_PKG_VERSION").to_string(),
+            calibration: None,
         }
     }
 }

@@ -15,9 +15,16 @@ use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
 use crate::machine::MachineInfo;
+use crate::samples::{FrameSamples, SamplesWriter};
 
 /// Bumped whenever a field changes meaning or is removed (adding a field does not bump it).
-pub const SCHEMA_VERSION: u32 = 1;
+/// Version 2 adds per-frame `samples`, the exact f32 image (`image_f32`, `image_hash`), the
+/// roofline columns and the machine's calibration; version 1 files still load (the new fields
+/// are then empty).
+pub const SCHEMA_VERSION: u32 = 2;
+
+/// The oldest schema [`ResultsFile::read`] still accepts.
+pub const OLDEST_READABLE_SCHEMA: u32 = 1;
 
 pub const CSV_FILE: &str = "results.csv";
 pub const JSON_FILE: &str = "results.json";
@@ -78,8 +85,28 @@ pub struct Row {
     /// same image ([`crate::suspect`]). Absent in files written before it existed.
     #[serde(default)]
     pub suspect: String,
+    /// The exact rendering (premultiplied linear RGBA f32, compressed, see [`crate::samples`]),
+    /// relative to the output directory, and the blake3 hash of its pixels.
+    #[serde(default)]
+    pub image_f32: String,
+    #[serde(default)]
+    pub image_hash: String,
+    /// Roofline against the backend's calibration ([`crate::calibrate`]): the time the
+    /// bounding resource alone needs, `roofline_ms / total_ms`, which resource that is, and
+    /// `total_ms / roofline_ms` (the machine-independent figure `compare --normalised` uses).
+    #[serde(default)]
+    pub roofline_ms: Option<f64>,
+    #[serde(default)]
+    pub limit_fraction: Option<f64>,
+    #[serde(default)]
+    pub bound_by: String,
+    #[serde(default)]
+    pub normalized_time: Option<f64>,
     /// Empty on success; otherwise what went wrong (the metrics are then empty).
     pub error: String,
+    /// Per-frame samples: in `results.json` only (`samples.csv` has them one per line).
+    #[serde(default, skip_serializing_if = "FrameSamples::is_empty")]
+    pub samples: FrameSamples,
 }
 
 impl Row {
@@ -103,6 +130,12 @@ pub struct RunDescription {
     pub projection: String,
     pub settings_filter: String,
     pub reference: bool,
+    /// `i/N` when this run is one shard of a larger matrix (`run --shard`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<String>,
+    /// The runs `report --merge` put together (empty for a plain run).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub merged_from: Vec<crate::shard::MergedRun>,
 }
 
 /// The whole of `results.json`.
@@ -127,9 +160,12 @@ impl ResultsFile {
         let value: serde_json::Value = serde_json::from_str(&text)
             .with_context(|| format!("{} is not JSON", path.display()))?;
         let version = value.get("schema_version").and_then(|v| v.as_u64());
-        if version != Some(SCHEMA_VERSION as u64) {
+        if !version
+            .is_some_and(|v| (OLDEST_READABLE_SCHEMA as u64..=SCHEMA_VERSION as u64).contains(&v))
+        {
             anyhow::bail!(
-                "{}: schema_version {:?}, this tetbench reads version {SCHEMA_VERSION}",
+                "{}: schema_version {:?}, this tetbench reads versions \
+                 {OLDEST_READABLE_SCHEMA} to {SCHEMA_VERSION}",
                 path.display(),
                 version
             );
@@ -143,6 +179,7 @@ impl ResultsFile {
 pub struct ResultsWriter {
     dir: PathBuf,
     csv: csv::Writer<File>,
+    samples: SamplesWriter,
     pub file: ResultsFile,
 }
 
@@ -164,6 +201,7 @@ impl ResultsWriter {
         let w = ResultsWriter {
             dir: dir.to_path_buf(),
             csv,
+            samples: SamplesWriter::create(dir)?,
             file: ResultsFile {
                 schema_version: SCHEMA_VERSION,
                 machine,
@@ -179,8 +217,13 @@ impl ResultsWriter {
 
     /// Appends a row to both files; both are on disk when this returns.
     pub fn push(&mut self, row: Row) -> anyhow::Result<()> {
-        self.csv.serialize(&row)?;
+        // The samples go to samples.csv; results.csv keeps one flat line per row.
+        self.csv.serialize(Row {
+            samples: FrameSamples::default(),
+            ..row.clone()
+        })?;
         self.csv.flush().context("writing results.csv")?;
+        self.samples.push(&row)?;
         self.file.rows.push(row);
         self.write_json()
     }
@@ -190,37 +233,48 @@ impl ResultsWriter {
         self.write_json()
     }
 
-    /// Rewrites both files from `self.file.rows`, for columns only known once every row is in
-    /// (the final `suspect` flags).
-    pub fn rewrite_rows(&mut self) -> anyhow::Result<()> {
-        let csv_path = self.dir.join(CSV_FILE);
-        let f = File::create(&csv_path)
-            .with_context(|| format!("cannot create {}", csv_path.display()))?;
-        let mut csv = csv::WriterBuilder::new().has_headers(false).from_writer(f);
-        csv.write_record(csv_header())?;
-        for row in &self.file.rows {
-            csv.serialize(row)?;
-        }
-        csv.flush().context("writing results.csv")?;
-        self.csv = csv;
-        self.write_json()
-    }
-
     pub fn finish(&mut self) -> anyhow::Result<()> {
         self.file.finished_utc = Some(crate::machine::iso8601_utc(std::time::SystemTime::now()));
         self.write_json()
     }
 
-    fn write_json(&self) -> anyhow::Result<()> {
-        let path = self.dir.join(JSON_FILE);
-        let tmp = self.dir.join(format!(".{JSON_FILE}.tmp"));
-        let mut f =
-            File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
-        serde_json::to_writer_pretty(&mut f, &self.file)?;
-        f.write_all(b"\n")?;
-        f.sync_all().ok();
-        std::fs::rename(&tmp, &path).with_context(|| format!("cannot write {}", path.display()))
+    /// Rewrites `results.csv` from the rows held (after [`crate::calibrate::annotate`] filled
+    /// in columns that need every row), then `results.json`.
+    pub fn rewrite_all(&mut self) -> anyhow::Result<()> {
+        write_csv(&self.dir, &self.file.rows)?;
+        self.write_json()
     }
+
+    fn write_json(&self) -> anyhow::Result<()> {
+        write_json(&self.dir, &self.file)
+    }
+}
+
+/// Writes `results.csv` for a whole set of rows (replacing the file).
+pub fn write_csv(dir: &Path, rows: &[Row]) -> anyhow::Result<()> {
+    let path = dir.join(CSV_FILE);
+    let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+    let mut csv = csv::WriterBuilder::new().has_headers(false).from_writer(f);
+    csv.write_record(csv_header())?;
+    for r in rows {
+        csv.serialize(Row {
+            samples: FrameSamples::default(),
+            ..r.clone()
+        })?;
+    }
+    csv.flush()
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes `results.json` atomically.
+pub fn write_json(dir: &Path, file: &ResultsFile) -> anyhow::Result<()> {
+    let path = dir.join(JSON_FILE);
+    let tmp = dir.join(format!(".{JSON_FILE}.tmp"));
+    let mut f = File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
+    serde_json::to_writer_pretty(&mut f, file)?;
+    f.write_all(b"\n")?;
+    f.sync_all().ok();
+    std::fs::rename(&tmp, &path).with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// The CSV header: [`Row`]'s field names in order (taken from serde so they cannot drift).
@@ -237,7 +291,7 @@ pub fn csv_header() -> Vec<String> {
         .collect()
 }
 
-fn example_row() -> Row {
+pub(crate) fn example_row() -> Row {
     Row {
         algorithm: String::new(),
         settings: String::new(),
@@ -280,7 +334,14 @@ fn example_row() -> Row {
         reference_image: String::new(),
         heatmap: String::new(),
         suspect: String::new(),
+        image_f32: String::new(),
+        image_hash: String::new(),
+        roofline_ms: None,
+        limit_fraction: None,
+        bound_by: String::new(),
+        normalized_time: None,
         error: String::new(),
+        samples: FrameSamples::default(),
     }
 }
 
@@ -363,6 +424,26 @@ mod tests {
         // Dropping the writer without `finish` (as a crash would) leaves both files readable.
         drop(w);
         assert_eq!(ResultsFile::read(dir.path()).unwrap().rows.len(), 3);
+    }
+
+    /// A results.json written by schema version 1 (before samples, f32 images and the
+    /// roofline existed) still loads, with those fields empty; so does its CSV.
+    #[test]
+    fn version_1_results_still_load() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/results-v1");
+        let file = ResultsFile::read(&dir).unwrap();
+        assert_eq!(file.schema_version, 1);
+        assert_eq!(file.rows.len(), 1);
+        let row = &file.rows[0];
+        assert_eq!(row.algorithm, "havs");
+        assert!(row.total_ms.is_some() && row.psnr_db.is_some());
+        assert!(row.samples.is_empty() && row.image_hash.is_empty());
+        assert_eq!(row.roofline_ms, None);
+        assert_eq!(file.machine.calibration, None);
+        let mut r = csv::Reader::from_path(dir.join(CSV_FILE)).unwrap();
+        let rows: Vec<Row> = r.deserialize().collect::<Result<_, _>>().unwrap();
+        assert_eq!(rows.len(), 1);
+        assert_eq!(rows[0].total_ms, row.total_ms);
     }
 
     #[test]

@@ -53,6 +53,10 @@ pub struct RunConfig {
     pub report: bool,
     /// Make suspect rows ([`crate::suspect`]) an error (non-zero exit), for CI.
     pub strict: bool,
+    /// Run only this part of the matrix (`--shard i/N`, see [`crate::shard`]).
+    pub shard: Option<crate::shard::Shard>,
+    /// Calibrate the backend (or reuse the cached figures) and add the roofline columns.
+    pub calibrate: bool,
 }
 
 /// Makes the variants of an algorithm by name (normally
@@ -192,7 +196,7 @@ impl Progress {
 }
 
 /// A data set's label in rows: the name as given (`spx`, `box:20k`), or a file's name.
-fn dataset_label(spec: &str) -> String {
+pub(crate) fn dataset_label(spec: &str) -> String {
     let p = Path::new(spec);
     if spec.contains(std::path::MAIN_SEPARATOR) || spec.contains('/') {
         p.file_name()
@@ -329,6 +333,29 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     let gpu = Gpu::new()?;
     let mut machine = MachineInfo::collect();
     machine.adapter = Some(gpu.adapter.clone());
+    if config.calibrate {
+        let t0 = Instant::now();
+        let (cal, cached) =
+            crate::calibrate::cached_or_measure(&gpu, &machine, &config.cache_dir, false)
+                .context("calibrating the backend (skip with --no-calibrate)")?;
+        if !cached {
+            eprintln!(
+                "tetbench: calibrated the backend in {:.1} s (cached for later runs)",
+                t0.elapsed().as_secs_f64()
+            );
+        }
+        machine.calibration = Some(cal);
+    }
+    // The (data set, algorithm, settings) units this shard runs; `None`: all.
+    let shard_units = match config.shard {
+        Some(shard) => Some(crate::shard::select(shard, &matrix_units(config, factory)?)),
+        None => None,
+    };
+    let in_shard = |label: &str, alg: &str, settings: &str| {
+        shard_units
+            .as_ref()
+            .is_none_or(|u| u.contains(&(label.to_string(), alg.to_string(), settings.to_string())))
+    };
     let description = RunDescription {
         command_line: config.command_line.clone(),
         algorithms: config.algorithms.clone(),
@@ -342,10 +369,15 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         projection: projection_name(&config.projection),
         settings_filter: config.settings_filter.to_string(),
         reference: config.reference,
+        shard: config.shard.map(|s| s.to_string()),
+        merged_from: vec![],
     };
     let mut writer = ResultsWriter::create(&config.out, machine, description)?;
-    let mut progress =
-        Progress::new((config.datasets.len() * variants_total * config.viewpoints.len()) as u64);
+    let units_total = match &shard_units {
+        Some(u) => u.len(),
+        None => config.datasets.len() * variants_total,
+    };
+    let mut progress = Progress::new((units_total * config.viewpoints.len()) as u64);
     progress.log(&format!(
         "tetbench: {} on {} ({}, {}); writing {}",
         config.algorithms.join(","),
@@ -364,6 +396,12 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
 
     for spec in &config.datasets {
         let label = dataset_label(spec);
+        if shard_units
+            .as_ref()
+            .is_some_and(|u| !u.iter().any(|(d, _, _)| *d == label))
+        {
+            continue; // nothing of this data set in this shard
+        }
         progress.status(&format!("loading {label}"));
         let t0 = Instant::now();
         let dataset = match guarded("loading", || {
@@ -377,7 +415,11 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
                 progress.log(&format!("ERROR: {msg}"));
                 writer.push_error(msg.clone())?;
                 outcome.errors.push(msg);
-                progress.skip((variants_total * config.viewpoints.len()) as u64);
+                let units = match &shard_units {
+                    Some(u) => u.iter().filter(|(d, _, _)| *d == label).count(),
+                    None => variants_total,
+                };
+                progress.skip((units * config.viewpoints.len()) as u64);
                 continue;
             }
         };
@@ -400,18 +442,16 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         };
         for (name, _) in &plan {
             let variants = factory(name)?;
-            for mut renderer in variants
-                .into_iter()
-                .filter(|r| config.settings_filter.accepts(&r.settings()))
-            {
+            for mut renderer in variants.into_iter().filter(|r| {
+                config.settings_filter.accepts(&r.settings())
+                    && in_shard(&label, name, &settings_string(&r.settings()))
+            }) {
                 ctx.run_variant(renderer.as_mut(), &mut writer, &mut progress, &mut outcome)?;
             }
         }
     }
     progress.finish();
-    if crate::suspect::mark_all(&mut writer.file.rows) > 0 {
-        writer.rewrite_rows()?;
-    }
+    crate::suspect::mark_all(&mut writer.file.rows);
     outcome.suspect_rows = writer
         .file
         .rows
@@ -424,6 +464,11 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
             )
         })
         .collect();
+    if let Some(cal) = writer.file.machine.calibration.clone() {
+        crate::calibrate::annotate(&mut writer.file.rows, &cal);
+    }
+    // Columns only known once every row is in (suspect flags, roofline): both files again.
+    writer.rewrite_all()?;
     writer.finish()?;
     outcome.rows = writer.file.rows.len();
     if config.report {
@@ -431,6 +476,29 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     }
     outcome.seconds = started.elapsed().as_secs_f64();
     Ok(outcome)
+}
+
+/// Every (data set, algorithm, settings) of the run, for `--shard`.
+fn matrix_units(
+    config: &RunConfig,
+    factory: VariantFactory,
+) -> anyhow::Result<Vec<crate::shard::Unit>> {
+    let mut units = vec![];
+    for spec in &config.datasets {
+        for name in &config.algorithms {
+            for r in factory(name)?
+                .iter()
+                .filter(|r| config.settings_filter.accepts(&r.settings()))
+            {
+                units.push((
+                    dataset_label(spec),
+                    name.clone(),
+                    settings_string(&r.settings()),
+                ));
+            }
+        }
+    }
+    Ok(units)
 }
 
 struct DatasetContext<'a> {
@@ -492,7 +560,14 @@ fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Ro
         reference_image: String::new(),
         heatmap: String::new(),
         suspect: String::new(),
+        image_f32: String::new(),
+        image_hash: String::new(),
+        roofline_ms: None,
+        limit_fraction: None,
+        bound_by: String::new(),
+        normalized_time: None,
         error: String::new(),
+        samples: Default::default(),
     }
 }
 
@@ -690,6 +765,7 @@ impl DatasetContext<'_> {
         }
         row.stages = median_named(&frames, |f| &f.stages);
         row.counters = median_named(&frames, |f| &f.counters);
+        row.samples = crate::samples::FrameSamples::from_frames(&frames);
 
         let (dir, rel) = self.images_dir(vp);
         std::fs::create_dir_all(&dir)
@@ -697,6 +773,10 @@ impl DatasetContext<'_> {
         let stem = format!("{}__{}", slug(&row.algorithm), slug(&row.settings));
         image.save_png(&dir.join(format!("{stem}.png")))?;
         row.image = format!("{rel}/{stem}.png");
+        let exact = format!("{stem}.{}", crate::samples::IMAGE_EXTENSION);
+        crate::samples::write_f32_image(&dir.join(&exact), &image)?;
+        row.image_f32 = format!("{rel}/{exact}");
+        row.image_hash = crate::samples::image_hash(&image);
 
         if c.reference {
             match self.reference(vp, &camera, progress) {

@@ -354,6 +354,8 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
             scalar: None,
             no_report: true,
             strict: false,
+            shard: None,
+            no_calibrate: false,
         };
         let config = run_args.to_config(
             ctx.data_dir.clone(),

@@ -1,0 +1,716 @@
+//! `tetbench compare BASE NEW`: did NEW get slower, less exact or bigger than BASE, beyond noise?
+//!
+//! Rows are matched by (algorithm, settings, data set, viewpoint, size). Per row:
+//! - **time** (`total_ms`, `cpu_ms`, `gpu_ms`): the Mann–Whitney U test on the per-frame
+//!   samples plus asv's factor threshold ([`crate::stats`] says why): "slower" needs the ratio
+//!   of medians ≥ threshold *and* p < α; never a decision on one number (rows without samples,
+//!   e.g. from schema 1, say "too few samples"). With the default suite's 3 frames a single
+//!   row cannot reach p < 0.05 (the smallest exact p of 3 vs 3 is 0.1), so the decision that
+//!   gates is the **group** test: per algorithm × settings × data set, every viewpoint's samples
+//!   divided by BASE's median of that viewpoint, pooled (9 vs 9 in the default suite).
+//!   Only `total_ms` gates; CPU and GPU ms are reported (a GPU-resident variant's 0.05 ms of CPU
+//!   time moves by 10 % with nothing changed).
+//! - **image**: rendering is deterministic on one adapter, so any changed f32 pixel is reported
+//!   (hash of the pixels; with both images present the changed-pixel count, largest difference
+//!   and a heatmap), as is any PSNR change > 0.1 dB; a PSNR drop > 0.1 dB is a regression.
+//! - **memory**: any change of GPU bytes; an increase is a regression.
+//!
+//! Runs on different adapters are refused unless `--normalised`: then every sample is divided
+//! by its row's roofline time (from that machine's calibration, [`crate::calibrate`]), images
+//! are not compared pixel by pixel (adapters legitimately differ), and every output says so.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use serde::{Deserialize, Serialize};
+
+use crate::results::{ResultsFile, Row};
+use crate::samples;
+use crate::stats::{mann_whitney_p, median};
+
+/// A PSNR change larger than this is reported (and a drop this large is a regression).
+pub const PSNR_TOLERANCE_DB: f64 = 0.1;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FailOn {
+    /// Always exit 0 (the report is the product).
+    Never,
+    /// Exit 1 when anything got slower, less exact, bigger, or failed.
+    Regression,
+    /// Exit 1 on any change at all, including improvements and changed pixels.
+    Change,
+}
+
+#[derive(Debug, Clone)]
+pub struct CompareOptions {
+    pub threshold: f64,
+    pub alpha: f64,
+    pub normalised: bool,
+    pub fail_on: FailOn,
+    pub out: PathBuf,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Verdict {
+    Faster,
+    Slower,
+    NoChange,
+    TooFewSamples,
+}
+
+impl Verdict {
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Faster => "faster",
+            Verdict::Slower => "slower",
+            Verdict::NoChange => "no change",
+            Verdict::TooFewSamples => "too few samples",
+        }
+    }
+}
+
+/// One time metric of one row (or pooled over a group's viewpoints).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TimeTest {
+    pub metric: String,
+    pub base_median: f64,
+    pub new_median: f64,
+    /// new median / base median.
+    pub ratio: f64,
+    pub p_value: Option<f64>,
+    pub verdict: Verdict,
+    /// The samples divided by BASE's median (what the ratio plots show).
+    pub base_ratios: Vec<f64>,
+    pub new_ratios: Vec<f64>,
+}
+
+/// The asv-style decision on two samples of one metric.
+pub fn time_test(metric: &str, base: &[f64], new: &[f64], threshold: f64, alpha: f64) -> TimeTest {
+    let (bm, nm) = (median(base), median(new));
+    let scale = |v: &[f64]| v.iter().map(|x| x / bm).collect::<Vec<_>>();
+    let p = mann_whitney_p(base, new);
+    let ratio = nm / bm;
+    let verdict = if base.len() < 2 || new.len() < 2 || !ratio.is_finite() {
+        Verdict::TooFewSamples
+    } else if p.is_some_and(|p| p < alpha) && ratio >= threshold {
+        Verdict::Slower
+    } else if p.is_some_and(|p| p < alpha) && ratio <= 1.0 / threshold {
+        Verdict::Faster
+    } else {
+        Verdict::NoChange
+    };
+    TimeTest {
+        metric: metric.to_string(),
+        base_median: bm,
+        new_median: nm,
+        ratio,
+        p_value: p,
+        verdict,
+        base_ratios: scale(base),
+        new_ratios: scale(new),
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImageChange {
+    pub psnr_base_db: Option<f64>,
+    pub psnr_new_db: Option<f64>,
+    pub psnr_delta_db: Option<f64>,
+    /// Whether the pixels' hashes differ (`None`: a side has no hash, or --normalised).
+    pub pixels_changed: Option<bool>,
+    /// With both f32 images at hand: pixels with any channel changed, largest difference, and
+    /// the heatmap of the difference (relative to the compare output directory).
+    pub changed_pixels: Option<u64>,
+    pub max_abs_difference: Option<f64>,
+    pub heatmap: String,
+    /// `same`, `changed`, `better` or `worse`.
+    pub verdict: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MemoryChange {
+    pub what: String,
+    pub base: u64,
+    pub new: u64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RowComparison {
+    pub algorithm: String,
+    pub settings: String,
+    pub dataset: String,
+    pub viewpoint: String,
+    pub width: u32,
+    pub height: u32,
+    /// `regression`, `improvement`, `changed`, `no change`, `only in base`, `only in new`.
+    pub status: String,
+    pub notes: Vec<String>,
+    pub times: Vec<TimeTest>,
+    pub image: Option<ImageChange>,
+    pub memory: Vec<MemoryChange>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GroupComparison {
+    pub algorithm: String,
+    pub settings: String,
+    pub dataset: String,
+    pub viewpoints: usize,
+    /// Pooled `total_ms` test over the viewpoints.
+    pub total: TimeTest,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Comparison {
+    pub base: String,
+    pub new: String,
+    pub base_adapter: String,
+    pub new_adapter: String,
+    pub base_commit: Option<String>,
+    pub new_commit: Option<String>,
+    pub normalised: bool,
+    pub threshold: f64,
+    pub alpha: f64,
+    pub test: String,
+    pub groups: Vec<GroupComparison>,
+    pub rows: Vec<RowComparison>,
+    pub regressions: Vec<String>,
+    pub improvements: Vec<String>,
+    pub changes: Vec<String>,
+}
+
+impl Comparison {
+    /// One word for the whole comparison.
+    pub fn outcome(&self) -> &'static str {
+        if !self.regressions.is_empty() {
+            "regression"
+        } else if !self.improvements.is_empty() || !self.changes.is_empty() {
+            "changed"
+        } else {
+            "no change"
+        }
+    }
+}
+
+fn adapter_of(f: &ResultsFile) -> String {
+    f.machine
+        .adapter
+        .as_ref()
+        .map(|a| {
+            format!("{} ({} {})", a.name, a.driver, a.driver_info)
+                .trim()
+                .to_string()
+        })
+        .unwrap_or_else(|| "unknown adapter".into())
+}
+
+type Key = (String, String, String, String, u32, u32);
+
+fn key(r: &Row) -> Key {
+    (
+        r.algorithm.clone(),
+        r.settings.clone(),
+        r.dataset.clone(),
+        r.viewpoint.clone(),
+        r.width,
+        r.height,
+    )
+}
+
+/// The samples of `metric`, divided by the row's roofline time when normalising.
+fn metric_samples(r: &Row, metric: &str, normalised: bool) -> anyhow::Result<Vec<f64>> {
+    let s = r.samples.metric(metric);
+    if !normalised || s.is_empty() {
+        return Ok(s.to_vec());
+    }
+    let roof = r.roofline_ms.filter(|t| *t > 0.0).ok_or_else(|| {
+        anyhow::anyhow!(
+            "--normalised: row {} {} {} {} has no roofline (was the run calibrated?)",
+            r.algorithm,
+            r.settings,
+            r.dataset,
+            r.viewpoint
+        )
+    })?;
+    Ok(s.iter().map(|x| x / roof).collect())
+}
+
+/// Compares two result directories; writes nothing (see [`write_outputs`]).
+pub fn compare(
+    base_dir: &Path,
+    new_dir: &Path,
+    opt: &CompareOptions,
+) -> anyhow::Result<Comparison> {
+    let base = ResultsFile::read(base_dir)?;
+    let new = ResultsFile::read(new_dir)?;
+    let (ba, na) = (adapter_of(&base), adapter_of(&new));
+    if ba != na && !opt.normalised {
+        anyhow::bail!(
+            "{} ran on {ba} but {} on {na}: times from two adapters say nothing about a change. \
+             Pass --normalised to compare calibration-normalised figures instead",
+            base_dir.display(),
+            new_dir.display()
+        );
+    }
+    if opt.normalised {
+        for (f, d) in [(&base, base_dir), (&new, new_dir)] {
+            anyhow::ensure!(
+                f.machine.calibration.is_some(),
+                "--normalised: {} has no calibration in its machine record (run it without \
+                 --no-calibrate)",
+                d.display()
+            );
+        }
+    }
+    let heat_dir = opt.out.join("heatmaps");
+    let mut rows = vec![];
+    for b in &base.rows {
+        let n = new.rows.iter().find(|n| key(n) == key(b));
+        rows.push(match n {
+            Some(n) => compare_rows(b, n, base_dir, new_dir, &heat_dir, opt)?,
+            None => only(b, "only in base"),
+        });
+    }
+    for n in &new.rows {
+        if !base.rows.iter().any(|b| key(b) == key(n)) {
+            rows.push(only(n, "only in new"));
+        }
+    }
+    let groups = group_tests(&base.rows, &new.rows, opt)?;
+    let mut cmp = Comparison {
+        base: base_dir.display().to_string(),
+        new: new_dir.display().to_string(),
+        base_adapter: ba,
+        new_adapter: na,
+        base_commit: base.machine.git_commit.clone(),
+        new_commit: new.machine.git_commit.clone(),
+        normalised: opt.normalised,
+        threshold: opt.threshold,
+        alpha: opt.alpha,
+        test: format!(
+            "Mann–Whitney U (two-sided, α = {}) and ratio of medians ≥ {} (asv's rule)",
+            opt.alpha, opt.threshold
+        ),
+        groups,
+        rows,
+        regressions: vec![],
+        improvements: vec![],
+        changes: vec![],
+    };
+    for g in &cmp.groups {
+        let name = format!(
+            "{} {} on {}: total_ms ×{:.3} (p = {})",
+            g.algorithm,
+            g.settings,
+            g.dataset,
+            g.total.ratio,
+            fmt_p(g.total.p_value)
+        );
+        match g.total.verdict {
+            Verdict::Slower => cmp.regressions.push(format!("slower: {name}")),
+            Verdict::Faster => cmp.improvements.push(format!("faster: {name}")),
+            _ => {}
+        }
+    }
+    for r in &cmp.rows {
+        let name = format!(
+            "{} {} {} {}: {}",
+            r.algorithm,
+            r.settings,
+            r.dataset,
+            r.viewpoint,
+            r.notes.join("; ")
+        );
+        match r.status.as_str() {
+            "regression" => cmp.regressions.push(name),
+            "improvement" => cmp.improvements.push(name),
+            "no change" => {}
+            _ => cmp.changes.push(name),
+        }
+    }
+    Ok(cmp)
+}
+
+fn only(r: &Row, status: &str) -> RowComparison {
+    RowComparison {
+        algorithm: r.algorithm.clone(),
+        settings: r.settings.clone(),
+        dataset: r.dataset.clone(),
+        viewpoint: r.viewpoint.clone(),
+        width: r.width,
+        height: r.height,
+        status: status.to_string(),
+        notes: vec![status.to_string()],
+        times: vec![],
+        image: None,
+        memory: vec![],
+    }
+}
+
+fn compare_rows(
+    b: &Row,
+    n: &Row,
+    base_dir: &Path,
+    new_dir: &Path,
+    heat_dir: &Path,
+    opt: &CompareOptions,
+) -> anyhow::Result<RowComparison> {
+    let mut out = only(b, "no change");
+    out.notes.clear();
+    let (mut worse, mut better, mut changed) = (false, false, false);
+    match (b.ok(), n.ok()) {
+        (true, false) => {
+            worse = true;
+            out.notes.push(format!("failed now: {}", n.error));
+        }
+        (false, true) => {
+            better = true;
+            out.notes.push("no longer fails".into());
+        }
+        (false, false) => out.notes.push("fails in both".into()),
+        (true, true) => {}
+    }
+    for metric in ["total_ms", "cpu_ms", "gpu_ms"] {
+        let (bs, ns) = (
+            metric_samples(b, metric, opt.normalised)?,
+            metric_samples(n, metric, opt.normalised)?,
+        );
+        if bs.is_empty() && ns.is_empty() {
+            continue;
+        }
+        let t = time_test(metric, &bs, &ns, opt.threshold, opt.alpha);
+        if metric == "total_ms" {
+            match t.verdict {
+                Verdict::Slower => {
+                    worse = true;
+                    out.notes.push(format!("slower ×{:.3}", t.ratio));
+                }
+                Verdict::Faster => {
+                    better = true;
+                    out.notes.push(format!("faster ×{:.3}", t.ratio));
+                }
+                _ => {}
+            }
+        }
+        out.times.push(t);
+    }
+    let img = image_change(b, n, base_dir, new_dir, heat_dir, opt)?;
+    match img.verdict.as_str() {
+        "worse" => worse = true,
+        "better" => better = true,
+        "changed" => changed = true,
+        _ => {}
+    }
+    if img.verdict != "same" {
+        out.notes.push(image_note(&img));
+    }
+    out.image = Some(img);
+    for (what, bv, nv) in [
+        ("gpu_bytes", b.gpu_bytes, n.gpu_bytes),
+        (
+            "gpu_bytes_persistent",
+            b.gpu_bytes_persistent,
+            n.gpu_bytes_persistent,
+        ),
+        ("gpu_bytes_frame", b.gpu_bytes_frame, n.gpu_bytes_frame),
+    ] {
+        if let (Some(bv), Some(nv)) = (bv, nv) {
+            if bv != nv {
+                out.memory.push(MemoryChange {
+                    what: what.into(),
+                    base: bv,
+                    new: nv,
+                });
+                if what == "gpu_bytes" {
+                    out.notes.push(format!("{what} {bv} → {nv}"));
+                    if nv > bv {
+                        worse = true;
+                    } else {
+                        better = true;
+                    }
+                }
+            }
+        }
+    }
+    out.status = if worse {
+        "regression"
+    } else if better {
+        "improvement"
+    } else if changed || !out.memory.is_empty() {
+        "changed"
+    } else {
+        "no change"
+    }
+    .to_string();
+    Ok(out)
+}
+
+fn image_note(i: &ImageChange) -> String {
+    let mut s = format!("image {}", i.verdict);
+    if let Some(d) = i.psnr_delta_db {
+        s.push_str(&format!(" (PSNR {d:+.2} dB"));
+        if let Some(c) = i.changed_pixels {
+            s.push_str(&format!(", {c} pixels differ"));
+        }
+        s.push(')');
+    } else if let Some(c) = i.changed_pixels {
+        s.push_str(&format!(" ({c} pixels differ)"));
+    }
+    s
+}
+
+fn image_change(
+    b: &Row,
+    n: &Row,
+    base_dir: &Path,
+    new_dir: &Path,
+    heat_dir: &Path,
+    opt: &CompareOptions,
+) -> anyhow::Result<ImageChange> {
+    let delta = b.psnr_db.zip(n.psnr_db).map(|(b, n)| n - b);
+    let mut c = ImageChange {
+        psnr_base_db: b.psnr_db,
+        psnr_new_db: n.psnr_db,
+        psnr_delta_db: delta,
+        pixels_changed: None,
+        changed_pixels: None,
+        max_abs_difference: None,
+        heatmap: String::new(),
+        verdict: "same".into(),
+    };
+    if !opt.normalised {
+        if !b.image_hash.is_empty() && !n.image_hash.is_empty() {
+            c.pixels_changed = Some(b.image_hash != n.image_hash);
+        }
+        if let (Some(bp), Some(np)) = (
+            samples::row_image(base_dir, b),
+            samples::row_image(new_dir, n),
+        ) {
+            let (bi, ni) = (samples::read_f32_image(&bp)?, samples::read_f32_image(&np)?);
+            let d = crate::compare_plot::image_difference(&bi, &ni)?;
+            c.changed_pixels = Some(d.changed_pixels);
+            c.max_abs_difference = Some(d.max_abs);
+            c.pixels_changed = Some(d.changed_pixels > 0);
+            if d.changed_pixels > 0 {
+                std::fs::create_dir_all(heat_dir)
+                    .with_context(|| format!("cannot create {}", heat_dir.display()))?;
+                let name = format!(
+                    "{}__{}__{}__{}.png",
+                    crate::run::slug(&b.dataset),
+                    crate::run::viewpoint_slug(&b.viewpoint),
+                    crate::run::slug(&b.algorithm),
+                    crate::run::slug(&b.settings)
+                );
+                let path = heat_dir.join(&name);
+                d.heatmap
+                    .save(&path)
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+                c.heatmap = format!("heatmaps/{name}");
+            }
+        }
+    }
+    c.verdict = match delta {
+        Some(d) if d < -PSNR_TOLERANCE_DB => "worse",
+        Some(d) if d > PSNR_TOLERANCE_DB => "better",
+        _ if c.pixels_changed == Some(true) => "changed",
+        _ => "same",
+    }
+    .to_string();
+    Ok(c)
+}
+
+/// The pooled `total_ms` test per algorithm × settings × data set.
+fn group_tests(
+    base: &[Row],
+    new: &[Row],
+    opt: &CompareOptions,
+) -> anyhow::Result<Vec<GroupComparison>> {
+    let mut groups: Vec<(String, String, String)> = vec![];
+    for r in base {
+        let g = (r.algorithm.clone(), r.settings.clone(), r.dataset.clone());
+        if !groups.contains(&g) {
+            groups.push(g);
+        }
+    }
+    let mut out = vec![];
+    for (algorithm, settings, dataset) in groups {
+        let (mut bs, mut ns, mut views) = (vec![], vec![], 0);
+        for b in base.iter().filter(|r| {
+            (&r.algorithm, &r.settings, &r.dataset) == (&algorithm, &settings, &dataset)
+        }) {
+            let Some(n) = new.iter().find(|n| key(n) == key(b)) else {
+                continue;
+            };
+            let (bv, nv) = (
+                metric_samples(b, "total_ms", opt.normalised)?,
+                metric_samples(n, "total_ms", opt.normalised)?,
+            );
+            let m = median(&bv);
+            if bv.is_empty() || nv.is_empty() || m.is_nan() || m <= 0.0 {
+                continue;
+            }
+            views += 1;
+            bs.extend(bv.iter().map(|x| x / m));
+            ns.extend(nv.iter().map(|x| x / m));
+        }
+        if views == 0 {
+            continue;
+        }
+        out.push(GroupComparison {
+            total: time_test("total_ms", &bs, &ns, opt.threshold, opt.alpha),
+            algorithm,
+            settings,
+            dataset,
+            viewpoints: views,
+        });
+    }
+    Ok(out)
+}
+
+pub fn fmt_p(p: Option<f64>) -> String {
+    match p {
+        Some(p) if p < 0.001 => format!("{p:.1e}"),
+        Some(p) => format!("{p:.3}"),
+        None => "-".into(),
+    }
+}
+
+/// `tetbench compare`: prints the table, writes compare.{md,json,html}, returns whether the
+/// `--fail-on` condition was met.
+pub fn run_command(base: &Path, new: &Path, opt: &CompareOptions) -> anyhow::Result<bool> {
+    let cmp = compare(base, new, opt)?;
+    std::fs::create_dir_all(&opt.out)
+        .with_context(|| format!("cannot create {}", opt.out.display()))?;
+    print!("{}", crate::compare_report::terminal(&cmp));
+    crate::compare_report::write_outputs(&cmp, &opt.out)?;
+    println!("wrote {}/compare.{{md,json,html}}", opt.out.display());
+    Ok(match opt.fail_on {
+        FailOn::Never => false,
+        FailOn::Regression => !cmp.regressions.is_empty(),
+        FailOn::Change => cmp.outcome() != "no change",
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::TestRng;
+
+    /// Frame times with 8 % multiplicative noise and occasional 30 % spikes, as on a busy
+    /// machine.
+    fn noisy(rng: &mut TestRng, n: usize, ms: f64) -> Vec<f64> {
+        (0..n)
+            .map(|_| {
+                let spike = if rng.uniform() < 0.1 { 1.3 } else { 1.0 };
+                ms * (1.0 + 0.08 * rng.normal()).max(0.5) * spike
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_20_percent_slowdown_is_found() {
+        let mut rng = TestRng::new(12);
+        let base = noisy(&mut rng, 10, 10.0);
+        let new = noisy(&mut rng, 10, 12.0);
+        let t = time_test("total_ms", &base, &new, 1.10, 0.05);
+        assert_eq!(t.verdict, Verdict::Slower, "{t:?}");
+        let t = time_test("total_ms", &new, &base, 1.10, 0.05);
+        assert_eq!(t.verdict, Verdict::Faster, "{t:?}");
+    }
+
+    #[test]
+    fn two_samplings_of_one_distribution_show_no_change() {
+        for seed in 1..=20 {
+            let mut rng = TestRng::new(seed);
+            let a = noisy(&mut rng, 10, 10.0);
+            let b = noisy(&mut rng, 10, 10.0);
+            let t = time_test("total_ms", &a, &b, 1.10, 0.05);
+            assert_eq!(t.verdict, Verdict::NoChange, "seed {seed}: {t:?}");
+        }
+    }
+
+    /// Writes a one-row results set whose f32 image is `img`, with 5 frames around `ms`.
+    fn results_dir(dir: &Path, img: &render_core::Image, ms: f64) {
+        std::fs::create_dir_all(dir.join("images")).unwrap();
+        let mut row = crate::results::example_row();
+        row.algorithm = "havs".into();
+        row.settings = "k=2".into();
+        row.dataset = "box:1k".into();
+        row.viewpoint = "+x".into();
+        row.total_ms = Some(ms);
+        row.psnr_db = Some(60.0);
+        row.gpu_bytes = Some(1000);
+        row.samples.total_ms = (0..5).map(|i| ms + 0.01 * i as f64).collect();
+        row.image_f32 = "images/a.f32.zz".into();
+        samples::write_f32_image(&dir.join(&row.image_f32), img).unwrap();
+        row.image_hash = samples::image_hash(img);
+        let file = ResultsFile {
+            schema_version: crate::results::SCHEMA_VERSION,
+            machine: crate::machine::MachineInfo::collect(),
+            run: Default::default(),
+            finished_utc: None,
+            rows: vec![row],
+            errors: vec![],
+        };
+        crate::results::write_json(dir, &file).unwrap();
+    }
+
+    /// Rendering is deterministic, so a single changed pixel — far below what PSNR or an
+    /// 8-bit PNG shows — is reported, with its heatmap; identical runs show no change.
+    #[test]
+    fn a_one_pixel_image_change_is_reported() {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut img = render_core::Image::new(16, 16);
+        img.pixels
+            .iter_mut()
+            .for_each(|p| *p = [0.2, 0.3, 0.4, 0.5]);
+        let mut changed = img.clone();
+        changed.pixels[37][2] = f32::from_bits(changed.pixels[37][2].to_bits() + 1);
+        let (a, b, c) = (
+            tmp.path().join("a"),
+            tmp.path().join("b"),
+            tmp.path().join("c"),
+        );
+        results_dir(&a, &img, 10.0);
+        results_dir(&b, &img, 10.0);
+        results_dir(&c, &changed, 10.0);
+        let opt = |out: &str| CompareOptions {
+            threshold: 1.10,
+            alpha: 0.05,
+            normalised: false,
+            fail_on: FailOn::Change,
+            out: tmp.path().join(out),
+        };
+        let same = compare(&a, &b, &opt("ab")).unwrap();
+        assert_eq!(same.outcome(), "no change", "{same:#?}");
+        assert!(!run_command(&a, &b, &opt("ab")).unwrap());
+        let diff = compare(&a, &c, &opt("ac")).unwrap();
+        let row = &diff.rows[0];
+        let image = row.image.as_ref().unwrap();
+        assert_eq!(image.changed_pixels, Some(1));
+        assert_eq!(image.pixels_changed, Some(true));
+        assert_eq!(image.verdict, "changed");
+        assert_eq!(row.status, "changed");
+        assert_eq!(diff.outcome(), "changed");
+        // fail-on change gates it; the outputs name the heatmap.
+        assert!(run_command(&a, &c, &opt("ac")).unwrap());
+        assert!(tmp.path().join("ac").join(&image.heatmap).is_file());
+        for f in [
+            "compare.md",
+            "compare.json",
+            "compare.html",
+            "charts/ratio_rows.png",
+        ] {
+            assert!(tmp.path().join("ac").join(f).is_file(), "{f}");
+        }
+    }
+
+    /// One sample is never enough to decide.
+    #[test]
+    fn one_number_decides_nothing() {
+        let t = time_test("total_ms", &[10.0], &[20.0], 1.10, 0.05);
+        assert_eq!(t.verdict, Verdict::TooFewSamples);
+    }
+}

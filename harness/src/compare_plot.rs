@@ -1,0 +1,192 @@
+//! Pictures of a comparison: the exact difference of two f32 images as a heatmap, and the ratio
+//! plots (each row's or group's frame samples divided by BASE's median, on a log axis).
+
+use std::path::Path;
+
+use anyhow::{anyhow, Context};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use render_core::Image;
+
+use crate::compare::Verdict;
+use crate::report::{register_font, FONT};
+
+/// Where two renderings of the same row differ.
+pub struct ImageDifference {
+    /// Pixels with any channel not bit-identical.
+    pub changed_pixels: u64,
+    pub max_abs: f64,
+    /// Black where identical; changed pixels on a log ramp from 1e-7 (a last-bit change still
+    /// shows) to 0.25 and above.
+    pub heatmap: image::RgbImage,
+}
+
+pub fn image_difference(base: &Image, new: &Image) -> anyhow::Result<ImageDifference> {
+    if (base.width, base.height) != (new.width, new.height) {
+        anyhow::bail!(
+            "images differ in size: {}x{} vs {}x{}",
+            base.width,
+            base.height,
+            new.width,
+            new.height
+        );
+    }
+    let mut heat = image::RgbImage::new(base.width, base.height);
+    let (mut changed, mut max_abs) = (0u64, 0.0f64);
+    let (lo, hi) = (1e-7f64.ln(), 0.25f64.ln());
+    for (i, (a, b)) in base.pixels.iter().zip(&new.pixels).enumerate() {
+        if a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()) {
+            continue;
+        }
+        changed += 1;
+        let d = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| {
+                let d = (*x as f64 - *y as f64).abs();
+                if d.is_nan() {
+                    1.0
+                } else {
+                    d
+                }
+            })
+            .fold(0.0, f64::max);
+        max_abs = max_abs.max(d);
+        let t = ((d.max(1e-7).ln() - lo) / (hi - lo)).clamp(0.0, 1.0);
+        heat.put_pixel(
+            i as u32 % base.width,
+            i as u32 / base.width,
+            image::Rgb(crate::metrics::ramp(t)),
+        );
+    }
+    Ok(ImageDifference {
+        changed_pixels: changed,
+        max_abs,
+        heatmap: heat,
+    })
+}
+
+/// One strip of a ratio plot.
+pub struct Strip {
+    pub label: String,
+    pub base: Vec<f64>,
+    pub new: Vec<f64>,
+    pub verdict: Verdict,
+}
+
+const LABEL_WIDTH: u32 = 560;
+const STRIP: u32 = 22;
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    strips: &[Strip],
+    threshold: f64,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing a ratio plot: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let all = strips
+        .iter()
+        .flat_map(|s| s.base.iter().chain(&s.new))
+        .copied();
+    let (mut lo, mut hi) = (1.0 / threshold, threshold);
+    for v in all.filter(|v| v.is_finite() && *v > 0.0) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    let (lo, hi) = (lo / 1.05, hi * 1.05);
+    let n = strips.len().max(1);
+    let (labels, plot) = root.split_horizontally(LABEL_WIDTH);
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(title, (FONT, 18).into_font())
+        .margin(10)
+        .x_label_area_size(36)
+        .y_label_area_size(0)
+        .build_cartesian_2d((lo..hi).log_scale(), 0f64..n as f64)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_y_mesh()
+        .y_labels(0)
+        .x_desc("sample / BASE median (log scale)")
+        .label_style((FONT, 13))
+        .axis_desc_style((FONT, 14))
+        .bold_line_style(BLACK.mix(0.12))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(err)?;
+    let line = |x: f64, style: ShapeStyle| PathElement::new(vec![(x, 0.0), (x, n as f64)], style);
+    chart
+        .draw_series([
+            line(1.0, BLACK.stroke_width(1)),
+            line(threshold, RGBColor(214, 39, 40).mix(0.5).stroke_width(1)),
+            line(
+                1.0 / threshold,
+                RGBColor(44, 160, 44).mix(0.5).stroke_width(1),
+            ),
+        ])
+        .map_err(err)?;
+    let text = TextStyle::from((FONT, 12).into_font()).pos(Pos::new(HPos::Right, VPos::Center));
+    for (i, s) in strips.iter().enumerate() {
+        let y = (n - 1 - i) as f64 + 0.5;
+        let colour = match s.verdict {
+            Verdict::Slower => RGBColor(214, 39, 40),
+            Verdict::Faster => RGBColor(44, 160, 44),
+            _ => RGBColor(31, 119, 180),
+        };
+        chart
+            .draw_series(
+                s.base
+                    .iter()
+                    .map(|&x| Circle::new((x, y + 0.18), 3, RGBColor(140, 140, 140).filled())),
+            )
+            .map_err(err)?;
+        chart
+            .draw_series(
+                s.new
+                    .iter()
+                    .map(|&x| Circle::new((x, y - 0.18), 3, colour.filled())),
+            )
+            .map_err(err)?;
+        let (_, py) = chart.backend_coord(&(1.0, y));
+        labels
+            .draw(&Text::new(
+                format!("{} [{}]", s.label, s.verdict.label()),
+                (LABEL_WIDTH as i32 - 8, py),
+                text.clone(),
+            ))
+            .map_err(err)?;
+    }
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// Writes `stem.png` and `stem.svg` into `dir`: grey dots BASE, coloured dots NEW (red slower,
+/// green faster, blue no change), lines at 1 and at the threshold factors.
+pub fn ratio_plot(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    strips: &[Strip],
+    threshold: f64,
+) -> anyhow::Result<()> {
+    register_font();
+    let size = (1300, 90 + STRIP * strips.len().max(1) as u32);
+    let png = dir.join(format!("{stem}.png"));
+    {
+        let root = BitMapBackend::new(&png, size).into_drawing_area();
+        draw(&root, title, strips, threshold)
+            .with_context(|| format!("writing {}", png.display()))?;
+    }
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        draw(&root, title, strips, threshold)?;
+    }
+    let path = dir.join(format!("{stem}.svg"));
+    std::fs::write(&path, svg).with_context(|| format!("cannot write {}", path.display()))
+}

@@ -1,0 +1,286 @@
+//! The outputs of `tetbench compare`: a terminal table, `compare.md`, `compare.json` and
+//! `compare.html` (with the ratio plots and the image-difference heatmaps).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::Context;
+
+use crate::compare::{fmt_p, Comparison, RowComparison, TimeTest};
+use crate::compare_plot::{ratio_plot, Strip};
+
+fn header(c: &Comparison) -> Vec<String> {
+    let commit = |c: &Option<String>| {
+        c.as_deref()
+            .map(|s| &s[..s.len().min(10)])
+            .unwrap_or("?")
+            .to_string()
+    };
+    vec![
+        format!("BASE {} — {} (commit {})", c.base, c.base_adapter, commit(&c.base_commit)),
+        format!("NEW  {} — {} (commit {})", c.new, c.new_adapter, commit(&c.new_commit)),
+        format!(
+            "test: {}{}",
+            c.test,
+            if c.normalised {
+                "; times NORMALISED by each machine's calibration (sample / roofline time)"
+            } else {
+                ""
+            }
+        ),
+        format!(
+            "outcome: {} — {} regression(s), {} improvement(s), {} other change(s) in {} rows, {} groups",
+            c.outcome().to_uppercase(),
+            c.regressions.len(),
+            c.improvements.len(),
+            c.changes.len(),
+            c.rows.len(),
+            c.groups.len()
+        ),
+    ]
+}
+
+fn time_cell(t: Option<&TimeTest>) -> String {
+    match t {
+        Some(t) => format!(
+            "×{:.3} p={} {}",
+            t.ratio,
+            fmt_p(t.p_value),
+            t.verdict.label()
+        ),
+        None => "-".into(),
+    }
+}
+
+fn metric<'a>(r: &'a RowComparison, name: &str) -> Option<&'a TimeTest> {
+    r.times.iter().find(|t| t.metric == name)
+}
+
+/// The terminal summary: header, group table, then only the rows with something to say.
+pub fn terminal(c: &Comparison) -> String {
+    let mut s = header(c).join("\n");
+    s.push_str("\n\ngroups (total_ms pooled over viewpoints):\n");
+    let w = c
+        .groups
+        .iter()
+        .map(|g| g.algorithm.len() + g.settings.len() + g.dataset.len() + 4)
+        .max()
+        .unwrap_or(10);
+    for g in &c.groups {
+        let name = format!("{} {} @ {}", g.algorithm, g.settings, g.dataset);
+        let _ = writeln!(s, "  {name:<w$}  {}", time_cell(Some(&g.total)));
+    }
+    let notable: Vec<&RowComparison> = c.rows.iter().filter(|r| r.status != "no change").collect();
+    let _ = writeln!(
+        s,
+        "\nrows with a change ({} of {}):",
+        notable.len(),
+        c.rows.len()
+    );
+    for r in notable {
+        let _ = writeln!(
+            s,
+            "  {:<12} {} {} @ {} {}: {}",
+            r.status,
+            r.algorithm,
+            r.settings,
+            r.dataset,
+            r.viewpoint,
+            r.notes.join("; ")
+        );
+    }
+    s.push('\n');
+    s
+}
+
+fn markdown(c: &Comparison) -> String {
+    let mut s = String::from("# tetbench compare\n\n");
+    for l in header(c) {
+        let _ = writeln!(s, "- {l}");
+    }
+    for (title, list) in [
+        ("Regressions", &c.regressions),
+        ("Improvements", &c.improvements),
+        ("Other changes", &c.changes),
+    ] {
+        if !list.is_empty() {
+            let _ = writeln!(s, "\n## {title}\n");
+            for l in list {
+                let _ = writeln!(s, "- {l}");
+            }
+        }
+    }
+    s.push_str("\n## Groups (total_ms pooled over viewpoints)\n\n");
+    s.push_str("| algorithm | settings | data set | views | base ms | new ms | ratio | p | verdict |\n|---|---|---|---:|---:|---:|---:|---:|---|\n");
+    for g in &c.groups {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {} | {} |",
+            g.algorithm,
+            g.settings,
+            g.dataset,
+            g.viewpoints,
+            g.total.base_median,
+            g.total.new_median,
+            g.total.ratio,
+            fmt_p(g.total.p_value),
+            g.total.verdict.label()
+        );
+    }
+    s.push_str("\n## Rows\n\n");
+    s.push_str("| status | algorithm | settings | data set | view | total_ms | cpu_ms | gpu_ms | PSNR Δ dB | changed px | memory | notes |\n|---|---|---|---|---|---|---|---|---:|---:|---|---|\n");
+    for r in &c.rows {
+        let img = r.image.as_ref();
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            r.status,
+            r.algorithm,
+            r.settings,
+            r.dataset,
+            r.viewpoint,
+            time_cell(metric(r, "total_ms")),
+            time_cell(metric(r, "cpu_ms")),
+            time_cell(metric(r, "gpu_ms")),
+            img.and_then(|i| i.psnr_delta_db)
+                .map(|d| format!("{d:+.3}"))
+                .unwrap_or_else(|| "-".into()),
+            img.and_then(|i| i.changed_pixels.map(|p| p.to_string()).or(i
+                .pixels_changed
+                .map(|b| if b { "yes".into() } else { "0".into() })))
+                .unwrap_or_else(|| "-".into()),
+            r.memory
+                .iter()
+                .map(|m| format!("{} {}→{}", m.what, m.base, m.new))
+                .collect::<Vec<_>>()
+                .join(", "),
+            r.notes.join("; ")
+        );
+    }
+    s
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+fn html(c: &Comparison) -> String {
+    let mut s = String::from(
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>tetbench compare</title>\
+         <style>body{font-family:sans-serif;margin:1.5em}table{border-collapse:collapse;font-size:13px}\
+         td,th{border:1px solid #ccc;padding:2px 6px}.regression{background:#fdd}.improvement{background:#dfd}\
+         .changed{background:#ffd}img{max-width:100%}</style></head><body><h1>tetbench compare</h1><ul>",
+    );
+    for l in header(c) {
+        let _ = write!(s, "<li>{}</li>", esc(&l));
+    }
+    s.push_str("</ul>");
+    for (title, list) in [
+        ("Regressions", &c.regressions),
+        ("Improvements", &c.improvements),
+        ("Other changes", &c.changes),
+    ] {
+        if !list.is_empty() {
+            let _ = write!(s, "<h2>{title}</h2><ul>");
+            for l in list {
+                let _ = write!(s, "<li>{}</li>", esc(l));
+            }
+            s.push_str("</ul>");
+        }
+    }
+    s.push_str(
+        "<h2>Ratio plots</h2><p>Each strip: grey dots are BASE's frames, coloured dots NEW's, both \
+         divided by BASE's median (red: slower, green: faster, blue: no change); vertical lines at 1 \
+         and at the threshold factors.</p><h3>Groups (viewpoints pooled)</h3>\
+         <img src=\"charts/ratio_groups.png\"><h3>Rows (total_ms)</h3><img src=\"charts/ratio_rows.png\">",
+    );
+    s.push_str("<h2>Rows</h2><table><tr><th>status</th><th>algorithm</th><th>settings</th><th>data set</th><th>view</th><th>total_ms</th><th>cpu_ms</th><th>gpu_ms</th><th>PSNR Δ</th><th>image</th><th>memory</th><th>notes</th></tr>");
+    for r in &c.rows {
+        let img = r.image.as_ref();
+        let heat = img
+            .filter(|i| !i.heatmap.is_empty())
+            .map(|i| {
+                format!(
+                    "<a href=\"{0}\"><img src=\"{0}\" width=64></a> {1} px",
+                    esc(&i.heatmap),
+                    i.changed_pixels.unwrap_or(0)
+                )
+            })
+            .unwrap_or_else(|| img.map(|i| i.verdict.clone()).unwrap_or_default());
+        let _ = write!(
+            s,
+            "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            r.status.replace(' ', "-"),
+            esc(&r.status),
+            esc(&r.algorithm),
+            esc(&r.settings),
+            esc(&r.dataset),
+            esc(&r.viewpoint),
+            esc(&time_cell(metric(r, "total_ms"))),
+            esc(&time_cell(metric(r, "cpu_ms"))),
+            esc(&time_cell(metric(r, "gpu_ms"))),
+            img.and_then(|i| i.psnr_delta_db).map(|d| format!("{d:+.3}")).unwrap_or_default(),
+            heat,
+            esc(&r.memory.iter().map(|m| format!("{} {}→{}", m.what, m.base, m.new)).collect::<Vec<_>>().join(", ")),
+            esc(&r.notes.join("; "))
+        );
+    }
+    s.push_str("</table></body></html>\n");
+    s
+}
+
+/// Writes compare.md, compare.json, compare.html and the ratio plots into `out`.
+pub fn write_outputs(c: &Comparison, out: &Path) -> anyhow::Result<()> {
+    let write = |name: &str, text: String| {
+        let p = out.join(name);
+        std::fs::write(&p, text).with_context(|| format!("cannot write {}", p.display()))
+    };
+    write("compare.md", markdown(c))?;
+    write("compare.json", serde_json::to_string_pretty(c)? + "\n")?;
+    let charts = out.join("charts");
+    std::fs::create_dir_all(&charts)
+        .with_context(|| format!("cannot create {}", charts.display()))?;
+    let groups: Vec<Strip> = c
+        .groups
+        .iter()
+        .map(|g| Strip {
+            label: format!("{} {} @ {}", g.algorithm, g.settings, g.dataset),
+            base: g.total.base_ratios.clone(),
+            new: g.total.new_ratios.clone(),
+            verdict: g.total.verdict,
+        })
+        .collect();
+    ratio_plot(
+        &charts,
+        "ratio_groups",
+        "total_ms per group",
+        &groups,
+        c.threshold,
+    )?;
+    let rows: Vec<Strip> = c
+        .rows
+        .iter()
+        .filter_map(|r| {
+            let t = metric(r, "total_ms")?;
+            Some(Strip {
+                label: format!(
+                    "{} {} @ {} {}",
+                    r.algorithm, r.settings, r.dataset, r.viewpoint
+                ),
+                base: t.base_ratios.clone(),
+                new: t.new_ratios.clone(),
+                verdict: t.verdict,
+            })
+        })
+        .collect();
+    ratio_plot(
+        &charts,
+        "ratio_rows",
+        "total_ms per row",
+        &rows,
+        c.threshold,
+    )?;
+    write("compare.html", html(c))
+}
