@@ -1,7 +1,8 @@
 //! vtkio (0.7, an independent Rust VTK reader) as the oracle of our hand-written VTK readers.
 //!
 //! Every VTK file the project can meet is read by both: the data directory's `.vtk`/`.vtu`
-//! files, the legacy reader's fuzz seeds, the malformed corpus (`tests/malformed_vtk.rs`) and
+//! files, the legacy reader's fuzz seeds, files written by VTK itself
+//! (`datasets/testdata/vtk-written`), the malformed corpus (`tests/malformed_vtk.rs`) and
 //! what our `.vtu` writer produces in each of its layouts for several generated meshes. vtkio's
 //! model goes through the same cell split and mesh checks as ours (`vtkio_model.rs`), so:
 //!
@@ -34,6 +35,11 @@ const VTKIO_REFUSES: &[(&str, &str, &str)] = &[
         "unknown variant `raw`",
         "raw appended data, ParaView's default: vtkio reads <AppendedData> only as base64 (its raw \
          path is behind a `binary` cfg that its Cargo.toml does not declare)",
+    ),
+    (
+        "vtk-written/wavelet-raw-zlib.vti",
+        "unknown variant `raw`",
+        "VTK's own raw appended, zlib-compressed image data: as above",
     ),
     (
         "writer/*/appended-*",
@@ -393,15 +399,22 @@ fn corpus(tmp: &Path) -> Vec<Input> {
             inputs.push(input(format!("data/{name}"), p));
         }
     }
-    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("../datasets/fuzz/seeds/vtk_legacy");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&seeds)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    files.sort();
-    for p in files {
-        let name = p.file_name().unwrap().to_string_lossy().into_owned();
-        inputs.push(input(format!("seed/{name}"), p));
+    // The legacy reader's fuzz seeds, and files VTK's own XML writers made (the XML reader's
+    // unit tests use them too).
+    let datasets_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../datasets");
+    for (prefix, dir) in [
+        ("seed", "fuzz/seeds/vtk_legacy"),
+        ("vtk-written", "testdata/vtk-written"),
+    ] {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(datasets_dir.join(dir))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        for p in files {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            inputs.push(input(format!("{prefix}/{name}"), p));
+        }
     }
     for c in tetbench_tests::malformed_vtk::cases() {
         let dir = tmp.join("malformed").join(c.case);
@@ -449,6 +462,8 @@ fn vtkio_reads_what_our_readers_read() {
     let mut used_refusals = vec![false; VTKIO_REFUSES.len()];
     let mut used_differences = vec![false; KNOWN_DIFFERENCES.len()];
     let (mut same, mut both_reject, mut refused, mut differ) = (0, 0, 0, 0);
+    let (mut tets_compared, mut arrays_compared) = (0, 0);
+    let mut reject_kinds: Vec<String> = Vec::new();
     // Per reader (legacy, XML): files, read by ours, read by vtkio.
     let mut per_reader = [[0usize; 3]; 2];
     println!("| file | verdict |\n|---|---|");
@@ -461,8 +476,15 @@ fn vtkio_reads_what_our_readers_read() {
         counts[1] += load(&input.path, &options(input.scalar.as_deref())).is_ok() as usize;
         counts[2] += matches!(verdict, Verdict::Same { .. }) as usize;
         match &verdict {
-            Verdict::Same { .. } => same += 1,
-            Verdict::BothReject(_) => both_reject += 1,
+            Verdict::Same { tets, arrays } => {
+                same += 1;
+                tets_compared += tets;
+                arrays_compared += arrays;
+            }
+            Verdict::BothReject(kind) => {
+                both_reject += 1;
+                reject_kinds.push(kind.clone());
+            }
             Verdict::VtkioRefused { vtkio, ours } => {
                 refused += 1;
                 let entry = VTKIO_REFUSES.iter().position(|(pat, msg, _)| {
@@ -505,6 +527,10 @@ fn vtkio_reads_what_our_readers_read() {
         "{} files: {same} read identically by both, {both_reject} rejected by both with the same \
          kind of error, {refused} refused by vtkio, {differ} listed differences",
         inputs.len()
+    );
+    println!(
+        "compared: {tets_compared} tets and {arrays_compared} arrays; rejected by both: {}",
+        reject_kinds.join(", ")
     );
     for (name, [n, ours, theirs]) in ["legacy", "XML"].iter().zip(per_reader) {
         println!(
