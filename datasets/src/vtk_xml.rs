@@ -7,6 +7,10 @@
 //! is binary (it may contain `<` and invalid UTF-8), so it is cut off before the XML parser
 //! sees it and addressed by the arrays' `offset` attributes, as VTK itself does.
 //!
+//! Hand-written rather than vtkio (which checks it: `tests/vtkio_oracle.rs`): vtkio 0.7.0-rc2
+//! refuses raw appended data, ParaView's and our writer's default layout, and its errors carry
+//! no position (measurements in the README, "Dependencies").
+//!
 //! Non-tetrahedral cells are split into conforming tets by [`crate::load::cell_to_tets`] (shared
 //! with the legacy reader); cell data is
 //! averaged to the points when a file has no point data (with a warning in the repair report).
