@@ -23,7 +23,7 @@ pub enum VtkioOutcome {
     /// vtkio parsed the file. Converting its model gave this mesh (with the asked-for scalar)
     /// and these array names (point arrays, then cell arrays), or the error our shared steps
     /// raise on it.
-    Parsed(Result<VtkioMesh, ErrorKind>),
+    Parsed(Result<Box<VtkioMesh>, ErrorKind>),
 }
 
 pub struct VtkioMesh {
@@ -61,7 +61,7 @@ pub fn read(bytes: &[u8], format: Format, scalar: Option<&str>) -> VtkioOutcome 
     };
     match parsed {
         Err(e) => VtkioOutcome::Refused(e.to_string()),
-        Ok(vtk) => VtkioOutcome::Parsed(build(vtk.data, scalar)),
+        Ok(vtk) => VtkioOutcome::Parsed(build(vtk.data, scalar).map(Box::new)),
     }
 }
 

@@ -537,8 +537,10 @@ fn vtkio_reads_what_our_readers_read() {
             "{name} VTK: {n} files, our reader reads {ours}, vtkio reads {theirs} (identically)"
         );
     }
+    // Without the data directory (a checkout without ../shared) its entries cannot happen.
+    let have_data = inputs.iter().any(|i| i.key.starts_with("data/"));
     for (i, used) in used_refusals.iter().enumerate() {
-        if !used {
+        if !used && (have_data || !VTKIO_REFUSES[i].0.starts_with("data/")) {
             failures.push(format!(
                 "VTKIO_REFUSES entry {:?} no longer happens",
                 VTKIO_REFUSES[i].0
