@@ -2,6 +2,9 @@
 
 use std::path::PathBuf;
 
+#[path = "malformed_vtk.rs"]
+pub mod malformed_vtk;
+
 /// The data directory of the papers' data sets, or `None` (and a printed reason) when absent;
 /// with `TETBENCH_REQUIRE_DATA=1` a missing directory fails the test instead
 /// (`datasets::registry::test_data_file`).

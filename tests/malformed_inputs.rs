@@ -43,6 +43,16 @@ fn fail_opts(name: &str, bytes: impl Into<Vec<u8>>, options: &LoadOptions) -> Lo
     e
 }
 
+/// Loads the malformed legacy VTK file `case` of the shared corpus (`tests/malformed_vtk.rs`).
+fn fail_case(case: &str) -> LoadError {
+    let c = tetbench_tests::malformed_vtk::case(case);
+    let options = LoadOptions {
+        scalar: c.scalar.map(String::from),
+        ..Default::default()
+    };
+    fail_opts(c.file, c.bytes, &options)
+}
+
 fn in_dir(e: &LoadError, name: &str) -> bool {
     e.path.file_name().is_some_and(|n| n == name)
 }
@@ -50,20 +60,12 @@ fn in_dir(e: &LoadError, name: &str) -> bool {
 // ------------------------------------------------------------------------------------------
 // Legacy VTK
 
-const HEAD: &str = "# vtk DataFile Version 4.2\nmalformed\nASCII\nDATASET UNSTRUCTURED_GRID\n";
-const PTS: &str = "POINTS 5 float\n0 0 0 1 0 0 0 1 0\n0 0 1 1 1 1\n";
-const CELLS: &str = "CELLS 2 10\n4 0 1 2 3\n4 1 2 3 4\nCELL_TYPES 2\n10\n10\n";
-const DATA: &str = "POINT_DATA 5\nSCALARS s float\nLOOKUP_TABLE default\n0 1 2 3 4\n";
-
-fn vtk(body: &str) -> Vec<u8> {
-    format!("{HEAD}{body}").into_bytes()
-}
-
 #[test]
 fn the_well_formed_base_loads() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("ok.vtk");
-    std::fs::write(&p, vtk(&format!("{PTS}{CELLS}{DATA}"))).unwrap();
+    let base = tetbench_tests::malformed_vtk::case("well_formed_base");
+    std::fs::write(&p, base.bytes).unwrap();
     assert_eq!(
         load(&p, &LoadOptions::default()).unwrap().mesh.num_tets(),
         2
@@ -72,26 +74,20 @@ fn the_well_formed_base_loads() {
 
 #[test]
 fn vtk_not_a_vtk_header() {
-    let e = fail("a.vtk", "hello world\n");
+    let e = fail_case("not_a_vtk_header");
     assert!(matches!(e.kind, ErrorKind::Syntax { .. }), "{e}");
     assert_eq!(e.location, Some(Location::Line(1)));
 }
 
 #[test]
 fn vtk_unsupported_version() {
-    let e = fail(
-        "a.vtk",
-        "# vtk DataFile Version 6.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\n",
-    );
+    let e = fail_case("unsupported_version");
     assert!(matches!(e.kind, ErrorKind::Unsupported(_)), "{e}");
 }
 
 #[test]
 fn vtk_polydata_is_unsupported() {
-    let e = fail(
-        "a.vtk",
-        "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 0 float\n",
-    );
+    let e = fail_case("polydata");
     assert!(
         matches!(&e.kind, ErrorKind::Unsupported(s) if s.contains("POLYDATA")),
         "{e}"
@@ -101,14 +97,14 @@ fn vtk_polydata_is_unsupported() {
 
 #[test]
 fn vtk_truncated_points() {
-    let e = fail("a.vtk", vtk("POINTS 5 float\n0 0 0 1 0 0 0 1 0\n"));
+    let e = fail_case("truncated_points");
     assert!(matches!(e.kind, ErrorKind::Truncated { .. }), "{e}");
 }
 
 #[test]
 fn vtk_absurd_point_count_is_checked_against_the_file_size() {
     // A billion points announced in a 100-byte file: refused before anything is allocated.
-    let e = fail("a.vtk", vtk("POINTS 1000000000 float\n0 0 0\n"));
+    let e = fail_case("absurd_point_count");
     assert!(
         matches!(&e.kind, ErrorKind::Truncated { expected } if expected.contains("1000000000") || expected.contains("3000000000")),
         "{e}"
@@ -117,7 +113,7 @@ fn vtk_absurd_point_count_is_checked_against_the_file_size() {
 
 #[test]
 fn vtk_point_count_overflowing_u32() {
-    let e = fail("a.vtk", vtk("POINTS 5000000000 float\n0 0 0\n"));
+    let e = fail_case("point_count_overflowing_u32");
     assert!(
         matches!(
             e.kind,
@@ -133,12 +129,7 @@ fn vtk_point_count_overflowing_u32() {
 
 #[test]
 fn vtk_index_out_of_range() {
-    let e = fail(
-        "a.vtk",
-        vtk(&format!(
-            "{PTS}CELLS 2 10\n4 0 1 2 3\n4 1 2 3 9\nCELL_TYPES 2\n10\n10\n{DATA}"
-        )),
-    );
+    let e = fail_case("index_out_of_range");
     assert_eq!(
         e.kind,
         ErrorKind::IndexOutOfRange {
@@ -152,12 +143,7 @@ fn vtk_index_out_of_range() {
 
 #[test]
 fn vtk_nan_coordinate() {
-    let e = fail(
-        "a.vtk",
-        vtk(&format!(
-            "POINTS 5 float\n0 0 0 1 0 0 0 nan 0\n0 0 1 1 1 1\n{CELLS}{DATA}"
-        )),
-    );
+    let e = fail_case("nan_coordinate");
     assert!(
         matches!(e.kind, ErrorKind::NonFinite { index: 2, .. }),
         "{e}"
@@ -167,12 +153,7 @@ fn vtk_nan_coordinate() {
 
 #[test]
 fn vtk_infinite_scalar() {
-    let e = fail(
-        "a.vtk",
-        vtk(&format!(
-            "{PTS}{CELLS}POINT_DATA 5\nSCALARS s double\nLOOKUP_TABLE default\n0 1\n2 inf 4\n"
-        )),
-    );
+    let e = fail_case("infinite_scalar");
     assert!(
         matches!(e.kind, ErrorKind::NonFinite { index: 3, .. }),
         "{e}"
@@ -182,12 +163,7 @@ fn vtk_infinite_scalar() {
 
 #[test]
 fn vtk_unknown_cell_type_is_named() {
-    let e = fail(
-        "a.vtk",
-        vtk(&format!(
-            "{PTS}CELLS 2 9\n4 0 1 2 3\n3 1 2 3\nCELL_TYPES 2\n10\n5\n{DATA}"
-        )),
-    );
+    let e = fail_case("unknown_cell_type");
     assert!(
         matches!(&e.kind, ErrorKind::UnknownCellType(s) if s.starts_with("5 (VTK_TRIANGLE)")),
         "{e}"
@@ -197,12 +173,7 @@ fn vtk_unknown_cell_type_is_named() {
 
 #[test]
 fn vtk_cell_types_count_mismatch() {
-    let e = fail(
-        "a.vtk",
-        vtk(&format!(
-            "{PTS}CELLS 2 10\n4 0 1 2 3\n4 1 2 3 4\nCELL_TYPES 1\n10\n{DATA}"
-        )),
-    );
+    let e = fail_case("cell_types_count_mismatch");
     assert!(
         matches!(
             e.kind,
@@ -218,12 +189,7 @@ fn vtk_cell_types_count_mismatch() {
 
 #[test]
 fn vtk_cells_size_mismatch() {
-    let e = fail(
-        "a.vtk",
-        vtk(&format!(
-            "{PTS}CELLS 2 11\n4 0 1 2 3\n4 1 2 3 4 0\nCELL_TYPES 2\n10\n10\n{DATA}"
-        )),
-    );
+    let e = fail_case("cells_size_mismatch");
     assert!(
         matches!(
             e.kind,
@@ -239,12 +205,7 @@ fn vtk_cells_size_mismatch() {
 
 #[test]
 fn vtk_point_data_count_mismatch() {
-    let e = fail(
-        "a.vtk",
-        vtk(&format!(
-            "{PTS}{CELLS}POINT_DATA 4\nSCALARS s float\nLOOKUP_TABLE default\n0 1 2 3\n"
-        )),
-    );
+    let e = fail_case("point_data_count_mismatch");
     assert!(
         matches!(
             e.kind,
@@ -260,12 +221,7 @@ fn vtk_point_data_count_mismatch() {
 
 #[test]
 fn vtk_wrong_vertex_count_for_tet() {
-    let e = fail(
-        "a.vtk",
-        vtk(&format!(
-            "{PTS}CELLS 2 9\n4 0 1 2 3\n3 1 2 3\nCELL_TYPES 2\n10\n10\n{DATA}"
-        )),
-    );
+    let e = fail_case("wrong_vertex_count_for_tet");
     assert!(
         matches!(
             e.kind,
@@ -281,14 +237,13 @@ fn vtk_wrong_vertex_count_for_tet() {
 
 #[test]
 fn vtk_no_cells_is_an_empty_mesh() {
-    let e = fail("a.vtk", vtk(&format!("{PTS}{DATA}")));
+    let e = fail_case("no_cells");
     assert!(matches!(e.kind, ErrorKind::EmptyMesh(_)), "{e}");
 }
 
 #[test]
 fn vtk_all_tets_degenerate_is_an_empty_mesh() {
-    let flat = "POINTS 5 float\n0 0 0 1 0 0 0 1 0\n1 1 0 2 2 0\n";
-    let e = fail("a.vtk", vtk(&format!("{flat}{CELLS}{DATA}")));
+    let e = fail_case("all_tets_degenerate");
     assert!(
         matches!(&e.kind, ErrorKind::EmptyMesh(s) if s.contains("2 degenerate")),
         "{e}"
@@ -297,11 +252,7 @@ fn vtk_all_tets_degenerate_is_an_empty_mesh() {
 
 #[test]
 fn vtk_missing_array() {
-    let opts = LoadOptions {
-        scalar: Some("temperature".into()),
-        ..Default::default()
-    };
-    let e = fail_opts("a.vtk", vtk(&format!("{PTS}{CELLS}{DATA}")), &opts);
+    let e = fail_case("missing_array");
     assert_eq!(
         e.kind,
         ErrorKind::MissingArray {
@@ -313,12 +264,7 @@ fn vtk_missing_array() {
 
 #[test]
 fn vtk_bad_number() {
-    let e = fail(
-        "a.vtk",
-        vtk(&format!(
-            "POINTS 5 float\n0 0 0 1 0 0 0 1 0\n0 0 1 1 1 one\n{CELLS}"
-        )),
-    );
+    let e = fail_case("bad_number");
     assert!(
         matches!(&e.kind, ErrorKind::Syntax { found, .. } if found == "one"),
         "{e}"
@@ -328,59 +274,34 @@ fn vtk_bad_number() {
 
 #[test]
 fn vtk_51_offsets_must_not_decrease() {
-    let cells = "CELLS 3 8\nOFFSETS vtktypeint64\n0 5 4\nCONNECTIVITY vtktypeint64\n0 1 2 3 1 2 3 4\nCELL_TYPES 2\n10\n10\n";
-    let e = fail("a.vtk", vtk(&format!("{PTS}{cells}")));
+    let e = fail_case("offsets_decreasing_51");
     assert!(matches!(e.kind, ErrorKind::Invalid(_)), "{e}");
-}
-
-fn be_i32(v: &[i32]) -> Vec<u8> {
-    v.iter().flat_map(|x| x.to_be_bytes()).collect()
-}
-
-fn binary_vtk(cell_types: Vec<u8>) -> Vec<u8> {
-    let mut b =
-        b"# vtk DataFile Version 4.2\nb\nBINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 float\n"
-            .to_vec();
-    b.extend(
-        [0f32, 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1., 1., 1., 1.]
-            .iter()
-            .flat_map(|v| v.to_be_bytes()),
-    );
-    b.extend_from_slice(b"\nCELLS 2 10\n");
-    b.extend(be_i32(&[4, 0, 1, 2, 3, 4, 1, 2, 3, 4]));
-    b.extend_from_slice(b"\nCELL_TYPES 2\n");
-    b.extend(cell_types);
-    b.push(b'\n');
-    b
 }
 
 #[test]
 fn vtk_binary_little_endian_is_a_byte_order_error() {
-    let mut le: Vec<u8> = 10i32.to_le_bytes().to_vec();
-    le.extend(10i32.to_le_bytes());
-    let e = fail("b.vtk", binary_vtk(le));
+    let e = fail_case("binary_little_endian");
     assert!(matches!(e.kind, ErrorKind::ByteOrder(_)), "{e}");
     assert!(matches!(e.location, Some(Location::Byte(_))));
 }
 
 #[test]
 fn vtk_binary_truncated() {
-    let good = binary_vtk(be_i32(&[10, 10]));
-    let e = fail("b.vtk", good[..good.len() - 6].to_vec());
+    let e = fail_case("binary_truncated");
     assert!(matches!(e.kind, ErrorKind::Truncated { .. }), "{e}");
     assert!(matches!(e.location, Some(Location::Byte(_))));
 }
 
 #[test]
 fn vtk_structured_points_overflowing_u32() {
-    let e = fail("v.vtk", "# vtk DataFile Version 3.0\nv\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 100000 100000 100000\nPOINT_DATA 1\nSCALARS s float\n0\n");
+    let e = fail_case("structured_points_overflowing_u32");
     assert!(matches!(e.kind, ErrorKind::IndexOverflow { .. }), "{e}");
 }
 
 #[test]
 fn vtk_structured_points_without_data() {
     // 10⁹ implicit points and no data backing them: refused, not allocated.
-    let e = fail("v.vtk", "# vtk DataFile Version 3.0\nv\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 1000 1000 1000\nSPACING 1 1 1\n");
+    let e = fail_case("structured_points_without_data");
     assert!(matches!(e.kind, ErrorKind::MissingArray { .. }), "{e}");
 }
 

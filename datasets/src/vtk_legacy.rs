@@ -9,7 +9,10 @@
 //! cannot give the typed, located errors tetbench promises for bad input; its 5.1 cell reader
 //! also accepts only `vtktypeint64` offsets. The format is small (keyword lines, then ASCII
 //! tokens or packed big-endian values), so a direct reader is short, checks every count against
-//! the bytes actually present before allocating, and converts binary blocks in bulk.
+//! the bytes actually present before allocating, and converts binary blocks in bulk. vtkio is
+//! kept as this reader's oracle (`tests/vtkio_oracle.rs`): it reads 11 of the 13 valid legacy
+//! files the project has exactly as we do, and refuses `ironProt.vtk` (blank header lines) and
+//! `unsigned_short` data.
 //!
 //! 5.1 layout: `CELLS n_offsets n_connectivity`, then `OFFSETS vtktypeint64` and
 //! `CONNECTIVITY vtktypeint64` arrays; older versions use `CELLS n size` with `npts id…` per
