@@ -204,6 +204,8 @@ impl Registry {
                 paper: n.paper,
             })
             .collect();
+        let derived = crate::standins::entries(&out);
+        out.extend(derived);
         for (spec, paper) in GENERATED {
             let kind = crate::generate::parse_spec(spec)
                 .map(|s| s.kind.description())
@@ -225,6 +227,10 @@ impl Registry {
         let key = name_or_path.trim();
         if let Some(n) = NAMED.iter().find(|n| n.name.eq_ignore_ascii_case(key)) {
             return self.load_named(n, options);
+        }
+        // The papers' derived data sets and stand-ins (spx1, spx2, fuel, …) and `NAME@splitN`.
+        if let Some(result) = crate::standins::resolve(self, key, options) {
+            return result;
         }
         if crate::generate::is_spec(key) {
             let mesh = crate::generate::from_spec(key, 1)?;
