@@ -39,6 +39,9 @@ pub enum Command {
     /// Analyses that reproduce the papers' tables.
     #[command(subcommand)]
     Analyze(AnalyzeCommand),
+    /// Reproduce a paper's tables with one command: runs what they need, then writes
+    /// OUT/<paper>/report.md and report.html with the paper's values beside ours.
+    Reproduce(crate::reproduce::Args),
     /// Re-render the report (charts, index.html) of an earlier run from its results.json.
     Report {
         /// The run's output directory.
@@ -263,6 +266,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
                 data_dir: cli.data_dir,
             },
         ),
+        Command::Reproduce(args) => crate::reproduce::run(args, cli.data_dir),
         Command::Report { out } => {
             crate::report::rewrite(&out)
                 .with_context(|| format!("re-rendering the report in {}", out.display()))?;

@@ -9,6 +9,7 @@ pub mod datasets_cmd;
 pub mod machine;
 pub mod metrics;
 pub mod report;
+pub mod reproduce;
 pub mod results;
 pub mod run;
 pub mod suite;
