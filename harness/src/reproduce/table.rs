@@ -78,8 +78,15 @@ fn round_sig(v: f64, digits: i32) -> f64 {
     if v == 0.0 {
         return 0.0;
     }
-    let scale = 10f64.powi(digits - 1 - v.abs().log10().floor() as i32);
-    (v * scale).round() / scale
+    // Divide or multiply by an exact power of ten so 1,500,282 → 1,500,000 exactly.
+    let e = v.abs().log10().floor() as i32 - (digits - 1);
+    if e >= 0 {
+        let p = 10f64.powi(e);
+        (v / p).round() * p
+    } else {
+        let p = 10f64.powi(-e);
+        (v * p).round() / p
+    }
 }
 
 /// One cell pair: the paper's value and ours.
