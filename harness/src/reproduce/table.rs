@@ -68,7 +68,7 @@ fn significant_digits(v: f64) -> i32 {
     if x == 0 {
         return 1;
     }
-    while x % 10 == 0 {
+    while x.is_multiple_of(10) {
         x /= 10;
     }
     x.to_string().len() as i32
