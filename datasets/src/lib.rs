@@ -9,6 +9,8 @@ pub mod mesh;
 pub mod mhd;
 pub mod plot3d;
 pub mod registry;
+pub mod split;
+pub mod standins;
 pub mod toff;
 pub mod volume;
 pub mod vtk_legacy;

@@ -176,6 +176,8 @@ enum Source {
     Named(&'static Named),
     Generated,
     File(PathBuf),
+    /// A stand-in or `NAME@splitN` ([`crate::standins`]).
+    StandIn,
 }
 
 /// Resolves names, specs and paths to data sets.
@@ -211,6 +213,8 @@ impl Registry {
                 paper: n.paper,
             })
             .collect();
+        let derived = crate::standins::entries(&out);
+        out.extend(derived);
         for (spec, paper) in GENERATED {
             let kind = crate::generate::parse_spec(spec)
                 .map(|s| s.kind.description())
@@ -252,6 +256,12 @@ impl Registry {
                 })
             }
             Source::File(p) => crate::load::load(&p, options),
+            Source::StandIn => crate::standins::resolve(self, key, options).unwrap_or_else(|| {
+                Err(LoadError::new(
+                    key,
+                    ErrorKind::Io("not a stand-in or split modifier".into()),
+                ))
+            }),
         }
     }
 
@@ -266,6 +276,17 @@ impl Registry {
         if let Some(n) = NAMED.iter().find(|n| n.name.eq_ignore_ascii_case(key)) {
             self.named_files(n)?;
             return Ok(Source::Named(n));
+        }
+        // The papers' derived data sets and stand-ins (spx1, spx2, fuel, …) and `NAME@splitN`
+        // (whose base must resolve in turn).
+        if let Some((base, modifier)) = key.rsplit_once('@') {
+            if crate::split::parse_modifier(modifier).is_some() {
+                self.locate(base)?;
+                return Ok(Source::StandIn);
+            }
+        }
+        if crate::standins::find(key).is_some() {
+            return Ok(Source::StandIn);
         }
         if crate::generate::is_spec(key) {
             crate::generate::parse_spec(key).map_err(|k| LoadError::new(key, k))?;

@@ -39,6 +39,9 @@ pub enum Command {
     /// Analyses that reproduce the papers' tables.
     #[command(subcommand)]
     Analyze(AnalyzeCommand),
+    /// Reproduce a paper's tables with one command: runs what they need, then writes
+    /// OUT/<paper>/report.md and report.html with the paper's values beside ours.
+    Reproduce(crate::reproduce::Args),
     /// Re-render the report (charts, index.html) of an earlier run from its results.json, or
     /// merge shards / runs of several machines: `report --merge DIR… --out OUT`.
     Report {
@@ -357,6 +360,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
                 data_dir: cli.data_dir,
             },
         ),
+        Command::Reproduce(args) => crate::reproduce::run(args, cli.data_dir),
         Command::Report { dir, merge, out } => {
             if !merge.is_empty() {
                 let out = out.context("report --merge needs --out OUT")?;

@@ -14,6 +14,7 @@ pub mod history;
 pub mod machine;
 pub mod metrics;
 pub mod report;
+pub mod reproduce;
 pub mod results;
 pub mod run;
 pub mod samples;

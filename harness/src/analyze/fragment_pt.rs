@@ -8,10 +8,9 @@
 //!   512², 768², 1024² by default), one `tetbench run` per size (timing only), plotted as
 //!   `fig8.png` / `fig8.svg` with `fig8.md` and `fig8.csv`.
 //!
-//! The paper's own figures go beside ours where we could find them. The per-data-set numbers of
-//! its Tables 1 and 2 and the curve of Fig. 8 were not available to us (the paper's text was not
-//! in any source we could search); its abstract states "over 2.0 M Tets/s" (GeForce 7900 GTX)
-//! and §3.1 about 20 bytes per tet for the model. The tables say so instead of inventing values.
+//! The paper's figures come from its transcribed tables (`reports/papers/fragment-pt_table*.csv`,
+//! provenance in `reports/papers/fragment-pt.md`); Fig. 8 is a plot whose numbers the text does
+//! not give. `tetbench reproduce fragment-pt` runs the paper's own data sets.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -27,37 +26,21 @@ use crate::results::{ResultsFile, Row};
 /// The data sets of the paper's Table 1, in its order (names as the registry knows them).
 pub const TABLE1_DATASETS: [&str; 4] = ["spx", "bluntfin", "comb", "post"];
 
-/// What the paper states that we could verify; `None` where its figure was not available.
-pub struct PaperFigure {
-    pub dataset: &'static str,
-    pub fps: Option<f64>,
-    pub k_tets_per_sec: Option<f64>,
+/// The paper's Table 1 (fps, K tets/s) for a registry data set, if the paper has it.
+fn paper_table1(dataset: &str) -> Option<(Option<f64>, Option<f64>)> {
+    let name = crate::reproduce::papers::paper_name("fragment-pt", dataset)?;
+    let t = crate::reproduce::papers::table("fragment-pt_table1").ok()?;
+    Some((
+        t.value(name, "fps"),
+        t.value(name, "tets_per_sec").map(|v| v / 1e3),
+    ))
 }
 
-/// The paper's Table 1 figures per data set. None were available to us (see the module
-/// documentation); the table prints "n/a (not found)" rather than a guess.
-pub const PAPER_TABLE1: [PaperFigure; 4] = [
-    PaperFigure {
-        dataset: "spx",
-        fps: None,
-        k_tets_per_sec: None,
-    },
-    PaperFigure {
-        dataset: "bluntfin",
-        fps: None,
-        k_tets_per_sec: None,
-    },
-    PaperFigure {
-        dataset: "comb",
-        fps: None,
-        k_tets_per_sec: None,
-    },
-    PaperFigure {
-        dataset: "post",
-        fps: None,
-        k_tets_per_sec: None,
-    },
-];
+/// The paper's Table 2 fps on Blunt and Post for one of its rows.
+fn paper_table2(row: &str) -> Option<(f64, f64)> {
+    let t = crate::reproduce::papers::table("fragment-pt_table2").ok()?;
+    Some((t.value(row, "blunt_fps")?, t.value(row, "post_fps")?))
+}
 
 /// The paper's headline rate (abstract): "over 2.0 M Tets/s".
 pub const PAPER_PEAK_K_TETS_PER_SEC: f64 = 2000.0;
@@ -140,10 +123,10 @@ pub fn tables_markdown(file: &ResultsFile) -> String {
             .filter(|a| a.algorithm == "fragment-pt" && &a.dataset == d)
         {
             any = true;
-            let paper = PAPER_TABLE1.iter().find(|p| p.dataset == d);
+            let paper = paper_table1(d);
             let paper_cell = |v: Option<f64>| match (paper, v) {
                 (Some(_), Some(x)) => format!("{x:.1}"),
-                (Some(_), None) => "n/a (not found)".into(),
+                (Some(_), None) => "–".into(),
                 (None, _) => "not in paper".into(),
             };
             let _ = writeln!(
@@ -158,8 +141,8 @@ pub fn tables_markdown(file: &ResultsFile) -> String {
                 fmt_opt(model_bytes_per_tet(rows, a), 1),
                 fmt_opt(a.bytes_per_tet, 1),
                 fmt_opt(a.psnr_db.map(|s| s.mean), 1),
-                paper_cell(paper.and_then(|p| p.fps)),
-                paper_cell(paper.and_then(|p| p.k_tets_per_sec)),
+                paper_cell(paper.and_then(|p| p.0)),
+                paper_cell(paper.and_then(|p| p.1)),
             );
         }
     }
@@ -168,8 +151,8 @@ pub fn tables_markdown(file: &ResultsFile) -> String {
     }
     let _ = writeln!(
         md,
-        "\nPaper: the per-data-set figures of Table 1 were not available to us; its abstract \
-         reports over {:.1} M tets/s and §3.1 about {PAPER_BYTES_PER_TET:.0} bytes/tet for the \
+        "\nPaper: GeForce 6800, 512², model rotating (reports/papers/fragment-pt_table1.csv); its \
+         abstract reports over {:.1} M tets/s and §4 about {PAPER_BYTES_PER_TET:.0} bytes/tet for the \
          model (our `model B/tet` column: tet indices + vertices; `all B/tet` adds the shading \
          tables).\n",
         PAPER_PEAK_K_TETS_PER_SEC / 1e3
@@ -220,9 +203,14 @@ pub fn tables_markdown(file: &ResultsFile) -> String {
     }
     let _ = writeln!(
         md,
-        "\nPaper: Table 2 compares fragment PT with GATOR (Wylie et al. 2002) and other methods \
-         on the authors' GPU; its per-method figures were not available to us, so only this \
-         run's measurements are shown (same machine, same viewpoints, same transfer function)."
+        "\nPaper's Table 2 (fps, GeForce 6800, reports/papers/fragment-pt_table2.csv), Blunt / Post: {}. \
+         Only this run's algorithms are measured above (same machine, viewpoints and transfer \
+         function); `tetbench reproduce fragment-pt` prints them side by side.",
+        ["GPU CP for Int. VR", "GATOR", "HARC", "HARC PPI", "VICP"]
+            .iter()
+            .filter_map(|r| paper_table2(r).map(|(b, p)| format!("{r} {b:.2} / {p:.2}")))
+            .collect::<Vec<_>>()
+            .join("; ")
     );
     md
 }
@@ -410,7 +398,7 @@ pub fn fig8_markdown(points: &[SweepPoint], adapter: &str) -> String {
     }
     let mut md = format!(
         "### Fig. 8 — average K tets/s against viewport size (Marroquim et al. 2006)\n\nAdapter {adapter}; \
-         mean over data sets of the mean over viewpoints. The paper's curve was not available to us.\n\n| series |"
+         mean over data sets of the mean over viewpoints. The paper gives Fig. 8 as a plot only (no numbers in its text).\n\n| series |"
     );
     for s in &sizes {
         let _ = write!(md, " {s}² |");

@@ -8,6 +8,39 @@ use anyhow::Context as _;
 use crate::report::{aggregate, markdown_summary, Spread};
 use crate::results::ResultsFile;
 
+/// The papers' tets/s beside ours for the series a paper table covers (GATOR Table 3, HAVS
+/// Table 4, fragment PT Table 1); empty when none does.
+pub fn paper_markdown(aggs: &[crate::report::Aggregate]) -> String {
+    let mut md = String::new();
+    for a in aggs {
+        let Some((source, paper)) =
+            crate::reproduce::papers::paper_tets_per_sec(&a.algorithm, &a.settings, &a.dataset)
+        else {
+            continue;
+        };
+        if md.is_empty() {
+            md.push_str(
+                "\nThe papers' rates on the same data sets (their GPUs: reports/papers/*.md):\n\n\
+                 | algorithm | settings | data set | M tets/s (ours) | M tets/s (paper) | ours/paper | paper table |\n\
+                 |---|---|---|---:|---:|---:|---|\n",
+            );
+        }
+        let ours = a.tets_per_sec.map(|s| s.mean);
+        md.push_str(&format!(
+            "| {} | {} | {} | {} | {:.3} | {} | {source} |\n",
+            a.algorithm,
+            a.settings,
+            a.dataset,
+            ours.map(|v| format!("{:.3}", v / 1e6))
+                .unwrap_or("–".into()),
+            paper / 1e6,
+            ours.map(|v| format!("{:.3}", v / paper))
+                .unwrap_or("–".into()),
+        ));
+    }
+    md
+}
+
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Output directory of a `tetbench run` (holds results.json).
@@ -24,11 +57,12 @@ pub fn run(args: Args, _ctx: &super::Context) -> anyhow::Result<()> {
         .map(|a| format!("{} ({})", a.name, a.backend))
         .unwrap_or_default();
     let md = format!(
-        "Means over viewpoints ({}), {}×{}, adapter {adapter}.\n\n{}",
+        "Means over viewpoints ({}), {}×{}, adapter {adapter}.\n\n{}{}",
         file.run.viewpoints,
         file.run.width,
         file.run.height,
-        markdown_summary(&aggs)
+        markdown_summary(&aggs),
+        paper_markdown(&aggs)
     );
     let md_path = args.out.join("summary.md");
     std::fs::write(&md_path, &md).with_context(|| format!("cannot write {}", md_path.display()))?;

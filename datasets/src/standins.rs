@@ -1,0 +1,715 @@
+//! The papers' data sets at the papers' sizes: those derived from files we have (`spx1`,
+//! `spx2`: spx split 1:8 once and twice; `brain`: HeadMRVolume resampled to 98³) and generated
+//! stand-ins with the exact tet counts of those we do not have (fuel, f117, kew, torso,
+//! fighter, Delta Wing) and the voxel volumes of the splatting paper (dimensions and effective
+//! voxel counts of its Table 1).
+//!
+//! A stand-in matches its original in *size* (tets; for the volumes, grid and effective
+//! voxels) and, where the original is non-convex, in having rays leave and re-enter the mesh
+//! (an interior cavity); its geometry and field are synthetic, so its images say nothing about
+//! the original's. Reports mark rows measured on stand-ins.
+//!
+//! Also the `NAME@splitN` modifier for any data set ([`crate::split`]).
+
+use rayon::prelude::*;
+
+use crate::error::{ErrorKind, LoadError};
+use crate::generate::{Field, FieldEval};
+use crate::load::{Dataset, LoadOptions};
+use crate::registry::{Entry, Registry};
+use crate::volume::{hex_cell_tets, VoxelGrid};
+use crate::TetMesh;
+
+/// How a data set of this module is made.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Recipe {
+    /// A registry data set split 1:8 `levels` times.
+    Split { base: &'static str, levels: u32 },
+    /// A 64³ synthetic volume (a fuel jet), 6 tets per cube.
+    Fuel,
+    /// `headmr` resampled (trilinear) to `n`³ points, 6 tets per cube.
+    Resampled { base: &'static str, n: usize },
+    /// A structured domain with an interior cavity (non-convex) or none (convex), cut at
+    /// exactly `tets` tets.
+    Domain { shape: Shape, tets: usize },
+    /// A splatting volume: grid dims and the exact number of non-empty voxels.
+    Volume { dims: [usize; 3], effective: usize },
+}
+
+/// Shapes of the generated domains (coordinates in the domain box, see [`Shape::extent`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shape {
+    /// A box around a flat, faceted (diamond-shaped) aircraft body: F117's class.
+    Faceted,
+    /// A box around a fuselage, delta wings and a fin: the fighter's class.
+    Fighter,
+    /// A box around a thin delta plate: the Delta Wing's class.
+    Delta,
+    /// An elliptic cylinder (a body) with two ellipsoidal cavities (lungs).
+    Torso,
+    /// A plain box (convex).
+    Box,
+}
+
+impl Shape {
+    /// Half-extents of the domain box.
+    fn extent(self) -> [f64; 3] {
+        match self {
+            Shape::Faceted => [1.0, 0.7, 0.4],
+            Shape::Fighter => [1.0, 0.7, 0.45],
+            Shape::Delta => [1.0, 0.6, 0.4],
+            Shape::Torso => [0.9, 0.55, 1.0],
+            Shape::Box => [1.0, 1.0, 1.0],
+        }
+    }
+
+    /// Whether the cell centred at `p` belongs to the mesh.
+    fn solid(self, p: [f64; 3]) -> bool {
+        let [x, y, z] = p;
+        match self {
+            Shape::Faceted => x.abs() / 0.55 + y.abs() / 0.4 + z.abs() / 0.09 >= 1.0,
+            Shape::Fighter => {
+                let fuselage = (x / 0.6).powi(2) + (y / 0.09).powi(2) + (z / 0.09).powi(2) < 1.0;
+                let wing =
+                    z.abs() < 0.035 && (-0.25..0.2).contains(&x) && y.abs() < 0.9 * (0.2 - x);
+                let fin = y.abs() < 0.03 && (0.3..0.55).contains(&x) && (0.0..0.22).contains(&z);
+                !(fuselage || wing || fin)
+            }
+            Shape::Delta => {
+                !(z.abs() < 0.045 && (-0.6..0.5).contains(&x) && y.abs() < 0.42 * (x + 0.6))
+            }
+            Shape::Torso => {
+                let body = (x / 0.9).powi(2) + (y / 0.55).powi(2) < 1.0;
+                let lung = |cx: f64| {
+                    ((x - cx) / 0.25).powi(2) + (y / 0.3).powi(2) + ((z - 0.2) / 0.5).powi(2) < 1.0
+                };
+                body && !lung(-0.38) && !lung(0.38)
+            }
+            Shape::Box => true,
+        }
+    }
+
+    pub fn is_convex(self) -> bool {
+        self == Shape::Box
+    }
+}
+
+/// One data set of this module.
+#[derive(Debug, Clone, Copy)]
+pub struct StandIn {
+    pub name: &'static str,
+    pub recipe: Recipe,
+    /// What it stands for, and where the paper's count comes from.
+    pub paper: &'static str,
+    pub description: &'static str,
+    /// Whether it is a generated stand-in (true) or derived from a real file (false).
+    pub generated: bool,
+}
+
+/// Every data set of this module, by registry name.
+pub const STANDINS: &[StandIn] = &[
+    StandIn {
+        name: "spx1",
+        recipe: Recipe::Split { base: "spx", levels: 1 },
+        paper: "tiled ray casting's spx1 (103 K tets)",
+        description: "spx split 1:8 at edge midpoints (scalar linear): 103,488 tets",
+        generated: false,
+    },
+    StandIn {
+        name: "spx2",
+        recipe: Recipe::Split { base: "spx", levels: 2 },
+        paper: "HAVS's spx2 (827,904 tets), fragment PT's Spx2 (150 K / 828 K)",
+        description: "spx split 1:8 twice: 827,904 tets",
+        generated: false,
+    },
+    StandIn {
+        name: "fuel",
+        recipe: Recipe::Fuel,
+        paper: "fragment PT's Fuel (262 K points / 1.5 M tets; the volvis.org volume is not here)",
+        description: "stand-in: synthetic 64³ fuel-jet volume, 6 tets per cube: 262,144 points, 1,500,282 tets (convex)",
+        generated: true,
+    },
+    StandIn {
+        name: "brain",
+        recipe: Recipe::Resampled { base: "headmr", n: 98 },
+        paper: "fragment PT's Brain (950 K points / 5.5 M tets; the volvis.org volume is not here)",
+        description: "stand-in: HeadMRVolume resampled to 98³ (trilinear), 6 tets per cube: 941,192 points, 5,476,038 tets",
+        generated: true,
+    },
+    StandIn {
+        name: "f117",
+        recipe: Recipe::Domain { shape: Shape::Faceted, tets: 240_122 },
+        paper: "HAVS's and tiled ray casting's f117 (240,122 tets, non-convex)",
+        description: "stand-in: box around a faceted aircraft-shaped cavity (non-convex), exactly 240,122 tets",
+        generated: true,
+    },
+    StandIn {
+        name: "kew",
+        recipe: Recipe::Domain { shape: Shape::Box, tets: 416_926 },
+        paper: "HAVS's kew (416,926 tets; shape not described by the paper)",
+        description: "stand-in: box (the original's shape is not stated; convex but for the partly filled top layer), exactly 416,926 tets",
+        generated: true,
+    },
+    StandIn {
+        name: "torso",
+        recipe: Recipe::Domain { shape: Shape::Torso, tets: 1_082_723 },
+        paper: "HAVS's torso (1,082,723 tets)",
+        description: "stand-in: elliptic body with two lung cavities (non-convex), exactly 1,082,723 tets",
+        generated: true,
+    },
+    StandIn {
+        name: "fighter",
+        recipe: Recipe::Domain { shape: Shape::Fighter, tets: 1_403_504 },
+        paper: "HAVS's fighter (1,403,504 tets, flow around an aircraft)",
+        description: "stand-in: box around a fuselage/wing/fin cavity (non-convex), exactly 1,403,504 tets",
+        generated: true,
+    },
+    StandIn {
+        name: "deltawing",
+        recipe: Recipe::Domain { shape: Shape::Delta, tets: 1_005_675 },
+        paper: "GATOR's Delta Wing (211,680 points / 1,005,675 tets, PLOT3D)",
+        description: "stand-in: box around a thin delta-plate cavity (non-convex), exactly 1,005,675 tets",
+        generated: true,
+    },
+    StandIn {
+        name: "lobster",
+        recipe: Recipe::Volume { dims: [324, 301, 56], effective: 233_000 },
+        paper: "splatting Table 1 Lobster (324×301×56, 233 K effective voxels)",
+        description: "stand-in volume: 324×301×56, exactly 233,000 non-empty voxels",
+        generated: true,
+    },
+    StandIn {
+        name: "engine",
+        recipe: Recipe::Volume { dims: [256, 256, 128], effective: 1_300_000 },
+        paper: "splatting Table 1 Engine (256²×128, 1.3 M effective voxels)",
+        description: "stand-in volume: 256×256×128, exactly 1,300,000 non-empty voxels",
+        generated: true,
+    },
+    StandIn {
+        name: "teapot",
+        recipe: Recipe::Volume { dims: [256, 256, 178], effective: 4_900_000 },
+        paper: "splatting Table 1 BostonTeapot (256²×178, 4.9 M effective voxels)",
+        description: "stand-in volume: 256×256×178, exactly 4,900,000 non-empty voxels",
+        generated: true,
+    },
+    StandIn {
+        name: "aneurism",
+        recipe: Recipe::Volume { dims: [256, 256, 256], effective: 169_000 },
+        paper: "splatting Table 1 Aneurism (256³, 169 K effective voxels)",
+        description: "stand-in volume: 256³, exactly 169,000 non-empty voxels",
+        generated: true,
+    },
+    StandIn {
+        name: "bonsai",
+        recipe: Recipe::Volume { dims: [256, 256, 256], effective: 1_300_000 },
+        paper: "splatting Table 1 Bonsai (256³, 1.3 M effective voxels)",
+        description: "stand-in volume: 256³, exactly 1,300,000 non-empty voxels",
+        generated: true,
+    },
+    StandIn {
+        name: "stagbeetle",
+        recipe: Recipe::Volume { dims: [832, 832, 494], effective: 13_800_000 },
+        paper: "splatting Table 1 StagBeetle (832²×494, 13.8 M effective voxels)",
+        description: "stand-in volume: 832×832×494, exactly 13,800,000 non-empty voxels",
+        generated: true,
+    },
+];
+
+/// A volume's 6-tet mesh is built only up to this many tets (beyond, only the voxel grid is
+/// useful and the loader says so).
+pub const MAX_VOLUME_MESH_TETS: usize = 60_000_000;
+
+/// The stand-in called `name` (case-insensitive), if any.
+pub fn find(name: &str) -> Option<&'static StandIn> {
+    STANDINS.iter().find(|s| s.name.eq_ignore_ascii_case(name))
+}
+
+/// Whether `name` is a generated stand-in (rows on it are marked in reports).
+pub fn is_generated(name: &str) -> bool {
+    find(name).is_some_and(|s| s.generated)
+}
+
+/// Registry entries of this module; `named` are the registry's file entries (for presence).
+pub fn entries(named: &[Entry]) -> Vec<Entry> {
+    STANDINS
+        .iter()
+        .map(|s| {
+            let base = match s.recipe {
+                Recipe::Split { base, .. } | Recipe::Resampled { base, .. } => Some(base),
+                _ => None,
+            };
+            let base_entry = base.and_then(|b| named.iter().find(|e| e.name == b));
+            Entry {
+                name: s.name.to_string(),
+                description: s.description.to_string(),
+                files: base_entry.map(|e| e.files.clone()).unwrap_or_default(),
+                present: base_entry.is_none_or(|e| e.present),
+                paper: s.paper,
+            }
+        })
+        .collect()
+}
+
+/// Resolves a name of this module or a `BASE@splitN` modifier; `None` when `key` is neither.
+pub fn resolve(
+    registry: &Registry,
+    key: &str,
+    options: &LoadOptions,
+) -> Option<Result<Dataset, LoadError>> {
+    if let Some((base, modifier)) = key.rsplit_once('@') {
+        let levels = crate::split::parse_modifier(modifier)?;
+        return Some(split_dataset(registry, key, base, levels, options));
+    }
+    let s = find(key)?;
+    Some(build(registry, s, options).map(|mut ds| {
+        ds.mesh.name = s.name.to_string();
+        ds.source = format!("{} ({})", s.name, s.description);
+        ds
+    }))
+}
+
+/// A missing file of a base data set, re-worded to name the derived one too.
+fn derived_error(key: &str, e: LoadError) -> LoadError {
+    match e.kind {
+        ErrorKind::MissingDataFile {
+            dataset,
+            file,
+            origin,
+        } => LoadError {
+            kind: ErrorKind::MissingDataFile {
+                dataset: format!("{key} (derived from {dataset})"),
+                file,
+                origin,
+            },
+            ..e
+        },
+        _ => e,
+    }
+}
+
+fn split_dataset(
+    registry: &Registry,
+    key: &str,
+    base: &str,
+    levels: u32,
+    options: &LoadOptions,
+) -> Result<Dataset, LoadError> {
+    let ds = registry
+        .resolve(base, options)
+        .map_err(|e| derived_error(key, e))?;
+    let mut mesh = crate::split::split(&ds.mesh, levels).map_err(|k| LoadError::new(key, k))?;
+    mesh.name = key.to_string();
+    Ok(Dataset {
+        mesh,
+        volume: None,
+        source: format!("{} split 1:8 ×{levels}", ds.source),
+    })
+}
+
+fn build(registry: &Registry, s: &StandIn, options: &LoadOptions) -> Result<Dataset, LoadError> {
+    let err = |k: ErrorKind| LoadError::new(s.name, k);
+    if let Some(want) = &options.scalar {
+        if matches!(
+            s.recipe,
+            Recipe::Fuel | Recipe::Domain { .. } | Recipe::Volume { .. }
+        ) {
+            return Err(err(ErrorKind::MissingArray {
+                name: want.clone(),
+                available: vec!["(generated field)".into()],
+            }));
+        }
+    }
+    match s.recipe {
+        Recipe::Split { base, levels } => split_dataset(registry, s.name, base, levels, options),
+        Recipe::Fuel => {
+            let grid = fuel_volume();
+            let mesh = six_tet_mesh(&grid).map_err(err)?;
+            Ok(Dataset {
+                mesh,
+                volume: Some(grid),
+                source: String::new(),
+            })
+        }
+        Recipe::Resampled { base, n } => {
+            let ds = registry
+                .resolve(base, options)
+                .map_err(|e| derived_error(s.name, e))?;
+            let Some(vol) = ds.volume else {
+                return Err(err(ErrorKind::Invalid(format!(
+                    "{base} is not a voxel volume, cannot resample it"
+                ))));
+            };
+            let grid = resample_trilinear(&vol, [n; 3]);
+            let mesh = six_tet_mesh(&grid).map_err(err)?;
+            Ok(Dataset {
+                mesh,
+                volume: Some(grid),
+                source: String::new(),
+            })
+        }
+        Recipe::Domain { shape, tets } => Ok(Dataset {
+            mesh: domain_mesh(shape, tets, seed_of(s.name)).map_err(err)?,
+            volume: None,
+            source: String::new(),
+        }),
+        Recipe::Volume { dims, effective } => {
+            let cells: usize = dims.iter().map(|d| d - 1).product();
+            if cells * 6 > MAX_VOLUME_MESH_TETS {
+                return Err(err(ErrorKind::Invalid(format!(
+                    "the {}×{}×{} volume would give {} tets (more than {MAX_VOLUME_MESH_TETS}); \
+                     renderers that splat voxels take it from datasets::standins::splat_volume",
+                    dims[0],
+                    dims[1],
+                    dims[2],
+                    cells * 6
+                ))));
+            }
+            let grid = splat_volume(dims, effective, seed_of(s.name));
+            let mesh = six_tet_mesh(&grid).map_err(err)?;
+            Ok(Dataset {
+                mesh,
+                volume: Some(grid),
+                source: String::new(),
+            })
+        }
+    }
+}
+
+/// A fixed seed per name, so every stand-in is the same mesh on every machine.
+fn seed_of(name: &str) -> u64 {
+    name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
+    })
+}
+
+/// The 6 tets of cube (i, j, k) of a grid with `dims` points: Kuhn's split along the diagonal
+/// from the cube's lowest to its highest corner. Every face is cut along the diagonal through
+/// its lowest corner, the same in both cubes that share it, so the mesh conforms. Tets are
+/// emitted positively oriented (the permutation's parity decides the vertex order).
+pub fn kuhn_cell_tets(dims: [usize; 3], i: usize, j: usize, k: usize) -> [[u32; 4]; 6] {
+    let idx = |d: [usize; 3]| (i + d[0] + dims[0] * ((j + d[1]) + dims[1] * (k + d[2]))) as u32;
+    const PERMS: [([usize; 3], bool); 6] = [
+        ([0, 1, 2], true),
+        ([1, 2, 0], true),
+        ([2, 0, 1], true),
+        ([0, 2, 1], false),
+        ([2, 1, 0], false),
+        ([1, 0, 2], false),
+    ];
+    PERMS.map(|(p, even)| {
+        let mut d = [0usize; 3];
+        let c0 = idx(d);
+        d[p[0]] = 1;
+        let c1 = idx(d);
+        d[p[1]] = 1;
+        let c2 = idx(d);
+        let c3 = idx([1, 1, 1]);
+        if even {
+            [c0, c1, c2, c3]
+        } else {
+            [c0, c2, c1, c3]
+        }
+    })
+}
+
+/// A voxel grid as a tet mesh, 6 tets per cube ([`kuhn_cell_tets`]).
+pub fn six_tet_mesh(grid: &VoxelGrid) -> Result<TetMesh, ErrorKind> {
+    let d = grid.dims;
+    let (nx, ny) = (d[0], d[1]);
+    let points: Vec<[f32; 3]> = (0..grid.num_voxels())
+        .into_par_iter()
+        .map(|g| {
+            grid.point(g % nx, (g / nx) % ny, g / (nx * ny))
+                .map(|c| c as f32)
+        })
+        .collect();
+    let c = d.map(|x| x.saturating_sub(1));
+    let tets: Vec<[u32; 4]> = (0..c[2])
+        .into_par_iter()
+        .flat_map_iter(|k| {
+            let mut out = Vec::with_capacity(c[0] * c[1] * 6);
+            for j in 0..c[1] {
+                for i in 0..c[0] {
+                    out.extend_from_slice(&kuhn_cell_tets(d, i, j, k));
+                }
+            }
+            out
+        })
+        .collect();
+    TetMesh::new(
+        "volume",
+        points,
+        grid.values.clone(),
+        grid.scalar_name.clone(),
+        tets,
+    )
+}
+
+/// The fuel stand-in: a 64³ grid on [-1,1]³ holding a synthetic jet — fuel entering at the
+/// bottom along the z axis, spreading and thinning as it rises, with a ripple along the jet.
+pub fn fuel_volume() -> VoxelGrid {
+    let n = 64;
+    let h = 2.0 / (n - 1) as f64;
+    let values: Vec<f32> = (0..n * n * n)
+        .into_par_iter()
+        .map(|g| {
+            let (x, y, z) = (
+                -1.0 + (g % n) as f64 * h,
+                -1.0 + ((g / n) % n) as f64 * h,
+                -1.0 + (g / (n * n)) as f64 * h,
+            );
+            let t = (z + 1.0) * 0.5;
+            let sigma = 0.06 + 0.3 * t;
+            let r2 = x * x + y * y;
+            let core = (-(r2) / (2.0 * sigma * sigma)).exp() * (1.0 - 0.6 * t);
+            let ripple = 1.0 + 0.15 * (10.0 * t + 4.0 * x).sin();
+            (core * ripple).max(0.0) as f32
+        })
+        .collect();
+    VoxelGrid {
+        dims: [n; 3],
+        spacing: [h; 3],
+        origin: [-1.0; 3],
+        values,
+        scalar_name: "fuel_density".into(),
+    }
+}
+
+/// Trilinear resampling of `grid` onto `dims` points spanning the same box.
+pub fn resample_trilinear(grid: &VoxelGrid, dims: [usize; 3]) -> VoxelGrid {
+    let ext: [f64; 3] = std::array::from_fn(|a| (grid.dims[a] - 1) as f64 * grid.spacing[a]);
+    let spacing: [f64; 3] = std::array::from_fn(|a| {
+        if dims[a] > 1 {
+            ext[a] / (dims[a] - 1) as f64
+        } else {
+            grid.spacing[a]
+        }
+    });
+    let sample = |q: [f64; 3]| -> f32 {
+        let mut i0 = [0usize; 3];
+        let mut f = [0.0f64; 3];
+        for a in 0..3 {
+            let u =
+                ((q[a] - grid.origin[a]) / grid.spacing[a]).clamp(0.0, (grid.dims[a] - 1) as f64);
+            let base = (u.floor() as usize).min(grid.dims[a].saturating_sub(2));
+            i0[a] = base;
+            f[a] = u - base as f64;
+        }
+        let mut acc = 0.0f64;
+        for c in 0..8 {
+            let d = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
+            let w: f64 = (0..3)
+                .map(|a| if d[a] == 1 { f[a] } else { 1.0 - f[a] })
+                .product();
+            let ii: [usize; 3] = std::array::from_fn(|a| (i0[a] + d[a]).min(grid.dims[a] - 1));
+            acc += w * grid.values[grid.index(ii[0], ii[1], ii[2])] as f64;
+        }
+        acc as f32
+    };
+    let n = dims.iter().product::<usize>();
+    let values: Vec<f32> = (0..n)
+        .into_par_iter()
+        .map(|g| {
+            let ijk = [
+                g % dims[0],
+                (g / dims[0]) % dims[1],
+                g / (dims[0] * dims[1]),
+            ];
+            sample(std::array::from_fn(|a| {
+                grid.origin[a] + ijk[a] as f64 * spacing[a]
+            }))
+        })
+        .collect();
+    VoxelGrid {
+        dims,
+        spacing,
+        origin: grid.origin,
+        values,
+        scalar_name: grid.scalar_name.clone(),
+    }
+}
+
+/// Number of kept cells of `shape` on an `n`-per-unit grid, and the grid's cell counts.
+fn domain_cells(shape: Shape, n: f64) -> ([usize; 3], Vec<[usize; 3]>) {
+    let ext = shape.extent();
+    let cells: [usize; 3] = std::array::from_fn(|a| ((2.0 * ext[a] * n).round() as usize).max(1));
+    let kept: Vec<[usize; 3]> = (0..cells[2])
+        .into_par_iter()
+        .flat_map_iter(|k| {
+            let mut out = vec![];
+            for j in 0..cells[1] {
+                for i in 0..cells[0] {
+                    let ijk = [i, j, k];
+                    let c = std::array::from_fn(|a| {
+                        -ext[a] + 2.0 * ext[a] * (ijk[a] as f64 + 0.5) / cells[a] as f64
+                    });
+                    if shape.solid(c) {
+                        out.push(ijk);
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    (cells, kept)
+}
+
+/// A structured domain of `shape`, 5 tets per cell ([`hex_cell_tets`]), with exactly `target`
+/// tets: the grid is the smallest (in steps of 1 %) whose kept cells give at least `target`
+/// tets, and the tets are taken layer by layer in z until the count is reached, so only the
+/// top layer is partly filled. Unused points are dropped; the field is seeded blobs.
+pub fn domain_mesh(shape: Shape, target: usize, seed: u64) -> Result<TetMesh, ErrorKind> {
+    let ext = shape.extent();
+    let volume: f64 = ext.iter().map(|e| 2.0 * e).product();
+    let (_, probe) = domain_cells(shape, 12.0);
+    let probe_cells: f64 = ext
+        .iter()
+        .map(|e| (2.0 * e * 12.0).round().max(1.0))
+        .product();
+    let frac = (probe.len() as f64 / probe_cells).max(1e-3);
+    let mut n = (target as f64 / 5.0 / frac / volume).cbrt();
+    let (cells, kept) = loop {
+        let (cells, kept) = domain_cells(shape, n);
+        if kept.len() * 5 >= target {
+            break (cells, kept);
+        }
+        n *= 1.01;
+    };
+    let d = cells.map(|c| c + 1);
+    let mut tets: Vec<[u32; 4]> = Vec::with_capacity(target);
+    for c in &kept {
+        let five = hex_cell_tets(d, c[0], c[1], c[2]);
+        let take = (target - tets.len()).min(5);
+        tets.extend_from_slice(&five[..take]);
+        if tets.len() == target {
+            break;
+        }
+    }
+    let mut remap = vec![u32::MAX; d.iter().product()];
+    let mut points: Vec<[f32; 3]> = vec![];
+    for t in tets.iter_mut() {
+        for v in t.iter_mut() {
+            let g = *v as usize;
+            if remap[g] == u32::MAX {
+                remap[g] = points.len() as u32;
+                let ijk = [g % d[0], (g / d[0]) % d[1], g / (d[0] * d[1])];
+                points.push(std::array::from_fn(|a| {
+                    (-ext[a] + 2.0 * ext[a] * ijk[a] as f64 / cells[a] as f64) as f32
+                }));
+            }
+            *v = remap[g];
+        }
+    }
+    let field = FieldEval::new(Field::Blobs, seed);
+    let scalars: Vec<f32> = points
+        .par_iter()
+        .map(|p| field.eval(std::array::from_fn(|a| p[a] as f64 / ext[a])) as f32)
+        .collect();
+    TetMesh::new("standin", points, scalars, field.name(), tets)
+}
+
+/// A splatting stand-in volume: `dims` grid points of a seeded blob field of which exactly
+/// `effective` voxels are non-zero (the largest values; ties broken by voxel index), the rest
+/// 0 — the paper's "effective voxels" under any transfer function that maps 0 to transparent.
+pub fn splat_volume(dims: [usize; 3], effective: usize, seed: u64) -> VoxelGrid {
+    let n: usize = dims.iter().product();
+    let field = FieldEval::new(Field::Blobs, seed);
+    let h: [f64; 3] = std::array::from_fn(|a| 2.0 / (dims[a].max(2) - 1) as f64);
+    // Strictly positive values, so 0 can mean "empty".
+    let mut values: Vec<f32> = (0..n)
+        .into_par_iter()
+        .map(|g| {
+            let ijk = [
+                g % dims[0],
+                (g / dims[0]) % dims[1],
+                g / (dims[0] * dims[1]),
+            ];
+            let p = std::array::from_fn(|a| -1.0 + ijk[a] as f64 * h[a]);
+            (field.eval(p) as f32).max(f32::MIN_POSITIVE)
+        })
+        .collect();
+    let effective = effective.min(n);
+    // Bisection on the bit pattern (monotone for positive floats): the smallest threshold τ
+    // with at most `effective` values above it.
+    let above = |t: u32| {
+        let tv = f32::from_bits(t);
+        values.par_iter().filter(|&&v| v > tv).count()
+    };
+    let (mut lo, mut hi) = (0u32, f32::MAX.to_bits());
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if above(mid) <= effective {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    let tau = f32::from_bits(lo);
+    let mut ties_left = effective - above(lo);
+    for v in values.iter_mut() {
+        if *v > tau {
+            continue;
+        }
+        if *v == tau && ties_left > 0 {
+            ties_left -= 1;
+        } else {
+            *v = 0.0;
+        }
+    }
+    VoxelGrid {
+        dims,
+        spacing: h,
+        origin: [-1.0; 3],
+        values,
+        scalar_name: field.name().into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kuhn_split_is_conforming_and_positive() {
+        let grid = VoxelGrid {
+            dims: [4, 3, 5],
+            spacing: [1.0, 0.5, 2.0],
+            origin: [0.0; 3],
+            values: vec![0.0; 60],
+            scalar_name: "z".into(),
+        };
+        let m = six_tet_mesh(&grid).unwrap();
+        assert_eq!(m.num_tets(), 3 * 2 * 4 * 6);
+        assert_eq!(m.repair.inverted_fixed, 0);
+        assert_eq!(m.repair.degenerate_dropped, 0);
+        let quads = 2 * (3 * 2 + 2 * 4 + 3 * 4);
+        assert_eq!(m.boundary_faces().len(), 2 * quads);
+        assert!(m.is_convex());
+    }
+
+    #[test]
+    fn domains_hit_exact_counts_and_cavities_make_them_non_convex() {
+        for (shape, target) in [
+            (Shape::Faceted, 20_011),
+            (Shape::Box, 9_999),
+            (Shape::Torso, 15_000),
+        ] {
+            let m = domain_mesh(shape, target, 3).unwrap();
+            assert_eq!(m.num_tets(), target, "{shape:?}");
+            assert_eq!(m.repair.degenerate_dropped, 0);
+            assert_eq!(m.repair.unused_points, 0);
+            if !shape.is_convex() {
+                assert!(!m.is_convex(), "{shape:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn splat_volumes_have_exactly_the_effective_voxels() {
+        let g = splat_volume([20, 17, 9], 777, 5);
+        assert_eq!(g.values.iter().filter(|&&v| v != 0.0).count(), 777);
+        let r = resample_trilinear(&g, [7, 7, 7]);
+        assert_eq!(r.values.len(), 343);
+        assert_eq!(r.values[0], g.values[0]);
+    }
+}

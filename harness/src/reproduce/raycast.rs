@@ -1,0 +1,257 @@
+//! Tiled ray casting with depth peeling (Bernardon, Pagot, Comba, Silva): Tables 3–6 and the
+//! 144 bytes/tet of §3.1.
+//!
+//! Plan (from `reports/papers/raycast.md`): spx1, blunt and f117 at 512², every tiling from
+//! 1×1 to 6×6, the 2D pre-integration table (Tables 3–5) and the 3D one (Table 6), over the
+//! camera positions (we use the 14 viewpoints). The tables here are generic paper-vs-ours
+//! comparisons from the CSVs; the `raycast` algorithm (issue 9) brings its own analysis
+//! (`tetbench analyze raycast`), to be connected here when it is merged. The setting names
+//! `tiles` (`NxN`) and `table` (`2d|3d`) and the counter `passes` are those issue 9 asks for.
+
+use super::papers;
+use super::table::{Cell, CompRow, Comparison, Metric, Ordering};
+use super::{is_standin, setting, Extra, Measured, Paper, Report, RunSpec, Session};
+
+pub const PAPER: Paper = Paper {
+    id: "raycast",
+    title: "Tiled ray casting with depth peeling (Bernardon, Pagot, Comba, Silva)",
+    citation: "F. F. Bernardon, C. A. Pagot, J. L. D. Comba, C. T. Silva, \"GPU-based Tiled Ray Casting using Depth Peeling\", journal of graphics tools (tech. report UUSCI-2004-006). Provenance: reports/papers/raycast.md.",
+    hardware: "one machine with an ATI Radeon 9700 Pro 128 MB and an NVIDIA GeForce 6800 GT 256 MB, DirectX 9 / HLSL; CPU not stated; 512², 2D pre-integration table except Table 6.",
+    algorithm: "raycast",
+    reproduce,
+};
+
+const DATASETS: [(&str, &str); 3] = [("spx1", "spx1"), ("blunt", "bluntfin"), ("f117", "f117")];
+const TILINGS: [&str; 6] = ["1x1", "2x2", "3x3", "4x4", "5x5", "6x6"];
+/// §3.1: 9 RGBA32F texels per tet.
+const PAPER_BYTES_PER_TET: f64 = 144.0;
+
+fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
+    let mut m = Measured::default();
+    s.run(
+        &RunSpec {
+            name: "raycast".into(),
+            algorithms: vec!["raycast".into()],
+            datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
+            viewpoints: "14".into(),
+            resolution: 512,
+            settings: Some(format!("tiles={};table=2d|3d", TILINGS.join("|"))),
+        },
+        &mut m,
+    )?;
+    Ok(tables(&m, &Extra::default()))
+}
+
+fn rows_of<'a>(
+    m: &'a Measured,
+    dataset: &str,
+    tiles: Option<&str>,
+    table: Option<&str>,
+) -> Vec<&'a crate::results::Row> {
+    m.rows
+        .iter()
+        .filter(|r| r.algorithm == "raycast" && r.dataset == dataset && r.ok())
+        .filter(|r| tiles.is_none_or(|t| setting(&r.settings, "tiles") == Some(t)))
+        .filter(|r| table.is_none_or(|t| setting(&r.settings, "table") == Some(t)))
+        .collect()
+}
+
+fn min_max(v: impl Iterator<Item = f64>) -> (Option<f64>, Option<f64>) {
+    let v: Vec<f64> = v.filter(|x| x.is_finite()).collect();
+    (
+        v.iter().copied().reduce(f64::min),
+        v.iter().copied().reduce(f64::max),
+    )
+}
+
+pub fn tables(m: &Measured, _x: &Extra) -> Report {
+    let mut report = Report::default();
+    let load = |n: &str| papers::table(n).expect("embedded paper CSV parses (tested)");
+    let t3 = load("raycast_table3");
+    let gpus: Vec<String> = {
+        let mut g: Vec<String> = t3
+            .keys()
+            .iter()
+            .filter_map(|k| k.split(" / ").next().map(String::from))
+            .collect();
+        g.dedup();
+        g
+    };
+
+    // Table 3: min/max fps and tets/s over views and tilings (2D table).
+    let mut rows = vec![];
+    for gpu in &gpus {
+        for (paper, d) in DATASETS {
+            let key = format!("{gpu} / {paper}");
+            let r = rows_of(m, d, None, Some("2d"));
+            let (fmin, fmax) = min_max(r.iter().filter_map(|r| r.fps));
+            let (tmin, tmax) = min_max(r.iter().filter_map(|r| r.tets_per_sec));
+            let why = m.why("raycast", d);
+            let cell = |col: &str, ours: Option<f64>| Cell {
+                paper: t3.value(&key, col),
+                ours,
+                why_no_ours: ours.is_none().then(|| why.clone()),
+                uncertain: t3.uncertain(&key, col),
+            };
+            rows.push(CompRow {
+                label: format!("{key} ({d})"),
+                standin: is_standin(d),
+                cells: vec![
+                    cell("min_fps", fmin),
+                    cell("max_fps", fmax),
+                    cell("min_tets_per_sec", tmin),
+                    cell("max_tets_per_sec", tmax),
+                ],
+            });
+        }
+    }
+    report.comparisons.push(Comparison {
+        key: "table3".into(),
+        title: "Table 3 — min/max fps and tets/s over camera positions and tilings (2D table)".into(),
+        conditions: "Paper: per GPU, 512², min/max over camera positions and all tilings 1×1…6×6. Ours: min/max over our viewpoints and tilings on this adapter (the same values are compared with each of the paper's GPUs).".into(),
+        metrics: vec![
+            Metric::new("min fps", 2),
+            Metric::new("max fps", 2),
+            Metric::new("min tets/s", 0),
+            Metric::new("max tets/s", 0),
+        ],
+        rows,
+        notes: vec![],
+    });
+
+    // Table 4: ray-casting passes.
+    let t4 = load("raycast_table4");
+    let rows = DATASETS
+        .iter()
+        .map(|(paper, d)| {
+            let passes = rows_of(m, d, None, Some("2d")).into_iter().filter_map(|r| {
+                r.counters.split(';').find_map(|kv| {
+                    let (k, v) = kv.split_once('=')?;
+                    (k == "passes").then(|| v.parse::<f64>().ok()).flatten()
+                })
+            });
+            let (lo, hi) = min_max(passes);
+            let why = m.why("raycast", d);
+            CompRow {
+                label: format!("{paper} ({d})"),
+                standin: is_standin(d),
+                cells: ["min_ray_casting_passes", "max_ray_casting_passes"]
+                    .iter()
+                    .zip([lo, hi])
+                    .map(|(c, ours)| Cell {
+                        paper: t4.value(paper, c),
+                        ours,
+                        why_no_ours: ours.is_none().then(|| why.clone()),
+                        uncertain: t4.uncertain(paper, c),
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    report.comparisons.push(Comparison {
+        key: "table4".into(),
+        title: "Table 4 — number of ray-casting passes (2D table)".into(),
+        conditions: "Paper: min/max passes per data set (GPU and tiling not stated). Ours: the `passes` counter over viewpoints and tilings. The count follows from the mesh and the views, not from the GPU.".into(),
+        metrics: vec![Metric::new("min passes", 0), Metric::new("max passes", 0)],
+        rows,
+        notes: vec![],
+    });
+
+    // Tables 5 and 6: ms per tiling, 2D and 3D tables.
+    for (name, table) in [("raycast_table5", "2d"), ("raycast_table6", "3d")] {
+        let t = load(name);
+        let mut rows = vec![];
+        for gpu in &gpus {
+            for (paper, d) in DATASETS {
+                let key = format!("{gpu} / {paper}");
+                let why = m.why("raycast", d);
+                let mut cells = vec![];
+                for tiles in TILINGS {
+                    let (lo, hi) = min_max(
+                        rows_of(m, d, Some(tiles), Some(table))
+                            .iter()
+                            .filter_map(|r| r.total_ms),
+                    );
+                    for (suffix, ours) in [("min_ms", lo), ("max_ms", hi)] {
+                        let col = format!("tiles_{tiles}_{suffix}");
+                        cells.push(Cell {
+                            paper: t.value(&key, &col),
+                            ours,
+                            why_no_ours: ours.is_none().then(|| why.clone()),
+                            uncertain: t.uncertain(&key, &col),
+                        });
+                    }
+                }
+                // The paper's best tiling (lowest worst-case ms) vs ours.
+                report.orderings.push(Ordering {
+                    claim: format!(
+                        "{} {key}: max ms per tiling, order of the tilings",
+                        if table == "2d" { "Table 5" } else { "Table 6" }
+                    ),
+                    items: TILINGS
+                        .iter()
+                        .enumerate()
+                        .map(|(i, tl)| {
+                            (
+                                tl.to_string(),
+                                cells[2 * i + 1].paper,
+                                cells[2 * i + 1].ours,
+                            )
+                        })
+                        .collect(),
+                });
+                rows.push(CompRow {
+                    label: format!("{key} ({d})"),
+                    standin: is_standin(d),
+                    cells,
+                });
+            }
+        }
+        report.comparisons.push(Comparison {
+            key: if table == "2d" { "table5" } else { "table6" }.into(),
+            title: format!(
+                "Table {} — min/max ms per frame per tiling, {} pre-integration table",
+                if table == "2d" { 5 } else { 6 },
+                table.to_uppercase()
+            ),
+            conditions: "Paper: min–max over camera positions, per GPU. Ours: min/max of the median frame time over our viewpoints, per tiling.".into(),
+            metrics: TILINGS
+                .iter()
+                .flat_map(|t| [Metric::new(format!("{t} min ms"), 0), Metric::new(format!("{t} max ms"), 0)])
+                .collect(),
+            rows,
+            notes: vec![],
+        });
+    }
+
+    // Bytes per tet (§3.1), independent of the GPU.
+    let rows = DATASETS
+        .iter()
+        .map(|(paper, d)| {
+            let b = m
+                .rows
+                .iter()
+                .find(|r| r.algorithm == "raycast" && r.dataset == *d)
+                .and_then(|r| r.bytes_per_tet);
+            CompRow {
+                label: format!("{paper} ({d})"),
+                standin: is_standin(d),
+                cells: vec![Cell {
+                    paper: Some(PAPER_BYTES_PER_TET),
+                    ours: b,
+                    why_no_ours: b.is_none().then(|| m.why("raycast", d)),
+                    uncertain: None,
+                }],
+            }
+        })
+        .collect();
+    report.comparisons.push(Comparison {
+        key: "memory".into(),
+        title: "§3.1 — persistent GPU bytes per tet".into(),
+        conditions: "Paper: 9 RGBA32F texels per tet = 144 B (Weiler et al.: 160 B). Ours: persistent bytes / tets (mesh layout plus tables).".into(),
+        metrics: vec![Metric::new("B/tet", 1)],
+        rows,
+        notes: vec![],
+    });
+    report
+}

@@ -1,0 +1,757 @@
+//! What every paper's report is made of: comparison tables (paper | ours | ours/paper, or an
+//! exact verdict for tables that do not depend on the GPU), the orderings the paper claims
+//! with whether ours agree, and their Markdown, HTML and bar charts.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{anyhow, Context};
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+
+/// How a metric is compared with the paper's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MetricKind {
+    /// Depends on the hardware: shown as ours/paper.
+    Measured,
+    /// Does not depend on the GPU: ours must equal the paper's.
+    Exact,
+    /// A count the paper prints rounded ("2.9 K"): ours rounded to the paper's significant
+    /// digits must equal it.
+    RoundedAsPrinted,
+}
+
+/// One metric (column group) of a comparison table.
+#[derive(Debug, Clone)]
+pub struct Metric {
+    pub name: String,
+    /// Digits after the decimal point when printed.
+    pub digits: usize,
+    pub kind: MetricKind,
+}
+
+impl Metric {
+    pub fn new(name: impl Into<String>, digits: usize) -> Metric {
+        Metric {
+            name: name.into(),
+            digits,
+            kind: MetricKind::Measured,
+        }
+    }
+    pub fn exact(name: impl Into<String>, digits: usize) -> Metric {
+        Metric {
+            kind: MetricKind::Exact,
+            ..Metric::new(name, digits)
+        }
+    }
+    pub fn rounded(name: impl Into<String>) -> Metric {
+        Metric {
+            kind: MetricKind::RoundedAsPrinted,
+            ..Metric::new(name, 0)
+        }
+    }
+    fn compared_exactly(&self) -> bool {
+        self.kind != MetricKind::Measured
+    }
+    /// Whether ours equals the paper's under this metric's rule.
+    pub fn agrees(&self, paper: f64, ours: f64) -> bool {
+        match self.kind {
+            MetricKind::RoundedAsPrinted => round_sig(ours, significant_digits(paper)) == paper,
+            _ => paper == ours,
+        }
+    }
+}
+
+/// Significant digits of a value printed rounded (trailing zeros of an integer do not count).
+fn significant_digits(v: f64) -> i32 {
+    let mut x = v.abs().round() as u64;
+    if x == 0 {
+        return 1;
+    }
+    while x.is_multiple_of(10) {
+        x /= 10;
+    }
+    x.to_string().len() as i32
+}
+
+fn round_sig(v: f64, digits: i32) -> f64 {
+    if v == 0.0 {
+        return 0.0;
+    }
+    // Divide or multiply by an exact power of ten so 1,500,282 → 1,500,000 exactly.
+    let e = v.abs().log10().floor() as i32 - (digits - 1);
+    if e >= 0 {
+        let p = 10f64.powi(e);
+        (v / p).round() * p
+    } else {
+        let p = 10f64.powi(-e);
+        (v * p).round() / p
+    }
+}
+
+/// One cell pair: the paper's value and ours.
+#[derive(Debug, Clone, Default)]
+pub struct Cell {
+    pub paper: Option<f64>,
+    pub ours: Option<f64>,
+    /// Why ours is empty (algorithm not built in, row failed, …).
+    pub why_no_ours: Option<String>,
+    /// Why the transcription calls the paper's value uncertain.
+    pub uncertain: Option<String>,
+}
+
+impl Cell {
+    pub fn new(paper: Option<f64>, ours: Option<f64>) -> Cell {
+        Cell {
+            paper,
+            ours,
+            ..Default::default()
+        }
+    }
+    pub fn missing(paper: Option<f64>, why: impl Into<String>) -> Cell {
+        Cell {
+            paper,
+            ours: None,
+            why_no_ours: Some(why.into()),
+            uncertain: None,
+        }
+    }
+    pub fn uncertain(mut self, why: Option<String>) -> Cell {
+        self.uncertain = why;
+        self
+    }
+    pub fn ratio(&self) -> Option<f64> {
+        match (self.paper, self.ours) {
+            (Some(p), Some(o)) if p != 0.0 && p.is_finite() && o.is_finite() => Some(o / p),
+            _ => None,
+        }
+    }
+}
+
+/// A row: a label (data set, algorithm, sort…), whether it was measured on a stand-in, one
+/// cell per metric.
+#[derive(Debug, Clone)]
+pub struct CompRow {
+    pub label: String,
+    pub standin: bool,
+    pub cells: Vec<Cell>,
+}
+
+/// A table in the paper's shape with our values beside the paper's.
+#[derive(Debug, Clone)]
+pub struct Comparison {
+    /// File-safe id (`table3`), used for chart names.
+    pub key: String,
+    pub title: String,
+    /// The paper's conditions and ours for this table.
+    pub conditions: String,
+    pub metrics: Vec<Metric>,
+    pub rows: Vec<CompRow>,
+    pub notes: Vec<String>,
+}
+
+impl Comparison {
+    /// The metrics compared exactly, over every non-stand-in cell where both have a value:
+    /// `Some(true)` if all agree, `None` when no such cell exists.
+    pub fn verdict(&self) -> Option<bool> {
+        let mut any = false;
+        for r in self.rows.iter().filter(|r| !r.standin) {
+            for (m, c) in self.metrics.iter().zip(&r.cells) {
+                if !m.compared_exactly() {
+                    continue;
+                }
+                if let (Some(p), Some(o)) = (c.paper, c.ours) {
+                    any = true;
+                    if !m.agrees(p, o) {
+                        return Some(false);
+                    }
+                }
+            }
+        }
+        any.then_some(true)
+    }
+}
+
+/// A claim of the paper about the relative order of items (faster, slower, larger…), checked
+/// on our measurements.
+#[derive(Debug, Clone)]
+pub struct Ordering {
+    /// The claim in words, e.g. "total ms on f117: HAVS < GATOR < PT < ZSWEEP".
+    pub claim: String,
+    /// (item, paper value, our value), in any order.
+    pub items: Vec<(String, Option<f64>, Option<f64>)>,
+}
+
+/// Whether our values order the items as the paper's do.
+#[derive(Debug, Clone, PartialEq)]
+pub enum OrderVerdict {
+    Holds,
+    DoesNotHold {
+        ours: String,
+    },
+    /// Fewer than two items measured by us.
+    CannotCheck,
+}
+
+impl Ordering {
+    fn sorted(items: &[(String, f64)]) -> Vec<String> {
+        let mut v = items.to_vec();
+        v.sort_by(|a, b| a.1.total_cmp(&b.1));
+        v.into_iter().map(|(n, _)| n).collect()
+    }
+
+    /// The items both have, in the paper's ascending order and ours.
+    pub fn verdict(&self) -> OrderVerdict {
+        let both: Vec<&(String, Option<f64>, Option<f64>)> = self
+            .items
+            .iter()
+            .filter(|(_, p, o)| p.is_some() && o.is_some())
+            .collect();
+        if both.len() < 2 {
+            return OrderVerdict::CannotCheck;
+        }
+        let paper = Self::sorted(
+            &both
+                .iter()
+                .map(|(n, p, _)| (n.clone(), p.unwrap_or(0.0)))
+                .collect::<Vec<_>>(),
+        );
+        let ours = Self::sorted(
+            &both
+                .iter()
+                .map(|(n, _, o)| (n.clone(), o.unwrap_or(0.0)))
+                .collect::<Vec<_>>(),
+        );
+        if paper == ours {
+            OrderVerdict::Holds
+        } else {
+            OrderVerdict::DoesNotHold {
+                ours: ours.join(" < "),
+            }
+        }
+    }
+
+    /// Items the paper orders but we did not measure.
+    pub fn missing(&self) -> Vec<String> {
+        self.items
+            .iter()
+            .filter(|(_, p, o)| p.is_some() && o.is_none())
+            .map(|(n, _, _)| n.clone())
+            .collect()
+    }
+
+    pub fn verdict_text(&self) -> String {
+        let missing = self.missing();
+        let tail = if missing.is_empty() {
+            String::new()
+        } else {
+            format!(" (not measured here: {})", missing.join(", "))
+        };
+        match self.verdict() {
+            OrderVerdict::Holds => format!("holds for the items measured{tail}"),
+            OrderVerdict::DoesNotHold { ours } => {
+                format!("does not hold: ours is {ours}{tail}")
+            }
+            OrderVerdict::CannotCheck => format!("cannot be checked{tail}"),
+        }
+    }
+}
+
+/// A number as printed in tables: fixed digits, `–` for none.
+pub fn num(v: Option<f64>, digits: usize) -> String {
+    match v {
+        Some(x) if x.is_finite() => {
+            if x.abs() >= 1e5 && digits == 0 {
+                format!("{:.0}", x)
+            } else {
+                format!("{x:.digits$}")
+            }
+        }
+        _ => "–".into(),
+    }
+}
+
+fn ratio_text(c: &Cell) -> String {
+    c.ratio().map(|r| format!("{r:.3}")).unwrap_or("–".into())
+}
+
+fn exact_text(m: &Metric, c: &Cell) -> &'static str {
+    match (c.paper, c.ours) {
+        (Some(p), Some(o)) if m.agrees(p, o) => "matches",
+        (Some(_), Some(_)) => "does not match",
+        _ => "–",
+    }
+}
+
+/// The table as Markdown: per metric the paper's value, ours, and ours/paper (or the exact
+/// verdict), then the footnotes (stand-ins, uncertain cells, missing values).
+pub fn markdown(c: &Comparison) -> String {
+    let mut md = format!("### {}\n\n{}\n\n", c.title, c.conditions);
+    let mut head = String::from("| row |");
+    let mut rule = String::from("|---|");
+    for m in &c.metrics {
+        let third = if m.compared_exactly() {
+            "verdict"
+        } else {
+            "ours/paper"
+        };
+        let _ = write!(head, " {0} paper | {0} ours | {third} |", m.name);
+        rule.push_str("---:|---:|---:|");
+    }
+    let _ = writeln!(md, "{head}\n{rule}");
+    let mut footnotes: Vec<String> = vec![];
+    let mut mark = |text: String| -> String {
+        let i = match footnotes.iter().position(|f| *f == text) {
+            Some(i) => i,
+            None => {
+                footnotes.push(text);
+                footnotes.len() - 1
+            }
+        };
+        format!("[{}]", i + 1)
+    };
+    for r in &c.rows {
+        let label = if r.standin {
+            format!("{} (stand-in)", r.label)
+        } else {
+            r.label.clone()
+        };
+        let _ = write!(md, "| {label} |");
+        for (m, cell) in c.metrics.iter().zip(&r.cells) {
+            let mut p = num(cell.paper, m.digits);
+            if let Some(u) = &cell.uncertain {
+                p.push_str(&format!(" ?{}", mark(format!("uncertain: {u}"))));
+            }
+            let mut o = num(cell.ours, m.digits);
+            if let Some(w) = &cell.why_no_ours {
+                o.push_str(&format!(" {}", mark(w.clone())));
+            }
+            let t = if m.compared_exactly() {
+                let v = exact_text(m, cell);
+                if r.standin && v != "–" {
+                    format!("{v} (stand-in)")
+                } else {
+                    v.to_string()
+                }
+            } else {
+                ratio_text(cell)
+            };
+            let _ = write!(md, " {p} | {o} | {t} |");
+        }
+        md.push('\n');
+    }
+    if c.metrics.iter().any(|m| m.compared_exactly()) {
+        let v = match c.verdict() {
+            Some(true) => {
+                "**ours matches the paper** in every cell both have (stand-in rows excluded)"
+            }
+            Some(false) => {
+                "**ours does not match the paper** in at least one cell (stand-in rows excluded)"
+            }
+            None => "no cell could be compared",
+        };
+        let _ = writeln!(md, "\nVerdict: {v}.");
+    }
+    if !footnotes.is_empty() {
+        md.push('\n');
+        for (i, f) in footnotes.iter().enumerate() {
+            let _ = writeln!(md, "[{}] {f}  ", i + 1);
+        }
+    }
+    for n in &c.notes {
+        let _ = writeln!(md, "\n{n}");
+    }
+    md
+}
+
+/// The orderings as a Markdown list.
+pub fn orderings_markdown(orderings: &[Ordering]) -> String {
+    let mut md = String::new();
+    for o in orderings {
+        let _ = writeln!(md, "- {} — {}", o.claim, o.verdict_text());
+    }
+    md
+}
+
+fn html_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// A small Markdown-to-HTML pass for the report: headings, tables, lists, images, paragraphs.
+pub fn markdown_to_html(md: &str, title: &str) -> String {
+    let mut html = format!(
+        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{}</title><style>\
+         body{{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em}}\
+         table{{border-collapse:collapse;margin:1em 0;font-size:90%}}\
+         td,th{{border:1px solid #bbb;padding:2px 6px;text-align:right}}\
+         td:first-child,th:first-child{{text-align:left}}img{{max-width:100%}}\
+         </style></head><body>\n",
+        html_escape(title)
+    );
+    let mut in_table = false;
+    let mut in_list = false;
+    for line in md.lines() {
+        let t = line.trim_end();
+        if t.starts_with('|') {
+            if in_list {
+                html.push_str("</ul>\n");
+                in_list = false;
+            }
+            let cells: Vec<&str> = t.trim_matches('|').split('|').map(str::trim).collect();
+            if cells.iter().all(|c| c.chars().all(|ch| "-:".contains(ch))) {
+                continue;
+            }
+            let tag = if in_table { "td" } else { "th" };
+            if !in_table {
+                html.push_str("<table>\n");
+                in_table = true;
+            }
+            html.push_str("<tr>");
+            for c in cells {
+                let _ = write!(html, "<{tag}>{}</{tag}>", inline(c));
+            }
+            html.push_str("</tr>\n");
+            continue;
+        }
+        if in_table {
+            html.push_str("</table>\n");
+            in_table = false;
+        }
+        if let Some(item) = t.strip_prefix("- ") {
+            if !in_list {
+                html.push_str("<ul>\n");
+                in_list = true;
+            }
+            let _ = writeln!(html, "<li>{}</li>", inline(item));
+            continue;
+        }
+        if in_list {
+            html.push_str("</ul>\n");
+            in_list = false;
+        }
+        if let Some(h) = t.strip_prefix("### ") {
+            let _ = writeln!(html, "<h3>{}</h3>", inline(h));
+        } else if let Some(h) = t.strip_prefix("## ") {
+            let _ = writeln!(html, "<h2>{}</h2>", inline(h));
+        } else if let Some(h) = t.strip_prefix("# ") {
+            let _ = writeln!(html, "<h1>{}</h1>", inline(h));
+        } else if !t.is_empty() {
+            let _ = writeln!(html, "<p>{}</p>", inline(t));
+        }
+    }
+    if in_table {
+        html.push_str("</table>\n");
+    }
+    if in_list {
+        html.push_str("</ul>\n");
+    }
+    html.push_str("</body></html>\n");
+    html
+}
+
+/// Inline Markdown: `![alt](src)` images, `**bold**`, `` `code` ``.
+fn inline(s: &str) -> String {
+    let mut out = String::new();
+    let mut rest = s;
+    while let Some(i) = rest.find("![") {
+        out.push_str(&inline_text(&rest[..i]));
+        let after = &rest[i + 2..];
+        match (after.find("]("), after.find(')')) {
+            (Some(a), Some(b)) if a < b => {
+                let alt = &after[..a];
+                let src = &after[a + 2..b];
+                let _ = write!(
+                    out,
+                    "<img src=\"{}\" alt=\"{}\">",
+                    html_escape(src),
+                    html_escape(alt)
+                );
+                rest = &after[b + 1..];
+            }
+            _ => {
+                out.push_str("![");
+                rest = after;
+            }
+        }
+    }
+    out.push_str(&inline_text(rest));
+    out
+}
+
+fn inline_text(s: &str) -> String {
+    let e = html_escape(s);
+    let mut out = String::new();
+    for (i, part) in e.split("**").enumerate() {
+        if i % 2 == 1 {
+            let _ = write!(out, "<b>{part}</b>");
+        } else {
+            for (j, p) in part.split('`').enumerate() {
+                if j % 2 == 1 {
+                    let _ = write!(out, "<code>{p}</code>");
+                } else {
+                    out.push_str(p);
+                }
+            }
+        }
+    }
+    out
+}
+
+const FONT: &str = "DejaVu Sans";
+
+fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let _ = plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
+    });
+}
+
+/// Bar charts paper vs ours, one PNG per metric of `c` that has values on both sides, on a
+/// log scale (papers' GPUs and ours differ by orders of magnitude). Returns the file names
+/// written (relative to `dir`).
+pub fn write_charts(dir: &Path, c: &Comparison) -> anyhow::Result<Vec<String>> {
+    register_font();
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut written = vec![];
+    for (mi, m) in c.metrics.iter().enumerate() {
+        // Exact metrics (counts, truth values) are compared in the table, not charted.
+        if m.compared_exactly() {
+            continue;
+        }
+        let bars: Vec<(String, Option<f64>, Option<f64>)> = c
+            .rows
+            .iter()
+            .map(|r| {
+                let cell = &r.cells[mi];
+                let label = if r.standin {
+                    format!("{}*", r.label)
+                } else {
+                    r.label.clone()
+                };
+                (
+                    label,
+                    cell.paper.filter(|v| *v > 0.0),
+                    cell.ours.filter(|v| *v > 0.0),
+                )
+            })
+            .filter(|(_, p, o)| p.is_some() || o.is_some())
+            .collect();
+        if !bars.iter().any(|(_, p, _)| p.is_some()) || !bars.iter().any(|(_, _, o)| o.is_some()) {
+            continue;
+        }
+        let name = format!("{}_{}.png", c.key, crate::run::slug(&m.name));
+        let path = dir.join(&name);
+        let title = format!("{} — {}", c.title, m.name);
+        draw_bars(&path, &title, &m.name, &bars)
+            .with_context(|| format!("writing {}", path.display()))?;
+        written.push(name);
+    }
+    Ok(written)
+}
+
+/// An axis value in few characters: 1.5M, 230k, 12, 0.05.
+fn compact(v: f64) -> String {
+    let a = v.abs();
+    if a >= 1e6 {
+        format!("{}M", trim(v / 1e6))
+    } else if a >= 1e3 {
+        format!("{}k", trim(v / 1e3))
+    } else {
+        trim(v)
+    }
+}
+
+fn trim(v: f64) -> String {
+    let s = format!("{v:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow!("drawing a chart: {e:?}")
+}
+
+fn draw_bars(
+    path: &Path,
+    title: &str,
+    y_desc: &str,
+    bars: &[(String, Option<f64>, Option<f64>)],
+) -> anyhow::Result<()> {
+    let values = bars.iter().flat_map(|(_, p, o)| [*p, *o]).flatten();
+    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
+    let (lo, hi) = (lo / 2.0, hi * 2.0);
+    let width = (160 + 90 * bars.len()).clamp(500, 1400) as u32;
+    let root = BitMapBackend::new(path, (width, 420)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let short: String = title.chars().take(90).collect();
+    let n = bars.len() as f64;
+    // Group i is centred on x = i, so the axis' integer ticks carry the row labels.
+    let mut chart = ChartBuilder::on(&root)
+        .caption(short, (FONT, 16).into_font())
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(-0.5..n - 0.5, (lo..hi).log_scale())
+        .map_err(err)?;
+    let labels: Vec<String> = bars.iter().map(|b| b.0.clone()).collect();
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .light_line_style(WHITE)
+        .x_labels(bars.len() + 1)
+        .x_label_formatter(&|x| {
+            let i = x.round();
+            if (x - i).abs() < 1e-6 && i >= 0.0 {
+                labels.get(i as usize).cloned().unwrap_or_default()
+            } else {
+                String::new()
+            }
+        })
+        .y_labels(8)
+        .y_label_formatter(&|y| compact(*y))
+        .y_desc(y_desc)
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 13))
+        .draw()
+        .map_err(err)?;
+    let paper_color = RGBColor(127, 127, 127);
+    let ours_color = RGBColor(31, 119, 180);
+    for (i, (_, p, o)) in bars.iter().enumerate() {
+        let x = i as f64;
+        if let Some(p) = p {
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(x - 0.4, lo), (x - 0.02, *p)],
+                    paper_color.filled(),
+                )))
+                .map_err(err)?;
+        }
+        if let Some(o) = o {
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(x + 0.02, lo), (x + 0.4, *o)],
+                    ours_color.filled(),
+                )))
+                .map_err(err)?;
+        }
+    }
+    chart
+        .draw_series(std::iter::once(Rectangle::new(
+            [(0.0, lo), (0.0, lo)],
+            paper_color.filled(),
+        )))
+        .map_err(err)?
+        .label("paper")
+        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], paper_color.filled()));
+    chart
+        .draw_series(std::iter::once(Rectangle::new(
+            [(0.0, lo), (0.0, lo)],
+            ours_color.filled(),
+        )))
+        .map_err(err)?
+        .label("ours")
+        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], ours_color.filled()));
+    chart
+        .configure_series_labels()
+        .label_font((FONT, 12))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn comparison(exact: bool, ours: f64) -> Comparison {
+        Comparison {
+            key: "t".into(),
+            title: "T".into(),
+            conditions: "c".into(),
+            metrics: vec![if exact {
+                Metric::exact("ms", 1)
+            } else {
+                Metric::new("ms", 1)
+            }],
+            rows: vec![
+                CompRow {
+                    label: "a".into(),
+                    standin: false,
+                    cells: vec![Cell::new(Some(2.0), Some(ours))],
+                },
+                CompRow {
+                    label: "b".into(),
+                    standin: true,
+                    cells: vec![Cell::missing(Some(3.0), "not built").uncertain(Some("x".into()))],
+                },
+            ],
+            notes: vec![],
+        }
+    }
+
+    #[test]
+    fn tables_ratios_and_verdicts() {
+        let md = markdown(&comparison(false, 4.0));
+        assert!(md.contains("| a | 2.0 | 4.0 | 2.000 |"), "{md}");
+        assert!(
+            md.contains("| b (stand-in) | 3.0 ?[1] | – [2] | – |"),
+            "{md}"
+        );
+        assert!(md.contains("[2] not built"), "{md}");
+        assert_eq!(comparison(true, 2.0).verdict(), Some(true));
+        assert_eq!(comparison(true, 2.5).verdict(), Some(false));
+        let r = Metric::rounded("tets");
+        assert!(r.agrees(2900.0, 2896.0) && r.agrees(187000.0, 187318.0));
+        assert!(r.agrees(1_500_000.0, 1_500_282.0) && !r.agrees(950_000.0, 941_192.0));
+        assert!(markdown(&comparison(true, 2.0)).contains("| a | 2.0 | 2.0 | matches |"));
+        let html = markdown_to_html(&markdown(&comparison(false, 4.0)), "t");
+        assert!(
+            html.contains("<table>") && html.contains("<td>2.000</td>"),
+            "{html}"
+        );
+    }
+
+    #[test]
+    fn orderings() {
+        let o = Ordering {
+            claim: "x".into(),
+            items: vec![
+                ("HAVS".into(), Some(148.0), Some(900.0)),
+                ("GATOR".into(), Some(270.0), Some(2000.0)),
+                ("PT".into(), Some(298.0), None),
+            ],
+        };
+        assert_eq!(o.verdict(), OrderVerdict::Holds);
+        assert_eq!(o.missing(), vec!["PT"]);
+        let mut bad = o.clone();
+        bad.items[0].2 = Some(3000.0);
+        assert!(matches!(bad.verdict(), OrderVerdict::DoesNotHold { .. }));
+        bad.items[1].2 = None;
+        assert_eq!(bad.verdict(), OrderVerdict::CannotCheck);
+    }
+
+    #[test]
+    fn charts_are_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let files = write_charts(dir.path(), &comparison(false, 4.0)).unwrap();
+        assert_eq!(files, vec!["t_ms.png"]);
+        assert!(write_charts(dir.path(), &comparison(true, 4.0))
+            .unwrap()
+            .is_empty());
+        assert_eq!(compact(1_500_000.0), "1.5M");
+        assert_eq!(compact(230_000.0), "230k");
+        assert_eq!(compact(0.05), "0.05");
+        assert!(
+            std::fs::metadata(dir.path().join("t_ms.png"))
+                .unwrap()
+                .len()
+                > 1000
+        );
+    }
+}
