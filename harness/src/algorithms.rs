@@ -41,6 +41,11 @@ pub fn variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
     Ok((entry(name)?.1)())
 }
 
+/// Every variant `name` offers (what `--settings` selects from), in table order.
+pub fn all_variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+    Ok((entry(name)?.2)())
+}
+
 /// The variants of `name` that `filter` selects. Drawn from every variant the algorithm offers:
 /// a setting the filter names must take one of the listed values; a setting it does not name
 /// keeps the values the default variants use. So no filter gives exactly the defaults,

@@ -44,6 +44,9 @@ pub enum Command {
         /// The run's output directory.
         out: PathBuf,
     },
+    /// Draw comparison charts (speed-error, scaling, resolution, bars, all) from any results,
+    /// or run a sweep first (--sweep).
+    Plot(crate::plot::cli::PlotArgs),
 }
 
 #[derive(Debug, Clone, clap::Args)]
@@ -269,6 +272,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             println!("wrote {}", out.join("index.html").display());
             Ok(())
         }
+        Command::Plot(args) => crate::plot::cli::run(args, cli.data_dir, command_line),
     }
 }
 

@@ -8,6 +8,7 @@ pub mod cli;
 pub mod datasets_cmd;
 pub mod machine;
 pub mod metrics;
+pub mod plot;
 pub mod report;
 pub mod results;
 pub mod run;
