@@ -9,7 +9,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use serde::Serialize;
 
 use super::data::{distinct, write_csv, Point};
-use super::draw::{self, err, Chart, LegendEntry, FONT, LEGEND_WIDTH, MAX_LEGEND_ROWS};
+use super::draw::{self, err, Chart, LegendEntry, FONT, MAX_LEGEND_ROWS, PLOT_WIDTH};
 use super::speed_error::sort_by_style;
 use super::style::StyleBook;
 use super::{ChartFile, Kind};
@@ -51,9 +51,29 @@ fn short_number(v: f64) -> String {
     }
 }
 
+impl Bars<'_> {
+    fn heading() -> Vec<String> {
+        vec!["mean over viewpoints,".into(), "whiskers min–max".into()]
+    }
+
+    fn entries(&self) -> Vec<LegendEntry> {
+        self.series
+            .iter()
+            .map(|(a, s)| LegendEntry {
+                style: self.book.get(a, s),
+                line: false,
+                extra: String::new(),
+            })
+            .collect()
+    }
+}
+
 impl Chart for Bars<'_> {
     fn size(&self) -> (u32, u32) {
-        (1200, draw::height_for_legend(self.series.len(), 2, 480))
+        (
+            PLOT_WIDTH + draw::legend_width(&Self::heading(), &self.entries()),
+            draw::height_for_legend(self.series.len(), 2, 480),
+        )
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()>
@@ -61,8 +81,7 @@ impl Chart for Bars<'_> {
         DB::ErrorType: 'static,
     {
         root.fill(&WHITE).map_err(err)?;
-        let (w, _) = root.dim_in_pixel();
-        let (plot, legend) = root.split_horizontally(w - LEGEND_WIDTH);
+        let (plot, legend) = root.split_horizontally(PLOT_WIDTH);
         let g = self.groups.len().max(1);
         let s = self.series.len().max(1);
         let ymax = self
@@ -134,6 +153,14 @@ impl Chart for Bars<'_> {
                         ])
                         .map_err(err)?;
                 }
+                // Shades repeat within a family; the marker on the bar tells variants apart.
+                let top = chart.backend_coord(&(xc, v.mean));
+                let r = ((chart.backend_coord(&(x1, 0.0)).0 - chart.backend_coord(&(x0, 0.0)).0)
+                    / 3)
+                .clamp(3, 7);
+                plot.draw(&Circle::new(top, r + 3, WHITE.filled()))
+                    .map_err(err)?;
+                draw::marker(&plot, top, r, &style)?;
                 if label_bars {
                     let ts = TextStyle::from((FONT, 12).into_font())
                         .pos(Pos::new(HPos::Center, VPos::Bottom));
@@ -154,20 +181,7 @@ impl Chart for Bars<'_> {
             plot.draw(&Text::new(name.clone(), (px, py + 8), name_style.clone()))
                 .map_err(err)?;
         }
-        let entries: Vec<LegendEntry> = self
-            .series
-            .iter()
-            .map(|(a, s)| LegendEntry {
-                style: self.book.get(a, s),
-                line: false,
-                extra: String::new(),
-            })
-            .collect();
-        draw::legend(
-            &legend,
-            &["mean over viewpoints,".into(), "whiskers min–max".into()],
-            &entries,
-        )?;
+        draw::legend(&legend, &Self::heading(), &self.entries())?;
         root.present().map_err(err)?;
         Ok(())
     }

@@ -197,12 +197,15 @@ impl Point {
     }
 }
 
-/// Suspect rows: PSNR below 20 dB, or more than 20 dB below the best row of the same data set,
-/// viewpoint and viewport (issue 15's rule). Returns one flag per row.
+/// Suspect rows (issue 15's rule): PSNR below 20 dB, or more than 20 dB below the best row of
+/// the same data set, viewpoint and viewport — unless at least 40 dB (RMSE ≤ 1 %, invisible),
+/// since next to a row at the 99 dB cap every merely excellent row would be 20 dB "below".
+/// Returns one flag per row.
 /// (When rows carry their own `suspect` column, this should read it.)
 pub fn suspect_flags(rows: &[Row]) -> Vec<bool> {
     const ABSOLUTE_DB: f64 = 20.0;
     const BELOW_BEST_DB: f64 = 20.0;
+    const NEVER_BELOW_DB: f64 = 40.0;
     rows.iter()
         .map(|r| {
             let Some(p) = r.psnr_db else { return false };
@@ -216,7 +219,7 @@ pub fn suspect_flags(rows: &[Row]) -> Vec<bool> {
                 })
                 .filter_map(|o| o.psnr_db)
                 .fold(f64::NEG_INFINITY, f64::max);
-            p < ABSOLUTE_DB || p < best - BELOW_BEST_DB
+            p < ABSOLUTE_DB || (p < NEVER_BELOW_DB && p < best - BELOW_BEST_DB)
         })
         .collect()
 }
@@ -373,6 +376,10 @@ pub(crate) mod tests {
         assert!(suspect_flags(&r).iter().all(|s| !s));
         r[0].psnr_db = Some(29.0);
         assert!(suspect_flags(&r)[0]);
+        // Next to a capped 99 dB row, 45 dB is still fine.
+        r[0].psnr_db = Some(45.0);
+        r[4].psnr_db = Some(99.0);
+        assert!(!suspect_flags(&r)[0]);
     }
 
     #[test]

@@ -9,6 +9,7 @@ use std::path::Path;
 use std::sync::Once;
 
 use anyhow::{anyhow, Context};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
@@ -164,7 +165,36 @@ pub struct LegendEntry {
 }
 
 pub const LEGEND_ROW: i32 = 22;
-pub const LEGEND_WIDTH: u32 = 330;
+/// Width of the plot panel; the legend panel beside it is as wide as its longest line.
+pub const PLOT_WIDTH: u32 = 860;
+
+impl LegendEntry {
+    pub fn text(&self) -> String {
+        if self.extra.is_empty() {
+            self.style.label.clone()
+        } else {
+            format!("{}  {}", self.style.label, self.extra)
+        }
+    }
+}
+
+/// Pixel width of `text` in the legend font (measured with the embedded font, so a legend
+/// is never cut).
+pub fn text_width(text: &str, size: f64) -> u32 {
+    register_font();
+    (FONT, size)
+        .into_font()
+        .box_size(text)
+        .map(|(w, _)| w)
+        .unwrap_or((text.chars().count() as f64 * size * 0.62) as u32)
+}
+
+/// Width of a legend panel holding `heading` and `entries`, margins included.
+pub fn legend_width(heading: &[String], entries: &[LegendEntry]) -> u32 {
+    let h = heading.iter().map(|t| 8 + text_width(t, 13.0));
+    let e = entries.iter().map(|e| 40 + text_width(&e.text(), 13.0));
+    h.chain(e).max().unwrap_or(0).max(200) + 16
+}
 /// Legend rows that fit beside a chart of the minimum height; beyond this charts are split.
 pub const MAX_LEGEND_ROWS: usize = 18;
 
@@ -194,12 +224,7 @@ where
             .map_err(err)?;
         }
         marker(area, (20, cy), 6, &e.style)?;
-        let text = if e.extra.is_empty() {
-            e.style.label.clone()
-        } else {
-            format!("{}  {}", e.style.label, e.extra)
-        };
-        area.draw(&Text::new(text, (40, y), (FONT, 13).into_font()))
+        area.draw(&Text::new(e.text(), (40, y), (FONT, 13).into_font()))
             .map_err(err)?;
         y += LEGEND_ROW;
     }
@@ -238,19 +263,15 @@ pub fn si(v: f64) -> String {
     format!("{t}{suffix}")
 }
 
-/// Bytes as B, KiB, MiB, GiB.
+/// Bytes in decimal units (B, kB, MB, GB), so that log-axis ticks at 1-2-5 read round.
 pub fn bytes(v: f64) -> String {
-    let units = ["B", "KiB", "MiB", "GiB", "TiB"];
-    let mut x = v;
-    let mut u = 0;
-    while x.abs() >= 1024.0 && u + 1 < units.len() {
-        x /= 1024.0;
-        u += 1;
-    }
-    if x.fract() == 0.0 || x.abs() >= 100.0 {
-        format!("{x:.0} {}", units[u])
-    } else {
-        format!("{x:.1} {}", units[u])
+    let t = si(v);
+    match t.chars().last() {
+        Some('k') | Some('M') | Some('G') => {
+            let (n, u) = t.split_at(t.len() - 1);
+            format!("{n} {}B", if u == "k" { "k" } else { u })
+        }
+        _ => format!("{t} B"),
     }
 }
 
@@ -286,6 +307,107 @@ pub fn log_range(lo: f64, hi: f64) -> (f64, f64) {
     (lo, hi)
 }
 
+/// One axis of a chart. Charts are built on linear coordinates; a log axis stores log10 of
+/// its values, and draws its own ticks at 1, 2 and 5 × 10ⁿ (plotters' log axis labels every
+/// integer multiple, and the labels collide).
+#[derive(Debug, Clone, Copy)]
+pub struct Axis {
+    pub log: bool,
+    /// Ends in data units.
+    pub lo: f64,
+    pub hi: f64,
+}
+
+impl Axis {
+    /// Chart coordinate of a data value.
+    pub fn at(&self, v: f64) -> f64 {
+        if self.log {
+            v.max(f64::MIN_POSITIVE).log10()
+        } else {
+            v
+        }
+    }
+
+    pub fn range(&self) -> std::ops::Range<f64> {
+        self.at(self.lo)..self.at(self.hi)
+    }
+
+    /// Tick values in data units.
+    pub fn ticks(&self) -> Vec<f64> {
+        let inside = |v: &f64| *v >= self.lo * (1.0 - 1e-9) && *v <= self.hi * (1.0 + 1e-9);
+        if self.log {
+            let (a, b) = (
+                self.lo.log10().floor() as i32,
+                self.hi.log10().ceil() as i32,
+            );
+            let decades = (b - a).max(1);
+            let mantissas: &[f64] = if decades > 4 {
+                &[1.0]
+            } else {
+                &[1.0, 2.0, 5.0]
+            };
+            (a..=b)
+                .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
+                .filter(inside)
+                .collect()
+        } else {
+            let span = (self.hi - self.lo).max(1e-12);
+            let raw = span / 6.0;
+            let d = 10f64.powf(raw.log10().floor());
+            let step = [1.0, 2.0, 5.0, 10.0]
+                .into_iter()
+                .map(|m| m * d)
+                .find(|&s| s >= raw)
+                .unwrap_or(10.0 * d);
+            let first = (self.lo / step).ceil() as i64;
+            let last = (self.hi / step).floor() as i64;
+            (first..=last).map(|i| i as f64 * step).collect()
+        }
+    }
+}
+
+/// Grid lines and tick labels of both axes (the mesh of plotters is switched off).
+pub fn grid<DB: DrawingBackend>(
+    chart: &ChartContext<DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    area: &DrawingArea<DB, Shift>,
+    x: Axis,
+    y: Axis,
+    x_fmt: fn(f64) -> String,
+    y_fmt: fn(f64) -> String,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    use plotters::style::text_anchor::{HPos, Pos, VPos};
+    let line = BLACK.mix(0.13).stroke_width(1);
+    let (xr, yr) = (x.range(), y.range());
+    let below = TextStyle::from((FONT, 14).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
+    let left = TextStyle::from((FONT, 14).into_font()).pos(Pos::new(HPos::Right, VPos::Center));
+    for t in x.ticks() {
+        let c = x.at(t);
+        let (p0, p1) = (
+            chart.backend_coord(&(c, yr.start)),
+            chart.backend_coord(&(c, yr.end)),
+        );
+        area.draw(&PathElement::new(vec![p0, p1], line))
+            .map_err(err)?;
+        area.draw(&Text::new(x_fmt(t), (p0.0, p0.1 + 6), below.clone()))
+            .map_err(err)?;
+    }
+    for t in y.ticks() {
+        let c = y.at(t);
+        let (p0, p1) = (
+            chart.backend_coord(&(xr.start, c)),
+            chart.backend_coord(&(xr.end, c)),
+        );
+        area.draw(&PathElement::new(vec![p0, p1], line))
+            .map_err(err)?;
+        area.draw(&Text::new(y_fmt(t), (p0.0 - 6, p0.1), left.clone()))
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -296,7 +418,20 @@ mod tests {
         assert_eq!(si(2_500_000.0), "2.5M");
         assert_eq!(si(0.5), "0.5");
         assert_eq!(si(1e9), "1G");
-        assert_eq!(bytes(3.0 * 1024.0 * 1024.0), "3 MiB");
+        assert_eq!(bytes(3e6), "3 MB");
+        assert_eq!(bytes(512.0), "512 B");
+        let a = Axis {
+            log: true,
+            lo: 20_000.0,
+            hi: 500_000.0,
+        };
+        assert_eq!(a.ticks(), [2e4, 5e4, 1e5, 2e5, 5e5]);
+        let l = Axis {
+            log: false,
+            lo: 38.0,
+            hi: 101.0,
+        };
+        assert_eq!(l.ticks(), [40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0]);
         let (lo, hi) = log_range(3_000.0, 4.1e6);
         assert_eq!((lo, hi), (2_000.0, 5e6));
     }

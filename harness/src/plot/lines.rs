@@ -6,8 +6,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::data::Bound;
-use super::draw::{self, err, Chart, LegendEntry, FONT, LEGEND_WIDTH};
-use super::style::{Marker, StyleBook};
+use super::draw::{self, err, Chart, LegendEntry, FONT, PLOT_WIDTH};
+use super::style::{Marker, Style, StyleBook};
 use crate::report::Spread;
 
 /// One measured (or failed) point of a line.
@@ -42,6 +42,17 @@ pub struct LineChart<'a> {
 }
 
 impl LineChart<'_> {
+    fn entries(&self) -> Vec<LegendEntry> {
+        self.lines
+            .iter()
+            .map(|l| LegendEntry {
+                style: self.book.get(&l.algorithm, &l.settings),
+                line: true,
+                extra: l.extra.clone(),
+            })
+            .collect()
+    }
+
     fn heading(&self) -> Vec<String> {
         let mut h = self.notes.clone();
         h.push("whiskers: min–max over viewpoints".into());
@@ -50,7 +61,8 @@ impl LineChart<'_> {
             .iter()
             .any(|l| l.points.iter().any(|p| p.y.is_none()))
         {
-            h.push("× on the bottom edge: failed there".into());
+            h.push("crossed out on the bottom edge:".into());
+            h.push("failed there (no measurement)".into());
         }
         h
     }
@@ -97,7 +109,7 @@ impl LineChart<'_> {
 impl Chart for LineChart<'_> {
     fn size(&self) -> (u32, u32) {
         (
-            1200,
+            PLOT_WIDTH + draw::legend_width(&self.heading(), &self.entries()),
             draw::height_for_legend(self.lines.len(), self.heading().len(), 620),
         )
     }
@@ -107,97 +119,78 @@ impl Chart for LineChart<'_> {
         DB::ErrorType: 'static,
     {
         root.fill(&WHITE).map_err(err)?;
-        let (w, _) = root.dim_in_pixel();
-        let (plot, legend) = root.split_horizontally(w - LEGEND_WIDTH);
+        let (plot, legend) = root.split_horizontally(PLOT_WIDTH);
         let (xlo, xhi) = self.x_range();
         let (ylo, yhi) = self.y_range();
-        // Both axis kinds go through one closure each way, so the drawing code below does
-        // not depend on which scale the x axis has.
-        let mut points_px: Vec<(
-            usize,
-            Vec<(Option<(i32, i32)>, (i32, i32), Option<(i32, i32)>)>,
-        )> = vec![];
-        let mut bound_px: Vec<(i32, i32, i32, String)> = vec![];
-        macro_rules! body {
-            ($chart:expr) => {{
-                let chart = $chart;
-                for (li, l) in self.lines.iter().enumerate() {
-                    let mut v = vec![];
-                    for p in &l.points {
-                        match p.y {
-                            Some(s) => v.push((
-                                Some(chart.backend_coord(&(p.x, s.min))),
-                                chart.backend_coord(&(p.x, s.mean)),
-                                Some(chart.backend_coord(&(p.x, s.max))),
-                            )),
-                            None => v.push((None, chart.backend_coord(&(p.x, ylo)), None)),
-                        }
-                    }
-                    points_px.push((li, v));
-                }
-                for b in &self.bounds {
-                    let (x0, y) = chart.backend_coord(&(xlo, b.per_sec));
-                    let (x1, _) = chart.backend_coord(&(xhi, b.per_sec));
-                    bound_px.push((
-                        x0,
-                        x1,
-                        y,
-                        format!(
-                            "calibrated bound: {} {}/s ({})",
-                            b.name,
-                            draw::si(b.per_sec),
-                            b.adapter
-                        ),
-                    ));
-                }
-            }};
-        }
-        fn builder<'a, 'b, DB: DrawingBackend>(
-            area: &'a DrawingArea<DB, Shift>,
-            title: &str,
-        ) -> ChartBuilder<'a, 'b, DB> {
-            let mut b = ChartBuilder::on(area);
-            b.caption(title, (FONT, 21).into_font())
-                .margin(14)
-                .x_label_area_size(52)
-                .y_label_area_size(72);
-            b
-        }
-        if self.x_log {
-            let mut chart = builder(&plot, &self.title)
-                .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())
-                .map_err(err)?;
-            chart
-                .configure_mesh()
-                .bold_line_style(BLACK.mix(0.12))
-                .light_line_style(BLACK.mix(0.04))
-                .x_desc(&self.x_desc)
-                .y_desc(&self.y_desc)
-                .x_label_formatter(&|v| (self.x_fmt)(*v))
-                .y_label_formatter(&|v| (self.y_fmt)(*v))
-                .label_style((FONT, 14))
-                .axis_desc_style((FONT, 15))
-                .draw()
-                .map_err(err)?;
-            body!(&chart);
-        } else {
-            let mut chart = builder(&plot, &self.title)
-                .build_cartesian_2d(xlo..xhi, (ylo..yhi).log_scale())
-                .map_err(err)?;
-            chart
-                .configure_mesh()
-                .bold_line_style(BLACK.mix(0.12))
-                .light_line_style(BLACK.mix(0.04))
-                .x_desc(&self.x_desc)
-                .y_desc(&self.y_desc)
-                .x_label_formatter(&|v| (self.x_fmt)(*v))
-                .y_label_formatter(&|v| (self.y_fmt)(*v))
-                .label_style((FONT, 14))
-                .axis_desc_style((FONT, 15))
-                .draw()
-                .map_err(err)?;
-            body!(&chart);
-        }
+        let xa = draw::Axis {
+            log: self.x_log,
+            lo: xlo,
+            hi: xhi,
+        };
+        let ya = draw::Axis {
+            log: true,
+            lo: ylo,
+            hi: yhi,
+        };
+        let mut chart = ChartBuilder::on(&plot)
+            .caption(&self.title, (FONT, 21).into_font())
+            .margin(14)
+            .x_label_area_size(52)
+            .y_label_area_size(72)
+            .build_cartesian_2d(xa.range(), ya.range())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(WHITE.mix(0.0))
+            .x_labels(0)
+            .y_labels(0)
+            .x_desc(&self.x_desc)
+            .y_desc(&self.y_desc)
+            .axis_desc_style((FONT, 15))
+            .draw()
+            .map_err(err)?;
+        draw::grid(&chart, &plot, xa, ya, self.x_fmt, self.y_fmt)?;
+        let px = |x: f64, y: f64| chart.backend_coord(&(xa.at(x), ya.at(y)));
+        // Per line, per point: (whisker bottom, centre, whisker top) in pixels; a failed
+        // point has no whisker and sits on the bottom edge.
+        type Px = (Option<(i32, i32)>, (i32, i32), Option<(i32, i32)>);
+        let points_px: Vec<(usize, Vec<Px>)> = self
+            .lines
+            .iter()
+            .enumerate()
+            .map(|(li, l)| {
+                let v = l
+                    .points
+                    .iter()
+                    .map(|p| match p.y {
+                        Some(s) => (Some(px(p.x, s.min)), px(p.x, s.mean), Some(px(p.x, s.max))),
+                        None => (None, px(p.x, ylo), None),
+                    })
+                    .collect();
+                (li, v)
+            })
+            .collect();
+        let bound_px: Vec<(i32, i32, i32, String)> = self
+            .bounds
+            .iter()
+            .map(|b| {
+                let (x0, y) = px(xlo, b.per_sec);
+                let (x1, _) = px(xhi, b.per_sec);
+                (
+                    x0,
+                    x1,
+                    y,
+                    format!(
+                        "calibrated bound: {} {}/s ({})",
+                        b.name,
+                        draw::si(b.per_sec),
+                        b.adapter
+                    ),
+                )
+            })
+            .collect();
         for (x0, x1, y, text) in &bound_px {
             plot.draw(&plotters::element::DashedPathElement::new(
                 vec![(*x0, *y), (*x1, *y)],
@@ -213,6 +206,8 @@ impl Chart for LineChart<'_> {
             ))
             .map_err(err)?;
         }
+        // Failed points sit on the bottom edge, stacked upwards where several share an x.
+        let mut failed_at: Vec<(i32, i32)> = vec![];
         for (li, pts) in &points_px {
             let st = self
                 .book
@@ -242,22 +237,22 @@ impl Chart for LineChart<'_> {
                         draw::marker(&plot, *mid, 6, &st)?;
                     }
                     _ => {
-                        let mut failed = st.clone();
-                        failed.marker = Marker::Cross;
-                        draw::marker(&plot, (mid.0, mid.1 - 8), 6, &failed)?;
+                        let below = failed_at.iter().filter(|(x, _)| *x == mid.0).count() as i32;
+                        failed_at.push(*mid);
+                        let c = (mid.0, mid.1 - 10 - 18 * below);
+                        draw::marker(&plot, c, 6, &st)?;
+                        let cross = Style {
+                            marker: Marker::Cross,
+                            color: BLACK,
+                            hollow: true,
+                            ..st.clone()
+                        };
+                        draw::marker(&plot, c, 5, &cross)?;
                     }
                 }
             }
         }
-        let entries: Vec<LegendEntry> = self
-            .lines
-            .iter()
-            .map(|l| LegendEntry {
-                style: self.book.get(&l.algorithm, &l.settings),
-                line: true,
-                extra: l.extra.clone(),
-            })
-            .collect();
+        let entries = self.entries();
         draw::legend(&legend, &self.heading(), &entries)?;
         root.present().map_err(err)?;
         Ok(())

@@ -369,6 +369,10 @@ mod tests {
                 "{f:?}"
             );
             assert!((f.gpu_bytes_exponent.unwrap() - 1.0).abs() < 1e-9, "{f:?}");
+            assert!(
+                (f.gpu_bytes_per_tet_marginal.unwrap() - 100.0).abs() < 1e-6,
+                "{f:?}"
+            );
         }
     }
 

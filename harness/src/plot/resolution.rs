@@ -72,7 +72,7 @@ pub fn write(
             pts.iter()
                 .map(|p| (p.algorithm.clone(), p.settings.clone())),
         );
-        variants.sort_by_key(|(a, s)| (super::style::is_peer(a), a.clone(), book.get(a, s).slot));
+        variants.sort_by_key(|(a, s)| super::style::order_key(book, a, s));
         let lines: Vec<Line> = variants
             .iter()
             .map(|(a, s)| Line {

@@ -43,6 +43,21 @@ pub fn power_law_exponent(xy: &[(f64, f64)]) -> Option<f64> {
     (sxx > 0.0).then(|| sxy / sxx)
 }
 
+/// Slope of the least-squares line through (x, y): e.g. GPU bytes per extra tet, which the
+/// log–log exponent hides when a fixed-size table dominates small meshes (HAVS's 3D
+/// pre-integration table).
+pub fn linear_slope(xy: &[(f64, f64)]) -> Option<f64> {
+    let n = xy.len() as f64;
+    if xy.len() < 2 {
+        return None;
+    }
+    let mx = xy.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = xy.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxx: f64 = xy.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = xy.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
 /// One CSV line: a variant at one mesh size.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct Record {
@@ -77,6 +92,8 @@ pub struct Fit {
     pub sizes_failed: usize,
     pub tets_per_sec_exponent: Option<f64>,
     pub gpu_bytes_exponent: Option<f64>,
+    /// GPU bytes per additional tet (linear fit of bytes against tets).
+    pub gpu_bytes_per_tet_marginal: Option<f64>,
 }
 
 /// What `write` made: the chart files and the fits (printed by `tetbench plot scaling`).
@@ -123,7 +140,7 @@ pub fn write(
             pts.iter()
                 .map(|p| (p.algorithm.clone(), p.settings.clone())),
         );
-        variants.sort_by_key(|(a, s)| (super::style::is_peer(a), a.clone(), book.get(a, s).slot));
+        variants.sort_by_key(|(a, s)| super::style::order_key(book, a, s));
         let records: Vec<Record> = pts
             .iter()
             .map(|p| Record {
@@ -171,6 +188,17 @@ pub fn write(
                 sizes_failed: mine.iter().filter(|p| p.tets_per_sec.is_none()).count(),
                 tets_per_sec_exponent: power_law_exponent(&tps),
                 gpu_bytes_exponent: power_law_exponent(&gb),
+                gpu_bytes_per_tet_marginal: linear_slope(&gb),
+            };
+            let failed_sizes: Vec<String> = mine
+                .iter()
+                .filter(|p| p.tets_per_sec.is_none())
+                .map(|p| draw::si(p.tets as f64))
+                .collect();
+            let failed_note = if failed_sizes.is_empty() {
+                String::new()
+            } else {
+                format!(", failed at {}", failed_sizes.join(", "))
             };
             speed_lines.push(Line {
                 algorithm: a.clone(),
@@ -182,7 +210,7 @@ pub fn write(
                         y: p.tets_per_sec,
                     })
                     .collect(),
-                extra: exponent_text(fit.tets_per_sec_exponent),
+                extra: exponent_text(fit.tets_per_sec_exponent) + &failed_note,
             });
             byte_lines.push(Line {
                 algorithm: a.clone(),
@@ -198,7 +226,7 @@ pub fn write(
                         }),
                     })
                     .collect(),
-                extra: exponent_text(fit.gpu_bytes_exponent),
+                extra: exponent_text(fit.gpu_bytes_exponent) + &failed_note,
             });
             out.fits.push(fit);
         }
@@ -304,13 +332,13 @@ pub fn write(
 /// The fits as a Markdown table.
 pub fn fits_markdown(fits: &[Fit]) -> String {
     let mut s = String::from(
-        "| family | viewport | label | algorithm | settings | sizes | failed | tets/s exponent | bytes exponent |\n\
-         |---|---|---|---|---|---:|---:|---:|---:|\n",
+        "| family | viewport | label | algorithm | settings | sizes | failed | tets/s exponent | bytes exponent | bytes per extra tet |\n\
+         |---|---|---|---|---|---:|---:|---:|---:|---:|\n",
     );
     let f = |v: Option<f64>| v.map(|v| format!("{v:+.3}")).unwrap_or_else(|| "–".into());
     for x in fits {
         s.push_str(&format!(
-            "| {} | {}×{} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {}×{} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             x.family,
             x.width,
             x.height,
@@ -320,7 +348,10 @@ pub fn fits_markdown(fits: &[Fit]) -> String {
             x.sizes_measured,
             x.sizes_failed,
             f(x.tets_per_sec_exponent),
-            f(x.gpu_bytes_exponent)
+            f(x.gpu_bytes_exponent),
+            x.gpu_bytes_per_tet_marginal
+                .map(|v| format!("{v:.1}"))
+                .unwrap_or_else(|| "–".into())
         ));
     }
     s
@@ -338,6 +369,8 @@ mod tests {
             .collect();
         assert!((power_law_exponent(&xy).unwrap() - 0.8).abs() < 1e-12);
         assert_eq!(power_law_exponent(&xy[..1]), None);
+        let lin = [(1e4, 5e6 + 20.0 * 1e4), (1e6, 5e6 + 20.0 * 1e6)];
+        assert!((linear_slope(&lin).unwrap() - 20.0).abs() < 1e-9);
         assert_eq!(family("box:10k"), "box");
         assert_eq!(family("spx"), "data sets");
     }

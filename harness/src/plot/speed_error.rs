@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use serde::Serialize;
 
 use super::data::{distinct, write_csv, Point};
-use super::draw::{self, err, Chart, LegendEntry, FONT, LEGEND_WIDTH, MAX_LEGEND_ROWS};
+use super::draw::{self, err, Chart, LegendEntry, FONT, MAX_LEGEND_ROWS, PLOT_WIDTH};
 use super::style::StyleBook;
 use super::ChartFile;
 use crate::metrics::PSNR_CAP_DB;
@@ -98,6 +98,25 @@ struct SpeedError<'a> {
 }
 
 impl SpeedError<'_> {
+    fn entries(&self) -> Vec<LegendEntry> {
+        self.records
+            .iter()
+            .map(|r| LegendEntry {
+                style: self.book.get(&r.algorithm, &r.settings),
+                line: false,
+                extra: if r.tets_per_sec_mean.is_none() {
+                    "(failed: not plotted)".into()
+                } else if r.psnr_db_mean.is_none() {
+                    "(no PSNR: not plotted)".into()
+                } else if r.suspect {
+                    "(suspect)".into()
+                } else {
+                    String::new()
+                },
+            })
+            .collect()
+    }
+
     fn heading(&self) -> Vec<String> {
         vec![
             "up and right is better".into(),
@@ -114,7 +133,7 @@ impl SpeedError<'_> {
 impl Chart for SpeedError<'_> {
     fn size(&self) -> (u32, u32) {
         (
-            1200,
+            PLOT_WIDTH + draw::legend_width(&self.heading(), &self.entries()),
             draw::height_for_legend(self.records.len(), self.heading().len(), 640),
         )
     }
@@ -124,8 +143,7 @@ impl Chart for SpeedError<'_> {
         DB::ErrorType: 'static,
     {
         root.fill(&WHITE).map_err(err)?;
-        let (w, _) = root.dim_in_pixel();
-        let (plot, legend) = root.split_horizontally(w - LEGEND_WIDTH);
+        let (plot, legend) = root.split_horizontally(PLOT_WIDTH);
         let plotted: Vec<&Record> = self
             .records
             .iter()
@@ -150,27 +168,39 @@ impl Chart for SpeedError<'_> {
         } else {
             (0.0, PSNR_CAP_DB + 1.0)
         };
+        let xa = draw::Axis {
+            log: true,
+            lo: xlo,
+            hi: xhi,
+        };
+        let ya = draw::Axis {
+            log: false,
+            lo: ylo,
+            hi: yhi,
+        };
         let mut chart = ChartBuilder::on(&plot)
             .caption(&self.title, (FONT, 21).into_font())
             .margin(14)
             .x_label_area_size(52)
             .y_label_area_size(64)
-            .build_cartesian_2d((xlo..xhi).log_scale(), ylo..yhi)
+            .build_cartesian_2d(xa.range(), ya.range())
             .map_err(err)?;
         chart
             .configure_mesh()
-            .bold_line_style(BLACK.mix(0.12))
-            .light_line_style(BLACK.mix(0.04))
+            .disable_mesh()
+            .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(WHITE.mix(0.0))
+            .x_labels(0)
+            .y_labels(0)
             .x_desc("tets per second (log scale)")
             .y_desc("PSNR against the exact reference (dB)")
-            .x_label_formatter(&|v| draw::si(*v))
-            .y_label_formatter(&|v| format!("{v:.0}"))
-            .label_style((FONT, 14))
             .axis_desc_style((FONT, 15))
             .draw()
             .map_err(err)?;
+        draw::grid(&chart, &plot, xa, ya, draw::si, |v| format!("{v:.0}"))?;
+        let at = |x: f64, y: f64| (xa.at(x), ya.at(y));
         if plotted.is_empty() {
-            let (px, py) = chart.backend_coord(&(xlo * 1.2, 0.5 * (ylo + yhi)));
+            let (px, py) = chart.backend_coord(&at(xlo * 1.2, 0.5 * (ylo + yhi)));
             plot.draw(&Text::new(
                 "no variant has both a speed and an error here (failed, or run without reference)",
                 (px, py),
@@ -186,10 +216,10 @@ impl Chart for SpeedError<'_> {
             .collect();
         front.sort_by(|a, b| b.0.total_cmp(&a.0));
         if front.len() > 1 {
-            let mut stairs = vec![front[0]];
+            let mut stairs = vec![at(front[0].0, front[0].1)];
             for w in front.windows(2) {
-                stairs.push((w[1].0, w[0].1));
-                stairs.push(w[1]);
+                stairs.push(at(w[1].0, w[0].1));
+                stairs.push(at(w[1].0, w[1].1));
             }
             chart
                 .draw_series(std::iter::once(plotters::element::DashedPathElement::new(
@@ -207,7 +237,7 @@ impl Chart for SpeedError<'_> {
             if let (Some(a), Some(b)) = (r.tets_per_sec_min, r.tets_per_sec_max) {
                 chart
                     .draw_series(std::iter::once(PathElement::new(
-                        vec![(a, y), (b, y)],
+                        vec![at(a, y), at(b, y)],
                         line,
                     )))
                     .map_err(err)?;
@@ -215,7 +245,7 @@ impl Chart for SpeedError<'_> {
             if let (Some(a), Some(b)) = (r.psnr_db_min, r.psnr_db_max) {
                 chart
                     .draw_series(std::iter::once(PathElement::new(
-                        vec![(x, a), (x, b)],
+                        vec![at(x, a), at(x, b)],
                         line,
                     )))
                     .map_err(err)?;
@@ -223,30 +253,14 @@ impl Chart for SpeedError<'_> {
         }
         for r in &plotted {
             let st = self.book.get(&r.algorithm, &r.settings);
-            let c = chart.backend_coord(&(r.tets_per_sec_mean.unwrap(), r.psnr_db_mean.unwrap()));
+            let c = chart.backend_coord(&at(r.tets_per_sec_mean.unwrap(), r.psnr_db_mean.unwrap()));
             if r.suspect {
                 plot.draw(&Circle::new(c, 13, RED.stroke_width(2)))
                     .map_err(err)?;
             }
             draw::marker(&plot, c, 7, &st)?;
         }
-        let entries: Vec<LegendEntry> = self
-            .records
-            .iter()
-            .map(|r| LegendEntry {
-                style: self.book.get(&r.algorithm, &r.settings),
-                line: false,
-                extra: if r.tets_per_sec_mean.is_none() {
-                    "(failed: not plotted)".into()
-                } else if r.psnr_db_mean.is_none() {
-                    "(no PSNR: not plotted)".into()
-                } else if r.suspect {
-                    "(suspect)".into()
-                } else {
-                    String::new()
-                },
-            })
-            .collect();
+        let entries = self.entries();
         draw::legend(&legend, &self.heading(), &entries)?;
         root.present().map_err(err)?;
         Ok(())
@@ -256,13 +270,7 @@ impl Chart for SpeedError<'_> {
 /// Orders a chart's points by algorithm, then style slot (the legend's order, the same in
 /// every chart).
 pub fn sort_by_style(points: &mut [&Point], book: &StyleBook) {
-    points.sort_by_key(|p| {
-        (
-            p.peer(),
-            p.algorithm.clone(),
-            book.get(&p.algorithm, &p.settings).slot,
-        )
-    });
+    points.sort_by_key(|p| super::style::order_key(book, &p.algorithm, &p.settings));
 }
 
 /// Draws one chart per data set × viewport (split per algorithm when the legend would not

@@ -129,6 +129,25 @@ pub fn is_peer(algorithm: &str) -> bool {
     algorithm.starts_with("vtk-")
 }
 
+/// The order of variants in legends and CSVs: own algorithms in the table's order, then
+/// unknown ones by name, then peers; within an algorithm by style slot.
+pub fn order_key(
+    book: &StyleBook,
+    algorithm: &str,
+    settings: &str,
+) -> (bool, usize, String, usize) {
+    let names = crate::algorithms::names();
+    (
+        is_peer(algorithm),
+        names
+            .iter()
+            .position(|n| *n == algorithm)
+            .unwrap_or(names.len()),
+        algorithm.to_string(),
+        book.get(algorithm, settings).slot,
+    )
+}
+
 /// 64-bit FNV-1a: a hash that does not change between Rust releases or runs.
 fn fnv1a(s: &str) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
