@@ -36,14 +36,14 @@ fn entry(name: &str) -> anyhow::Result<&'static (&'static str, Variants, Variant
         .ok_or_else(|| anyhow::anyhow!("unknown algorithm {name:?}; known: {}", names().join(", ")))
 }
 
-/// Every variant `name` offers (what `--settings` selects from).
-pub fn all_variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
-    Ok((entry(name)?.2)())
-}
-
 /// The default variants of `name`, or an error listing the known names.
 pub fn variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
     Ok((entry(name)?.1)())
+}
+
+/// Every variant `name` offers (what `--settings` selects from), in table order.
+pub fn all_variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+    Ok((entry(name)?.2)())
 }
 
 /// The variants of `name` that `filter` selects. Drawn from every variant the algorithm offers:

@@ -84,6 +84,9 @@ pub enum Command {
         #[arg(long, default_value_t = 1.10)]
         threshold: f64,
     },
+    /// Draw comparison charts (speed-error, scaling, resolution, bars, all) from any results,
+    /// or run a sweep first (--sweep).
+    Plot(crate::plot::cli::PlotArgs),
 }
 
 #[derive(Debug, Clone, clap::Args)]
@@ -409,6 +412,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             out,
             threshold,
         } => crate::history::run_command(&dirs, &out, threshold, 0.05),
+        Command::Plot(args) => crate::plot::cli::run(args, cli.data_dir, command_line),
     }
 }
 

@@ -10,7 +10,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use render_core::Image;
 
 use crate::compare::Verdict;
-use crate::report::{register_font, FONT};
+use crate::plot::draw::{register_font, FONT};
 
 /// Where two renderings of the same row differ.
 pub struct ImageDifference {

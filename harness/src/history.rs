@@ -15,7 +15,7 @@ use plotters::prelude::*;
 use serde::Serialize;
 
 use crate::compare::{time_test, Verdict, PSNR_TOLERANCE_DB};
-use crate::report::{register_font, FONT};
+use crate::plot::draw::{register_font, FONT};
 use crate::results::{ResultsFile, Row};
 use crate::stats::{median, quantile};
 
@@ -200,7 +200,7 @@ fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<(
         .draw()
         .map_err(err)?;
     for (k, s) in series.iter().enumerate() {
-        let col = crate::report::palette(k);
+        let col = palette(k);
         let mut band: Vec<(f64, f64)> =
             s.points.iter().map(|p| (p.run as f64, p.band_hi)).collect();
         band.extend(s.points.iter().rev().map(|p| (p.run as f64, p.band_lo)));
@@ -294,4 +294,22 @@ pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> 
     print!("{md}");
     println!("wrote {}/history.{{md,html,json}}", out.display());
     Ok(())
+}
+
+/// Line colours of the history charts (one per group; the comparison charts' per-variant styles
+/// live in `crate::plot::style`).
+fn palette(i: usize) -> RGBColor {
+    const PALETTE: [RGBColor; 10] = [
+        RGBColor(31, 119, 180),
+        RGBColor(255, 127, 14),
+        RGBColor(44, 160, 44),
+        RGBColor(214, 39, 40),
+        RGBColor(148, 103, 189),
+        RGBColor(140, 86, 75),
+        RGBColor(227, 119, 194),
+        RGBColor(127, 127, 127),
+        RGBColor(188, 189, 34),
+        RGBColor(23, 190, 207),
+    ];
+    PALETTE[i % PALETTE.len()]
 }

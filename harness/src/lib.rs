@@ -13,6 +13,7 @@ pub mod datasets_cmd;
 pub mod history;
 pub mod machine;
 pub mod metrics;
+pub mod plot;
 pub mod report;
 pub mod reproduce;
 pub mod results;

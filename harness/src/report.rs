@@ -1,37 +1,16 @@
 //! The report of a run, written into its output directory from `results.json` alone (so
-//! `tetbench report OUT` can redo it): charts of tets/sec and PSNR per algorithm × data set
-//! (PNG and SVG) and an `index.html` with the machine, the summary and full tables, the charts,
-//! and every image beside its reference and error heatmap.
-//!
-//! Charts use plotters' pure-Rust text path (ab_glyph) with DejaVu Sans compiled in, so they
-//! render on machines without any font installed. The SVGs name the family "DejaVu Sans" and
-//! load it with `@font-face` from `charts/DejaVuSans.ttf`, written beside them.
+//! `tetbench report OUT` can redo it): the charts of [`crate::plot`] (speed vs error first) in
+//! `charts/`, and an `index.html` with the machine, the charts and their key, the summary and
+//! full tables (peers and suspect rows marked), and every image beside its reference and error
+//! heatmap.
 
 use std::fmt::Write as _;
 use std::path::Path;
-use std::sync::Once;
 
-use anyhow::{anyhow, Context};
-use plotters::coord::Shift;
-use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
-use plotters::style::FontStyle;
+use anyhow::Context;
 
 use crate::metrics::{HEATMAP_MAX_ERROR, ONE_STEP, PSNR_CAP_DB};
 use crate::results::{ResultsFile, Row};
-
-pub(crate) const FONT: &str = "DejaVu Sans";
-
-pub(crate) fn register_font() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        // The font is compiled in, so failure would be a corrupt build: nothing to recover.
-        plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular())
-            .unwrap_or_else(|_| panic!("embedded DejaVu Sans is not a valid font"));
-        plotters::style::register_font(FONT, FontStyle::Bold, dejavu::sans::bold())
-            .unwrap_or_else(|_| panic!("embedded DejaVu Sans Bold is not a valid font"));
-    });
-}
 
 /// Mean, minimum and maximum over the viewpoints of a group.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,7 +20,7 @@ pub struct Spread {
     pub max: f64,
 }
 
-fn spread(values: impl Iterator<Item = f64>) -> Option<Spread> {
+pub fn spread(values: impl Iterator<Item = f64>) -> Option<Spread> {
     let v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
     if v.is_empty() {
         return None;
@@ -132,282 +111,14 @@ pub fn aggregate(rows: &[Row]) -> Vec<Aggregate> {
         .collect()
 }
 
-/// A grouped bar chart: one group per data set, one bar per series, whiskers min–max.
-struct BarChart<'a> {
-    title: &'a str,
-    y_desc: &'a str,
-    groups: Vec<String>,
-    series: Vec<(String, Vec<Option<Spread>>)>,
-}
-
-const PALETTE: [RGBColor; 10] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(127, 127, 127),
-    RGBColor(188, 189, 34),
-    RGBColor(23, 190, 207),
-];
-
-/// The chart colour of series `i` (shared with the compare and history plots).
-pub(crate) fn palette(i: usize) -> RGBColor {
-    PALETTE[i % PALETTE.len()]
-}
-
-const LEGEND_WIDTH: u32 = 400;
-
-/// Shortens long series names for the legend (the full names are in the tables).
-fn ellipsize(s: &str, max_chars: usize) -> String {
-    if s.chars().count() <= max_chars {
-        s.to_string()
-    } else {
-        let mut t: String = s.chars().take(max_chars - 1).collect();
-        t.push('…');
-        t
-    }
-}
-
-fn short_number(v: f64) -> String {
-    let a = v.abs();
-    if a >= 100.0 {
-        format!("{v:.0}")
-    } else if a >= 10.0 {
-        format!("{v:.1}")
-    } else {
-        format!("{v:.2}")
-    }
-}
-
-impl BarChart<'_> {
-    fn size(&self) -> (u32, u32) {
-        (1200, (90 + 22 * self.series.len() as u32).max(460))
-    }
-
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()>
-    where
-        DB::ErrorType: 'static,
-    {
-        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing a chart: {e:?}");
-        root.fill(&WHITE).map_err(err)?;
-        let (w, _) = root.dim_in_pixel();
-        let (plot, legend) = root.split_horizontally(w - LEGEND_WIDTH);
-        let g = self.groups.len().max(1);
-        let s = self.series.len().max(1);
-        let ymax = self
-            .series
-            .iter()
-            .flat_map(|(_, v)| v.iter().flatten().map(|p| p.max.max(p.mean)))
-            .fold(0.0f64, f64::max);
-        let ymax = if ymax > 0.0 { ymax * 1.12 } else { 1.0 };
-        let mut chart = ChartBuilder::on(&plot)
-            .caption(self.title, (FONT, 22).into_font())
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0f64..g as f64, 0f64..ymax)
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .bold_line_style(BLACK.mix(0.12))
-            .light_line_style(WHITE.mix(0.0))
-            // Group names are drawn below at the group centres; plotters' own x labels would
-            // fall at "nice" numbers instead.
-            .x_labels(0)
-            .y_desc(self.y_desc)
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 15))
-            .draw()
-            .map_err(err)?;
-        let bar = 0.8 / s as f64;
-        let label_bars = g * s <= 24;
-        for (si, (_, values)) in self.series.iter().enumerate() {
-            let color = PALETTE[si % PALETTE.len()];
-            for (gi, v) in values.iter().enumerate() {
-                let Some(v) = v else { continue };
-                let x0 = gi as f64 + 0.1 + si as f64 * bar;
-                let x1 = x0 + bar * 0.9;
-                let xc = 0.5 * (x0 + x1);
-                chart
-                    .draw_series(std::iter::once(Rectangle::new(
-                        [(x0, 0.0), (x1, v.mean)],
-                        color.filled(),
-                    )))
-                    .map_err(err)?;
-                if v.max > v.min {
-                    let cap = bar * 0.2;
-                    chart
-                        .draw_series([
-                            PathElement::new(vec![(xc, v.min), (xc, v.max)], BLACK.stroke_width(1)),
-                            PathElement::new(
-                                vec![(xc - cap, v.min), (xc + cap, v.min)],
-                                BLACK.stroke_width(1),
-                            ),
-                            PathElement::new(
-                                vec![(xc - cap, v.max), (xc + cap, v.max)],
-                                BLACK.stroke_width(1),
-                            ),
-                        ])
-                        .map_err(err)?;
-                }
-                if label_bars {
-                    let style = TextStyle::from((FONT, 12).into_font())
-                        .pos(Pos::new(HPos::Center, VPos::Bottom));
-                    chart
-                        .draw_series(std::iter::once(Text::new(
-                            short_number(v.mean),
-                            (xc, v.max.max(v.mean) + ymax * 0.01),
-                            style,
-                        )))
-                        .map_err(err)?;
-                }
-            }
-        }
-        let name_style =
-            TextStyle::from((FONT, 15).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
-        for (gi, name) in self.groups.iter().enumerate() {
-            let (px, py) = chart.backend_coord(&(gi as f64 + 0.5, 0.0));
-            root.draw(&Text::new(name.clone(), (px, py + 8), name_style.clone()))
-                .map_err(err)?;
-        }
-        // The legend in its own panel, so it never hides a bar however many series there are.
-        legend
-            .draw(&Text::new(
-                "mean over viewpoints,",
-                (8, 40),
-                (FONT, 13).into_font(),
-            ))
-            .map_err(err)?;
-        legend
-            .draw(&Text::new(
-                "whiskers min–max",
-                (8, 56),
-                (FONT, 13).into_font(),
-            ))
-            .map_err(err)?;
-        for (si, (name, _)) in self.series.iter().enumerate() {
-            let y = 80 + 22 * si as i32;
-            let color = PALETTE[si % PALETTE.len()];
-            legend
-                .draw(&Rectangle::new([(8, y), (24, y + 14)], color.filled()))
-                .map_err(err)?;
-            legend
-                .draw(&Text::new(
-                    ellipsize(name, 52),
-                    (30, y),
-                    (FONT, 12).into_font(),
-                ))
-                .map_err(err)?;
-        }
-        root.present().map_err(err)?;
-        Ok(())
-    }
-
-    /// Writes `stem.png` and `stem.svg` into `dir`.
-    fn write(&self, dir: &Path, stem: &str) -> anyhow::Result<()> {
-        register_font();
-        let size = self.size();
-        let png = dir.join(format!("{stem}.png"));
-        {
-            let root = BitMapBackend::new(&png, size).into_drawing_area();
-            self.draw(&root)
-                .with_context(|| format!("writing {}", png.display()))?;
-        }
-        let mut svg = String::new();
-        {
-            let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-            self.draw(&root)?;
-        }
-        // Let viewers without DejaVu installed load it from beside the SVG.
-        let style = format!(
-            "<style>@font-face {{ font-family: \"{FONT}\"; src: url(\"DejaVuSans.ttf\") format(\"truetype\"); }}</style>"
-        );
-        if let Some(end) = svg
-            .find("<svg")
-            .and_then(|i| svg[i..].find('>').map(|j| i + j + 1))
-        {
-            svg.insert_str(end, &style);
-        }
-        let path = dir.join(format!("{stem}.svg"));
-        std::fs::write(&path, svg).with_context(|| format!("cannot write {}", path.display()))
-    }
-}
-
-fn series_and_groups(aggs: &[Aggregate]) -> (Vec<(String, String)>, Vec<String>) {
-    let mut series: Vec<(String, String)> = vec![];
-    let mut groups: Vec<String> = vec![];
-    for a in aggs {
-        let k = (a.algorithm.clone(), a.settings.clone());
-        if !series.contains(&k) {
-            series.push(k);
-        }
-        if !groups.contains(&a.dataset) {
-            groups.push(a.dataset.clone());
-        }
-    }
-    (series, groups)
-}
-
-fn chart_of(
-    aggs: &[Aggregate],
-    title: &'static str,
-    y_desc: &'static str,
-    pick: impl Fn(&Aggregate) -> Option<Spread>,
-) -> BarChart<'static> {
-    let (series, groups) = series_and_groups(aggs);
-    let series = series
-        .iter()
-        .map(|(alg, set)| {
-            let v = groups
-                .iter()
-                .map(|d| {
-                    aggs.iter()
-                        .find(|a| &a.algorithm == alg && &a.settings == set && &a.dataset == d)
-                        .and_then(&pick)
-                })
-                .collect();
-            (series_label(alg, set), v)
-        })
-        .collect();
-    BarChart {
-        title,
-        y_desc,
-        groups,
-        series,
-    }
-}
-
-/// Writes the charts and `index.html` into `out` for the results in `file`.
+/// Writes the charts (see [`crate::plot`]) and `index.html` into `out` for the results in
+/// `file`.
 pub fn write(out: &Path, file: &ResultsFile) -> anyhow::Result<()> {
-    let charts = out.join("charts");
-    std::fs::create_dir_all(&charts)
-        .with_context(|| format!("cannot create {}", charts.display()))?;
-    std::fs::write(charts.join("DejaVuSans.ttf"), dejavu::sans::regular())?;
+    let mut inputs = crate::plot::data::Inputs::default();
+    inputs.add(file, crate::plot::raw_results(out).as_ref());
+    let charts = crate::plot::write_charts(&out.join("charts"), &inputs, crate::plot::Kind::All)?;
     let aggs = aggregate(&file.rows);
-    let scale = |s: Spread| Spread {
-        mean: s.mean * 1e-6,
-        min: s.min * 1e-6,
-        max: s.max * 1e-6,
-    };
-    chart_of(
-        &aggs,
-        "Throughput per algorithm and data set",
-        "million tets / s",
-        |a| a.tets_per_sec.map(scale),
-    )
-    .write(&charts, "tets_per_sec")?;
-    chart_of(
-        &aggs,
-        "Image error against the exact reference (higher is better)",
-        "PSNR (dB)",
-        |a| a.psnr_db,
-    )
-    .write(&charts, "psnr")?;
-    let html = html(file, &aggs);
+    let html = html(file, &aggs, &crate::plot::html_section(&charts, "charts"));
     let path = out.join("index.html");
     std::fs::write(&path, html).with_context(|| format!("cannot write {}", path.display()))
 }
@@ -425,6 +136,25 @@ fn esc(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// ` class="…"` for a table row: failed, suspect (issue 15's rule) and peer rows are marked.
+fn row_class(failed: bool, suspect: bool, algorithm: &str) -> String {
+    let mut c = vec![];
+    if failed {
+        c.push("failed");
+    }
+    if suspect {
+        c.push("suspect");
+    }
+    if crate::plot::style::is_peer(algorithm) {
+        c.push("peer");
+    }
+    if c.is_empty() {
+        String::new()
+    } else {
+        format!(" class=\"{}\"", c.join(" "))
+    }
+}
+
 fn opt(v: Option<f64>, digits: usize) -> String {
     v.map(|v| format!("{v:.digits$}"))
         .unwrap_or_else(|| "–".into())
@@ -435,7 +165,7 @@ fn mb(v: Option<u64>) -> String {
         .unwrap_or_else(|| "–".into())
 }
 
-fn html(file: &ResultsFile, aggs: &[Aggregate]) -> String {
+fn html(file: &ResultsFile, aggs: &[Aggregate], charts: &str) -> String {
     let m = &file.machine;
     let r = &file.run;
     let mut h = String::new();
@@ -450,8 +180,12 @@ table {{ border-collapse: collapse; font-size: 13px; margin: 0.5em 0 1.5em; }}
 th, td {{ border: 1px solid #ccc; padding: 2px 6px; text-align: right; }}
 th {{ background: #eee; }} td.l, th.l {{ text-align: left; }}
 tr.failed td {{ background: #fdd; }}
-tr.suspect td {{ background: #ffe4b3; }}
-.suspect figure {{ border: 2px solid #e69500; padding: 3px; }}
+tr.suspect td {{ background: #ffe4b5; }} tr.suspect td:first-child::after {{ content: " ⚠ suspect"; color: #b00; }}
+tr.peer td:first-child::after {{ content: " (peer)"; color: #666; font-style: italic; }}
+figure.chart {{ margin: 0 0 14px; font-size: 13px; text-align: left; }}
+figure.chart img {{ width: auto; height: auto; max-width: 100%; background: #fff; object-fit: initial; image-rendering: auto; }}
+table.key td {{ text-align: left; }}
+.swatch {{ display: inline-block; width: 12px; height: 12px; border: 2px solid transparent; vertical-align: middle; }}
 dl {{ display: grid; grid-template-columns: max-content auto; gap: 2px 12px; font-size: 14px; }}
 dt {{ font-weight: bold; }} dd {{ margin: 0; }}
 .charts img {{ max-width: 100%; border: 1px solid #ddd; margin-bottom: 8px; }}
@@ -518,49 +252,7 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
         h.push_str("</ul>\n");
     }
 
-    let suspects: Vec<&Row> = file.rows.iter().filter(|r| !r.suspect.is_empty()).collect();
-    if !suspects.is_empty() {
-        let _ = write!(
-            h,
-            "<h2>Suspect rows ({})</h2><p>Image error far out of line with the other algorithms on \
-             the same image: probably a renderer defect, or a mesh the method cannot handle. \
-             Heatmap first, then the rendering and the reference.</p><div class=\"strip suspect\">",
-            suspects.len()
-        );
-        for row in suspects {
-            let _ = write!(h, "<figure><div class=pair>");
-            for (path, alt) in [
-                (&row.heatmap, "error heatmap"),
-                (&row.image, "image"),
-                (&row.reference_image, "reference"),
-            ] {
-                if !path.is_empty() {
-                    let _ = write!(
-                        h,
-                        "<a href=\"{0}\"><img src=\"{0}\" alt=\"{alt}\" loading=lazy></a>",
-                        esc(path)
-                    );
-                }
-            }
-            let _ = write!(
-                h,
-                "</div><figcaption>{} on {} {}<br>{}</figcaption></figure>",
-                esc(&series_label(&row.algorithm, &row.settings)),
-                esc(&row.dataset),
-                esc(&row.viewpoint),
-                esc(&row.suspect)
-            );
-        }
-        h.push_str("</div>\n");
-    }
-
-    h.push_str(
-        "<h2>Charts</h2><div class=\"charts\">\
-         <img src=\"charts/tets_per_sec.png\" alt=\"tets per second per algorithm and data set\">\
-         <p><a href=\"charts/tets_per_sec.svg\">SVG</a></p>\
-         <img src=\"charts/psnr.png\" alt=\"PSNR per algorithm and data set\">\
-         <p><a href=\"charts/psnr.svg\">SVG</a></p></div>\n",
-    );
+    h.push_str(charts);
 
     h.push_str(
         "<h2>Summary</h2><p>Mean over viewpoints (min–max in brackets).</p><table><tr>\
@@ -568,6 +260,7 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
          <th>total ms</th><th>CPU ms</th><th>GPU ms</th><th>fps</th><th>M tets/s</th><th>PSNR dB</th>\
          <th>bad pixels %</th><th>bytes/tet</th><th>GPU MiB</th></tr>\n",
     );
+    let suspect = crate::plot::data::suspect_flags(&file.rows);
     for a in aggs {
         let sp = |s: Option<Spread>, k: f64, d: usize| {
             s.map(|s| {
@@ -584,7 +277,15 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
             h,
             "<tr{}><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td>{}</td><td>{}{}</td><td>{}</td><td>{}</td>\
              <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            if a.failed > 0 { " class=failed" } else { "" },
+            row_class(
+                a.failed > 0,
+                file.rows.iter().zip(&suspect).any(|(r, s)| {
+                    *s && r.algorithm == a.algorithm
+                        && r.settings == a.settings
+                        && r.dataset == a.dataset
+                }),
+                &a.algorithm
+            ),
             esc(&a.algorithm),
             esc(&a.settings),
             esc(&a.dataset),
@@ -674,19 +375,13 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
          <th>GPU MiB</th><th>bytes/tet</th><th>RMSE</th><th>PSNR dB</th><th>max err</th><th>bad %</th>\
          <th class=l>stages (ms)</th><th class=l>error</th></tr>\n",
     );
-    for row in &file.rows {
+    for (row, suspect) in file.rows.iter().zip(&suspect) {
         let _ = writeln!(
             h,
             "<tr{}><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td>{}</td><td>{}</td>\
              <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
              <td class=l>{}</td><td class=l>{}</td></tr>",
-            if !row.ok() {
-                " class=failed"
-            } else if !row.suspect.is_empty() {
-                " class=suspect"
-            } else {
-                ""
-            },
+            row_class(!row.ok(), *suspect, &row.algorithm),
             esc(&row.algorithm),
             esc(&row.settings),
             esc(&row.dataset),

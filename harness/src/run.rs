@@ -196,7 +196,7 @@ impl Progress {
 }
 
 /// A data set's label in rows: the name as given (`spx`, `box:20k`), or a file's name.
-pub(crate) fn dataset_label(spec: &str) -> String {
+pub fn dataset_label(spec: &str) -> String {
     let p = Path::new(spec);
     if spec.contains(std::path::MAIN_SEPARATOR) || spec.contains('/') {
         p.file_name()

@@ -1,0 +1,257 @@
+//! `tetbench plot KIND RESULTS… --out DIR [--sweep SPEC …]`: draws charts from results
+//! already measured, or runs a sweep first (mesh sizes for `scaling`, viewport sizes for
+//! `resolution`) with the run loop of `tetbench run` and then draws them.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+
+use super::data::Inputs;
+use super::Kind;
+use crate::cli::RunArgs;
+
+#[derive(Debug, clap::Args)]
+pub struct PlotArgs {
+    /// Which charts: speed-error, scaling, resolution, bars or all.
+    #[arg(value_enum)]
+    pub kind: Kind,
+    /// Results to draw from: run directories, results.json files, or directories whose
+    /// sub-directories hold runs (shards, sweeps). Optional with --sweep.
+    pub results: Vec<PathBuf>,
+    /// Output directory for the charts (PNG, SVG, CSV) and key.csv.
+    #[arg(long, value_name = "DIR", default_value = "plots")]
+    pub out: PathBuf,
+    /// Measure first, then plot: for `scaling` the mesh sizes (`box:10k,100k,1m,5m`: sizes
+    /// after the first keep its generator; names and files also allowed), for `resolution`
+    /// the square viewport sizes (`128,256,512`). Runs go to OUT/sweep/.
+    #[arg(long, value_name = "SPEC")]
+    pub sweep: Option<String>,
+    /// Sweep: comma-separated algorithms (default: all).
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    pub algorithms: Vec<String>,
+    /// Sweep (resolution): data sets (default box:100k).
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    pub datasets: Vec<String>,
+    /// Sweep: viewpoints, as `tetbench run --viewpoints` (default +x,+x+y+z,-x+y-z).
+    #[arg(long, value_name = "SPEC")]
+    pub viewpoints: Option<String>,
+    /// Sweep (scaling): square viewport in pixels (default 128).
+    #[arg(long, value_name = "PIXELS")]
+    pub resolution: Option<u32>,
+    /// Sweep: timed frames per viewpoint (default 3).
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u32>,
+    /// Sweep: warm-up frames (default 1).
+    #[arg(long, value_name = "N")]
+    pub warmup: Option<u32>,
+    /// Sweep: keep only variants whose settings match (as `tetbench run --settings`).
+    #[arg(long, value_name = "FILTER")]
+    pub settings: Option<String>,
+    /// Sweep: timing only, no reference images or error metrics (the charts say so).
+    #[arg(long)]
+    pub no_reference: bool,
+    /// Sweep: transfer function preset or file.
+    #[arg(long, value_name = "NAME|FILE", default_value = "low-opacity")]
+    pub tf: String,
+}
+
+/// `box:10k,100k,1m` → `box:10k`, `box:100k`, `box:1m`; names and paths are kept as given.
+pub fn expand_sizes(spec: &str) -> Vec<String> {
+    let mut generator: Option<String> = None;
+    let mut out = vec![];
+    for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        if let Some((g, _)) = item.split_once(':') {
+            generator = Some(g.to_string());
+            out.push(item.to_string());
+        } else if let (Some(g), true) = (&generator, item.starts_with(|c: char| c.is_ascii_digit()))
+        {
+            out.push(format!("{g}:{item}"));
+        } else {
+            generator = None;
+            out.push(item.to_string());
+        }
+    }
+    out
+}
+
+impl PlotArgs {
+    fn run_args(&self, datasets: Vec<String>, resolution: u32, out: PathBuf) -> RunArgs {
+        RunArgs {
+            algorithms: self.algorithms.clone(),
+            datasets,
+            viewpoints: Some(
+                self.viewpoints
+                    .clone()
+                    .unwrap_or_else(|| crate::suite::DEFAULT_SUITE.viewpoints.to_string()),
+            ),
+            resolution: Some(resolution),
+            tf: self.tf.clone(),
+            frames: Some(self.frames.unwrap_or(crate::suite::DEFAULT_SUITE.frames)),
+            warmup: Some(self.warmup.unwrap_or(crate::suite::DEFAULT_SUITE.warmup)),
+            out,
+            settings: self.settings.clone(),
+            no_reference: self.no_reference,
+            cache_dir: None,
+            orthographic: false,
+            scalar: None,
+            no_report: true,
+            strict: false,
+            shard: None,
+            no_calibrate: false,
+        }
+    }
+}
+
+/// Runs one sweep step; failures of rows are reported and kept (they are plotted as missing).
+fn measure(
+    args: RunArgs,
+    data_dir: Option<PathBuf>,
+    command_line: &[String],
+) -> anyhow::Result<PathBuf> {
+    let out = args.out.clone();
+    let config = args.to_config(data_dir, command_line.to_vec())?;
+    let filter = config.settings_filter.clone();
+    let outcome = crate::run::run(&config, &|name: &str| {
+        crate::algorithms::selected_variants(name, &filter)
+    })?;
+    if !outcome.all_ok() {
+        eprintln!(
+            "tetbench plot: {} of {} rows failed in {} (plotted as missing){}",
+            outcome.failed_rows,
+            outcome.rows,
+            out.display(),
+            outcome
+                .errors
+                .iter()
+                .map(|e| format!("\n  {e}"))
+                .collect::<String>()
+        );
+    }
+    Ok(out)
+}
+
+/// Runs the sweep `spec` for `kind`; returns the run directories.
+fn sweep(
+    args: &PlotArgs,
+    spec: &str,
+    data_dir: Option<PathBuf>,
+    command_line: &[String],
+) -> anyhow::Result<Vec<PathBuf>> {
+    let root = args.out.join("sweep");
+    match args.kind {
+        Kind::Scaling => {
+            let datasets = expand_sizes(spec);
+            if datasets.len() < 2 {
+                anyhow::bail!("--sweep {spec:?}: a scaling sweep needs at least two mesh sizes");
+            }
+            let res = args
+                .resolution
+                .unwrap_or(crate::suite::DEFAULT_SUITE.resolution);
+            Ok(vec![measure(
+                args.run_args(datasets, res, root.join("scaling")),
+                data_dir,
+                command_line,
+            )?])
+        }
+        Kind::Resolution => {
+            let sizes: Vec<u32> = spec
+                .split(',')
+                .map(str::trim)
+                .filter(|s| !s.is_empty())
+                .map(|s| {
+                    s.parse::<u32>().map_err(|_| {
+                        anyhow::anyhow!("--sweep {spec:?}: {s:?} is not a viewport size in pixels")
+                    })
+                })
+                .collect::<anyhow::Result<_>>()?;
+            if sizes.len() < 2 {
+                anyhow::bail!("--sweep {spec:?}: a resolution sweep needs at least two sizes");
+            }
+            let datasets = if args.datasets.is_empty() {
+                vec!["box:100k".to_string()]
+            } else {
+                args.datasets.clone()
+            };
+            sizes
+                .iter()
+                .map(|&n| {
+                    eprintln!("tetbench plot: viewport {n}×{n}");
+                    measure(
+                        args.run_args(datasets.clone(), n, root.join(format!("res-{n}"))),
+                        data_dir.clone(),
+                        command_line,
+                    )
+                })
+                .collect()
+        }
+        k => anyhow::bail!(
+            "--sweep works with `scaling` (mesh sizes) or `resolution` (viewport sizes), not {:?}",
+            k
+        ),
+    }
+}
+
+/// `tetbench plot …`.
+pub fn run(
+    args: PlotArgs,
+    data_dir: Option<PathBuf>,
+    command_line: Vec<String>,
+) -> anyhow::Result<()> {
+    let mut sources = args.results.clone();
+    if let Some(spec) = &args.sweep {
+        sources.extend(sweep(&args, spec, data_dir, &command_line)?);
+    } else if !args.datasets.is_empty() || args.resolution.is_some() || args.no_reference {
+        anyhow::bail!("--datasets, --resolution and --no-reference only apply with --sweep");
+    }
+    let inputs = Inputs::read(&sources)?;
+    let charts = super::write_charts(&args.out, &inputs, args.kind)
+        .with_context(|| format!("drawing charts into {}", args.out.display()))?;
+    for (k, why) in &charts.skipped {
+        eprintln!(
+            "tetbench plot: no {} chart: {why}",
+            k.heading().to_lowercase()
+        );
+    }
+    if charts.files.is_empty() {
+        anyhow::bail!("nothing to plot from {} row(s)", inputs.rows.len());
+    }
+    if !charts.fits.is_empty() {
+        let md = super::scaling::fits_markdown(&charts.fits);
+        let path = args.out.join("scaling_fits.md");
+        std::fs::write(&path, &md).with_context(|| format!("cannot write {}", path.display()))?;
+        print!("{md}");
+    }
+    print_files(&args.out, &charts.files);
+    Ok(())
+}
+
+fn print_files(dir: &Path, files: &[super::ChartFile]) {
+    for f in files {
+        println!(
+            "{}  {}.{{png,svg,csv}}",
+            f.title,
+            dir.join(&f.stem).display()
+        );
+    }
+    println!("key: {}", dir.join("key.csv").display());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sweep_sizes_inherit_the_generator() {
+        assert_eq!(
+            expand_sizes("box:10k,100k, 1m,spx,shell:20k,50k"),
+            [
+                "box:10k",
+                "box:100k",
+                "box:1m",
+                "spx",
+                "shell:20k",
+                "shell:50k"
+            ]
+        );
+    }
+}

@@ -1,0 +1,395 @@
+//! What the charts are drawn from: rows read from any number of results (one run, shards,
+//! several runs), grouped into points — one per algorithm × settings × data set × viewport,
+//! over its viewpoints — and the flags the charts show (peers, suspect rows).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use serde::Serialize;
+
+use crate::report::Spread;
+use crate::results::{ResultsFile, Row, JSON_FILE};
+
+/// Rows of every input, with what the charts need from the runs' headers.
+#[derive(Debug, Clone, Default)]
+pub struct Inputs {
+    pub rows: Vec<Row>,
+    /// The runs' adapters, distinct, in input order (`name (backend)`).
+    pub adapters: Vec<String>,
+    /// Whether any run skipped the reference (`--no-reference`).
+    pub without_reference: bool,
+    /// Data sets a run asked for that have no row (not loaded), with the run's error message.
+    pub missing_datasets: Vec<(String, String)>,
+    /// Calibrated bounds of the backends (see [`calibrated_bounds`]).
+    pub bounds: Vec<Bound>,
+    /// The files read.
+    pub sources: Vec<PathBuf>,
+}
+
+/// A backend limit measured by `tetbench calibrate`, drawn as a horizontal line.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Bound {
+    pub adapter: String,
+    pub name: String,
+    /// In the unit of the chart it is drawn on (tets/s).
+    pub per_sec: f64,
+}
+
+/// Finds the `results.json` files an argument stands for: the file itself, a directory holding
+/// one, or a directory whose sub-directories hold them (a sweep, shards).
+pub fn result_files(arg: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    if arg.is_file() {
+        return Ok(vec![arg.to_path_buf()]);
+    }
+    if arg.join(JSON_FILE).is_file() {
+        return Ok(vec![arg.join(JSON_FILE)]);
+    }
+    if !arg.is_dir() {
+        anyhow::bail!("{}: no such file or directory", arg.display());
+    }
+    let mut found: Vec<PathBuf> = std::fs::read_dir(arg)
+        .with_context(|| format!("cannot read {}", arg.display()))?
+        .filter_map(|e| e.ok())
+        .map(|e| e.path().join(JSON_FILE))
+        .filter(|p| p.is_file())
+        .collect();
+    found.sort();
+    if found.is_empty() {
+        anyhow::bail!(
+            "{}: holds no {JSON_FILE}, nor do its sub-directories",
+            arg.display()
+        );
+    }
+    Ok(found)
+}
+
+impl Inputs {
+    /// Reads every results file the arguments stand for.
+    pub fn read(args: &[PathBuf]) -> anyhow::Result<Inputs> {
+        if args.is_empty() {
+            anyhow::bail!("no results given (directories or results.json files)");
+        }
+        let mut inputs = Inputs::default();
+        for arg in args {
+            for path in result_files(arg)? {
+                let dir = path.parent().unwrap_or(Path::new("."));
+                let file = ResultsFile::read(dir)?;
+                let text = std::fs::read_to_string(&path)
+                    .with_context(|| format!("cannot read {}", path.display()))?;
+                let raw: serde_json::Value = serde_json::from_str(&text)
+                    .with_context(|| format!("{} is not JSON", path.display()))?;
+                inputs.add(&file, Some(&raw));
+                inputs.sources.push(path);
+            }
+        }
+        Ok(inputs)
+    }
+
+    /// Adds one run (its raw JSON, when at hand, for fields this version does not know).
+    pub fn add(&mut self, file: &ResultsFile, raw: Option<&serde_json::Value>) {
+        let adapter = file
+            .machine
+            .adapter
+            .as_ref()
+            .map(|a| format!("{} ({})", a.name, a.backend))
+            .unwrap_or_else(|| "unknown adapter".into());
+        if !self.adapters.contains(&adapter) {
+            self.adapters.push(adapter.clone());
+        }
+        if !file.run.reference && !file.rows.is_empty() {
+            self.without_reference = true;
+        }
+        for d in &file.run.datasets {
+            let label = crate::run::dataset_label(d);
+            if !file.rows.iter().any(|r| r.dataset == label) {
+                let why = file
+                    .errors
+                    .iter()
+                    .find(|e| e.contains(&format!("{d:?}")))
+                    .cloned()
+                    .unwrap_or_else(|| "no rows".into());
+                self.missing_datasets.push((label, why));
+            }
+        }
+        if let Some(raw) = raw {
+            for b in calibrated_bounds(raw, &adapter) {
+                if !self.bounds.contains(&b) {
+                    self.bounds.push(b);
+                }
+            }
+        }
+        self.rows.extend(file.rows.iter().cloned());
+    }
+}
+
+/// Rates in the run's machine record (`machine.calibration`, written by `tetbench calibrate`)
+/// that bound tets/s: any numeric field whose name ends in `tets_per_sec`, else the backend's
+/// small-triangle rate (`…triangles_per_sec`), which bounds every algorithm that rasterises at
+/// least one triangle per tet. Runs without a calibration have none.
+pub fn calibrated_bounds(raw: &serde_json::Value, adapter: &str) -> Vec<Bound> {
+    let Some(cal) = raw.get("machine").and_then(|m| m.get("calibration")) else {
+        return vec![];
+    };
+    let mut flat: Vec<(String, f64)> = vec![];
+    fn walk(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, f64)>) {
+        match v {
+            serde_json::Value::Object(m) => {
+                for (k, v) in m {
+                    let key = if prefix.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{prefix}.{k}")
+                    };
+                    walk(&key, v, out);
+                }
+            }
+            serde_json::Value::Number(n) => {
+                if let Some(x) = n.as_f64().filter(|x| x.is_finite() && *x > 0.0) {
+                    out.push((prefix.to_string(), x));
+                }
+            }
+            _ => {}
+        }
+    }
+    walk("", cal, &mut flat);
+    let pick = |suffix: &str| -> Vec<Bound> {
+        flat.iter()
+            .filter(|(k, _)| k.ends_with(suffix))
+            .map(|(k, v)| Bound {
+                adapter: adapter.to_string(),
+                name: k.clone(),
+                per_sec: *v,
+            })
+            .collect()
+    };
+    let tets = pick("tets_per_sec");
+    if !tets.is_empty() {
+        return tets;
+    }
+    pick("triangles_per_sec")
+}
+
+/// One algorithm × settings × data set × viewport, over its viewpoints.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    pub algorithm: String,
+    pub settings: String,
+    pub dataset: String,
+    pub tets: u64,
+    pub width: u32,
+    pub height: u32,
+    pub rows: usize,
+    pub failed: usize,
+    /// The first failed row's error (what a chart says instead of a value).
+    pub error: String,
+    pub tets_per_sec: Option<Spread>,
+    pub psnr_db: Option<Spread>,
+    /// Largest GPU bytes over the viewpoints.
+    pub gpu_bytes: Option<u64>,
+    pub bytes_per_tet: Option<f64>,
+    /// Any of its rows is suspect (see [`suspect_flags`]).
+    pub suspect: bool,
+}
+
+impl Point {
+    pub fn peer(&self) -> bool {
+        super::style::is_peer(&self.algorithm)
+    }
+}
+
+/// Suspect rows (issue 15's rule): PSNR below 20 dB, or more than 20 dB below the best row of
+/// the same data set, viewpoint and viewport — unless at least 40 dB (RMSE ≤ 1 %, invisible),
+/// since next to a row at the 99 dB cap every merely excellent row would be 20 dB "below".
+/// Returns one flag per row.
+/// (When rows carry their own `suspect` column, this should read it.)
+pub fn suspect_flags(rows: &[Row]) -> Vec<bool> {
+    const ABSOLUTE_DB: f64 = 20.0;
+    const BELOW_BEST_DB: f64 = 20.0;
+    const NEVER_BELOW_DB: f64 = 40.0;
+    rows.iter()
+        .map(|r| {
+            let Some(p) = r.psnr_db else { return false };
+            let best = rows
+                .iter()
+                .filter(|o| {
+                    o.dataset == r.dataset
+                        && o.viewpoint == r.viewpoint
+                        && o.width == r.width
+                        && o.height == r.height
+                })
+                .filter_map(|o| o.psnr_db)
+                .fold(f64::NEG_INFINITY, f64::max);
+            p < ABSOLUTE_DB || (p < NEVER_BELOW_DB && p < best - BELOW_BEST_DB)
+        })
+        .collect()
+}
+
+/// Groups rows into points, in order of first appearance (charts order their series by style,
+/// not by this order).
+pub fn points(rows: &[Row]) -> Vec<Point> {
+    let suspect = suspect_flags(rows);
+    let mut out: Vec<Point> = vec![];
+    let mut members: Vec<Vec<usize>> = vec![];
+    for (i, r) in rows.iter().enumerate() {
+        let pos = out.iter().position(|p| {
+            p.algorithm == r.algorithm
+                && p.settings == r.settings
+                && p.dataset == r.dataset
+                && p.width == r.width
+                && p.height == r.height
+        });
+        match pos {
+            Some(j) => members[j].push(i),
+            None => {
+                members.push(vec![i]);
+                out.push(Point {
+                    algorithm: r.algorithm.clone(),
+                    settings: r.settings.clone(),
+                    dataset: r.dataset.clone(),
+                    tets: r.tets,
+                    width: r.width,
+                    height: r.height,
+                    rows: 0,
+                    failed: 0,
+                    error: String::new(),
+                    tets_per_sec: None,
+                    psnr_db: None,
+                    gpu_bytes: None,
+                    bytes_per_tet: None,
+                    suspect: false,
+                });
+            }
+        }
+    }
+    for (p, m) in out.iter_mut().zip(&members) {
+        let g: Vec<&Row> = m.iter().map(|&i| &rows[i]).collect();
+        p.rows = g.len();
+        p.failed = g.iter().filter(|r| !r.ok()).count();
+        p.error = g
+            .iter()
+            .find(|r| !r.ok())
+            .map(|r| r.error.clone())
+            .unwrap_or_default();
+        p.tets_per_sec = crate::report::spread(g.iter().filter_map(|r| r.tets_per_sec));
+        p.psnr_db = crate::report::spread(g.iter().filter_map(|r| r.psnr_db));
+        p.gpu_bytes = g.iter().filter_map(|r| r.gpu_bytes).max();
+        p.bytes_per_tet = g.iter().find_map(|r| r.bytes_per_tet);
+        p.suspect = m.iter().any(|&i| suspect[i]);
+    }
+    out
+}
+
+/// Distinct values in order of first appearance.
+pub fn distinct<T: PartialEq + Clone>(items: impl IntoIterator<Item = T>) -> Vec<T> {
+    let mut v: Vec<T> = vec![];
+    for x in items {
+        if !v.contains(&x) {
+            v.push(x);
+        }
+    }
+    v
+}
+
+/// The CSV text of `records` (header from the struct's fields).
+pub fn csv_text<T: Serialize>(records: &[T]) -> anyhow::Result<String> {
+    let mut w = csv::Writer::from_writer(vec![]);
+    for r in records {
+        w.serialize(r)?;
+    }
+    Ok(String::from_utf8(
+        w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?,
+    )?)
+}
+
+/// Writes `records` as `dir/stem.csv`.
+pub fn write_csv<T: Serialize>(dir: &Path, stem: &str, records: &[T]) -> anyhow::Result<()> {
+    let path = dir.join(format!("{stem}.csv"));
+    std::fs::write(&path, csv_text(records)?)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::results::test_row;
+
+    /// Rows of two variants × two data sets × two viewpoints, with one failure.
+    pub fn rows() -> Vec<Row> {
+        let mut rows = vec![];
+        for (a, s) in [
+            ("havs", "k=2;sort=cpu-radix"),
+            ("gator-pt", "variant=linear"),
+        ] {
+            for (d, tets) in [("box:10k", 10_000u64), ("box:100k", 100_000)] {
+                for v in 0..2u32 {
+                    let mut r = test_row(v);
+                    r.algorithm = a.into();
+                    r.settings = s.into();
+                    r.dataset = d.into();
+                    r.tets = tets;
+                    let f = if a == "havs" { 1.0 } else { 2.0 };
+                    r.tets_per_sec = Some(f * tets as f64 * (1.0 + v as f64));
+                    r.psnr_db = Some(if a == "havs" { 15.0 + v as f64 } else { 50.0 });
+                    r.gpu_bytes = Some(100 * tets);
+                    rows.push(r);
+                }
+            }
+        }
+        let mut failed = test_row(2);
+        failed.algorithm = "havs".into();
+        failed.settings = "k=2;sort=cpu-radix".into();
+        failed.dataset = "box:100k".into();
+        failed.tets = 100_000;
+        failed.tets_per_sec = None;
+        failed.error = "out of memory".into();
+        rows.push(failed);
+        rows
+    }
+
+    #[test]
+    fn points_group_by_variant_data_set_and_viewport() {
+        let p = points(&rows());
+        assert_eq!(p.len(), 4);
+        let h = &p[1];
+        assert_eq!(
+            (h.algorithm.as_str(), h.dataset.as_str()),
+            ("havs", "box:100k")
+        );
+        assert_eq!((h.rows, h.failed), (3, 1));
+        assert_eq!(h.error, "out of memory");
+        let t = h.tets_per_sec.unwrap();
+        assert_eq!((t.mean, t.min, t.max), (150_000.0, 100_000.0, 200_000.0));
+        // HAVS's 15–16 dB is below 20 dB: suspect; GATOR's 50 dB is not.
+        assert!(h.suspect);
+        assert!(!p[3].suspect);
+    }
+
+    #[test]
+    fn suspect_rule() {
+        let mut r = rows();
+        for x in &mut r {
+            if x.algorithm == "havs" {
+                x.psnr_db = Some(35.0);
+            }
+        }
+        // 35 dB is above 20 but 15 dB below GATOR's 50: not suspect; 29 dB would be.
+        assert!(suspect_flags(&r).iter().all(|s| !s));
+        r[0].psnr_db = Some(29.0);
+        assert!(suspect_flags(&r)[0]);
+        // Next to a capped 99 dB row, 45 dB is still fine.
+        r[0].psnr_db = Some(45.0);
+        r[4].psnr_db = Some(99.0);
+        assert!(!suspect_flags(&r)[0]);
+    }
+
+    #[test]
+    fn calibration_bounds_are_read_when_present() {
+        let raw: serde_json::Value = serde_json::json!({
+            "machine": {"calibration": {"raster": {"triangles_per_sec": 2.0e8}, "copy_bytes_per_sec": 1e10}}
+        });
+        let b = calibrated_bounds(&raw, "llvmpipe");
+        assert_eq!(b.len(), 1);
+        assert_eq!(b[0].name, "raster.triangles_per_sec");
+        assert!(calibrated_bounds(&serde_json::json!({"machine": {}}), "x").is_empty());
+    }
+}

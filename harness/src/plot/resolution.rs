@@ -1,0 +1,152 @@
+//! Throughput against viewport size for every algorithm: the fragment PT paper's Fig. 8
+//! (Marroquim et al. 2006, §6: K tets/s at 256² … 1024² for one algorithm) generalised to
+//! every variant of a run, one chart per data set with at least two viewport sizes.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::data::{distinct, write_csv, Inputs, Point};
+use super::draw::{self, MAX_LEGEND_ROWS};
+use super::lines::{Line, LineChart, LinePoint};
+use super::speed_error::sort_by_style;
+use super::style::StyleBook;
+use super::{ChartFile, Kind};
+
+/// One CSV line: a variant on one data set at one viewport size.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct Record {
+    pub dataset: String,
+    pub tets: u64,
+    pub width: u32,
+    pub height: u32,
+    pub label: String,
+    pub algorithm: String,
+    pub settings: String,
+    pub rows: usize,
+    pub failed: usize,
+    pub tets_per_sec_mean: Option<f64>,
+    pub tets_per_sec_min: Option<f64>,
+    pub tets_per_sec_max: Option<f64>,
+    pub error: String,
+}
+
+fn pixels(v: f64) -> String {
+    format!("{v:.0}")
+}
+
+pub fn write(
+    dir: &Path,
+    points: &[Point],
+    inputs: &Inputs,
+    book: &StyleBook,
+) -> anyhow::Result<Vec<ChartFile>> {
+    let mut files = vec![];
+    for dataset in distinct(points.iter().map(|p| p.dataset.clone())) {
+        let mut pts: Vec<&Point> = points.iter().filter(|p| p.dataset == dataset).collect();
+        if distinct(pts.iter().map(|p| (p.width, p.height))).len() < 2 {
+            continue;
+        }
+        sort_by_style(&mut pts, book);
+        pts.sort_by_key(|p| (p.width, p.height));
+        let square = pts.iter().all(|p| p.width == p.height);
+        let records: Vec<Record> = pts
+            .iter()
+            .map(|p| Record {
+                dataset: p.dataset.clone(),
+                tets: p.tets,
+                width: p.width,
+                height: p.height,
+                label: book.get(&p.algorithm, &p.settings).label,
+                algorithm: p.algorithm.clone(),
+                settings: p.settings.clone(),
+                rows: p.rows,
+                failed: p.failed,
+                tets_per_sec_mean: p.tets_per_sec.map(|s| s.mean),
+                tets_per_sec_min: p.tets_per_sec.map(|s| s.min),
+                tets_per_sec_max: p.tets_per_sec.map(|s| s.max),
+                error: p.error.clone(),
+            })
+            .collect();
+        let mut variants = distinct(
+            pts.iter()
+                .map(|p| (p.algorithm.clone(), p.settings.clone())),
+        );
+        variants.sort_by_key(|(a, s)| super::style::order_key(book, a, s));
+        let lines: Vec<Line> = variants
+            .iter()
+            .map(|(a, s)| Line {
+                algorithm: a.clone(),
+                settings: s.clone(),
+                points: pts
+                    .iter()
+                    .filter(|p| &p.algorithm == a && &p.settings == s)
+                    .map(|p| LinePoint {
+                        // Square viewports by the side (as Fig. 8); others by √pixels.
+                        x: if square {
+                            p.width as f64
+                        } else {
+                            ((p.width as f64) * (p.height as f64)).sqrt()
+                        },
+                        y: p.tets_per_sec,
+                    })
+                    .collect(),
+                extra: String::new(),
+            })
+            .collect();
+        let mut notes = vec![format!("{} tets", draw::si(pts[0].tets as f64))];
+        if inputs.without_reference {
+            notes.push("timing only (--no-reference)".into());
+        }
+        let parts: Vec<(String, Vec<Line>)> = if lines.len() > MAX_LEGEND_ROWS {
+            distinct(lines.iter().map(|l| l.algorithm.clone()))
+                .into_iter()
+                .map(|a| {
+                    let v = lines.iter().filter(|l| l.algorithm == a).cloned().collect();
+                    (a, v)
+                })
+                .collect()
+        } else {
+            vec![(String::new(), lines)]
+        };
+        for (alg, part) in parts {
+            let mut stem = format!("resolution_{}", crate::run::slug(&dataset));
+            if !alg.is_empty() {
+                stem.push_str(&format!("_{}", crate::run::slug(&alg)));
+            }
+            let title = format!(
+                "Throughput vs viewport size — {dataset}{}",
+                if alg.is_empty() {
+                    String::new()
+                } else {
+                    format!(", {alg}")
+                }
+            );
+            let chart = LineChart {
+                title: title.clone(),
+                x_desc: if square {
+                    "viewport side (pixels, square)".into()
+                } else {
+                    "√(width × height) (pixels)".into()
+                },
+                y_desc: "tets per second (log)".into(),
+                x_log: false,
+                x_fmt: pixels,
+                y_fmt: draw::si,
+                lines: part,
+                bounds: vec![],
+                notes: notes.clone(),
+                book,
+            };
+            draw::save(&chart, dir, &stem)?;
+            write_csv(dir, &stem, &records)?;
+            files.push(ChartFile {
+                kind: Kind::Resolution,
+                title,
+                stem,
+                note: String::new(),
+            });
+        }
+    }
+    Ok(files)
+}

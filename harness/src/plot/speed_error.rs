@@ -1,0 +1,357 @@
+//! Speed vs error, the chart users look at first: per data set (and viewport), each variant a
+//! point at (mean tets/s, mean PSNR) over the viewpoints, whiskers min–max both ways, the
+//! Pareto front (variants nothing else beats on both speed and exactness), speed on a log axis.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use serde::Serialize;
+
+use super::data::{distinct, write_csv, Point};
+use super::draw::{self, err, Chart, LegendEntry, FONT, MAX_LEGEND_ROWS, PLOT_WIDTH};
+use super::style::StyleBook;
+use super::ChartFile;
+use crate::metrics::PSNR_CAP_DB;
+
+/// One CSV line: a variant's point on one data set's chart.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct Record {
+    pub dataset: String,
+    pub tets: u64,
+    pub width: u32,
+    pub height: u32,
+    pub label: String,
+    pub algorithm: String,
+    pub settings: String,
+    pub rows: usize,
+    pub failed: usize,
+    pub tets_per_sec_mean: Option<f64>,
+    pub tets_per_sec_min: Option<f64>,
+    pub tets_per_sec_max: Option<f64>,
+    pub psnr_db_mean: Option<f64>,
+    pub psnr_db_min: Option<f64>,
+    pub psnr_db_max: Option<f64>,
+    pub pareto: bool,
+    pub peer: bool,
+    pub suspect: bool,
+    pub error: String,
+}
+
+/// Which of `xy` (higher is better on both axes) no other point beats on both: the Pareto
+/// front. Ties on both coordinates keep both.
+pub fn pareto_front(xy: &[(f64, f64)]) -> Vec<bool> {
+    xy.iter()
+        .map(|&(x, y)| {
+            !xy.iter()
+                .any(|&(ox, oy)| ox >= x && oy >= y && (ox > x || oy > y))
+        })
+        .collect()
+}
+
+fn records(points: &[&Point], book: &StyleBook) -> Vec<Record> {
+    let xy: Vec<Option<(f64, f64)>> = points
+        .iter()
+        .map(|p| Some((p.tets_per_sec?.mean, p.psnr_db?.mean)))
+        .collect();
+    let plotted: Vec<(f64, f64)> = xy.iter().flatten().copied().collect();
+    let front = pareto_front(&plotted);
+    let mut k = 0;
+    points
+        .iter()
+        .zip(&xy)
+        .map(|(p, xy)| {
+            let on_front = xy.is_some() && {
+                k += 1;
+                front[k - 1]
+            };
+            Record {
+                dataset: p.dataset.clone(),
+                tets: p.tets,
+                width: p.width,
+                height: p.height,
+                label: book.get(&p.algorithm, &p.settings).label,
+                algorithm: p.algorithm.clone(),
+                settings: p.settings.clone(),
+                rows: p.rows,
+                failed: p.failed,
+                tets_per_sec_mean: p.tets_per_sec.map(|s| s.mean),
+                tets_per_sec_min: p.tets_per_sec.map(|s| s.min),
+                tets_per_sec_max: p.tets_per_sec.map(|s| s.max),
+                psnr_db_mean: p.psnr_db.map(|s| s.mean),
+                psnr_db_min: p.psnr_db.map(|s| s.min),
+                psnr_db_max: p.psnr_db.map(|s| s.max),
+                pareto: on_front,
+                peer: p.peer(),
+                suspect: p.suspect,
+                error: p.error.clone(),
+            }
+        })
+        .collect()
+}
+
+struct SpeedError<'a> {
+    title: String,
+    records: Vec<Record>,
+    book: &'a StyleBook,
+    viewpoints: usize,
+}
+
+impl SpeedError<'_> {
+    fn entries(&self) -> Vec<LegendEntry> {
+        self.records
+            .iter()
+            .map(|r| LegendEntry {
+                style: self.book.get(&r.algorithm, &r.settings),
+                line: false,
+                extra: if r.tets_per_sec_mean.is_none() {
+                    "(failed: not plotted)".into()
+                } else if r.psnr_db_mean.is_none() {
+                    "(no PSNR: not plotted)".into()
+                } else if r.suspect {
+                    "(suspect)".into()
+                } else {
+                    String::new()
+                },
+            })
+            .collect()
+    }
+
+    fn heading(&self) -> Vec<String> {
+        vec![
+            "up and right is better".into(),
+            format!("point: mean over {} viewpoint(s)", self.viewpoints),
+            "whiskers: min–max over viewpoints".into(),
+            "dashed: Pareto front".into(),
+            "red ring: suspect row(s)".into(),
+            "hollow grey: outside peers".into(),
+            format!("PSNR capped at {PSNR_CAP_DB:.0} dB"),
+        ]
+    }
+}
+
+impl Chart for SpeedError<'_> {
+    fn size(&self) -> (u32, u32) {
+        (
+            PLOT_WIDTH + draw::legend_width(&self.heading(), &self.entries()),
+            draw::height_for_legend(self.records.len(), self.heading().len(), 640),
+        )
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE).map_err(err)?;
+        let (plot, legend) = root.split_horizontally(PLOT_WIDTH);
+        let plotted: Vec<&Record> = self
+            .records
+            .iter()
+            .filter(|r| r.tets_per_sec_mean.is_some() && r.psnr_db_mean.is_some())
+            .collect();
+        let xs = plotted
+            .iter()
+            .flat_map(|r| [r.tets_per_sec_min, r.tets_per_sec_max])
+            .flatten();
+        let (xlo, xhi) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+        let (xlo, xhi) = draw::log_range(xlo, xhi);
+        let ys = plotted
+            .iter()
+            .flat_map(|r| [r.psnr_db_min, r.psnr_db_max])
+            .flatten();
+        let (ylo, yhi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
+            (a.min(y), b.max(y))
+        });
+        let (ylo, yhi) = if ylo.is_finite() {
+            let pad = ((yhi - ylo) * 0.08).max(2.0);
+            ((ylo - pad).max(0.0), yhi + pad)
+        } else {
+            (0.0, PSNR_CAP_DB + 1.0)
+        };
+        let xa = draw::Axis {
+            log: true,
+            lo: xlo,
+            hi: xhi,
+        };
+        let ya = draw::Axis {
+            log: false,
+            lo: ylo,
+            hi: yhi,
+        };
+        let mut chart = ChartBuilder::on(&plot)
+            .caption(&self.title, (FONT, 21).into_font())
+            .margin(14)
+            .x_label_area_size(52)
+            .y_label_area_size(64)
+            .build_cartesian_2d(xa.range(), ya.range())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(WHITE.mix(0.0))
+            .x_labels(0)
+            .y_labels(0)
+            .x_desc("tets per second (log scale)")
+            .y_desc("PSNR against the exact reference (dB)")
+            .axis_desc_style((FONT, 15))
+            .draw()
+            .map_err(err)?;
+        draw::grid(&chart, &plot, xa, ya, draw::si, |v| format!("{v:.0}"))?;
+        let at = |x: f64, y: f64| (xa.at(x), ya.at(y));
+        if plotted.is_empty() {
+            let (px, py) = chart.backend_coord(&at(xlo * 1.2, 0.5 * (ylo + yhi)));
+            plot.draw(&Text::new(
+                "no variant has both a speed and an error here (failed, or run without reference)",
+                (px, py),
+                (FONT, 15).into_font(),
+            ))
+            .map_err(err)?;
+        }
+        // The Pareto front as a staircase from the fastest to the most exact.
+        let mut front: Vec<(f64, f64)> = plotted
+            .iter()
+            .filter(|r| r.pareto)
+            .filter_map(|r| Some((r.tets_per_sec_mean?, r.psnr_db_mean?)))
+            .collect();
+        front.sort_by(|a, b| b.0.total_cmp(&a.0));
+        if front.len() > 1 {
+            let mut stairs = vec![at(front[0].0, front[0].1)];
+            for w in front.windows(2) {
+                stairs.push(at(w[1].0, w[0].1));
+                stairs.push(at(w[1].0, w[1].1));
+            }
+            chart
+                .draw_series(std::iter::once(plotters::element::DashedPathElement::new(
+                    stairs,
+                    6,
+                    4,
+                    BLACK.mix(0.55).stroke_width(2),
+                )))
+                .map_err(err)?;
+        }
+        for r in &plotted {
+            let st = self.book.get(&r.algorithm, &r.settings);
+            let (x, y) = (r.tets_per_sec_mean.unwrap(), r.psnr_db_mean.unwrap());
+            let line = st.color.mix(0.8).stroke_width(2);
+            if let (Some(a), Some(b)) = (r.tets_per_sec_min, r.tets_per_sec_max) {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        vec![at(a, y), at(b, y)],
+                        line,
+                    )))
+                    .map_err(err)?;
+            }
+            if let (Some(a), Some(b)) = (r.psnr_db_min, r.psnr_db_max) {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        vec![at(x, a), at(x, b)],
+                        line,
+                    )))
+                    .map_err(err)?;
+            }
+        }
+        for r in &plotted {
+            let st = self.book.get(&r.algorithm, &r.settings);
+            let c = chart.backend_coord(&at(r.tets_per_sec_mean.unwrap(), r.psnr_db_mean.unwrap()));
+            if r.suspect {
+                plot.draw(&Circle::new(c, 13, RED.stroke_width(2)))
+                    .map_err(err)?;
+            }
+            draw::marker(&plot, c, 7, &st)?;
+        }
+        let entries = self.entries();
+        draw::legend(&legend, &self.heading(), &entries)?;
+        root.present().map_err(err)?;
+        Ok(())
+    }
+}
+
+/// Orders a chart's points by algorithm, then style slot (the legend's order, the same in
+/// every chart).
+pub fn sort_by_style(points: &mut [&Point], book: &StyleBook) {
+    points.sort_by_key(|p| super::style::order_key(book, &p.algorithm, &p.settings));
+}
+
+/// Draws one chart per data set × viewport (split per algorithm when the legend would not
+/// fit) into `dir`, each with its CSV.
+pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<Vec<ChartFile>> {
+    let mut files = vec![];
+    let groups = distinct(
+        points
+            .iter()
+            .map(|p| (p.dataset.clone(), p.width, p.height)),
+    );
+    let many_sizes = distinct(points.iter().map(|p| (p.width, p.height))).len() > 1;
+    for (dataset, width, height) in groups {
+        let mut pts: Vec<&Point> = points
+            .iter()
+            .filter(|p| p.dataset == dataset && p.width == width && p.height == height)
+            .collect();
+        sort_by_style(&mut pts, book);
+        let parts: Vec<(String, Vec<&Point>)> = if pts.len() > MAX_LEGEND_ROWS {
+            distinct(pts.iter().map(|p| p.algorithm.clone()))
+                .into_iter()
+                .map(|a| {
+                    let v = pts.iter().filter(|p| p.algorithm == a).copied().collect();
+                    (a, v)
+                })
+                .collect()
+        } else {
+            vec![(String::new(), pts)]
+        };
+        for (alg, part) in parts {
+            let records = records(&part, book);
+            let tets = part.first().map(|p| p.tets).unwrap_or(0);
+            let viewpoints = part.iter().map(|p| p.rows).max().unwrap_or(0);
+            let mut stem = format!("speed_error_{}", crate::run::slug(&dataset));
+            if many_sizes {
+                stem.push_str(&format!("_{width}x{height}"));
+            }
+            if !alg.is_empty() {
+                stem.push_str(&format!("_{}", crate::run::slug(&alg)));
+            }
+            let title = format!(
+                "Speed vs error — {dataset}{} ({} tets, {width}×{height})",
+                if alg.is_empty() {
+                    String::new()
+                } else {
+                    format!(", {alg}")
+                },
+                draw::si(tets as f64)
+            );
+            let chart = SpeedError {
+                title: title.clone(),
+                records: records.clone(),
+                book,
+                viewpoints,
+            };
+            draw::save(&chart, dir, &stem)?;
+            write_csv(dir, &stem, &records)?;
+            files.push(ChartFile {
+                kind: super::Kind::SpeedError,
+                title,
+                stem,
+                note: String::new(),
+            });
+        }
+    }
+    Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pareto_front_keeps_the_undominated() {
+        let f = pareto_front(&[
+            (1.0, 50.0),
+            (2.0, 40.0),
+            (0.5, 45.0),
+            (2.0, 40.0),
+            (3.0, 10.0),
+        ]);
+        assert_eq!(f, [true, true, false, true, true]);
+    }
+}
