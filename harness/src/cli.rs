@@ -94,6 +94,10 @@ pub struct RunArgs {
     /// Do not write the HTML report and charts.
     #[arg(long)]
     pub no_report: bool,
+    /// Add other packages' renderers as peers: `vtk` (vtk-pt, vtk-raycast, vtk-zsweep through
+    /// VTK's Python package; see scripts/setup-vtk.sh).
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    pub peers: Vec<String>,
 }
 
 /// The reference cache: `--cache-dir`, `$TETBENCH_CACHE`, `$XDG_CACHE_HOME/tetbench`,
@@ -162,8 +166,13 @@ impl RunArgs {
         let warmup = pick(self.warmup, DEFAULT_SUITE.warmup, suite::STANDARD_WARMUP);
 
         let known = algorithms::names();
-        let algorithms: Vec<String> = if self.algorithms.is_empty() {
-            known.iter().map(|s| s.to_string()).collect()
+        let mut algorithms: Vec<String> = if self.algorithms.is_empty() {
+            // "All" means tetbench's own; peers come with --peers or by name.
+            known
+                .iter()
+                .filter(|n| !algorithms::is_peer(n))
+                .map(|s| s.to_string())
+                .collect()
         } else {
             self.algorithms
                 .iter()
@@ -177,6 +186,20 @@ impl RunArgs {
                     "--algorithms: unknown algorithm {a:?}; known: {}",
                     known.join(", ")
                 );
+            }
+        }
+        for group in self
+            .peers
+            .iter()
+            .map(|s| s.trim())
+            .filter(|s| !s.is_empty())
+        {
+            for name in
+                algorithms::peer_group(group).map_err(|e| anyhow::anyhow!("--peers: {e}"))?
+            {
+                if !algorithms.iter().any(|a| a == name) {
+                    algorithms.push(name.to_string());
+                }
             }
         }
         if algorithms.is_empty() {

@@ -353,6 +353,7 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
             orthographic: false,
             scalar: None,
             no_report: true,
+            peers: vec![],
         };
         let config = run_args.to_config(
             ctx.data_dir.clone(),
