@@ -17,6 +17,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::FontStyle;
 
+use crate::algorithms::is_peer;
 use crate::metrics::{HEATMAP_MAX_ERROR, ONE_STEP, PSNR_CAP_DB};
 use crate::results::{ResultsFile, Row};
 
@@ -516,8 +517,15 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
          <p><a href=\"charts/psnr.svg\">SVG</a></p></div>\n",
     );
 
+    h.push_str("<h2>Summary</h2><p>Mean over viewpoints (min–max in brackets).");
+    if file.rows.iter().any(|r| is_peer(&r.algorithm)) {
+        h.push_str(
+            " <em>peer</em>: another package's renderer (VTK, through its Python package) \
+             measured in the same run; VTK reports no GPU memory.",
+        );
+    }
     h.push_str(
-        "<h2>Summary</h2><p>Mean over viewpoints (min–max in brackets).</p><table><tr>\
+        "</p><table><tr>\
          <th class=l>algorithm</th><th class=l>settings</th><th class=l>data set</th><th>tets</th><th>rows</th>\
          <th>total ms</th><th>CPU ms</th><th>GPU ms</th><th>fps</th><th>M tets/s</th><th>PSNR dB</th>\
          <th>bad pixels %</th><th>bytes/tet</th><th>GPU MiB</th></tr>\n",
@@ -539,7 +547,7 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
             "<tr{}><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td>{}</td><td>{}{}</td><td>{}</td><td>{}</td>\
              <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             if a.failed > 0 { " class=failed" } else { "" },
-            esc(&a.algorithm),
+            algorithm_cell(&a.algorithm),
             esc(&a.settings),
             esc(&a.dataset),
             a.tets,
@@ -552,8 +560,8 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
             sp(a.tets_per_sec, 1e-6, 3),
             sp(a.psnr_db, 1.0, 2),
             sp(a.bad_pixel_share, 100.0, 2),
-            opt(a.bytes_per_tet, 1),
-            mb(a.gpu_bytes),
+            opt(a.bytes_per_tet.filter(|_| !is_peer(&a.algorithm)), 1),
+            mb(a.gpu_bytes.filter(|_| !is_peer(&a.algorithm))),
         );
     }
     h.push_str("</table>\n");
@@ -635,7 +643,7 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
              <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
              <td class=l>{}</td><td class=l>{}</td></tr>",
             if row.ok() { "" } else { " class=failed" },
-            esc(&row.algorithm),
+            algorithm_cell(&row.algorithm),
             esc(&row.settings),
             esc(&row.dataset),
             esc(&row.viewpoint),
@@ -689,6 +697,15 @@ pub fn markdown_summary(aggs: &[Aggregate]) -> String {
         );
     }
     s
+}
+
+/// The algorithm's name for the HTML tables, with peers (other packages' renderers) marked.
+fn algorithm_cell(name: &str) -> String {
+    if is_peer(name) {
+        format!("{} <small class=peer>(peer)</small>", esc(name))
+    } else {
+        esc(name)
+    }
 }
 
 #[cfg(test)]

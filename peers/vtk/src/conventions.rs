@@ -188,4 +188,31 @@ mod tests {
         let r = camera_request(&cam, PixelSampling::Centres);
         assert_eq!(r["window_center"], json!([0.0, 0.0]));
     }
+    /// A ParaView colormap with opacities renders in VTK with ParaView's own attenuation:
+    /// opacity o at x attenuates o / u per world unit, u = diagonal / PARAVIEW_OPACITY_SCALE.
+    #[test]
+    fn paraview_colormap_maps_back_to_paraview_attenuation() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("pv.json");
+        std::fs::write(
+            &path,
+            r#"[{"Name":"ramp","RGBPoints":[10,0,0,1, 30,1,0,0],"Points":[10,0.1,0.5,0, 20,0.8,0.5,0, 30,0.4,0.5,0]}]"#,
+        )
+        .unwrap();
+        let tf = TransferFunction::load(path.to_str().unwrap()).unwrap();
+        let optics = Optics {
+            tf,
+            scalar_min: 10.0,
+            scalar_max: 30.0,
+            length_unit: 7.0,
+        };
+        let v = vtk_transfer(&optics);
+        let u = 7.0 / render_core::transfer::PARAVIEW_OPACITY_SCALE;
+        let want = [(10.0, 0.1), (20.0, 0.8), (30.0, 0.4)];
+        assert_eq!(v.points.len(), want.len());
+        for (p, (x, o)) in v.points.iter().zip(want) {
+            assert!((p[0] - x).abs() < 1e-12);
+            assert!((p[4] / v.unit_distance - o / u).abs() < 1e-9, "{p:?}");
+        }
+    }
 }
