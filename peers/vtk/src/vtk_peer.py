@@ -51,8 +51,7 @@ try:
         vtkUnstructuredGridVolumeZSweepMapper,
     )
 except Exception as e:  # noqa: BLE001  (any import failure means: no usable VTK)
-    reply({"ok": False, "error": f"cannot import VTK in {sys.executable}: {e} "
-           "(install it with `pip install vtk`, or run scripts/setup-vtk.sh)"})
+    reply({"ok": False, "error": f"cannot import VTK in {sys.executable}: {e}"})
     sys.exit(1)
 
 vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
