@@ -258,6 +258,22 @@ mod tests {
     }
 
     #[test]
+    fn peers_are_registered_and_marked() {
+        for (_, peers) in PEERS {
+            for p in *peers {
+                assert!(names().contains(p) && is_peer(p), "{p}");
+                assert_eq!(variants(p).unwrap()[0].algorithm(), *p);
+            }
+        }
+        assert!(!is_peer("gator-pt"));
+        assert_eq!(peer_group("vtk").unwrap().len(), 3);
+        assert!(peer_group("paraview")
+            .unwrap_err()
+            .to_string()
+            .contains("vtk"));
+    }
+
+    #[test]
     fn unknown_algorithm_lists_the_known_ones() {
         let e = variants("no-such").err().unwrap().to_string();
         assert!(e.contains("gator-pt"), "{e}");

@@ -304,4 +304,25 @@ mod tests {
         use clap::CommandFactory;
         Cli::command().debug_assert();
     }
+
+    fn run_algorithms(args: &[&str]) -> anyhow::Result<Vec<String>> {
+        let mut all = vec!["tetbench", "run", "--datasets", "box:1k"];
+        all.extend_from_slice(args);
+        let Command::Run(run) = Cli::try_parse_from(all).unwrap().command else {
+            unreachable!()
+        };
+        Ok(run.to_config(None, vec![])?.algorithms)
+    }
+
+    #[test]
+    fn peers_join_a_run_only_when_asked_for() {
+        let plain = run_algorithms(&[]).unwrap();
+        assert!(!plain.is_empty() && plain.iter().all(|a| !algorithms::is_peer(a)));
+        let with = run_algorithms(&["--peers", "vtk"]).unwrap();
+        assert_eq!(with.len(), plain.len() + 3);
+        assert!(with.ends_with(&["vtk-pt".into(), "vtk-raycast".into(), "vtk-zsweep".into()]));
+        let one = run_algorithms(&["--algorithms", "vtk-pt", "--peers", "vtk"]).unwrap();
+        assert_eq!(one, ["vtk-pt", "vtk-raycast", "vtk-zsweep"]);
+        assert!(run_algorithms(&["--peers", "nope"]).is_err());
+    }
 }
