@@ -295,7 +295,7 @@ impl Renderer for VtkPeer {
 
     fn render(&mut self, _gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
         self.frame += 1;
-        let nudge = if self.frame % 2 == 0 {
+        let nudge = if self.frame.is_multiple_of(2) {
             NUDGE_DEG
         } else {
             -NUDGE_DEG
