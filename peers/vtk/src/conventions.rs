@@ -156,8 +156,8 @@ mod tests {
             let tau = lerp(4) / v.unit_distance;
             assert!((tau - tf.kappa_at(s) / 10.0).abs() < 1e-12, "s={s}");
             let c = tf.color_at(s);
-            for k in 0..3 {
-                assert!((lerp(k + 1) - c[k]).abs() < 1e-12, "s={s}");
+            for (k, ck) in c.iter().enumerate() {
+                assert!((lerp(k + 1) - ck).abs() < 1e-12, "s={s}");
             }
         }
     }
