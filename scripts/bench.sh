@@ -5,5 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/common.sh
 ensure_prerequisites
+# VTK's mappers (--peers vtk, or an algorithm vtk-*) need VTK's Python package.
+case " $* " in *vtk*) ensure_vtk_python ;; esac
 cargo build --release -p harness --bin tetbench
 exec target/release/tetbench run "$@"

@@ -57,3 +57,35 @@ ensure_prerequisites() {
     # Mesa's drivers warn (and some loaders fail) without a runtime directory.
     export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
 }
+
+# VTK for the peer algorithms (vtk-pt, vtk-raycast, vtk-zsweep) and the outside check of the
+# reference: Python's `vtk` package in a virtual environment (.venv-vtk/ at the repository
+# root, or $TETBENCH_VTK_VENV), never in the system Python, plus Mesa's EGL and llvmpipe so
+# that VTK renders offscreen without a display or GPU. Exports TETBENCH_VTK_PYTHON.
+have_lib() {
+    ldconfig -p 2>/dev/null | grep -q "$1" || ls /usr/lib/*/"$1"* >/dev/null 2>&1
+}
+ensure_vtk_python() {
+    local venv="${TETBENCH_VTK_VENV:-$PWD/.venv-vtk}"
+    local need=()
+    have_lib 'libEGL.so.1' || need+=(libegl1)
+    have_lib 'libEGL_mesa.so.0' || need+=(libegl-mesa0)
+    have_lib 'libGL.so.1' || need+=(libgl1)
+    ls /usr/lib/*/dri/swrast_dri.so >/dev/null 2>&1 || need+=(libgl1-mesa-dri)
+    command -v python3 >/dev/null 2>&1 || need+=(python3)
+    if ! python3 -c 'import ensurepip, venv' >/dev/null 2>&1; then
+        need+=(python3-venv)
+    fi
+    if [ "${#need[@]}" -gt 0 ]; then
+        echo "tetbench: installing ${need[*]} (offscreen OpenGL and Python for VTK)" >&2
+        apt_install "${need[@]}" || return 1
+    fi
+    local check='import vtkmodules.vtkRenderingVolume, vtkmodules.vtkRenderingOpenGL2'
+    if ! "$venv/bin/python" -c "$check" >/dev/null 2>&1; then
+        echo "tetbench: creating $venv with Python's vtk package (pip install vtk)" >&2
+        python3 -m venv "$venv" || return 1
+        "$venv/bin/python" -m pip install --quiet --disable-pip-version-check vtk || return 1
+        "$venv/bin/python" -c "$check" || return 1
+    fi
+    export TETBENCH_VTK_PYTHON="$venv/bin/python"
+}

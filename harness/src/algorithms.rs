@@ -18,7 +18,39 @@ const TABLE: &[(&str, Variants, Variants)] = &[
         fragment_pt::default_variants,
         fragment_pt::all_variants,
     ),
+    ("vtk-pt", vtk_peer::pt_variants, vtk_peer::pt_variants),
+    (
+        "vtk-raycast",
+        vtk_peer::raycast_default_variants,
+        vtk_peer::raycast_all_variants,
+    ),
+    (
+        "vtk-zsweep",
+        vtk_peer::zsweep_default_variants,
+        vtk_peer::zsweep_all_variants,
+    ),
 ];
+
+/// Peers: other software's renderers measured beside tetbench's (`--peers vtk`). They are not
+/// part of "all algorithms" and are marked as peers in the reports.
+pub const PEERS: &[(&str, &[&str])] = &[("vtk", &["vtk-pt", "vtk-raycast", "vtk-zsweep"])];
+
+/// Whether `name` is a peer (another package's renderer) rather than a tetbench algorithm.
+pub fn is_peer(name: &str) -> bool {
+    PEERS.iter().any(|(_, names)| names.contains(&name))
+}
+
+/// The algorithms of a peer group (`vtk`), or an error listing the groups.
+pub fn peer_group(group: &str) -> anyhow::Result<&'static [&'static str]> {
+    PEERS
+        .iter()
+        .find(|(g, _)| *g == group)
+        .map(|(_, names)| *names)
+        .ok_or_else(|| {
+            let groups: Vec<&str> = PEERS.iter().map(|(g, _)| *g).collect();
+            anyhow::anyhow!("unknown peer group {group:?}; known: {}", groups.join(", "))
+        })
+}
 
 fn all_gator_variants() -> Vec<Box<dyn Renderer>> {
     gator_pt::variants(&render_core::visibility::VisibilityOrder::ALL)
@@ -228,6 +260,22 @@ mod tests {
         assert_eq!(race.len(), 1, "{race:?}");
         let frag = settings_of("fragment-pt", "sort=mpvonc");
         assert_eq!(frag.len(), 2, "{frag:?}");
+    }
+
+    #[test]
+    fn peers_are_registered_and_marked() {
+        for (_, peers) in PEERS {
+            for p in *peers {
+                assert!(names().contains(p) && is_peer(p), "{p}");
+                assert_eq!(variants(p).unwrap()[0].algorithm(), *p);
+            }
+        }
+        assert!(!is_peer("gator-pt"));
+        assert_eq!(peer_group("vtk").unwrap().len(), 3);
+        assert!(peer_group("paraview")
+            .unwrap_err()
+            .to_string()
+            .contains("vtk"));
     }
 
     #[test]

@@ -171,6 +171,10 @@ pub struct RunArgs {
     /// Skip the backend calibration (and the rows' roofline columns).
     #[arg(long)]
     pub no_calibrate: bool,
+    /// Add other packages' renderers as peers: `vtk` (vtk-pt, vtk-raycast, vtk-zsweep through
+    /// VTK's Python package; see scripts/setup-vtk.sh).
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    pub peers: Vec<String>,
 }
 
 /// The reference cache: `--cache-dir`, `$TETBENCH_CACHE`, `$XDG_CACHE_HOME/tetbench`,
@@ -239,8 +243,13 @@ impl RunArgs {
         let warmup = pick(self.warmup, DEFAULT_SUITE.warmup, suite::STANDARD_WARMUP);
 
         let known = algorithms::names();
-        let algorithms: Vec<String> = if self.algorithms.is_empty() {
-            known.iter().map(|s| s.to_string()).collect()
+        let mut algorithms: Vec<String> = if self.algorithms.is_empty() {
+            // "All" means tetbench's own; peers come with --peers or by name.
+            known
+                .iter()
+                .filter(|n| !algorithms::is_peer(n))
+                .map(|s| s.to_string())
+                .collect()
         } else {
             self.algorithms
                 .iter()
@@ -254,6 +263,20 @@ impl RunArgs {
                     "--algorithms: unknown algorithm {a:?}; known: {}",
                     known.join(", ")
                 );
+            }
+        }
+        for group in self
+            .peers
+            .iter()
+            .map(|s| s.trim())
+            .filter(|s| !s.is_empty())
+        {
+            for name in
+                algorithms::peer_group(group).map_err(|e| anyhow::anyhow!("--peers: {e}"))?
+            {
+                if !algorithms.iter().any(|a| a == name) {
+                    algorithms.push(name.to_string());
+                }
             }
         }
         if algorithms.is_empty() {
@@ -424,5 +447,26 @@ mod tests {
     fn cli_definition_is_consistent() {
         use clap::CommandFactory;
         Cli::command().debug_assert();
+    }
+
+    fn run_algorithms(args: &[&str]) -> anyhow::Result<Vec<String>> {
+        let mut all = vec!["tetbench", "run", "--datasets", "box:1k"];
+        all.extend_from_slice(args);
+        let Command::Run(run) = Cli::try_parse_from(all).unwrap().command else {
+            unreachable!()
+        };
+        Ok(run.to_config(None, vec![])?.algorithms)
+    }
+
+    #[test]
+    fn peers_join_a_run_only_when_asked_for() {
+        let plain = run_algorithms(&[]).unwrap();
+        assert!(!plain.is_empty() && plain.iter().all(|a| !algorithms::is_peer(a)));
+        let with = run_algorithms(&["--peers", "vtk"]).unwrap();
+        assert_eq!(with.len(), plain.len() + 3);
+        assert!(with.ends_with(&["vtk-pt".into(), "vtk-raycast".into(), "vtk-zsweep".into()]));
+        let one = run_algorithms(&["--algorithms", "vtk-pt", "--peers", "vtk"]).unwrap();
+        assert_eq!(one, ["vtk-pt", "vtk-raycast", "vtk-zsweep"]);
+        assert!(run_algorithms(&["--peers", "nope"]).is_err());
     }
 }

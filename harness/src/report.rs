@@ -9,6 +9,7 @@ use std::path::Path;
 
 use anyhow::Context;
 
+use crate::algorithms::is_peer;
 use crate::metrics::{HEATMAP_MAX_ERROR, ONE_STEP, PSNR_CAP_DB};
 use crate::results::{ResultsFile, Row};
 
@@ -254,8 +255,15 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
 
     h.push_str(charts);
 
+    h.push_str("<h2>Summary</h2><p>Mean over viewpoints (min–max in brackets).");
+    if file.rows.iter().any(|r| is_peer(&r.algorithm)) {
+        h.push_str(
+            " <em>peer</em>: another package's renderer (VTK, through its Python package) \
+             measured in the same run; VTK reports no GPU memory.",
+        );
+    }
     h.push_str(
-        "<h2>Summary</h2><p>Mean over viewpoints (min–max in brackets).</p><table><tr>\
+        "</p><table><tr>\
          <th class=l>algorithm</th><th class=l>settings</th><th class=l>data set</th><th>tets</th><th>rows</th>\
          <th>total ms</th><th>CPU ms</th><th>GPU ms</th><th>fps</th><th>M tets/s</th><th>PSNR dB</th>\
          <th>bad pixels %</th><th>bytes/tet</th><th>GPU MiB</th></tr>\n",
@@ -286,7 +294,7 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
                 }),
                 &a.algorithm
             ),
-            esc(&a.algorithm),
+            algorithm_cell(&a.algorithm),
             esc(&a.settings),
             esc(&a.dataset),
             a.tets,
@@ -299,8 +307,8 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
             sp(a.tets_per_sec, 1e-6, 3),
             sp(a.psnr_db, 1.0, 2),
             sp(a.bad_pixel_share, 100.0, 2),
-            opt(a.bytes_per_tet, 1),
-            mb(a.gpu_bytes),
+            opt(a.bytes_per_tet.filter(|_| !is_peer(&a.algorithm)), 1),
+            mb(a.gpu_bytes.filter(|_| !is_peer(&a.algorithm))),
         );
     }
     h.push_str("</table>\n");
@@ -382,7 +390,7 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
              <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
              <td class=l>{}</td><td class=l>{}</td></tr>",
             row_class(!row.ok(), *suspect, &row.algorithm),
-            esc(&row.algorithm),
+            algorithm_cell(&row.algorithm),
             esc(&row.settings),
             esc(&row.dataset),
             esc(&row.viewpoint),
@@ -451,6 +459,15 @@ pub fn markdown_summary(aggs: &[Aggregate]) -> String {
         }
     }
     s
+}
+
+/// The algorithm's name for the HTML tables, with peers (other packages' renderers) marked.
+fn algorithm_cell(name: &str) -> String {
+    if is_peer(name) {
+        format!("{} <small class=peer>(peer)</small>", esc(name))
+    } else {
+        esc(name)
+    }
 }
 
 #[cfg(test)]

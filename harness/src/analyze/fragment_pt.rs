@@ -344,6 +344,7 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
             strict: false,
             shard: None,
             no_calibrate: false,
+            peers: vec![],
         };
         let config = run_args.to_config(
             ctx.data_dir.clone(),

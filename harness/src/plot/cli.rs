@@ -98,6 +98,7 @@ impl PlotArgs {
             strict: false,
             shard: None,
             no_calibrate: false,
+            peers: vec![],
         }
     }
 }

@@ -271,6 +271,7 @@ impl Session {
             strict: false,
             shard: None,
             no_calibrate: false,
+            peers: vec![],
         };
         let command = format!(
             "tetbench run --algorithms {} --datasets {} --viewpoints {viewpoints} --resolution {}{}{}",

@@ -139,14 +139,10 @@ pub enum TransferError {
 /// Names accepted by [`TransferFunction::preset`], the default first.
 pub const PRESET_NAMES: [&str; 2] = ["low-opacity", "high-opacity"];
 
-/// Default scale K of the ParaView opacity mapping κ = −ln(1 − o)·K (see
-/// [`TransferFunction::from_paraview_json`]): an opacity `o` is the opacity of a slab one tenth
-/// of the bounding-box diagonal thick.
+/// Default scale K of the ParaView opacity mapping κ = o·K (see
+/// [`TransferFunction::from_paraview_json`]): K is the bounding-box diagonal over ParaView's
+/// "Scalar Opacity Unit Distance", here one tenth of the diagonal.
 pub const PARAVIEW_OPACITY_SCALE: f64 = 10.0;
-
-/// ParaView opacities are clamped to this before the logarithm, so o = 1 maps to a finite κ
-/// (−ln(10⁻³)·K ≈ 6.9·K).
-const PARAVIEW_MAX_OPACITY: f64 = 0.999;
 
 /// Linear pieces each non-linear ParaView opacity interval (midpoint ≠ ½ or sharpness ≠ 0) is
 /// sampled into, so the function stays piecewise linear for exact pre-integration.
@@ -288,9 +284,12 @@ impl TransferFunction {
     ///
     /// Colours are interpolated linearly in RGB (ParaView may interpolate in Lab or the
     /// diverging Msh space; our optical model is piecewise linear in RGB, which exact
-    /// pre-integration needs). Opacity o becomes extinction κ = −ln(1 − min(o, 0.999))·K per
-    /// diagonal, with K = `opacity_scale`: o is then the opacity of a slab 1/K of the diagonal
-    /// thick. Intervals with ParaView's non-linear midpoint/sharpness shape (vtkPiecewiseFunction)
+    /// pre-integration needs). Opacity o becomes extinction κ = o·K per diagonal, with
+    /// K = `opacity_scale`: VTK's unstructured-grid mappers, which ParaView uses for
+    /// tetrahedral meshes (projected tetra, ZSweep, Bunyk ray casting), read a scalar opacity
+    /// as the attenuation o / u per world unit, u the "Scalar Opacity Unit Distance"; with
+    /// K = diagonal / u the two attenuate alike, and κ stays linear wherever o is, as it does in
+    /// VTK. Intervals with ParaView's non-linear midpoint/sharpness shape (vtkPiecewiseFunction)
     /// are sampled into 16 linear pieces; κ is linear between the resulting points. Without
     /// `Points`, opacity ramps linearly from 0 to 1.
     ///
@@ -389,7 +388,7 @@ fn parse_transfer_json(
             rgb: [c[1], c[2], c[3]],
         })
         .collect();
-    let kappa_of = |o: f64| -(1.0 - o.clamp(0.0, PARAVIEW_MAX_OPACITY)).ln() * opacity_scale;
+    let kappa_of = |o: f64| o.max(0.0) * opacity_scale;
     let kappa = match numbers("Points")? {
         None => vec![
             KappaPoint {
@@ -578,8 +577,9 @@ mod tests {
         assert_eq!(tf.name, "Cool to Warm");
         assert_eq!(tf.color.len(), 3);
         assert!((tf.color[1].s - 0.5).abs() < 1e-15 && (tf.color[2].s - 1.0).abs() < 1e-15);
-        // o = 0.5 at the top: κ = ln 2 · K.
-        assert!((tf.kappa_at(1.0) - 2f64.ln() * PARAVIEW_OPACITY_SCALE).abs() < 1e-12);
+        // o = 0.5 at the top: κ = 0.5 · K, as VTK's attenuation o / unit distance.
+        assert!((tf.kappa_at(1.0) - 0.5 * PARAVIEW_OPACITY_SCALE).abs() < 1e-12);
+        assert!((tf.kappa_at(0.5) - 0.25 * PARAVIEW_OPACITY_SCALE).abs() < 1e-12);
         assert_eq!(tf.kappa_at(0.0), 0.0);
         // A non-linear interval becomes 16 linear pieces that pass through the end values.
         std::fs::write(
@@ -589,7 +589,7 @@ mod tests {
         .unwrap();
         let tf = TransferFunction::from_paraview_json(&path).unwrap();
         assert_eq!(tf.kappa.len(), 17);
-        assert!((tf.kappa_at(1.0) - -(0.1f64).ln() * PARAVIEW_OPACITY_SCALE).abs() < 1e-9);
+        assert!((tf.kappa_at(1.0) - 0.9 * PARAVIEW_OPACITY_SCALE).abs() < 1e-9);
         tf.validate().unwrap();
     }
 

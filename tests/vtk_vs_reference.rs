@@ -1,0 +1,157 @@
+//! The outside check of the reference: VTK's ray caster (`vtkUnstructuredGridVolumeRayCastMapper`
+//! with its linear integrator, which like tetbench's reference integrates a linear scalar
+//! through piecewise-linear colour and extinction exactly) against `reference::render`, on SPX
+//! and a generated non-convex mesh at 128², through the `vtk-raycast` peer with the conventions
+//! of `vtk_peer::conventions`.
+//!
+//! The exact comparison reads VTK's per-pixel integration in float (`readout=rays`, early
+//! termination off); VTK's own 8-bit display (`readout=framebuffer`) and its PT and ZSweep
+//! mappers are checked with looser bounds. Needs Python with the `vtk` package
+//! (`scripts/setup-vtk.sh`; `scripts/test.sh` runs it): without it the tests fail and say so.
+
+use datasets::TetMesh;
+use harness::metrics::{compare, ImageError};
+use render_core::{Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint};
+use vtk_peer::{Integrator, Readout, VtkMapper, VtkPeer};
+
+fn gpu() -> Gpu {
+    std::env::set_var(
+        "XDG_RUNTIME_DIR",
+        std::env::var("XDG_RUNTIME_DIR").unwrap_or_else(|_| "/tmp".into()),
+    );
+    Gpu::new().expect("a wgpu adapter (lavapipe: apt-get install mesa-vulkan-drivers)")
+}
+
+fn camera(mesh: &TetMesh, name: &str, dir: [f64; 3]) -> Camera {
+    Camera::fit(
+        &mesh.bounds(),
+        &Viewpoint::new(name, dir),
+        Projection::default(),
+        128,
+        128,
+    )
+}
+
+/// Renders `cameras` with one VTK mapper (one Python process for all of them).
+fn vtk_images(
+    gpu: &Gpu,
+    mesh: &TetMesh,
+    optics: &Optics,
+    peer: VtkPeer,
+    cameras: &[Camera],
+) -> Vec<Image> {
+    let mut peer = peer;
+    let prepared = peer.prepare(gpu, mesh, optics).unwrap_or_else(|e| {
+        panic!("VTK is needed for the outside check and could not be started: {e:#}")
+    });
+    assert_eq!(prepared.tets, mesh.num_tets() as u64);
+    cameras
+        .iter()
+        .map(|c| {
+            let stats = peer.render(gpu, c).unwrap();
+            assert!(stats.total_ms > 0.0);
+            let img = peer.read_image(gpu).unwrap();
+            assert!(img.pixels.iter().flatten().all(|v| v.is_finite()));
+            img
+        })
+        .collect()
+}
+
+fn check(
+    what: &str,
+    mesh: &TetMesh,
+    cameras: &[Camera],
+    peer: impl Fn() -> VtkPeer,
+) -> Vec<ImageError> {
+    let gpu = gpu();
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), mesh);
+    let images = vtk_images(&gpu, mesh, &optics, peer(), cameras);
+    cameras
+        .iter()
+        .zip(images)
+        .map(|(c, img)| {
+            let reference = reference::render(mesh, &optics, c);
+            let e = compare(&img, &reference).unwrap();
+            eprintln!(
+                "{what} on {} ({} tets, 128², {}): PSNR {:.2} dB, RMSE {:.3e}, max error {:.5}, \
+                 bad pixels {:.4}",
+                mesh.name,
+                mesh.num_tets(),
+                c.viewpoint,
+                e.psnr_db,
+                e.rmse,
+                e.max_abs_error,
+                e.bad_pixel_share
+            );
+            e
+        })
+        .collect()
+}
+
+fn exact_ray_caster() -> VtkPeer {
+    VtkPeer::new(VtkMapper::RayCast, Integrator::Linear, Readout::Rays, false)
+}
+
+fn displayed(mapper: VtkMapper) -> VtkPeer {
+    VtkPeer::new(mapper, Integrator::Linear, Readout::Framebuffer, true)
+}
+
+fn spx() -> Option<TetMesh> {
+    let path = tetbench_tests::data_file("spx.vtk")?;
+    let mesh = datasets::load::load(&path, &Default::default())
+        .unwrap()
+        .mesh;
+    assert_eq!(mesh.num_tets(), 12936);
+    Some(mesh)
+}
+
+fn shell() -> TetMesh {
+    let mesh = datasets::registry::Registry::new(None)
+        .resolve("shell:20k", &Default::default())
+        .unwrap()
+        .mesh;
+    assert!(!mesh.is_convex());
+    mesh
+}
+
+#[test]
+fn vtk_ray_caster_agrees_with_the_reference_on_spx() {
+    let Some(mesh) = spx() else { return };
+    let cams = [
+        camera(&mesh, "+x", [1.0, 0.0, 0.0]),
+        camera(&mesh, "+x+y+z", [1.0, 1.0, 1.0]),
+    ];
+    for e in check("vtk-raycast linear, float", &mesh, &cams, exact_ray_caster) {
+        assert!(e.psnr_db >= 90.0, "PSNR {:.2} dB", e.psnr_db);
+        assert!(e.max_abs_error <= 1.0 / 255.0, "{e:?}");
+    }
+    for e in check("vtk-raycast linear, displayed", &mesh, &cams, || {
+        displayed(VtkMapper::RayCast)
+    }) {
+        assert!(e.psnr_db >= 50.0, "PSNR {:.2} dB", e.psnr_db);
+    }
+}
+
+#[test]
+fn vtk_ray_caster_agrees_with_the_reference_on_a_non_convex_shell() {
+    let mesh = shell();
+    let cams = [
+        camera(&mesh, "+x+y+z", [1.0, 1.0, 1.0]),
+        camera(&mesh, "-x+y-z", [-1.0, 1.0, -1.0]),
+    ];
+    for e in check("vtk-raycast linear, float", &mesh, &cams, exact_ray_caster) {
+        assert!(e.psnr_db >= 80.0, "PSNR {:.2} dB", e.psnr_db);
+        assert!(e.max_abs_error <= 1.0 / 255.0, "{e:?}");
+    }
+}
+
+#[test]
+fn vtk_projected_tetrahedra_and_zsweep_see_the_same_scene() {
+    let Some(mesh) = spx() else { return };
+    let cams = [camera(&mesh, "+x+y+z", [1.0, 1.0, 1.0])];
+    for mapper in [VtkMapper::ProjectedTetrahedra, VtkMapper::ZSweep] {
+        for e in check(mapper.class_name(), &mesh, &cams, || displayed(mapper)) {
+            assert!(e.psnr_db >= 45.0, "PSNR {:.2} dB", e.psnr_db);
+        }
+    }
+}
