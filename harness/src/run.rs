@@ -603,6 +603,10 @@ impl DatasetContext<'_> {
         let stem = format!("{}__{}", slug(&row.algorithm), slug(&row.settings));
         image.save_png(&dir.join(format!("{stem}.png")))?;
         row.image = format!("{rel}/{stem}.png");
+        // A renderer's second picture (the ray caster's pass-count map) goes beside it.
+        if let Some((suffix, extra)) = guarded("extra_image", || renderer.extra_image(self.gpu))? {
+            extra.save_png(&dir.join(format!("{stem}.{suffix}.png")))?;
+        }
 
         if c.reference {
             match self.reference(vp, &camera, progress) {
