@@ -14,10 +14,13 @@ const STAT_SKIPPED: u32 = 4u;
 const STAT_STEPS: u32 = 5u;
 const STAT_MAX_STEPS: u32 = 6u;
 
-struct TileParams {
+struct TileRect {
     origin: vec2<u32>,
     end: vec2<u32>,
-    index: u32,
+}
+
+struct PassParams {
+    // 1 on the pass that ends a round: rays still active are counted per tile.
     count: u32,
 }
 
@@ -29,7 +32,10 @@ struct TileParams {
 @group(1) @binding(4) var<storage, read> table: array<vec4<f32>>;
 @group(1) @binding(5) var<storage, read_write> tile_counts: array<atomic<u32>>;
 @group(1) @binding(6) var<storage, read_write> stats: array<atomic<u32>>;
-@group(1) @binding(7) var<uniform> tile: TileParams;
+@group(1) @binding(7) var<storage, read> tiles: array<TileRect>;
+// The tiles that still have active rays; workgroup z picks one.
+@group(1) @binding(8) var<storage, read> active_tiles: array<u32>;
+@group(1) @binding(9) var<uniform> pass_params: PassParams;
 
 // Linear interpolation coordinate as render_core::preintegration samples its tables.
 fn axis(x: f32, n: u32) -> vec2<f32> {
@@ -176,13 +182,27 @@ fn init(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// mode=passes: one step of every active ray of one tile (one GPU pass, as the paper's
-// screen-aligned rectangle per tile); on counting passes the rays still active are counted
-// (the paper's occlusion query, here an atomic count).
+// The pixel of an invocation: workgroup z is a slot of the active-tile list, x and y cover
+// that tile's rectangle (all active tiles of a pass run in one dispatch, as the paper draws one
+// rectangle per tile in a pass). Returns the tile index, or NONE outside the rectangle.
+fn tile_pixel(wg: vec3<u32>, lid: vec3<u32>, p: ptr<function, vec2<u32>>) -> u32 {
+    let t = active_tiles[wg.z];
+    let r = tiles[t];
+    *p = r.origin + wg.xy * 8u + lid.xy;
+    if (*p).x >= r.end.x || (*p).y >= r.end.y {
+        return NONE;
+    }
+    return t;
+}
+
+// mode=passes: one step of every active ray of the listed tiles (one GPU pass); on the pass
+// that ends a round the rays still active are counted per tile (the paper's occlusion query,
+// here an atomic count).
 @compute @workgroup_size(8, 8)
-fn step(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let p = tile.origin + gid.xy;
-    if p.x >= tile.end.x || p.y >= tile.end.y {
+fn step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    var p: vec2<u32>;
+    let t = tile_pixel(wg, lid, &p);
+    if t == NONE {
         return;
     }
     let i = p.y * frame.size.x + p.x;
@@ -193,16 +213,18 @@ fn step(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ray = pixel_ray(vec2<f32>(p) + 0.5);
     let still_active = advance(&st, p, ray);
     store(i, st);
-    if still_active && tile.count != 0u {
-        atomicAdd(&tile_counts[tile.index], 1u);
+    if still_active && pass_params.count != 0u {
+        atomicAdd(&tile_counts[t], 1u);
     }
 }
 
-// mode=loop: one dispatch per tile; each ray steps until it leaves the last layer.
+// mode=loop: one dispatch over the non-empty tiles; each ray steps until it leaves the last
+// layer.
 @compute @workgroup_size(8, 8)
-fn run_loop(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let p = tile.origin + gid.xy;
-    if p.x >= tile.end.x || p.y >= tile.end.y {
+fn run_loop(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    var p: vec2<u32>;
+    let t = tile_pixel(wg, lid, &p);
+    if t == NONE {
         return;
     }
     let i = p.y * frame.size.x + p.x;

@@ -11,9 +11,7 @@ use render_core::{
 };
 
 use crate::layout::{MeshLayout, TetRef, MESH_SLOTS};
-use crate::resources::{
-    FrameParams, Pipelines, Target, TileParams, MAX_TILES, STAT_SLOTS, UNIFORM_STRIDE,
-};
+use crate::resources::{FrameParams, Pipelines, Target, TileRect, MAX_TILES, STAT_SLOTS};
 use crate::settings::{Mode, RaycastSettings, TableKind};
 use crate::step::{LayerEntry, RayFrame};
 use crate::{COUNT_EVERY, ET_OPACITY, PEEL_BIAS, TABLE_LENGTH, TABLE_SCALAR};
@@ -269,19 +267,14 @@ fn read_layer(
     Ok(out)
 }
 
-fn tile_rects(w: u32, h: u32, n: u32) -> ([u32; 2], Vec<TileParams>) {
+fn tile_rects(w: u32, h: u32, n: u32) -> ([u32; 2], Vec<TileRect>) {
     let (tw, th) = (w.div_ceil(n), h.div_ceil(n));
     let mut v = Vec::new();
     for ty in 0..n {
         for tx in 0..n {
-            let origin = [(tx * tw).min(w), (ty * th).min(h)];
-            let end = [((tx + 1) * tw).min(w), ((ty + 1) * th).min(h)];
-            v.push(TileParams {
-                origin,
-                end,
-                index: ty * n + tx,
-                count: 0,
-                pad: [0; 2],
+            v.push(TileRect {
+                origin: [(tx * tw).min(w), (ty * th).min(h)],
+                end: [((tx + 1) * tw).min(w), ((ty + 1) * th).min(h)],
             });
         }
     }
@@ -499,20 +492,12 @@ fn frame(
         st.target_bytes = target_ledger.per_frame;
     }
     let t = st.target.as_ref().expect("target created above");
-    let (tile_size, mut rects) = tile_rects(w, h, s.tiles);
+    let (tile_size, rects) = tile_rects(w, h, s.tiles);
     let ntiles = rects.len();
-    // Two parameter blocks per tile: without and with the active-ray count.
-    let mut tile_bytes = vec![0u8; 2 * MAX_TILES * UNIFORM_STRIDE as usize];
-    for (i, r) in rects.iter_mut().enumerate() {
-        for count in 0..2 {
-            r.count = count;
-            let off = (2 * i + count as usize) * UNIFORM_STRIDE as usize;
-            tile_bytes[off..off + 32].copy_from_slice(bytemuck::bytes_of(r));
-        }
-    }
     st.timer.start_wall();
     let started = Instant::now();
-    gpu.queue.write_buffer(&t.tile_params, 0, &tile_bytes);
+    gpu.queue
+        .write_buffer(&t.tile_rects, 0, bytemuck::cast_slice(&rects));
     let rf = RayFrame::new(camera, st.layout.origin);
     let p4 = |v: [f32; 3]| [v[0], v[1], v[2], 0.0];
     let model = glam::DMat4::from_translation(glam::DVec3::from(st.layout.origin));
@@ -635,28 +620,31 @@ fn frame(
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(&st.pipes.init);
         pass.set_bind_group(0, &st.mesh_bind, &[]);
-        pass.set_bind_group(1, &t.cast_bind, &[0]);
+        pass.set_bind_group(1, &t.cast_binds[0], &[]);
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
     gpu.queue.submit([enc.finish()]);
     let mut counts = read_counts(gpu, &t.tile_counts, ntiles)?;
     let mut tile_passes = vec![0u32; ntiles];
     let mut rounds = 0u32;
-    let dispatch = |pass: &mut wgpu::ComputePass, tile: usize, count: bool| {
-        let r = &rects[tile];
-        let off = ((2 * tile + count as usize) as u64 * UNIFORM_STRIDE) as u32;
-        pass.set_bind_group(1, &t.cast_bind, &[off]);
-        pass.dispatch_workgroups(
-            (r.end[0] - r.origin[0]).div_ceil(8),
-            (r.end[1] - r.origin[1]).div_ceil(8),
-            1,
-        );
+    // One dispatch per pass covers every listed tile (workgroup z = slot in the list).
+    let groups = [tile_size[0].div_ceil(8), tile_size[1].div_ceil(8)];
+    let list = |counts: &[u32]| -> Vec<u32> {
+        (0..ntiles as u32)
+            .filter(|&i| counts[i as usize] > 0)
+            .collect()
     };
     match s.mode {
         Mode::Passes => {
-            // Phase 3: rounds of k passes per tile that still has active rays, then the count.
-            while counts.iter().any(|&c| c > 0) {
-                let active: Vec<usize> = (0..ntiles).filter(|&i| counts[i] > 0).collect();
+            // Phase 3: rounds of k passes over the tiles that still have active rays; the last
+            // pass of a round counts them, and tiles at zero leave the list.
+            loop {
+                let active = list(&counts);
+                if active.is_empty() {
+                    break;
+                }
+                gpu.queue
+                    .write_buffer(&t.active_tiles, 0, bytemuck::cast_slice(&active));
                 gpu.queue
                     .write_buffer(&t.tile_counts, 0, &[0u8; MAX_TILES * 4]);
                 let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -665,31 +653,37 @@ fn frame(
                     pass.set_pipeline(&st.pipes.step);
                     pass.set_bind_group(0, &st.mesh_bind, &[]);
                     for k in 0..COUNT_EVERY {
-                        for &tile in &active {
-                            dispatch(&mut pass, tile, k + 1 == COUNT_EVERY);
-                        }
+                        let count = (k + 1 == COUNT_EVERY) as usize;
+                        pass.set_bind_group(1, &t.cast_binds[count], &[]);
+                        pass.dispatch_workgroups(groups[0], groups[1], active.len() as u32);
                     }
                 }
                 gpu.queue.submit([enc.finish()]);
                 for &tile in &active {
-                    tile_passes[tile] += COUNT_EVERY;
+                    tile_passes[tile as usize] += COUNT_EVERY;
                 }
                 rounds += 1;
                 counts = read_counts(gpu, &t.tile_counts, ntiles)?;
             }
         }
         Mode::Loop => {
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = enc.begin_compute_pass(&Default::default());
-                pass.set_pipeline(&st.pipes.run_loop);
-                pass.set_bind_group(0, &st.mesh_bind, &[]);
-                for tile in (0..ntiles).filter(|&i| counts[i] > 0) {
-                    dispatch(&mut pass, tile, false);
-                    tile_passes[tile] = 1;
+            let active = list(&counts);
+            if !active.is_empty() {
+                gpu.queue
+                    .write_buffer(&t.active_tiles, 0, bytemuck::cast_slice(&active));
+                let mut enc = gpu.device.create_command_encoder(&Default::default());
+                {
+                    let mut pass = enc.begin_compute_pass(&Default::default());
+                    pass.set_pipeline(&st.pipes.run_loop);
+                    pass.set_bind_group(0, &st.mesh_bind, &[]);
+                    pass.set_bind_group(1, &t.cast_binds[0], &[]);
+                    pass.dispatch_workgroups(groups[0], groups[1], active.len() as u32);
+                }
+                gpu.queue.submit([enc.finish()]);
+                for &tile in &active {
+                    tile_passes[tile as usize] = 1;
                 }
             }
-            gpu.queue.submit([enc.finish()]);
         }
     }
     let mut enc = gpu.device.create_command_encoder(&Default::default());

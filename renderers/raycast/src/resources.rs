@@ -6,8 +6,6 @@ use render_core::Gpu;
 
 use crate::layout::MESH_SLOTS;
 
-/// Uniform offsets must be multiples of this (wgpu's largest `min_uniform_buffer_offset_alignment`).
-pub const UNIFORM_STRIDE: u64 = 256;
 /// Slots of the statistics buffer (see `STAT_*` in cast.wgsl).
 pub const STAT_SLOTS: usize = 8;
 /// At most 6 × 6 tiles (the paper's largest tiling).
@@ -30,15 +28,12 @@ pub struct FrameParams {
     pub table: [u32; 4],
 }
 
-/// One tile's rectangle (`TileParams` in cast.wgsl).
+/// One tile's rectangle (`TileRect` in cast.wgsl).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct TileParams {
+pub struct TileRect {
     pub origin: [u32; 2],
     pub end: [u32; 2],
-    pub index: u32,
-    pub count: u32,
-    pub pad: [u32; 2],
 }
 
 fn buffer_entry(
@@ -115,7 +110,9 @@ impl Pipelines {
                 buffer_entry(4, RO, false),
                 buffer_entry(5, RW, false),
                 buffer_entry(6, RW, false),
-                buffer_entry(7, UNIFORM, true),
+                buffer_entry(7, RO, false),
+                buffer_entry(8, RO, false),
+                buffer_entry(9, UNIFORM, false),
             ],
         });
         let probe_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -221,10 +218,13 @@ pub struct Target {
     /// One view per layer (render attachments and the previous-layer input of peeling).
     pub layer_views: Vec<wgpu::TextureView>,
     pub depth_view: wgpu::TextureView,
-    pub tile_params: wgpu::Buffer,
+    pub tile_rects: wgpu::Buffer,
+    pub active_tiles: wgpu::Buffer,
     pub tile_counts: wgpu::Buffer,
     pub stats: wgpu::Buffer,
-    pub cast_bind: wgpu::BindGroup,
+    /// `cast_binds[c]`: traversal bindings with the pass's count flag `c` (0: plain pass,
+    /// 1: the pass that ends a round and counts active rays).
+    pub cast_binds: [wgpu::BindGroup; 2],
     /// `peel_binds[l]` reads layer `l` (used while peeling layer `l + 1`).
     pub peel_binds: Vec<wgpu::BindGroup>,
     pub occlusion: wgpu::QuerySet,
@@ -281,13 +281,34 @@ impl Target {
             STAT_SLOTS as u64 * 4,
             storage,
         );
-        let tile_params = ledger.buffer(
+        let tile_rects = ledger.buffer(
             gpu,
-            "raycast tile params",
+            "raycast tile rectangles",
             Lifetime::PerFrame,
-            2 * MAX_TILES as u64 * UNIFORM_STRIDE,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            MAX_TILES as u64 * 16,
+            storage,
         );
+        let active_tiles = ledger.buffer(
+            gpu,
+            "raycast active tiles",
+            Lifetime::PerFrame,
+            MAX_TILES as u64 * 4,
+            storage,
+        );
+        let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        let pass_flags: Vec<wgpu::Buffer> = (0..2u32)
+            .map(|c| {
+                let mut bytes = [0u8; 16];
+                bytes[..4].copy_from_slice(&c.to_le_bytes());
+                ledger.buffer_init(
+                    gpu,
+                    "raycast pass flag",
+                    Lifetime::PerFrame,
+                    &bytes,
+                    uniform,
+                )
+            })
+            .collect();
         let size = wgpu::Extent3d {
             width,
             height,
@@ -349,30 +370,28 @@ impl Target {
                 resource: b.as_entire_binding(),
             }
         }
-        let cast_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("raycast traversal"),
-            layout: &pipes.cast_layout,
-            entries: &[
-                buf(0, &rays),
-                buf(1, &colours),
-                buf(2, &aux),
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&array_view),
-                },
-                buf(4, table),
-                buf(5, &tile_counts),
-                buf(6, &stats),
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &tile_params,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<TileParams>() as u64),
-                    }),
-                },
-            ],
-        });
+        let cast_bind = |flag: &wgpu::Buffer| {
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("raycast traversal"),
+                layout: &pipes.cast_layout,
+                entries: &[
+                    buf(0, &rays),
+                    buf(1, &colours),
+                    buf(2, &aux),
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&array_view),
+                    },
+                    buf(4, table),
+                    buf(5, &tile_counts),
+                    buf(6, &stats),
+                    buf(7, &tile_rects),
+                    buf(8, &active_tiles),
+                    buf(9, flag),
+                ],
+            })
+        };
+        let cast_binds = [cast_bind(&pass_flags[0]), cast_bind(&pass_flags[1])];
         let peel_binds = layer_views
             .iter()
             .map(|v| {
@@ -406,10 +425,11 @@ impl Target {
             layers,
             layer_views,
             depth_view: depth.create_view(&Default::default()),
-            tile_params,
+            tile_rects,
+            active_tiles,
             tile_counts,
             stats,
-            cast_bind,
+            cast_binds,
             peel_binds,
             occlusion,
             occlusion_resolve,
