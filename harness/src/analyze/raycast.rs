@@ -212,12 +212,23 @@ pub fn write_tables(rows: &[Row], out: &Path) -> anyhow::Result<String> {
         .or(rows3d.first())
         .map(|r| format!("{}×{}", r.width, r.height))
         .unwrap_or_default();
+    let et: Vec<&str> = {
+        let mut v: Vec<&str> = rows2d
+            .iter()
+            .chain(&rows3d)
+            .filter_map(|r| setting(&r.settings, "et"))
+            .collect();
+        v.sort();
+        v.dedup();
+        v
+    };
     writeln!(
         md,
         "Tiled ray casting (Bernardon et al. 2005), Tables 3–6. Ours: adapter {adapter}, {size}, \
-         {views} viewpoints, mode=passes (one GPU pass per ray step), medians over the timed frames \
-         of each view. Paper: ATI Radeon 9700 Pro and GeForce 6800 GT at 512×512, camera positions \
-         not stated; its GeForce F117 rows are missing from the text. Ratios are ours / paper.\n"
+         {views} viewpoints, mode=passes (one GPU pass per ray step), early termination {}, \
+         medians over the timed frames of each view. Paper: ATI Radeon 9700 Pro and GeForce 6800 GT at 512×512, camera positions \
+         not stated; its GeForce F117 rows are missing from the text. Ratios are ours / paper.\n",
+        et.join("/")
     )?;
 
     // Table 3.
