@@ -18,6 +18,7 @@ const TABLE: &[(&str, Variants, Variants)] = &[
         fragment_pt::default_variants,
         fragment_pt::all_variants,
     ),
+    ("raycast", raycast::default_variants, raycast::all_variants),
     ("vtk-pt", vtk_peer::pt_variants, vtk_peer::pt_variants),
     (
         "vtk-raycast",

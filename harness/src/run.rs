@@ -777,6 +777,10 @@ impl DatasetContext<'_> {
         crate::samples::write_f32_image(&dir.join(&exact), &image)?;
         row.image_f32 = format!("{rel}/{exact}");
         row.image_hash = crate::samples::image_hash(&image);
+        // A renderer's second picture (the ray caster's pass-count map) goes beside it.
+        if let Some((suffix, extra)) = guarded("extra_image", || renderer.extra_image(self.gpu))? {
+            extra.save_png(&dir.join(format!("{stem}.{suffix}.png")))?;
+        }
 
         if c.reference {
             match self.reference(vp, &camera, progress) {

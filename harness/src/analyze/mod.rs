@@ -10,6 +10,7 @@ use clap::Subcommand;
 
 pub mod fragment_pt;
 pub mod havs;
+pub mod raycast;
 pub mod summary;
 
 /// What every analysis may need from the global options.
@@ -35,6 +36,9 @@ pub enum AnalyzeCommand {
     Kbuffer(havs::KbufferArgs),
     /// HAVS Tables 3 and 4 from a finished `tetbench run --algorithms havs`.
     HavsTables(havs::TablesArgs),
+    /// Tiled ray casting (Bernardon et al. 2005) Tables 3–6 from a finished
+    /// `tetbench run --algorithms raycast`, beside the paper's.
+    Raycast(raycast::Args),
 }
 
 pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
@@ -45,5 +49,6 @@ pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
         AnalyzeCommand::Sort(args) => havs::run_sort(args, ctx),
         AnalyzeCommand::Kbuffer(args) => havs::run_kbuffer(args, ctx),
         AnalyzeCommand::HavsTables(args) => havs::run_tables(args, ctx),
+        AnalyzeCommand::Raycast(args) => raycast::run(args, ctx),
     }
 }

@@ -78,4 +78,10 @@ pub trait Renderer {
 
     /// Reads back the last rendered image (premultiplied linear RGBA, row 0 at the top).
     fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image>;
+
+    /// An optional second picture of the last frame that the harness saves beside the
+    /// rendering as `….SUFFIX.png` (e.g. the ray caster's pass-count map, `passes`).
+    fn extra_image(&mut self, _gpu: &Gpu) -> anyhow::Result<Option<(&'static str, Image)>> {
+        Ok(None)
+    }
 }

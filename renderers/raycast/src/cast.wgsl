@@ -1,0 +1,242 @@
+// Phase 3 of §3.2: per pixel, the ray's current cell (the paper's Table 2: tet (t_u, t_v), λ,
+// s(e + λr)) and its colour; each step crosses one tet — exit face = smallest λ among faces with
+// a positive denominator (§2.2) — and composites that segment front to back (Eq. 3) with the
+// 3D pre-integrated table (s_front, s_back, length / longest edge) or the 2D one (fixed length,
+// scaled by length as the paper's code does). A ray that leaves the mesh continues from its
+// next peeling layer. `step` is one pass (mode=passes), `run_loop` loops to the end (mode=loop).
+
+// Statistics slots (atomics).
+const STAT_ENTERED: u32 = 0u;
+const STAT_TERMINATED: u32 = 1u;
+const STAT_STALLED: u32 = 2u;
+const STAT_DROPPED: u32 = 3u;
+const STAT_SKIPPED: u32 = 4u;
+const STAT_STEPS: u32 = 5u;
+const STAT_MAX_STEPS: u32 = 6u;
+
+struct TileRect {
+    origin: vec2<u32>,
+    end: vec2<u32>,
+}
+
+struct PassParams {
+    // 1 on the pass that ends a round: rays still active are counted per tile.
+    count: u32,
+}
+
+@group(1) @binding(0) var<storage, read_write> rays: array<vec4<u32>>;
+@group(1) @binding(1) var<storage, read_write> colours: array<vec4<f32>>;
+// (peel layer the ray is in, steps taken)
+@group(1) @binding(2) var<storage, read_write> aux: array<vec2<u32>>;
+@group(1) @binding(3) var layers: texture_2d_array<u32>;
+@group(1) @binding(4) var<storage, read> table: array<vec4<f32>>;
+@group(1) @binding(5) var<storage, read_write> tile_counts: array<atomic<u32>>;
+@group(1) @binding(6) var<storage, read_write> stats: array<atomic<u32>>;
+@group(1) @binding(7) var<storage, read> tiles: array<TileRect>;
+// The tiles that still have active rays; workgroup z picks one.
+@group(1) @binding(8) var<storage, read> active_tiles: array<u32>;
+@group(1) @binding(9) var<uniform> pass_params: PassParams;
+
+// Linear interpolation coordinate as render_core::preintegration samples its tables.
+fn axis(x: f32, n: u32) -> vec2<f32> {
+    let f = clamp(x * f32(n - 1u), 0.0, f32(n - 1u));
+    let i = min(floor(f), f32(n - 2u));
+    return vec2<f32>(i, f - i);
+}
+
+fn lookup(s_f: f32, s_b: f32, len: f32) -> vec4<f32> {
+    let n = frame.table.x;
+    let a = axis(s_f, n);
+    let b = axis(s_b, n);
+    let i = u32(a.x);
+    let j = u32(b.x);
+    if (frame.counts.w & FLAG_TABLE3D) != 0u {
+        let c = axis(len * frame.misc.w, frame.table.y);
+        let k = u32(c.x);
+        var plane: array<vec4<f32>, 2>;
+        for (var dk = 0u; dk < 2u; dk++) {
+            let base = (k + dk) * n * n;
+            let x0 = mix(table[base + j * n + i], table[base + j * n + i + 1u], a.y);
+            let x1 = mix(table[base + (j + 1u) * n + i], table[base + (j + 1u) * n + i + 1u], a.y);
+            plane[dk] = mix(x0, x1, b.y);
+        }
+        return mix(plane[0], plane[1], c.y);
+    }
+    let x0 = mix(table[j * n + i], table[j * n + i + 1u], a.y);
+    let x1 = mix(table[(j + 1u) * n + i], table[(j + 1u) * n + i + 1u], a.y);
+    // The 2D table holds a segment of the fixed length; the paper's code scales by length.
+    return min(mix(x0, x1, b.y) * (len * frame.misc.w), vec4<f32>(1.0));
+}
+
+struct State {
+    tet: vec2<u32>,
+    lambda: f32,
+    s: f32,
+    layer: u32,
+    steps: u32,
+    colour: vec4<f32>,
+}
+
+fn load(i: u32) -> State {
+    let r = rays[i];
+    let a = aux[i];
+    var st: State;
+    st.tet = r.xy;
+    st.lambda = bitcast<f32>(r.z);
+    st.s = bitcast<f32>(r.w);
+    st.layer = a.x;
+    st.steps = a.y;
+    st.colour = colours[i];
+    return st;
+}
+
+fn store(i: u32, st: State) {
+    rays[i] = vec4<u32>(st.tet, bitcast<u32>(st.lambda), bitcast<u32>(st.s));
+    aux[i] = vec2<u32>(st.layer, st.steps);
+    colours[i] = st.colour;
+}
+
+fn finish(st: ptr<function, State>) {
+    (*st).tet = vec2<u32>(NONE, NONE);
+    atomicAdd(&stats[STAT_STEPS], (*st).steps);
+    atomicMax(&stats[STAT_MAX_STEPS], (*st).steps);
+}
+
+// One ray step (phase 3a); returns whether the ray is still active.
+fn advance(st: ptr<function, State>, p: vec2<u32>, ray: Ray) -> bool {
+    let ex = exit_of((*st).tet, ray.o, ray.d, (*st).lambda);
+    let next = ex.next;
+    let lambda_exit = ex.lambda;
+    let s_exit = ex.s;
+    let seg = lookup((*st).s, s_exit, lambda_exit - (*st).lambda);
+    (*st).colour += (1.0 - (*st).colour.a) * seg;
+    (*st).steps += 1u;
+    (*st).tet = next;
+    (*st).lambda = lambda_exit;
+    (*st).s = s_exit;
+    if (frame.counts.w & FLAG_ET) != 0u && (*st).colour.a >= frame.misc.z {
+        atomicAdd(&stats[STAT_TERMINATED], 1u);
+        finish(st);
+        return false;
+    }
+    if (*st).steps >= frame.counts.z {
+        atomicAdd(&stats[STAT_STALLED], 1u);
+        finish(st);
+        return false;
+    }
+    if next.x == NONE {
+        // Left the mesh: continue from the next peeling layer that lies ahead (§2.4).
+        loop {
+            (*st).layer += 1u;
+            if (*st).layer >= frame.counts.y {
+                finish(st);
+                return false;
+            }
+            let e = textureLoad(layers, vec2<i32>(p), i32((*st).layer), 0);
+            if e.x == NONE {
+                finish(st);
+                return false;
+            }
+            let l = bitcast<f32>(e.z);
+            if l >= lambda_exit - frame.misc.y {
+                (*st).tet = e.xy;
+                (*st).lambda = l;
+                (*st).s = bitcast<f32>(e.w);
+                break;
+            }
+            atomicAdd(&stats[STAT_SKIPPED], 1u);
+        }
+    }
+    return true;
+}
+
+fn tile_of(p: vec2<u32>) -> u32 {
+    return (p.y / frame.size.w) * frame.counts.x + p.x / frame.size.z;
+}
+
+// Per frame: every ray starts at its first-layer entry; colour cleared; active rays counted
+// per tile (so an empty tile never runs a pass).
+@compute @workgroup_size(8, 8)
+fn init(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let p = gid.xy;
+    if p.x >= frame.size.x || p.y >= frame.size.y {
+        return;
+    }
+    let i = p.y * frame.size.x + p.x;
+    colours[i] = vec4<f32>(0.0);
+    aux[i] = vec2<u32>(0u, 0u);
+    var e = vec4<u32>(NONE);
+    if frame.counts.y > 0u {
+        e = textureLoad(layers, vec2<i32>(p), 0, 0);
+    }
+    rays[i] = e;
+    if e.x != NONE {
+        atomicAdd(&tile_counts[tile_of(p)], 1u);
+        atomicAdd(&stats[STAT_ENTERED], 1u);
+    }
+    if (frame.counts.w & FLAG_COUNT_DROPPED) != 0u {
+        let d = textureLoad(layers, vec2<i32>(p), i32(frame.table.z), 0);
+        if d.x != NONE {
+            atomicAdd(&stats[STAT_DROPPED], 1u);
+        }
+    }
+}
+
+// The pixel of an invocation: workgroup z is a slot of the active-tile list, x and y cover
+// that tile's rectangle (all active tiles of a pass run in one dispatch, as the paper draws one
+// rectangle per tile in a pass). Returns the tile index, or NONE outside the rectangle.
+fn tile_pixel(wg: vec3<u32>, lid: vec3<u32>, p: ptr<function, vec2<u32>>) -> u32 {
+    let t = active_tiles[wg.z];
+    let r = tiles[t];
+    *p = r.origin + wg.xy * 8u + lid.xy;
+    if (*p).x >= r.end.x || (*p).y >= r.end.y {
+        return NONE;
+    }
+    return t;
+}
+
+// mode=passes: one step of every active ray of the listed tiles (one GPU pass); on the pass
+// that ends a round the rays still active are counted per tile (the paper's occlusion query,
+// here an atomic count).
+@compute @workgroup_size(8, 8)
+fn step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    var p: vec2<u32>;
+    let t = tile_pixel(wg, lid, &p);
+    if t == NONE {
+        return;
+    }
+    let i = p.y * frame.size.x + p.x;
+    if rays[i].x == NONE {
+        return;
+    }
+    var st = load(i);
+    let ray = pixel_ray(vec2<f32>(p) + 0.5);
+    let still_active = advance(&st, p, ray);
+    store(i, st);
+    if still_active && pass_params.count != 0u {
+        atomicAdd(&tile_counts[t], 1u);
+    }
+}
+
+// mode=loop: one dispatch over the non-empty tiles; each ray steps until it leaves the last
+// layer.
+@compute @workgroup_size(8, 8)
+fn run_loop(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    var p: vec2<u32>;
+    let t = tile_pixel(wg, lid, &p);
+    if t == NONE {
+        return;
+    }
+    let i = p.y * frame.size.x + p.x;
+    if rays[i].x == NONE {
+        return;
+    }
+    var st = load(i);
+    let ray = pixel_ray(vec2<f32>(p) + 0.5);
+    loop {
+        if !advance(&st, p, ray) {
+            break;
+        }
+    }
+    store(i, st);
+}

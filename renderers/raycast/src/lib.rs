@@ -1,0 +1,44 @@
+//! Tiled ray casting with depth peeling: Bernardon, Pagot, Comba and Silva (2005), "GPU-based
+//! Tiled Ray Casting using Depth Peeling" — the one image-order algorithm of tetbench.
+//!
+//! * Mesh layout ([`layout`], §3.1 Table 1): 144 bytes per tet, in up to [`layout::MESH_SLOTS`]
+//!   storage bindings so rays walk across bindings (the paper's 2D-texture coordinates
+//!   (t_u, t_v) become (binding, index)).
+//! * Phases 1–2 (`peel.wgsl`, §2.4, §3.2): the front-facing boundary faces are rasterised with
+//!   the Z-buffer to find each pixel's entry tet and λ; each further layer peels the next entry
+//!   behind the previous one (bias on λ), until a layer is empty (an occlusion query per layer)
+//!   or [`RaycastSettings::max_layers`].
+//! * Phase 3a (`cast.wgsl`): each active ray crosses one tet per step and composites the segment
+//!   front to back with the 2D or 3D pre-integrated table; a ray that leaves the mesh continues
+//!   from its next layer; early ray termination at opacity [`ET_OPACITY`] (the paper's code).
+//! * Phase 3b / tiles (§2.3): the screen is cut into N×N tiles; each runs its own number of
+//!   passes. The paper's z-update and occlusion query every k passes is here an atomic count of
+//!   the tile's active rays in every [`COUNT_EVERY`]-th pass, read back by the CPU; a tile whose
+//!   count is zero gets no more passes, and a tile no ray enters gets none at all.
+//! * [`Mode::Loop`]: the modern variant, one dispatch per tile looping each ray to its end.
+//!
+//! The CPU twin of a ray step is [`step`]; the pass-count map (the paper's Fig. 5) is
+//! [`passmap`].
+
+pub mod layout;
+pub mod passmap;
+mod render;
+pub mod resources;
+pub mod settings;
+pub mod step;
+
+pub use render::{PassData, Raycast};
+pub use settings::{all_variants, default_variants, Mode, RaycastSettings, TableKind};
+
+/// Opacity at which a ray stops when early termination is on (the paper's shader uses 0.95).
+pub const ET_OPACITY: f32 = 0.95;
+/// The termination test (an atomic count of active rays per tile) runs in every k-th pass; the
+/// paper amortises its occlusion query the same way without giving k.
+pub const COUNT_EVERY: u32 = 8;
+/// Entries per scalar axis of both tables, and per length axis of the 3D one (HAVS' 128³).
+pub const TABLE_SCALAR: usize = 128;
+pub const TABLE_LENGTH: usize = 128;
+/// Bias on λ between peeling layers, relative to the bounding-box diagonal (the paper adds an
+/// unstated bias; its code uses 0.01 scene units). Well above f32 round-off of λ (~4e-7 of the
+/// diagonal at the fitted camera distance).
+pub const PEEL_BIAS: f64 = 1e-5;

@@ -1,0 +1,752 @@
+//! The renderer: uploads (prepare) and the per-frame phases (render).
+
+use std::time::Instant;
+
+use anyhow::{anyhow, bail, Context};
+use datasets::TetMesh;
+use render_core::gpu::{Lifetime, MemoryLedger};
+use render_core::preintegration::{Table2d, Table3d};
+use render_core::{
+    Camera, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Setting,
+};
+
+use crate::layout::{MeshLayout, TetRef, MESH_SLOTS};
+use crate::resources::{FrameParams, Pipelines, Target, TileRect, MAX_TILES, STAT_SLOTS};
+use crate::settings::{Mode, RaycastSettings, TableKind};
+use crate::step::{LayerEntry, RayFrame};
+use crate::{COUNT_EVERY, ET_OPACITY, PEEL_BIAS, TABLE_LENGTH, TABLE_SCALAR};
+
+const FLAG_ET: u32 = 1;
+const FLAG_TABLE3D: u32 = 2;
+const FLAG_COUNT_DROPPED: u32 = 4;
+const STAT_ENTERED: usize = 0;
+const STAT_TERMINATED: usize = 1;
+const STAT_STALLED: usize = 2;
+const STAT_DROPPED: usize = 3;
+const STAT_SKIPPED: usize = 4;
+const STAT_STEPS: usize = 5;
+const STAT_MAX_STEPS: usize = 6;
+
+/// Tiled ray caster (`raycast`).
+pub struct Raycast {
+    pub settings: RaycastSettings,
+    /// Bytes per mesh binding when smaller than the adapter's limit (tests split small meshes
+    /// across bindings this way).
+    max_binding: Option<u64>,
+    state: Option<State>,
+}
+
+struct State {
+    layout: MeshLayout,
+    tets: u64,
+    ledger: MemoryLedger,
+    pipes: Pipelines,
+    frame_params: wgpu::Buffer,
+    mesh_bind: wgpu::BindGroup,
+    faces: wgpu::Buffer,
+    face_vertices: u32,
+    table: wgpu::Buffer,
+    table_bytes: u64,
+    /// 1 / (longest edge) for the 3D table, 1 / (fixed length) for the 2D one.
+    inv_table_length: f32,
+    length_unit: f64,
+    max_steps: u32,
+    target: Option<Target>,
+    /// Bytes of the viewport-sized buffers and textures of `target`.
+    target_bytes: u64,
+    timer: FrameTimer,
+    last: Option<LastFrame>,
+}
+
+/// What the last frame did, for counters, the pass map and tests.
+#[derive(Debug, Clone)]
+struct LastFrame {
+    camera: Camera,
+    layers_used: u32,
+    tile_passes: Vec<u32>,
+    tile_size: [u32; 2],
+}
+
+/// Per-pixel results of the last frame, read back for tests and the pass map.
+#[derive(Debug, Clone)]
+pub struct PassData {
+    pub width: u32,
+    pub height: u32,
+    /// Steps (tets crossed) per pixel.
+    pub steps: Vec<u32>,
+    /// Peeling layers filled, and per pixel the entries of each (layer-major).
+    pub layers_used: u32,
+    pub layers: Vec<Vec<Option<LayerEntry>>>,
+    /// Passes each tile ran (row-major), and the tile size in pixels.
+    pub tile_passes: Vec<u32>,
+    pub tile_size: [u32; 2],
+    /// The ray parameters of the frame (object coordinates).
+    pub ray_frame: RayFrame,
+    pub bias: f32,
+    pub max_steps: u32,
+}
+
+impl Raycast {
+    pub fn new(settings: RaycastSettings) -> Raycast {
+        Raycast {
+            settings,
+            max_binding: None,
+            state: None,
+        }
+    }
+
+    /// Splits the mesh into bindings of at most `bytes` (rounded down to whole tets).
+    pub fn with_max_binding(mut self, bytes: u64) -> Raycast {
+        self.max_binding = Some(bytes);
+        self
+    }
+
+    fn state(&self) -> anyhow::Result<&State> {
+        self.state
+            .as_ref()
+            .ok_or_else(|| anyhow!("raycast: prepare first"))
+    }
+
+    /// The packed mesh (for the CPU twin).
+    pub fn layout(&self) -> anyhow::Result<&MeshLayout> {
+        Ok(&self.state()?.layout)
+    }
+
+    /// Runs the shader's `exit_of` for arbitrary rays: (origin, direction, tet, λ at entry) →
+    /// (exit face, next tet, λ exit, s exit). For tests against [`crate::step::exit_of`].
+    pub fn probe(
+        &self,
+        gpu: &Gpu,
+        rays: &[([f32; 3], [f32; 3], TetRef, f32)],
+    ) -> anyhow::Result<Vec<(u32, TetRef, f32, f32)>> {
+        let st = self.state()?;
+        let mut input: Vec<[u32; 4]> = Vec::with_capacity(rays.len() * 3);
+        for (o, d, t, l) in rays {
+            let f = |v: f32| v.to_bits();
+            input.push([f(o[0]), f(o[1]), f(o[2]), f(*l)]);
+            input.push([f(d[0]), f(d[1]), f(d[2]), 0]);
+            input.push([t.chunk, t.local, 0, 0]);
+        }
+        let mut ledger = MemoryLedger::default();
+        let inbuf = ledger.buffer_init(
+            gpu,
+            "raycast probe in",
+            Lifetime::PerFrame,
+            bytemuck::cast_slice(&input),
+            wgpu::BufferUsages::STORAGE,
+        )?;
+        let out = ledger.buffer(
+            gpu,
+            "raycast probe out",
+            Lifetime::PerFrame,
+            rays.len() as u64 * 32,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        )?;
+        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("raycast probe"),
+            layout: &st.pipes.probe_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: inbuf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: out.as_entire_binding(),
+                },
+            ],
+        });
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&st.pipes.probe);
+            pass.set_bind_group(0, &st.mesh_bind, &[]);
+            pass.set_bind_group(1, &bind, &[]);
+            pass.dispatch_workgroups((rays.len() as u32).div_ceil(64), 1, 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let bytes = gpu.read_buffer(&out, 0, rays.len() as u64 * 32)?;
+        let raw: &[[u32; 4]] = bytemuck::cast_slice(&bytes);
+        Ok((0..rays.len())
+            .map(|k| {
+                let a = raw[2 * k];
+                let b = raw[2 * k + 1];
+                (
+                    a[0],
+                    TetRef {
+                        chunk: a[1],
+                        local: a[2],
+                    },
+                    f32::from_bits(a[3]),
+                    f32::from_bits(b[0]),
+                )
+            })
+            .collect())
+    }
+
+    /// Steps per pixel, peeling layers and passes per tile of the last frame.
+    pub fn pass_data(&self, gpu: &Gpu) -> anyhow::Result<PassData> {
+        let st = self.state()?;
+        let (t, last) = match (&st.target, &st.last) {
+            (Some(t), Some(l)) => (t, l),
+            _ => bail!("raycast: render before pass_data"),
+        };
+        let pixels = t.width as u64 * t.height as u64;
+        let aux = gpu.read_buffer(&t.aux, 0, pixels * 8)?;
+        let aux: &[[u32; 2]] = bytemuck::cast_slice(&aux);
+        let mut layers = Vec::new();
+        for l in 0..last.layers_used {
+            layers.push(read_layer(gpu, &t.layers, l, t.width, t.height)?);
+        }
+        Ok(PassData {
+            width: t.width,
+            height: t.height,
+            steps: aux.iter().map(|a| a[1]).collect(),
+            layers_used: last.layers_used,
+            layers,
+            tile_passes: last.tile_passes.clone(),
+            tile_size: last.tile_size,
+            ray_frame: RayFrame::new(&last.camera, st.layout.origin),
+            bias: (PEEL_BIAS * st.length_unit) as f32,
+            max_steps: st.max_steps,
+        })
+    }
+}
+
+/// Reads one layer of the peeling texture.
+fn read_layer(
+    gpu: &Gpu,
+    tex: &wgpu::Texture,
+    layer: u32,
+    w: u32,
+    h: u32,
+) -> anyhow::Result<Vec<Option<LayerEntry>>> {
+    let unpadded = w as u64 * 16;
+    let padded = unpadded.div_ceil(256) * 256;
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("raycast layer readback"),
+        size: padded * h as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture: tex,
+            mip_level: 0,
+            origin: wgpu::Origin3d {
+                x: 0,
+                y: 0,
+                z: layer,
+            },
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &staging,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded as u32),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+    );
+    gpu.queue.submit([enc.finish()]);
+    let bytes = gpu.read_buffer(&staging, 0, padded * h as u64)?;
+    let mut out = Vec::with_capacity((w * h) as usize);
+    for y in 0..h as usize {
+        let row: &[[u32; 4]] = bytemuck::cast_slice(
+            &bytes[y * padded as usize..y * padded as usize + unpadded as usize],
+        );
+        out.extend(row.iter().map(|&t| LayerEntry::decode(t)));
+    }
+    Ok(out)
+}
+
+fn tile_rects(w: u32, h: u32, n: u32) -> ([u32; 2], Vec<TileRect>) {
+    let (tw, th) = (w.div_ceil(n), h.div_ceil(n));
+    let mut v = Vec::new();
+    for ty in 0..n {
+        for tx in 0..n {
+            v.push(TileRect {
+                origin: [(tx * tw).min(w), (ty * th).min(h)],
+                end: [((tx + 1) * tw).min(w), ((ty + 1) * th).min(h)],
+            });
+        }
+    }
+    ([tw, th], v)
+}
+
+impl Renderer for Raycast {
+    fn algorithm(&self) -> &'static str {
+        "raycast"
+    }
+
+    fn settings(&self) -> Vec<Setting> {
+        self.settings.to_settings()
+    }
+
+    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+        self.state = None;
+        self.settings.validate()?;
+        let max_binding = self.max_binding.map_or(gpu.max_storage_binding(), |b| {
+            b.min(gpu.max_storage_binding())
+        });
+        let layout = MeshLayout::build(mesh, optics, max_binding)?;
+        let needed_storage = (MESH_SLOTS + 6) as u32;
+        if gpu.limits.max_storage_buffers_per_shader_stage < needed_storage {
+            bail!(
+                "raycast: adapter {} allows {} storage buffers per shader stage, {needed_storage} needed",
+                gpu.adapter.name,
+                gpu.limits.max_storage_buffers_per_shader_stage
+            );
+        }
+        let mut ledger = MemoryLedger::default();
+        let storage = wgpu::BufferUsages::STORAGE;
+        let chunk_buffers: Vec<wgpu::Buffer> = layout
+            .chunks
+            .iter()
+            .enumerate()
+            .map(|(c, data)| {
+                ledger.buffer_init(
+                    gpu,
+                    &format!("raycast mesh binding {c}"),
+                    Lifetime::Persistent,
+                    bytemuck::cast_slice(data),
+                    storage,
+                )
+            })
+            .collect::<anyhow::Result<_>>()?;
+        // Boundary faces as geometry (phase 1): position (OCS) and the tet's (binding, index).
+        let o = layout.origin;
+        let mut verts: Vec<u32> = Vec::with_capacity(mesh.boundary_faces().len() * 15);
+        for bf in mesh.boundary_faces() {
+            let r = layout.tet_ref(bf.tet);
+            for v in bf.vertices(mesh) {
+                let p = mesh.points[v as usize];
+                for a in 0..3 {
+                    verts.push(((p[a] as f64 - o[a]) as f32).to_bits());
+                }
+                verts.push(r.chunk);
+                verts.push(r.local);
+            }
+        }
+        let face_vertices = (verts.len() / 5) as u32;
+        let faces = ledger.buffer_init(
+            gpu,
+            "raycast boundary faces",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&verts),
+            wgpu::BufferUsages::VERTEX,
+        )?;
+        let (table_data, inv_table_length) = match self.settings.table {
+            TableKind::ThreeD => {
+                let t = Table3d::build(optics, TABLE_SCALAR, TABLE_LENGTH, layout.longest_edge);
+                (
+                    t.data,
+                    (1.0 / layout.longest_edge.max(f64::MIN_POSITIVE)) as f32,
+                )
+            }
+            TableKind::TwoD => {
+                let t = Table2d::build(optics, TABLE_SCALAR, layout.mean_edge);
+                (
+                    t.data,
+                    (1.0 / layout.mean_edge.max(f64::MIN_POSITIVE)) as f32,
+                )
+            }
+        };
+        let table = ledger.buffer_init(
+            gpu,
+            "raycast pre-integration table",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&table_data),
+            storage,
+        )?;
+        let table_bytes = table_data.len() as u64 * 16;
+        let frame_params = ledger.buffer(
+            gpu,
+            "raycast frame params",
+            Lifetime::PerFrame,
+            std::mem::size_of::<FrameParams>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        )?;
+        let pipes = Pipelines::new(gpu);
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: frame_params.as_entire_binding(),
+        }];
+        for slot in 0..MESH_SLOTS {
+            // Unused slots repeat binding 0 (never addressed).
+            let b = &chunk_buffers[slot.min(chunk_buffers.len() - 1)];
+            entries.push(wgpu::BindGroupEntry {
+                binding: slot as u32 + 1,
+                resource: b.as_entire_binding(),
+            });
+        }
+        let mesh_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("raycast frame + mesh"),
+            layout: &pipes.mesh_layout,
+            entries: &entries,
+        });
+        let n = mesh.num_tets() as u64;
+        // A guard against rays that cycle between tets through round-off: far more steps than
+        // a straight ray crosses in any mesh we know (counted as stalled when reached).
+        let max_steps = (64.0 * (n as f64).cbrt()).ceil() as u32 + 1024;
+        let persistent = ledger.persistent;
+        self.state = Some(State {
+            layout,
+            tets: n,
+            ledger,
+            pipes,
+            frame_params,
+            mesh_bind,
+            faces,
+            face_vertices,
+            table,
+            table_bytes,
+            inv_table_length,
+            length_unit: optics.length_unit,
+            max_steps,
+            target: None,
+            target_bytes: 0,
+            timer: FrameTimer::new(gpu),
+            last: None,
+        });
+        Ok(Prepared {
+            persistent_bytes: persistent,
+            tets: n,
+        })
+    }
+
+    fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
+        let s = self.settings;
+        let st = self
+            .state
+            .as_mut()
+            .ok_or_else(|| anyhow!("raycast: render before prepare"))?;
+        frame(gpu, st, &s, camera)
+    }
+
+    fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image> {
+        let st = self.state()?;
+        let t = st
+            .target
+            .as_ref()
+            .ok_or_else(|| anyhow!("raycast: read_image before render"))?;
+        let bytes = gpu
+            .read_buffer(&t.colours, 0, t.width as u64 * t.height as u64 * 16)
+            .context("raycast: reading the image back")?;
+        let mut img = Image::new(t.width, t.height);
+        img.pixels.copy_from_slice(bytemuck::cast_slice(&bytes));
+        Ok(img)
+    }
+
+    fn extra_image(&mut self, gpu: &Gpu) -> anyhow::Result<Option<(&'static str, Image)>> {
+        let d = self.pass_data(gpu)?;
+        let entered: Vec<bool> = match d.layers.first() {
+            Some(l0) => l0.iter().map(|e| e.is_some()).collect(),
+            None => vec![false; d.steps.len()],
+        };
+        Ok(Some((
+            "passes",
+            crate::passmap::pass_map(
+                d.width,
+                d.height,
+                self.settings.tiles,
+                d.tile_size,
+                &d.tile_passes,
+                &entered,
+            ),
+        )))
+    }
+}
+
+fn frame(
+    gpu: &Gpu,
+    st: &mut State,
+    s: &RaycastSettings,
+    camera: &Camera,
+) -> anyhow::Result<FrameStats> {
+    let (w, h) = (camera.width, camera.height);
+    let slots = s.max_layers + 1;
+    if st
+        .target
+        .as_ref()
+        .is_none_or(|t| t.width != w || t.height != h)
+    {
+        st.target = None;
+        let mut target_ledger = MemoryLedger::default();
+        st.target = Some(Target::new(
+            gpu,
+            &st.pipes,
+            &mut target_ledger,
+            &st.table,
+            w,
+            h,
+            slots,
+        )?);
+        st.target_bytes = target_ledger.per_frame;
+    }
+    let t = st.target.as_ref().expect("target created above");
+    let (tile_size, rects) = tile_rects(w, h, s.tiles);
+    let ntiles = rects.len();
+    st.timer.start_wall();
+    let started = Instant::now();
+    gpu.queue
+        .write_buffer(&t.tile_rects, 0, bytemuck::cast_slice(&rects));
+    let rf = RayFrame::new(camera, st.layout.origin);
+    let p4 = |v: [f32; 3]| [v[0], v[1], v[2], 0.0];
+    let model = glam::DMat4::from_translation(glam::DVec3::from(st.layout.origin));
+    let vp: glam::Mat4 = (camera.view_proj() * model).as_mat4();
+    // λ of the farthest point any ray can reach inside the fitted frustum (slightly beyond far).
+    let lambda_far = camera.far * 2.0;
+    let mut params = FrameParams {
+        o0: p4(rf.o0),
+        ox: p4(rf.ox),
+        oy: p4(rf.oy),
+        d0: p4(rf.d0),
+        dx: p4(rf.dx),
+        dy: p4(rf.dy),
+        view_proj: vp.to_cols_array_2d(),
+        size: [w, h, tile_size[0], tile_size[1]],
+        counts: [s.tiles, 0, st.max_steps, 0],
+        misc: [
+            (1.0 / lambda_far) as f32,
+            (PEEL_BIAS * st.length_unit) as f32,
+            ET_OPACITY,
+            st.inv_table_length,
+        ],
+        table: [TABLE_SCALAR as u32, TABLE_LENGTH as u32, s.max_layers, 0],
+    };
+    gpu.queue
+        .write_buffer(&st.frame_params, 0, bytemuck::bytes_of(&params));
+
+    // Phases 1–2: peel until a layer is empty (occlusion query) or the maximum is reached; then
+    // one more layer into the spare slot, only to count the re-entries that are dropped.
+    let mut layers_used = 0u32;
+    let mut dropped_check = false;
+    let t_peel = Instant::now();
+    for l in 0..slots {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        if l == 0 {
+            st.timer.begin(&mut enc);
+        }
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("raycast peel"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &t.layer_views[l as usize],
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color {
+                            r: u32::MAX as f64,
+                            g: u32::MAX as f64,
+                            b: u32::MAX as f64,
+                            a: u32::MAX as f64,
+                        }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &t.depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: Some(&t.occlusion),
+                multiview_mask: None,
+            });
+            if l == 0 {
+                pass.set_pipeline(&st.pipes.first);
+            } else {
+                pass.set_pipeline(&st.pipes.peel);
+                pass.set_bind_group(1, &t.peel_binds[l as usize - 1], &[]);
+            }
+            pass.set_bind_group(0, &st.mesh_bind, &[]);
+            pass.set_vertex_buffer(0, st.faces.slice(..));
+            pass.begin_occlusion_query(l);
+            pass.draw(0..st.face_vertices, 0..1);
+            pass.end_occlusion_query();
+        }
+        enc.resolve_query_set(
+            &t.occlusion,
+            l..l + 1,
+            &t.occlusion_resolve,
+            l as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
+        );
+        gpu.queue.submit([enc.finish()]);
+        let q = gpu.read_buffer(
+            &t.occlusion_resolve,
+            l as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
+            8,
+        )?;
+        let samples = u64::from_le_bytes(q[..8].try_into().expect("8 bytes"));
+        if samples == 0 {
+            break;
+        }
+        if l == s.max_layers {
+            dropped_check = true;
+            break;
+        }
+        layers_used += 1;
+    }
+    let peel_ms = t_peel.elapsed().as_secs_f64() * 1e3;
+
+    // Rays start at their first entry; active rays are counted per tile.
+    params.counts[1] = layers_used;
+    params.counts[3] = if s.early_termination { FLAG_ET } else { 0 }
+        | if s.table == TableKind::ThreeD {
+            FLAG_TABLE3D
+        } else {
+            0
+        }
+        | if dropped_check { FLAG_COUNT_DROPPED } else { 0 };
+    gpu.queue
+        .write_buffer(&st.frame_params, 0, bytemuck::bytes_of(&params));
+    gpu.queue.write_buffer(&t.stats, 0, &[0u8; STAT_SLOTS * 4]);
+    gpu.queue
+        .write_buffer(&t.tile_counts, 0, &[0u8; MAX_TILES * 4]);
+    let t_cast = Instant::now();
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&st.pipes.init);
+        pass.set_bind_group(0, &st.mesh_bind, &[]);
+        pass.set_bind_group(1, &t.cast_binds[0], &[]);
+        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+    }
+    gpu.queue.submit([enc.finish()]);
+    let mut counts = read_counts(gpu, &t.tile_counts, ntiles)?;
+    let mut tile_passes = vec![0u32; ntiles];
+    let mut rounds = 0u32;
+    // One dispatch per pass covers every listed tile (workgroup z = slot in the list).
+    let groups = [tile_size[0].div_ceil(8), tile_size[1].div_ceil(8)];
+    let list = |counts: &[u32]| -> Vec<u32> {
+        (0..ntiles as u32)
+            .filter(|&i| counts[i as usize] > 0)
+            .collect()
+    };
+    match s.mode {
+        Mode::Passes => {
+            // Phase 3: rounds of k passes over the tiles that still have active rays; the last
+            // pass of a round counts them, and tiles at zero leave the list.
+            loop {
+                let active = list(&counts);
+                if active.is_empty() {
+                    break;
+                }
+                gpu.queue
+                    .write_buffer(&t.active_tiles, 0, bytemuck::cast_slice(&active));
+                gpu.queue
+                    .write_buffer(&t.tile_counts, 0, &[0u8; MAX_TILES * 4]);
+                let mut enc = gpu.device.create_command_encoder(&Default::default());
+                {
+                    let mut pass = enc.begin_compute_pass(&Default::default());
+                    pass.set_pipeline(&st.pipes.step);
+                    pass.set_bind_group(0, &st.mesh_bind, &[]);
+                    for k in 0..COUNT_EVERY {
+                        let count = (k + 1 == COUNT_EVERY) as usize;
+                        pass.set_bind_group(1, &t.cast_binds[count], &[]);
+                        pass.dispatch_workgroups(groups[0], groups[1], active.len() as u32);
+                    }
+                }
+                gpu.queue.submit([enc.finish()]);
+                for &tile in &active {
+                    tile_passes[tile as usize] += COUNT_EVERY;
+                }
+                rounds += 1;
+                counts = read_counts(gpu, &t.tile_counts, ntiles)?;
+            }
+        }
+        Mode::Loop => {
+            let active = list(&counts);
+            if !active.is_empty() {
+                gpu.queue
+                    .write_buffer(&t.active_tiles, 0, bytemuck::cast_slice(&active));
+                let mut enc = gpu.device.create_command_encoder(&Default::default());
+                {
+                    let mut pass = enc.begin_compute_pass(&Default::default());
+                    pass.set_pipeline(&st.pipes.run_loop);
+                    pass.set_bind_group(0, &st.mesh_bind, &[]);
+                    pass.set_bind_group(1, &t.cast_binds[0], &[]);
+                    pass.dispatch_workgroups(groups[0], groups[1], active.len() as u32);
+                }
+                gpu.queue.submit([enc.finish()]);
+                for &tile in &active {
+                    tile_passes[tile as usize] = 1;
+                }
+            }
+        }
+    }
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    st.timer.end(&mut enc);
+    gpu.queue.submit([enc.finish()]);
+    let stats_bytes = gpu.read_buffer(&t.stats, 0, STAT_SLOTS as u64 * 4)?;
+    let cast_ms = t_cast.elapsed().as_secs_f64() * 1e3;
+    let total_ms = started.elapsed().as_secs_f64() * 1e3;
+    let gpu_ms = st.timer.gpu_ms(gpu)?;
+    let stats: &[u32] = bytemuck::cast_slice(&stats_bytes);
+    let entered = stats[STAT_ENTERED] as f64;
+    let max_passes = tile_passes.iter().copied().max().unwrap_or(0);
+    let mean_passes = tile_passes.iter().map(|&p| p as f64).sum::<f64>() / ntiles as f64;
+    let counters = vec![
+        ("passes_max".to_string(), max_passes as f64),
+        ("passes_mean".to_string(), mean_passes),
+        (
+            "tiles_empty".to_string(),
+            tile_passes.iter().filter(|&&p| p == 0).count() as f64,
+        ),
+        ("count_rounds".to_string(), rounds as f64),
+        ("peel_layers".to_string(), layers_used as f64),
+        ("rays".to_string(), entered),
+        (
+            "steps_mean".to_string(),
+            if entered > 0.0 {
+                stats[STAT_STEPS] as f64 / entered
+            } else {
+                0.0
+            },
+        ),
+        ("steps_max".to_string(), stats[STAT_MAX_STEPS] as f64),
+        (
+            "early_terminated_rays".to_string(),
+            stats[STAT_TERMINATED] as f64,
+        ),
+        ("stalled_rays".to_string(), stats[STAT_STALLED] as f64),
+        ("dropped_reentries".to_string(), stats[STAT_DROPPED] as f64),
+        ("skipped_entries".to_string(), stats[STAT_SKIPPED] as f64),
+        (
+            "mesh_bytes_per_tet".to_string(),
+            st.layout.bytes() as f64 / st.tets.max(1) as f64,
+        ),
+        ("table_bytes".to_string(), st.table_bytes as f64),
+        ("mesh_bindings".to_string(), st.layout.chunks.len() as f64),
+    ];
+    st.last = Some(LastFrame {
+        camera: camera.clone(),
+        layers_used,
+        tile_passes,
+        tile_size,
+    });
+    Ok(FrameStats {
+        cpu_ms: 0.0,
+        gpu_ms,
+        total_ms,
+        frame_bytes: st.ledger.per_frame + st.target_bytes,
+        stages: vec![("peel".to_string(), peel_ms), ("cast".to_string(), cast_ms)],
+        counters,
+    })
+}
+
+fn read_counts(gpu: &Gpu, buf: &wgpu::Buffer, n: usize) -> anyhow::Result<Vec<u32>> {
+    let b = gpu.read_buffer(buf, 0, n as u64 * 4)?;
+    Ok(bytemuck::cast_slice(&b).to_vec())
+}

@@ -1,0 +1,438 @@
+//! GPU objects of the ray caster: the bind group layouts and pipelines (created once per
+//! mesh), and the per-viewport traversal buffers, peeling layers and tile parameters.
+
+use render_core::gpu::{Lifetime, MemoryLedger};
+use render_core::Gpu;
+
+use crate::layout::MESH_SLOTS;
+
+/// Slots of the statistics buffer (see `STAT_*` in cast.wgsl).
+pub const STAT_SLOTS: usize = 8;
+/// At most 6 × 6 tiles (the paper's largest tiling).
+pub const MAX_TILES: usize = 36;
+
+/// The frame parameters (`Frame` in common.wgsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameParams {
+    pub o0: [f32; 4],
+    pub ox: [f32; 4],
+    pub oy: [f32; 4],
+    pub d0: [f32; 4],
+    pub dx: [f32; 4],
+    pub dy: [f32; 4],
+    pub view_proj: [[f32; 4]; 4],
+    pub size: [u32; 4],
+    pub counts: [u32; 4],
+    pub misc: [f32; 4],
+    pub table: [u32; 4],
+}
+
+/// One tile's rectangle (`TileRect` in cast.wgsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct TileRect {
+    pub origin: [u32; 2],
+    pub end: [u32; 2],
+}
+
+fn buffer_entry(
+    binding: u32,
+    ty: wgpu::BufferBindingType,
+    dynamic: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: dynamic,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn uint_texture_entry(binding: u32, dim: wgpu::TextureViewDimension) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Uint,
+            view_dimension: dim,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+const RO: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: true };
+const RW: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: false };
+const UNIFORM: wgpu::BufferBindingType = wgpu::BufferBindingType::Uniform;
+
+pub const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Layouts and pipelines, independent of the viewport.
+pub struct Pipelines {
+    pub mesh_layout: wgpu::BindGroupLayout,
+    pub peel_layout: wgpu::BindGroupLayout,
+    pub cast_layout: wgpu::BindGroupLayout,
+    pub probe_layout: wgpu::BindGroupLayout,
+    pub first: wgpu::RenderPipeline,
+    pub peel: wgpu::RenderPipeline,
+    pub init: wgpu::ComputePipeline,
+    pub step: wgpu::ComputePipeline,
+    pub run_loop: wgpu::ComputePipeline,
+    pub probe: wgpu::ComputePipeline,
+}
+
+impl Pipelines {
+    pub fn new(gpu: &Gpu) -> Pipelines {
+        let dev = &gpu.device;
+        let mut mesh_entries = vec![buffer_entry(0, UNIFORM, false)];
+        mesh_entries.extend((1..=MESH_SLOTS as u32).map(|b| buffer_entry(b, RO, false)));
+        let mesh_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("raycast frame + mesh"),
+            entries: &mesh_entries,
+        });
+        let peel_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("raycast previous layer"),
+            entries: &[uint_texture_entry(0, wgpu::TextureViewDimension::D2)],
+        });
+        let cast_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("raycast traversal"),
+            entries: &[
+                buffer_entry(0, RW, false),
+                buffer_entry(1, RW, false),
+                buffer_entry(2, RW, false),
+                uint_texture_entry(3, wgpu::TextureViewDimension::D2Array),
+                buffer_entry(4, RO, false),
+                buffer_entry(5, RW, false),
+                buffer_entry(6, RW, false),
+                buffer_entry(7, RO, false),
+                buffer_entry(8, RO, false),
+                buffer_entry(9, UNIFORM, false),
+            ],
+        });
+        let probe_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("raycast probe"),
+            entries: &[buffer_entry(0, RO, false), buffer_entry(1, RW, false)],
+        });
+        let common = include_str!("common.wgsl");
+        let peel_src = format!("{common}\n{}", include_str!("peel.wgsl"));
+        let cast_src = format!("{common}\n{}", include_str!("cast.wgsl"));
+        let probe_src = format!("{common}\n{}", include_str!("probe.wgsl"));
+        let peel_module = gpu.shader("raycast peel", &peel_src);
+        let cast_module = gpu.shader("raycast cast", &cast_src);
+        let probe_module = gpu.shader("raycast probe", &probe_src);
+        let layout = |label: &str, groups: &[&wgpu::BindGroupLayout]| {
+            let groups: Vec<Option<&wgpu::BindGroupLayout>> =
+                groups.iter().map(|g| Some(*g)).collect();
+            dev.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &groups,
+                immediate_size: 0,
+            })
+        };
+        let first_layout = layout("raycast first hit", &[&mesh_layout]);
+        let peel_pl = layout("raycast peel", &[&mesh_layout, &peel_layout]);
+        let cast_pl = layout("raycast cast", &[&mesh_layout, &cast_layout]);
+        let probe_pl = layout("raycast probe", &[&mesh_layout, &probe_layout]);
+        let raster = |label: &str, pl: &wgpu::PipelineLayout, fs: &str| {
+            dev.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(pl),
+                vertex: wgpu::VertexState {
+                    module: &peel_module,
+                    entry_point: Some("vs_face"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: 20,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32x2],
+                    })],
+                },
+                // §2.4: only front-facing boundary faces (back faces culled); boundary faces are
+                // wound counter-clockwise seen from outside the mesh.
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    front_face: wgpu::FrontFace::Ccw,
+                    cull_mode: Some(wgpu::Face::Back),
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &peel_module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: LAYER_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let first = raster("raycast first hit", &first_layout, "fs_first");
+        let peel = raster("raycast peel", &peel_pl, "fs_peel");
+        let init = gpu.compute_pipeline("raycast init", Some(&cast_pl), &cast_module, "init");
+        let step = gpu.compute_pipeline("raycast step", Some(&cast_pl), &cast_module, "step");
+        let run_loop =
+            gpu.compute_pipeline("raycast loop", Some(&cast_pl), &cast_module, "run_loop");
+        let probe = gpu.compute_pipeline("raycast probe", Some(&probe_pl), &probe_module, "probe");
+        Pipelines {
+            mesh_layout,
+            peel_layout,
+            cast_layout,
+            probe_layout,
+            first,
+            peel,
+            init,
+            step,
+            run_loop,
+            probe,
+        }
+    }
+}
+
+/// Everything sized by the viewport: traversal structures (the paper's Table 2: current cell
+/// and colour, plus the layer index and step count per ray), the peeling layers, the depth
+/// buffer, per-tile parameters and counters.
+pub struct Target {
+    pub width: u32,
+    pub height: u32,
+    pub rays: wgpu::Buffer,
+    pub colours: wgpu::Buffer,
+    pub aux: wgpu::Buffer,
+    pub layers: wgpu::Texture,
+    /// One view per layer (render attachments and the previous-layer input of peeling).
+    pub layer_views: Vec<wgpu::TextureView>,
+    pub depth_view: wgpu::TextureView,
+    pub tile_rects: wgpu::Buffer,
+    pub active_tiles: wgpu::Buffer,
+    pub tile_counts: wgpu::Buffer,
+    pub stats: wgpu::Buffer,
+    /// `cast_binds[c]`: traversal bindings with the pass's count flag `c` (0: plain pass,
+    /// 1: the pass that ends a round and counts active rays).
+    pub cast_binds: [wgpu::BindGroup; 2],
+    /// `peel_binds[l]` reads layer `l` (used while peeling layer `l + 1`).
+    pub peel_binds: Vec<wgpu::BindGroup>,
+    pub occlusion: wgpu::QuerySet,
+    pub occlusion_resolve: wgpu::Buffer,
+}
+
+impl Target {
+    /// `layer_slots` = maximum peeling layers + 1 (the slot that counts dropped re-entries).
+    pub fn new(
+        gpu: &Gpu,
+        pipes: &Pipelines,
+        ledger: &mut MemoryLedger,
+        table: &wgpu::Buffer,
+        width: u32,
+        height: u32,
+        layer_slots: u32,
+    ) -> anyhow::Result<Target> {
+        let pixels = width as u64 * height as u64;
+        let storage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let rays = ledger.buffer(
+            gpu,
+            "raycast current cell",
+            Lifetime::PerFrame,
+            pixels * 16,
+            storage,
+        )?;
+        let colours = ledger.buffer(
+            gpu,
+            "raycast colour",
+            Lifetime::PerFrame,
+            pixels * 16,
+            storage,
+        )?;
+        let aux = ledger.buffer(
+            gpu,
+            "raycast layer + steps",
+            Lifetime::PerFrame,
+            pixels * 8,
+            storage,
+        )?;
+        let tile_counts = ledger.buffer(
+            gpu,
+            "raycast tile counts",
+            Lifetime::PerFrame,
+            MAX_TILES as u64 * 4,
+            storage,
+        )?;
+        let stats = ledger.buffer(
+            gpu,
+            "raycast stats",
+            Lifetime::PerFrame,
+            STAT_SLOTS as u64 * 4,
+            storage,
+        )?;
+        let tile_rects = ledger.buffer(
+            gpu,
+            "raycast tile rectangles",
+            Lifetime::PerFrame,
+            MAX_TILES as u64 * 16,
+            storage,
+        )?;
+        let active_tiles = ledger.buffer(
+            gpu,
+            "raycast active tiles",
+            Lifetime::PerFrame,
+            MAX_TILES as u64 * 4,
+            storage,
+        )?;
+        let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        let pass_flags: Vec<wgpu::Buffer> = (0..2u32)
+            .map(|c| {
+                let mut bytes = [0u8; 16];
+                bytes[..4].copy_from_slice(&c.to_le_bytes());
+                ledger.buffer_init(
+                    gpu,
+                    "raycast pass flag",
+                    Lifetime::PerFrame,
+                    &bytes,
+                    uniform,
+                )
+            })
+            .collect::<anyhow::Result<_>>()?;
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: layer_slots,
+        };
+        let layers = ledger.texture(
+            gpu,
+            Lifetime::PerFrame,
+            &wgpu::TextureDescriptor {
+                label: Some("raycast peeling layers"),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: LAYER_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            },
+        )?;
+        let depth = ledger.texture(
+            gpu,
+            Lifetime::PerFrame,
+            &wgpu::TextureDescriptor {
+                label: Some("raycast depth"),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            },
+        )?;
+        let layer_views: Vec<wgpu::TextureView> = (0..layer_slots)
+            .map(|l| {
+                layers.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some("raycast layer"),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: l,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let array_view = layers.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("raycast layers"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        fn buf(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry {
+                binding,
+                resource: b.as_entire_binding(),
+            }
+        }
+        let cast_bind = |flag: &wgpu::Buffer| {
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("raycast traversal"),
+                layout: &pipes.cast_layout,
+                entries: &[
+                    buf(0, &rays),
+                    buf(1, &colours),
+                    buf(2, &aux),
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&array_view),
+                    },
+                    buf(4, table),
+                    buf(5, &tile_counts),
+                    buf(6, &stats),
+                    buf(7, &tile_rects),
+                    buf(8, &active_tiles),
+                    buf(9, flag),
+                ],
+            })
+        };
+        let cast_binds = [cast_bind(&pass_flags[0]), cast_bind(&pass_flags[1])];
+        let peel_binds = layer_views
+            .iter()
+            .map(|v| {
+                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("raycast previous layer"),
+                    layout: &pipes.peel_layout,
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(v),
+                    }],
+                })
+            })
+            .collect();
+        let occlusion = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("raycast peel occlusion"),
+            ty: wgpu::QueryType::Occlusion,
+            count: layer_slots,
+        });
+        let occlusion_resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("raycast occlusion resolve"),
+            size: layer_slots as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        Ok(Target {
+            width,
+            height,
+            rays,
+            colours,
+            aux,
+            layers,
+            layer_views,
+            depth_view: depth.create_view(&Default::default()),
+            tile_rects,
+            active_tiles,
+            tile_counts,
+            stats,
+            cast_binds,
+            peel_binds,
+            occlusion,
+            occlusion_resolve,
+        })
+    }
+}

@@ -1,0 +1,142 @@
+//! The paper's knobs as typed settings, and the variants the harness runs.
+
+use anyhow::anyhow;
+use render_core::{Renderer, Setting};
+
+/// Which pre-integration table composites a segment (§2.2, §4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TableKind {
+    /// (s_front, s_back) for one fixed length, scaled by the segment length as the paper's
+    /// code does; every figure of the paper except Table 6.
+    TwoD,
+    /// (s_front, s_back, length / longest edge); the paper's Table 6.
+    ThreeD,
+}
+
+impl TableKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            TableKind::TwoD => "2d",
+            TableKind::ThreeD => "3d",
+        }
+    }
+}
+
+/// How ray steps are scheduled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// Faithful: one GPU pass per ray step and tile, as on 2005 hardware; a tile stops when a
+    /// count of its active rays (every [`crate::COUNT_EVERY`] passes) is zero.
+    Passes,
+    /// Modern: one compute dispatch per tile in which every ray loops until it is done.
+    Loop,
+}
+
+impl Mode {
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Passes => "passes",
+            Mode::Loop => "loop",
+        }
+    }
+}
+
+/// The settings of one variant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RaycastSettings {
+    /// N for an N×N tiling of the screen (§2.3; the paper: 1…6).
+    pub tiles: u32,
+    pub table: TableKind,
+    pub mode: Mode,
+    /// Early ray termination at opacity [`crate::ET_OPACITY`].
+    pub early_termination: bool,
+    /// Most peeling layers (§2.4); re-entries beyond are counted as dropped.
+    pub max_layers: u32,
+}
+
+impl Default for RaycastSettings {
+    fn default() -> Self {
+        RaycastSettings {
+            tiles: 5,
+            table: TableKind::TwoD,
+            mode: Mode::Passes,
+            early_termination: true,
+            max_layers: 8,
+        }
+    }
+}
+
+impl RaycastSettings {
+    pub fn to_settings(&self) -> Vec<Setting> {
+        vec![
+            Setting::new("tiles", format!("{0}x{0}", self.tiles)),
+            Setting::new("table", self.table.name()),
+            Setting::new("mode", self.mode.name()),
+            Setting::new("et", if self.early_termination { "on" } else { "off" }),
+            Setting::new("layers", self.max_layers),
+        ]
+    }
+
+    /// Checks the ranges (tiles 1…6, at least one layer).
+    pub fn validate(&self) -> anyhow::Result<()> {
+        if !(1..=6).contains(&self.tiles) {
+            return Err(anyhow!(
+                "raycast: tiles must be 1x1 … 6x6, got {}",
+                self.tiles
+            ));
+        }
+        if self.max_layers == 0 || self.max_layers > 64 {
+            return Err(anyhow!(
+                "raycast: layers must be 1 … 64, got {}",
+                self.max_layers
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Peeling-layer limits `--settings layers=…` can choose.
+pub const LAYER_CHOICES: [u32; 4] = [4, 8, 16, 32];
+
+/// The default variants (the default suite runs each, so they are kept to two): the paper's
+/// configuration (5×5 tiles, 2D table, one pass per step, early termination) and the
+/// exact-order image (3D table, no early termination) in the modern looping mode. Every other
+/// combination is reachable with `--settings` (e.g. `tiles=1x1|5x5;table=2d|3d;mode=passes|loop`).
+pub fn default_variants() -> Vec<Box<dyn Renderer>> {
+    let base = RaycastSettings::default();
+    [
+        base,
+        RaycastSettings {
+            table: TableKind::ThreeD,
+            early_termination: false,
+            mode: Mode::Loop,
+            ..base
+        },
+    ]
+    .into_iter()
+    .map(|s| Box::new(crate::Raycast::new(s)) as Box<dyn Renderer>)
+    .collect()
+}
+
+/// Every combination: tiles 1…6 × table × mode × et × layers.
+pub fn all_variants() -> Vec<Box<dyn Renderer>> {
+    let mut v: Vec<Box<dyn Renderer>> = Vec::new();
+    for tiles in 1..=6 {
+        for table in [TableKind::TwoD, TableKind::ThreeD] {
+            for mode in [Mode::Passes, Mode::Loop] {
+                for et in [true, false] {
+                    for max_layers in LAYER_CHOICES {
+                        v.push(Box::new(crate::Raycast::new(RaycastSettings {
+                            tiles,
+                            table,
+                            mode,
+                            early_termination: et,
+                            max_layers,
+                        })));
+                    }
+                }
+            }
+        }
+    }
+    v
+}

@@ -1,0 +1,316 @@
+//! The ray caster against its CPU twin and the exact reference, on lavapipe at small sizes:
+//!
+//! * one ray step (exit face, next tet, exit λ and scalar) on random rays, shader vs twin;
+//! * every pixel's step count equals the twin's walk from the same peeling layers, every tile's
+//!   pass count is the number of k-pass rounds its slowest ray needs, and an empty tile runs
+//!   no pass;
+//! * the image against the reference on a non-convex mesh (rays leave and re-enter) and on SPX;
+//! * a mesh split over several bindings renders the same image as in one binding, and both
+//!   modes agree.
+
+use datasets::TetMesh;
+use raycast::layout::{MeshLayout, TetRef, BYTES_PER_TET};
+use raycast::step;
+use raycast::{Mode, Raycast, RaycastSettings, TableKind, COUNT_EVERY};
+use render_core::{
+    fixed_viewpoints, Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction,
+};
+
+fn gpu() -> Gpu {
+    Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)")
+}
+
+fn psnr(a: &Image, b: &Image) -> f64 {
+    let mut se = 0.0;
+    for (p, q) in a.pixels.iter().zip(&b.pixels) {
+        for c in 0..3 {
+            let d = p[c].clamp(0.0, 1.0) as f64 - q[c].clamp(0.0, 1.0) as f64;
+            se += d * d;
+        }
+    }
+    let mse = se / (a.pixels.len() * 3) as f64;
+    if mse == 0.0 {
+        99.0
+    } else {
+        -10.0 * mse.log10()
+    }
+}
+
+fn exact() -> RaycastSettings {
+    RaycastSettings {
+        tiles: 3,
+        table: TableKind::ThreeD,
+        mode: Mode::Passes,
+        early_termination: false,
+        max_layers: 8,
+    }
+}
+
+fn shell() -> TetMesh {
+    datasets::generate::from_spec("shell:20k", 1).unwrap()
+}
+
+/// SplitMix64 for reproducible random rays.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[test]
+fn layout_is_144_bytes_per_tet_and_splits_across_bindings() {
+    let mesh = shell();
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    let n = mesh.num_tets() as u64;
+    let one = MeshLayout::build(&mesh, &optics, 1 << 27).unwrap();
+    assert_eq!(one.bytes(), BYTES_PER_TET * n);
+    assert_eq!(one.chunks.len(), 1);
+    // Three bindings: every neighbour pair still names the right tet.
+    let per = n.div_ceil(3) * BYTES_PER_TET;
+    let split = MeshLayout::build(&mesh, &optics, per).unwrap();
+    assert_eq!(split.chunks.len(), 3);
+    assert_eq!(split.bytes(), BYTES_PER_TET * n);
+    for (t, adj) in mesh.adjacency().iter().enumerate() {
+        let r = split.tet_ref(t as u32);
+        assert_eq!(split.global(r), t as u32);
+        let x = split.texels(r);
+        // Geometry and scalar are the same in both; only the neighbour addresses differ.
+        let whole = one.texels(one.tet_ref(t as u32));
+        assert_eq!(x[..6], whole[..6]);
+        assert_eq!(x[8], whole[8]);
+        for (f, &nb) in adj.iter().enumerate() {
+            let pair = x[6 + f / 2];
+            let got = TetRef {
+                chunk: pair[2 * (f % 2)],
+                local: pair[2 * (f % 2) + 1],
+            };
+            assert_eq!(got, split.tet_ref(nb), "tet {t} face {f}");
+        }
+    }
+    // Too many bindings is an error naming the mesh, not a panic.
+    let err = MeshLayout::build(&mesh, &optics, BYTES_PER_TET * 10)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("storage bindings"), "{err}");
+}
+
+#[test]
+fn one_step_on_the_gpu_agrees_with_the_cpu_twin() {
+    let gpu = gpu();
+    let mesh = shell();
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    let mut r = Raycast::new(exact()).with_max_binding(mesh.num_tets().div_ceil(2) as u64 * 144);
+    r.prepare(&gpu, &mesh, &optics).unwrap();
+    let layout = r.layout().unwrap().clone();
+    assert_eq!(layout.chunks.len(), 2);
+    let mut rng = Rng(7);
+    let scale = mesh.bounds().diagonal() as f32;
+    let mut rays = Vec::new();
+    for _ in 0..4000 {
+        let t = (rng.next() * mesh.num_tets() as f64) as u32 % mesh.num_tets() as u32;
+        let tref = layout.tet_ref(t);
+        // A point inside the tet (positive barycentric weights), a random direction.
+        let w: [f64; 4] = std::array::from_fn(|_| rng.next() + 0.05);
+        let sum: f64 = w.iter().sum();
+        let p = mesh.tet_points(t as usize);
+        let x: [f32; 3] = std::array::from_fn(|a| {
+            ((0..4).map(|k| w[k] * p[k][a]).sum::<f64>() / sum - layout.origin[a]) as f32
+        });
+        let (th, ph) = (
+            rng.next() * std::f64::consts::TAU,
+            (2.0 * rng.next() - 1.0).acos(),
+        );
+        let d = [
+            (ph.sin() * th.cos()) as f32,
+            (ph.sin() * th.sin()) as f32,
+            ph.cos() as f32,
+        ];
+        // Start the ray a random distance before the point, with λ at the point.
+        let back = rng.next() as f32 * scale;
+        let o = std::array::from_fn(|a| x[a] - back * d[a]);
+        rays.push((o, d, tref, back));
+    }
+    let got = r.probe(&gpu, &rays).unwrap();
+    let mut ties = 0;
+    for ((o, d, t, l), (face, next, lambda, s)) in rays.iter().zip(&got) {
+        let cpu = step::exit_of(&layout, *t, *o, *d, *l);
+        let tol = 2e-5 * scale;
+        if cpu.face != *face {
+            // Only where two faces give (almost) the same exit: a ray through an edge.
+            assert!(
+                (cpu.runner_up - cpu.lambda).abs() < tol,
+                "face {} vs {face} at {cpu:?}",
+                cpu.face
+            );
+            ties += 1;
+            continue;
+        }
+        assert_eq!(cpu.next, *next);
+        assert!(
+            (cpu.lambda - lambda).abs() <= tol,
+            "λ {} vs {lambda}",
+            cpu.lambda
+        );
+        assert!((cpu.s - s).abs() <= 1e-4, "s {} vs {s}", cpu.s);
+    }
+    assert!(ties <= 4, "{ties} ties in 4000 random rays");
+}
+
+/// Renders `mesh` from `view` at `size`², returning the image and the pass data.
+fn render(
+    gpu: &Gpu,
+    r: &mut Raycast,
+    mesh: &TetMesh,
+    optics: &Optics,
+    view: usize,
+    size: u32,
+) -> (Image, raycast::PassData, render_core::FrameStats, Camera) {
+    let camera = Camera::fit(
+        &mesh.bounds(),
+        &fixed_viewpoints()[view],
+        Projection::default(),
+        size,
+        size,
+    );
+    r.prepare(gpu, mesh, optics).unwrap();
+    let stats = r.render(gpu, &camera).unwrap();
+    let img = r.read_image(gpu).unwrap();
+    assert!(img.pixels.iter().all(|p| p.iter().all(|v| v.is_finite())));
+    let data = r.pass_data(gpu).unwrap();
+    (img, data, stats, camera)
+}
+
+fn counter(stats: &render_core::FrameStats, name: &str) -> f64 {
+    stats
+        .counters
+        .iter()
+        .find(|(k, _)| k == name)
+        .map(|(_, v)| *v)
+        .unwrap()
+}
+
+#[test]
+fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
+    let gpu = gpu();
+    let mesh = shell();
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    let settings = RaycastSettings {
+        tiles: 6,
+        ..exact()
+    };
+    let mut r = Raycast::new(settings);
+    // View 6 is the first diagonal: the sphere leaves the screen's corner tiles empty.
+    let (_, d, stats, _) = render(&gpu, &mut r, &mesh, &optics, 6, 72);
+    assert!(
+        d.layers_used >= 2,
+        "a shell needs at least two layers, got {}",
+        d.layers_used
+    );
+    let layout = r.layout().unwrap();
+    let mut reentering = 0;
+    for y in 0..d.height {
+        for x in 0..d.width {
+            let i = (y * d.width + x) as usize;
+            let entries: Vec<_> = d.layers.iter().map(|l| l[i]).collect();
+            let (o, dir) = d.ray_frame.ray(x as f32 + 0.5, y as f32 + 0.5);
+            let w = step::walk(layout, &entries, o, dir, d.bias, d.max_steps);
+            assert_eq!(w.steps, d.steps[i], "pixel ({x}, {y})");
+            assert!(!w.stalled);
+            if entries.iter().filter(|e| e.is_some()).count() > 1 {
+                reentering += 1;
+            }
+        }
+    }
+    assert!(reentering > 0, "no ray re-entered the shell");
+    let n = settings.tiles;
+    let mut empty = 0;
+    for ty in 0..n {
+        for tx in 0..n {
+            let mut max_steps = 0;
+            for y in ty * d.tile_size[1]..((ty + 1) * d.tile_size[1]).min(d.height) {
+                for x in tx * d.tile_size[0]..((tx + 1) * d.tile_size[0]).min(d.width) {
+                    max_steps = max_steps.max(d.steps[(y * d.width + x) as usize]);
+                }
+            }
+            let passes = d.tile_passes[(ty * n + tx) as usize];
+            assert_eq!(
+                passes,
+                max_steps.div_ceil(COUNT_EVERY) * COUNT_EVERY,
+                "tile ({tx}, {ty})"
+            );
+            if max_steps == 0 {
+                empty += 1;
+                assert_eq!(passes, 0);
+            }
+        }
+    }
+    assert!(empty > 0, "expected empty corner tiles");
+    assert_eq!(counter(&stats, "tiles_empty"), empty as f64);
+    assert_eq!(counter(&stats, "stalled_rays"), 0.0);
+    assert_eq!(counter(&stats, "mesh_bytes_per_tet"), 144.0);
+}
+
+#[test]
+fn images_match_the_reference_on_a_non_convex_mesh_in_both_modes_and_across_bindings() {
+    let gpu = gpu();
+    let mesh = shell();
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    let size = 64;
+    let mut passes = Raycast::new(exact());
+    let (img, _, stats, camera) = render(&gpu, &mut passes, &mesh, &optics, 6, size);
+    let reference = reference::render(&mesh, &optics, &camera);
+    let p = psnr(&img, &reference);
+    eprintln!(
+        "shell:20k 3D table, et=off: {p:.2} dB, counters {:?}",
+        stats.counters
+    );
+    assert!(p >= 45.0, "{p:.2} dB");
+    let mut looped = Raycast::new(RaycastSettings {
+        mode: Mode::Loop,
+        tiles: 1,
+        ..exact()
+    });
+    let (img_loop, ..) = render(&gpu, &mut looped, &mesh, &optics, 6, size);
+    let mut split =
+        Raycast::new(exact()).with_max_binding(mesh.num_tets().div_ceil(3) as u64 * 144);
+    let (img_split, _, split_stats, _) = render(&gpu, &mut split, &mesh, &optics, 6, size);
+    assert_eq!(counter(&split_stats, "mesh_bindings"), 3.0);
+    // The same arithmetic in the same order: identical images.
+    assert_eq!(img.pixels, img_loop.pixels);
+    assert_eq!(img.pixels, img_split.pixels);
+    // The 2D table with early termination (the paper's figures) is an approximation.
+    let mut paper = Raycast::new(RaycastSettings::default());
+    let (img_2d, _, stats_2d, _) = render(&gpu, &mut paper, &mesh, &optics, 6, size);
+    let p2 = psnr(&img_2d, &reference);
+    eprintln!(
+        "shell:20k 2D table, et=on: {p2:.2} dB, counters {:?}",
+        stats_2d.counters
+    );
+    assert!(p2 >= 50.0, "{p2:.2} dB");
+}
+
+#[test]
+fn spx_matches_the_reference() {
+    let Some(path) = datasets::registry::test_data_file("spx.vtk") else {
+        return;
+    };
+    let mesh = datasets::load::load(&path, &Default::default())
+        .unwrap()
+        .mesh;
+    let gpu = gpu();
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    let mut r = Raycast::new(exact());
+    let (img, _, stats, camera) = render(&gpu, &mut r, &mesh, &optics, 6, 96);
+    let reference = reference::render(&mesh, &optics, &camera);
+    let p = psnr(&img, &reference);
+    eprintln!(
+        "spx 3D table, et=off: {p:.2} dB, counters {:?}",
+        stats.counters
+    );
+    assert!(p >= 45.0, "{p:.2} dB");
+}
