@@ -59,7 +59,15 @@ fn row(algorithm: &str, settings: &str, dataset: &str, viewpoint: &str, i: usize
         image: String::new(),
         reference_image: String::new(),
         heatmap: String::new(),
+        image_f32: String::new(),
+        image_hash: String::new(),
+        roofline_ms: None,
+        limit_fraction: None,
+        bound_by: String::new(),
+        normalized_time: None,
+        suspect: String::new(),
         error: String::new(),
+        samples: Default::default(),
     }
 }
 
