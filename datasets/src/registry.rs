@@ -216,6 +216,25 @@ impl Registry {
                 paper,
             });
         }
+        out.push(Entry {
+            name: "vol:64".into(),
+            description: "generated volume: smooth compact bumps on a 64³ grid (any vol:N or vol:NXxNYxNZ[:eff=COUNT])".into(),
+            files: vec![],
+            present: true,
+            paper: "regular volume for splatting (Grau & Tost 2007)",
+        });
+        for (name, dims, eff) in crate::gen_volume::TABLE1_STANDINS {
+            out.push(Entry {
+                name: format!("standin:{name}"),
+                description: format!(
+                    "generated volume {}×{}×{} with {eff} effective voxels",
+                    dims[0], dims[1], dims[2]
+                ),
+                files: vec![],
+                present: true,
+                paper: "stand-in for a Grau & Tost 2007 Table 1 volume (size only)",
+            });
+        }
         out
     }
 
@@ -225,6 +244,15 @@ impl Registry {
         let key = name_or_path.trim();
         if let Some(n) = NAMED.iter().find(|n| n.name.eq_ignore_ascii_case(key)) {
             return self.load_named(n, options);
+        }
+        if crate::gen_volume::is_volume_spec(key) {
+            let mesh = crate::gen_volume::from_volume_spec(key)?;
+            let volume = mesh.source_grid.as_deref().cloned();
+            return Ok(Dataset {
+                mesh,
+                volume,
+                source: key.to_string(),
+            });
         }
         if crate::generate::is_spec(key) {
             let mesh = crate::generate::from_spec(key, 1)?;
@@ -260,7 +288,7 @@ impl Registry {
         Err(LoadError::new(
             key,
             ErrorKind::Io(format!(
-                "no such file, named data set ({}) or generator spec (box|shell|tunnels|slivers:SIZE[:field=…][:seed=…])",
+                "no such file, named data set ({}) or generator spec (box|shell|tunnels|slivers:SIZE[:field=…][:seed=…], vol:N[:eff=…], standin:NAME)",
                 known.join(", ")
             )),
         ))

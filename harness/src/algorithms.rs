@@ -18,6 +18,7 @@ const TABLE: &[(&str, Variants, Variants)] = &[
         fragment_pt::default_variants,
         fragment_pt::all_variants,
     ),
+    ("splat", splat::default_variants, splat::all_variants),
 ];
 
 fn all_gator_variants() -> Vec<Box<dyn Renderer>> {

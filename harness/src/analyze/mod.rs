@@ -10,6 +10,7 @@ use clap::Subcommand;
 
 pub mod fragment_pt;
 pub mod havs;
+pub mod splat;
 pub mod summary;
 
 /// What every analysis may need from the global options.
@@ -35,6 +36,8 @@ pub enum AnalyzeCommand {
     Kbuffer(havs::KbufferArgs),
     /// HAVS Tables 3 and 4 from a finished `tetbench run --algorithms havs`.
     HavsTables(havs::TablesArgs),
+    /// Grau & Tost 2007 Table 1 (CPU vs GPU buckets) from a finished `tetbench run --algorithms splat`.
+    Splat(splat::Args),
 }
 
 pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
@@ -45,5 +48,6 @@ pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
         AnalyzeCommand::Sort(args) => havs::run_sort(args, ctx),
         AnalyzeCommand::Kbuffer(args) => havs::run_kbuffer(args, ctx),
         AnalyzeCommand::HavsTables(args) => havs::run_tables(args, ctx),
+        AnalyzeCommand::Splat(args) => splat::run(args, ctx),
     }
 }
