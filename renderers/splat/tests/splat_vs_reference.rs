@@ -169,8 +169,8 @@ fn single_voxel_matches_its_analytic_projection() {
         eprintln!("single voxel {vp}: peak alpha {peak:.3}, worst error so far {worst:.2e}");
     }
     // The footprint table is sampled bilinearly from 32² texels (0.125 kernel units) and
-    // linearly between 8 slices per slab: the measured worst error is ~1e-3.
-    assert!(worst < 4e-3, "worst channel error {worst}");
+    // linearly between 8 slices per slab: the measured worst error is 3.0e-3 (lavapipe).
+    assert!(worst < 5e-3, "worst channel error {worst}");
 }
 
 /// Issue 10: a smooth generated volume against the exact reference of its tet split, both
