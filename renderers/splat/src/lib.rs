@@ -125,15 +125,18 @@ pub fn all_variants() -> Vec<Box<dyn Renderer>> {
             for (radius, slab) in [(2.0, 1.0), (2.0, 0.5), (1.5, 1.5)] {
                 for grid in [32, 64, 128] {
                     for ese in [true, false] {
-                        out.push(Box::new(Splat::new(SplatSettings {
-                            buckets,
-                            sort,
-                            radius,
-                            slab,
-                            grid,
-                            ese,
-                            ..Default::default()
-                        })));
+                        for brick in [None, Some(1_000_000)] {
+                            out.push(Box::new(Splat::new(SplatSettings {
+                                buckets,
+                                sort,
+                                radius,
+                                slab,
+                                grid,
+                                ese,
+                                brick,
+                                ..Default::default()
+                            })));
+                        }
                     }
                 }
             }

@@ -206,30 +206,31 @@ fn smooth_volume_agrees_with_the_reference_of_its_tet_split() {
             &optics,
             &cam,
         );
-        let bricked = render(
-            &gpu,
-            SplatSettings {
-                brick: Some(3000),
-                ..Default::default()
-            },
-            &mesh,
-            &optics,
-            &cam,
-        );
+        let mut br = Splat::new(SplatSettings {
+            brick: Some(3000),
+            ..Default::default()
+        });
+        br.prepare(&gpu, &mesh, &optics).unwrap();
+        let bricks = br.voxels().unwrap().bricks.len();
+        assert!(bricks > 4, "{bricks} bricks");
+        br.render(&gpu, &cam).unwrap();
+        let bricked = br.read_image(&gpu).unwrap();
         let (d_radix, d_cpu) = (max_diff(&gpu_img, &radix), max_diff(&gpu_img, &cpu));
         let p_brick = psnr(&bricked, &gpu_img);
         eprintln!(
             "vol:28 {name}: PSNR vs reference {p:.2} dB; max |gpu−radix| {d_radix:.1e}, \
-             max |gpu−cpu| {d_cpu:.1e}; bricked vs whole {p_brick:.2} dB, vs reference {:.2} dB",
+             max |gpu−cpu| {d_cpu:.1e}; {bricks} bricks vs whole {p_brick:.2} dB, vs reference {:.2} dB",
             psnr(&bricked, &reference)
         );
         // Same voxels in the same order: only the rounding of depths may differ.
         assert!(d_radix < 1e-4 && d_cpu < 1e-4, "{d_radix} {d_cpu}");
-        // Post-classified splatting is not exact: see README (the kernel smooths the linear
-        // field, and each slab is classified by its mean value). Measured on lavapipe ~(see
-        // README); the bound is 3 dB below.
-        assert!(p > 30.0, "{name}: {p:.2} dB");
-        assert!(p_brick > 30.0, "{name} bricked: {p_brick:.2} dB");
+        // Post-classified splatting is not exact (README, "Splatting"): the Gaussian kernel
+        // (σ = 0.65 voxel) smooths the piecewise-linear field of the tets, and each slab is
+        // classified by its mean value rather than integrated through the transfer function.
+        // Measured on lavapipe: 46.7 dB perspective, 46.3 dB orthographic; bricked
+        // (3,000 voxels a brick) vs whole 66 dB. Bounds 3 dB below the measurements (bricks: 60 dB).
+        assert!(p > 43.0, "{name}: {p:.2} dB");
+        assert!(p_brick > 60.0, "{name} bricked: {p_brick:.2} dB");
     }
 }
 
@@ -252,5 +253,7 @@ fn resampled_mesh_is_close_to_the_reference() {
     let img = r.read_image(&gpu).unwrap();
     let p = psnr(&img, &reference);
     eprintln!("box:3k resampled on 32 points: PSNR {p:.2} dB");
-    assert!(p > 25.0, "{p:.2} dB");
+    // Measured on lavapipe: 34.2 dB (the resampling adds its own error: 32 points across a
+    // box of ~8 tets per side, and points outside the mesh are not splatted). Bound 3 dB below.
+    assert!(p > 31.0, "{p:.2} dB");
 }
