@@ -55,7 +55,12 @@ pub struct VolumeSpec {
 
 /// Whether `s` names a generated volume (`vol:…`, `standin:…`).
 pub fn is_volume_spec(s: &str) -> bool {
-    let head = s.split(':').next().unwrap_or("").trim().to_ascii_lowercase();
+    let head = s
+        .split(':')
+        .next()
+        .unwrap_or("")
+        .trim()
+        .to_ascii_lowercase();
     s.contains(':') && (head == "vol" || head == "standin")
 }
 
@@ -89,7 +94,12 @@ pub fn parse_volume_spec(spec: &str) -> Result<VolumeSpec, ErrorKind> {
             .split('x')
             .map(|d| d.parse::<usize>().ok().filter(|&d| (2..=4096).contains(&d)))
             .collect::<Option<Vec<_>>>()
-            .ok_or_else(|| syntax("grid points per axis, 2…4096: vol:64 or vol:128x96x64", &size))?;
+            .ok_or_else(|| {
+                syntax(
+                    "grid points per axis, 2…4096: vol:64 or vol:128x96x64",
+                    &size,
+                )
+            })?;
         let dims = match dims[..] {
             [n] => [n; 3],
             [x, y, z] => [x, y, z],
@@ -112,19 +122,17 @@ pub fn parse_volume_spec(spec: &str) -> Result<VolumeSpec, ErrorKind> {
                         .ok_or_else(|| syntax("eff=<voxel count> such as 233k", v))?,
                 )
             }
-            "seed" => {
-                out.seed = v
-                    .trim()
-                    .parse()
-                    .map_err(|_| syntax("seed=<integer>", v))?
-            }
+            "seed" => out.seed = v.trim().parse().map_err(|_| syntax("seed=<integer>", v))?,
             _ => return Err(syntax("an option eff=… or seed=…", opt)),
         }
     }
     let n: usize = out.dims.iter().product();
     if let Some(e) = out.effective {
         if e == 0 || e >= n {
-            return Err(syntax(&format!("eff between 1 and {} (voxels)", n - 1), &e.to_string()));
+            return Err(syntax(
+                &format!("eff between 1 and {} (voxels)", n - 1),
+                &e.to_string(),
+            ));
         }
     }
     Ok(out)
@@ -194,7 +202,11 @@ pub fn volume_grid(spec: &VolumeSpec) -> Result<VoxelGrid, ErrorKind> {
         let mut values: Vec<f32> = (0..n)
             .into_par_iter()
             .map(|g| {
-                let p = [g % dims[0], (g / dims[0]) % dims[1], g / (dims[0] * dims[1])];
+                let p = [
+                    g % dims[0],
+                    (g / dims[0]) % dims[1],
+                    g / (dims[0] * dims[1]),
+                ];
                 field(&bs, p.map(|c| c as f64)) as f32
             })
             .collect();
@@ -300,7 +312,14 @@ mod tests {
         assert_eq!((s.dims, s.effective, s.seed), ([20, 12, 8], Some(300), 4));
         let s = parse_volume_spec("standin:Lobster").unwrap();
         assert_eq!((s.dims, s.effective), ([324, 301, 56], Some(233_000)));
-        for bad in ["vol:1", "vol:8x8", "vol:abc", "standin:teapot", "vol:8:eff=9999", "vol:8:x=1"] {
+        for bad in [
+            "vol:1",
+            "vol:8x8",
+            "vol:abc",
+            "standin:teapot",
+            "vol:8:eff=9999",
+            "vol:8:x=1",
+        ] {
             assert!(parse_volume_spec(bad).is_err(), "{bad}");
         }
         assert!(is_volume_spec("vol:8") && is_volume_spec("standin:bonsai"));

@@ -152,10 +152,7 @@ impl std::fmt::Debug for TetMesh {
             .field("tets", &self.tets.len())
             .field("scalar_name", &self.scalar_name)
             .field("repair", &self.repair)
-            .field(
-                "source_grid",
-                &self.source_grid.as_ref().map(|g| g.dims),
-            )
+            .field("source_grid", &self.source_grid.as_ref().map(|g| g.dims))
             .finish()
     }
 }

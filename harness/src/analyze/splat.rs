@@ -219,7 +219,13 @@ pub fn write_table(rows: &[Row], out: &Path) -> anyhow::Result<String> {
                 format!("{:.1}", p.gpu_buckets_fps),
                 format!("{:.2}", p.gpu_buckets_fps / p.cpu_buckets_fps),
             ),
-            None => ("not in paper".into(), "–".into(), "–".into(), "–".into(), "–".into()),
+            None => (
+                "not in paper".into(),
+                "–".into(),
+                "–".into(),
+                "–".into(),
+                "–".into(),
+            ),
         };
         let _ = writeln!(
             md,
@@ -252,7 +258,10 @@ pub fn write_table(rows: &[Row], out: &Path) -> anyhow::Result<String> {
             p.map_or(String::new(), |p| p.effective_voxels.to_string()),
             p.map_or(String::new(), |p| p.cpu_buckets_fps.to_string()),
             p.map_or(String::new(), |p| p.gpu_buckets_fps.to_string()),
-            p.map_or(String::new(), |p| format!("{:.4}", p.gpu_buckets_fps / p.cpu_buckets_fps)),
+            p.map_or(String::new(), |p| format!(
+                "{:.4}",
+                p.gpu_buckets_fps / p.cpu_buckets_fps
+            )),
             l.settings
         );
     }

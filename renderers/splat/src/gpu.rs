@@ -127,20 +127,37 @@ impl Pipelines {
                 storage(5, c, false),
             ],
         );
-        let compute_module = gpu.shader("splat compute.wgsl", &with_frame(include_str!("compute.wgsl")));
+        let compute_module = gpu.shader(
+            "splat compute.wgsl",
+            &with_frame(include_str!("compute.wgsl")),
+        );
         let cpl = pipeline_layout("splat buckets", &[&compute_layout]);
-        let transform = gpu.compute_pipeline("splat transform", Some(&cpl), &compute_module, "transform");
+        let transform =
+            gpu.compute_pipeline("splat transform", Some(&cpl), &compute_module, "transform");
         let gather = gpu.compute_pipeline("splat gather", Some(&cpl), &compute_module, "gather");
-        let boundaries =
-            gpu.compute_pipeline("splat boundaries", Some(&cpl), &compute_module, "boundaries");
+        let boundaries = gpu.compute_pipeline(
+            "splat boundaries",
+            Some(&cpl),
+            &compute_module,
+            "boundaries",
+        );
 
         let bitonic_layout = layout(
             "splat bitonic",
-            &[uniform(0, c, true), storage(1, c, false), storage(2, c, false)],
+            &[
+                uniform(0, c, true),
+                storage(1, c, false),
+                storage(2, c, false),
+            ],
         );
         let bitonic_module = gpu.shader("splat bitonic.wgsl", include_str!("bitonic.wgsl"));
         let bpl = pipeline_layout("splat bitonic", &[&bitonic_layout]);
-        let bitonic = gpu.compute_pipeline("splat bitonic", Some(&bpl), &bitonic_module, "bitonic_stage");
+        let bitonic = gpu.compute_pipeline(
+            "splat bitonic",
+            Some(&bpl),
+            &bitonic_module,
+            "bitonic_stage",
+        );
 
         let splat_layout = layout(
             "splat sheet",
@@ -151,7 +168,10 @@ impl Pipelines {
                 float_texture(3),
             ],
         );
-        let slab_layout = layout("splat slab", &[uniform(0, wgpu::ShaderStages::VERTEX, true)]);
+        let slab_layout = layout(
+            "splat slab",
+            &[uniform(0, wgpu::ShaderStages::VERTEX, true)],
+        );
         let splat_module = gpu.shader("splat splat.wgsl", &with_frame(include_str!("splat.wgsl")));
         let add = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
@@ -180,8 +200,10 @@ impl Pipelines {
                 storage(2, wgpu::ShaderStages::FRAGMENT, true),
             ],
         );
-        let composite_module =
-            gpu.shader("splat composite.wgsl", &with_frame(include_str!("composite.wgsl")));
+        let composite_module = gpu.shader(
+            "splat composite.wgsl",
+            &with_frame(include_str!("composite.wgsl")),
+        );
         // Front-to-back "under": C += (1 − A_dst) · C_src, premultiplied.
         let under = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::OneMinusDstAlpha,

@@ -188,7 +188,8 @@ impl FootprintTable {
                         for sx in 0..TEXEL_SUBSAMPLES {
                             let sub = |t: usize, s: usize| {
                                 -kernel.radius
-                                    + texel * (t as f64 + (s as f64 + 0.5) / TEXEL_SUBSAMPLES as f64)
+                                    + texel
+                                        * (t as f64 + (s as f64 + 0.5) / TEXEL_SUBSAMPLES as f64)
                             };
                             let (x, y) = (sub(tx, sx), sub(ty, sy));
                             sum += kernel.z_integral((x * x + y * y).sqrt(), z0, z1);

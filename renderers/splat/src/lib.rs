@@ -33,8 +33,8 @@ use anyhow::{bail, Context};
 use datasets::TetMesh;
 use render_core::gpu_sort::GpuRadixSort;
 use render_core::{
-    Camera, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics, Prepared,
-    Renderer, Setting,
+    Camera, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics, Prepared, Renderer,
+    Setting,
 };
 
 pub use buckets::{bucket_ends, depth, SlabGeometry};
@@ -220,7 +220,13 @@ impl Splat {
         let row = depth_row(camera);
         let (mut dmin, mut dmax) = (f64::INFINITY, f64::NEG_INFINITY);
         for c in 0..8 {
-            let p = [0, 1, 2].map(|a| if c >> a & 1 == 1 { st.set.max[a] } else { st.set.min[a] });
+            let p = [0, 1, 2].map(|a| {
+                if c >> a & 1 == 1 {
+                    st.set.max[a]
+                } else {
+                    st.set.min[a]
+                }
+            });
             let d = depth(row, [p[0] as f32, p[1] as f32, p[2] as f32, 0.0]) as f64;
             dmin = dmin.min(d);
             dmax = dmax.max(d);
@@ -628,7 +634,12 @@ impl Renderer for Splat {
         let cap = s.brick.map_or(cap, |b| b.min(cap));
         let mut set = VoxelSet::new(mesh, optics, s.grid, cap);
         set.border_voxels = set.count_border_voxels(s.radius);
-        let table = FootprintTable::new(Kernel::new(s.radius, SIGMA), s.slab, s.subslices, s.footprint);
+        let table = FootprintTable::new(
+            Kernel::new(s.radius, SIGMA),
+            s.slab,
+            s.subslices,
+            s.footprint,
+        );
         let mut ledger = MemoryLedger::default();
         let storage = wgpu::BufferUsages::STORAGE;
         let bricks: Vec<wgpu::Buffer> = set
@@ -660,10 +671,12 @@ impl Renderer for Splat {
             storage,
         );
         // Enough slabs for any view: the voxels' diagonal plus the kernel on both sides.
-        let d = (0..3).map(|a| (set.max[a] - set.min[a]).powi(2)).sum::<f64>().sqrt();
-        let max_slabs = ((d + 2.0 * s.radius * set.kernel_unit) / (s.slab * set.kernel_unit))
-            .ceil() as u32
-            + 4;
+        let d = (0..3)
+            .map(|a| (set.max[a] - set.min[a]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let max_slabs =
+            ((d + 2.0 * s.radius * set.kernel_unit) / (s.slab * set.kernel_unit)).ceil() as u32 + 4;
         let mut slab_params = vec![0u8; max_slabs as usize * UNIFORM_STRIDE as usize];
         for i in 0..max_slabs as usize {
             let o = i * UNIFORM_STRIDE as usize;
@@ -698,8 +711,20 @@ impl Renderer for Splat {
         );
         let gpu_side = s.buckets == Buckets::Gpu;
         let key_len = if gpu_side { padded_max } else { 1 } as u64;
-        let keys = ledger.buffer(gpu, "splat depth keys", Lifetime::PerFrame, key_len * 4, storage | wgpu::BufferUsages::COPY_SRC);
-        let vals = ledger.buffer(gpu, "splat voxel ids", Lifetime::PerFrame, key_len * 4, storage);
+        let keys = ledger.buffer(
+            gpu,
+            "splat depth keys",
+            Lifetime::PerFrame,
+            key_len * 4,
+            storage | wgpu::BufferUsages::COPY_SRC,
+        );
+        let vals = ledger.buffer(
+            gpu,
+            "splat voxel ids",
+            Lifetime::PerFrame,
+            key_len * 4,
+            storage,
+        );
         let sorted = ledger.buffer(
             gpu,
             "splat depth-sorted voxels",
@@ -751,7 +776,10 @@ impl Renderer for Splat {
     }
 
     fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
-        let st = self.state.as_mut().context("splat: render before prepare")?;
+        let st = self
+            .state
+            .as_mut()
+            .context("splat: render before prepare")?;
         st.timer.start_wall();
         self.ensure_targets(gpu, camera.width, camera.height);
         let st = self.state.as_ref().unwrap();
@@ -825,18 +853,29 @@ impl Renderer for Splat {
                 ("splats".into(), stats.splats as f64),
                 (
                     "bytes_per_voxel".into(),
-                    if eff > 0.0 { st.voxel_bytes as f64 / eff } else { 0.0 },
+                    if eff > 0.0 {
+                        st.voxel_bytes as f64 / eff
+                    } else {
+                        0.0
+                    },
                 ),
                 (
                     "voxels_per_sec".into(),
-                    if total_ms > 0.0 { eff / (total_ms * 1e-3) } else { 0.0 },
+                    if total_ms > 0.0 {
+                        eff / (total_ms * 1e-3)
+                    } else {
+                        0.0
+                    },
                 ),
             ],
         })
     }
 
     fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image> {
-        let t = self.targets.as_ref().context("splat: read_image before render")?;
+        let t = self
+            .targets
+            .as_ref()
+            .context("splat: read_image before render")?;
         gpu.read_rgba32f(&t.image)
     }
 }
@@ -847,6 +886,8 @@ fn params_u32(dst: &mut [u8], v: u32) {
 
 impl std::fmt::Debug for Splat {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Splat").field("settings", &self.settings).finish()
+        f.debug_struct("Splat")
+            .field("settings", &self.settings)
+            .finish()
     }
 }

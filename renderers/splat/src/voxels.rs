@@ -114,7 +114,11 @@ impl VoxelSet {
             .par_iter()
             .map(|&(s, i)| {
                 let i = i as usize;
-                let p = g.point(i % dims[0], (i / dims[0]) % dims[1], i / (dims[0] * dims[1]));
+                let p = g.point(
+                    i % dims[0],
+                    (i / dims[0]) % dims[1],
+                    i / (dims[0] * dims[1]),
+                );
                 [p[0] as f32, p[1] as f32, p[2] as f32, s]
             })
             .collect();
@@ -157,7 +161,8 @@ impl VoxelSet {
                     .filter(|v| {
                         (0..3).any(|a| {
                             let x = v[a] as f64;
-                            let face = |i: usize| self.origin[a] + (i as f64 - 0.5) * self.spacing[a];
+                            let face =
+                                |i: usize| self.origin[a] + (i as f64 - 0.5) * self.spacing[a];
                             (b.lo[a] > 0 && x - face(b.lo[a]) < r)
                                 || (b.hi[a] < self.dims[a] && face(b.hi[a]) - x < r)
                         })
@@ -227,8 +232,14 @@ fn build(
     let mut parts: Vec<Vec<(f32, u32)>> = vec![vec![]; 8];
     for &(s, i) in list {
         let i_us = i as usize;
-        let c = [i_us % dims[0], (i_us / dims[0]) % dims[1], i_us / (dims[0] * dims[1])];
-        let o = (0..3).map(|a| ((c[a] >= mid[a]) as usize) << a).sum::<usize>();
+        let c = [
+            i_us % dims[0],
+            (i_us / dims[0]) % dims[1],
+            i_us / (dims[0] * dims[1]),
+        ];
+        let o = (0..3)
+            .map(|a| ((c[a] >= mid[a]) as usize) << a)
+            .sum::<usize>();
         parts[o].push((s, i));
     }
     let children = parts

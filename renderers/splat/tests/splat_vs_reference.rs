@@ -50,7 +50,13 @@ fn render(gpu: &Gpu, s: SplatSettings, mesh: &TetMesh, optics: &Optics, cam: &Ca
 }
 
 fn camera(mesh: &TetMesh, vp: &str, dir: [f64; 3], projection: Projection, size: u32) -> Camera {
-    Camera::fit(&mesh.bounds(), &Viewpoint::new(vp, dir), projection, size, size)
+    Camera::fit(
+        &mesh.bounds(),
+        &Viewpoint::new(vp, dir),
+        projection,
+        size,
+        size,
+    )
 }
 
 fn volume(spec: &str) -> TetMesh {
@@ -181,7 +187,10 @@ fn smooth_volume_agrees_with_the_reference_of_its_tet_split() {
     let gpu = gpu();
     let mesh = volume("vol:28");
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
-    for (proj, name) in [(Projection::default(), "perspective"), (Projection::Orthographic, "orthographic")] {
+    for (proj, name) in [
+        (Projection::default(), "perspective"),
+        (Projection::Orthographic, "orthographic"),
+    ] {
         let cam = camera(&mesh, "+x+y+z", [1.0, 1.0, 1.0], proj, 96);
         let reference = reference::render(&mesh, &optics, &cam);
         let gpu_img = render(&gpu, SplatSettings::default(), &mesh, &optics, &cam);
@@ -249,7 +258,10 @@ fn resampled_mesh_is_close_to_the_reference() {
     assert!(v.resampled);
     assert_eq!(v.dims.iter().copied().max(), Some(32));
     let stats = r.render(&gpu, &cam).unwrap();
-    assert!(stats.counters.iter().any(|(k, v)| k == "resampled" && *v == 1.0));
+    assert!(stats
+        .counters
+        .iter()
+        .any(|(k, v)| k == "resampled" && *v == 1.0));
     let img = r.read_image(&gpu).unwrap();
     let p = psnr(&img, &reference);
     eprintln!("box:3k resampled on 32 points: PSNR {p:.2} dB");
