@@ -334,7 +334,7 @@ mod tests {
         assert_eq!(m.num_points(), g.num_voxels());
         assert_eq!(m.points[g.index(3, 2, 1)], [3.0, 2.0, 1.0]);
         // Only support cells are split; all of them are non-degenerate.
-        assert!(m.num_tets() < 23 * 19 * 15 * 5 && m.num_tets() % 5 == 0);
+        assert!(m.num_tets() < 23 * 19 * 15 * 5 && m.num_tets().is_multiple_of(5));
         assert_eq!(m.repair.degenerate_dropped, 0);
         assert_eq!(m.scalar_range(), (0.0, 1.0));
         let full = from_volume_spec("vol:12").unwrap();
