@@ -3,6 +3,7 @@
 //! data sets resolved from a data directory.
 
 pub mod error;
+pub mod gen_volume;
 pub mod generate;
 pub mod load;
 pub mod mesh;

@@ -135,6 +135,12 @@ pub struct TetMesh {
     /// Every tet positively oriented and of non-zero volume.
     pub tets: Vec<[u32; 4]>,
     pub repair: RepairReport,
+    /// The regular grid this mesh was split from (volume files, generated volumes), for
+    /// renderers that work on voxels (`splat`); `None` for unstructured meshes. When set, mesh
+    /// point `i` is grid point `i` (same position and value; x fastest), and the tets split
+    /// the grid's cells (every cell, or for generated volumes with compact support only the
+    /// cells with a non-zero corner: see `crate::gen_volume`). Other renderers ignore it.
+    pub source_grid: Option<std::sync::Arc<crate::volume::VoxelGrid>>,
     cache: DerivedCache,
 }
 
@@ -146,6 +152,7 @@ impl std::fmt::Debug for TetMesh {
             .field("tets", &self.tets.len())
             .field("scalar_name", &self.scalar_name)
             .field("repair", &self.repair)
+            .field("source_grid", &self.source_grid.as_ref().map(|g| g.dims))
             .finish()
     }
 }
@@ -288,6 +295,7 @@ impl TetMesh {
             scalar_name: scalar_name.into(),
             tets: kept,
             repair,
+            source_grid: None,
             cache: DerivedCache::default(),
         })
     }

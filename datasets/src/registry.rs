@@ -178,6 +178,8 @@ enum Source {
     File(PathBuf),
     /// A stand-in or `NAME@splitN` ([`crate::standins`]).
     StandIn,
+    /// A generated volume (`vol:N`, `standin:NAME`, [`crate::gen_volume`]).
+    Volume,
 }
 
 /// Resolves names, specs and paths to data sets.
@@ -227,6 +229,25 @@ impl Registry {
                 paper,
             });
         }
+        out.push(Entry {
+            name: "vol:64".into(),
+            description: "generated volume: smooth compact bumps on a 64³ grid (any vol:N or vol:NXxNYxNZ[:eff=COUNT])".into(),
+            files: vec![],
+            present: true,
+            paper: "regular volume for splatting (Grau & Tost 2007)",
+        });
+        for (name, dims, eff) in crate::gen_volume::TABLE1_STANDINS {
+            out.push(Entry {
+                name: format!("standin:{name}"),
+                description: format!(
+                    "generated volume {}×{}×{} with {eff} effective voxels",
+                    dims[0], dims[1], dims[2]
+                ),
+                files: vec![],
+                present: true,
+                paper: "stand-in for a Grau & Tost 2007 Table 1 volume (size only)",
+            });
+        }
         out
     }
 
@@ -256,6 +277,15 @@ impl Registry {
                 })
             }
             Source::File(p) => crate::load::load(&p, options),
+            Source::Volume => {
+                let mesh = crate::gen_volume::from_volume_spec(key)?;
+                let volume = mesh.source_grid.as_deref().cloned();
+                Ok(Dataset {
+                    mesh,
+                    volume,
+                    source: key.to_string(),
+                })
+            }
             Source::StandIn => crate::standins::resolve(self, key, options).unwrap_or_else(|| {
                 Err(LoadError::new(
                     key,
@@ -288,6 +318,10 @@ impl Registry {
         if crate::standins::find(key).is_some() {
             return Ok(Source::StandIn);
         }
+        if crate::gen_volume::is_volume_spec(key) {
+            crate::gen_volume::parse_volume_spec(key).map_err(|k| LoadError::new(key, k))?;
+            return Ok(Source::Volume);
+        }
         if crate::generate::is_spec(key) {
             crate::generate::parse_spec(key).map_err(|k| LoadError::new(key, k))?;
             return Ok(Source::Generated);
@@ -307,7 +341,7 @@ impl Registry {
         Err(LoadError::new(
             key,
             ErrorKind::Io(format!(
-                "no such file, named data set ({}) or generator spec (box|shell|tunnels|slivers|onion:SIZE[:field=…][:seed=…]); `tetbench datasets list` shows them",
+                "no such file, named data set ({}) or generator spec (box|shell|tunnels|slivers|onion:SIZE[:field=…][:seed=…], vol:N[:eff=…], standin:NAME); `tetbench datasets list` shows them",
                 known.join(", ")
             )),
         ))

@@ -80,6 +80,12 @@ impl VoxelGrid {
     /// the uniform bin structure, the work is O(tets + covered grid points) and parallel, and
     /// the smallest containing tet wins, so the result is deterministic.
     pub fn resample(mesh: &TetMesh, dims: [usize; 3]) -> VoxelGrid {
+        VoxelGrid::resample_with_inside(mesh, dims).0
+    }
+
+    /// [`VoxelGrid::resample`], also returning which grid points lie inside the mesh (the
+    /// others hold the minimum only as a filler; a splatter must not draw them).
+    pub fn resample_with_inside(mesh: &TetMesh, dims: [usize; 3]) -> (VoxelGrid, Vec<bool>) {
         let dims = dims.map(|d| d.max(1));
         let b = mesh.bounds();
         let mut origin = b.min;
@@ -149,13 +155,20 @@ impl VoxelGrid {
                 (0..4).map(|c| w[c] * s[c]).sum::<f64>() as f32
             })
             .collect();
-        VoxelGrid {
-            dims,
-            spacing,
-            origin,
-            values,
-            scalar_name: mesh.scalar_name.clone(),
-        }
+        let inside = claim
+            .par_iter()
+            .map(|c| c.load(Ordering::Relaxed) != u32::MAX)
+            .collect();
+        (
+            VoxelGrid {
+                dims,
+                spacing,
+                origin,
+                values,
+                scalar_name: mesh.scalar_name.clone(),
+            },
+            inside,
+        )
     }
 }
 

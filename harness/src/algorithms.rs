@@ -19,6 +19,7 @@ const TABLE: &[(&str, Variants, Variants)] = &[
         fragment_pt::all_variants,
     ),
     ("raycast", raycast::default_variants, raycast::all_variants),
+    ("splat", splat::default_variants, splat::all_variants),
     ("vtk-pt", vtk_peer::pt_variants, vtk_peer::pt_variants),
     (
         "vtk-raycast",

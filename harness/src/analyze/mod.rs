@@ -11,6 +11,7 @@ use clap::Subcommand;
 pub mod fragment_pt;
 pub mod havs;
 pub mod raycast;
+pub mod splat;
 pub mod summary;
 
 /// What every analysis may need from the global options.
@@ -39,6 +40,8 @@ pub enum AnalyzeCommand {
     /// Tiled ray casting (Bernardon et al. 2005) Tables 3–6 from a finished
     /// `tetbench run --algorithms raycast`, beside the paper's.
     Raycast(raycast::Args),
+    /// Grau & Tost 2007 Table 1 (CPU vs GPU buckets) from a finished `tetbench run --algorithms splat`.
+    Splat(splat::Args),
 }
 
 pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
@@ -50,5 +53,6 @@ pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
         AnalyzeCommand::Kbuffer(args) => havs::run_kbuffer(args, ctx),
         AnalyzeCommand::HavsTables(args) => havs::run_tables(args, ctx),
         AnalyzeCommand::Raycast(args) => raycast::run(args, ctx),
+        AnalyzeCommand::Splat(args) => splat::run(args, ctx),
     }
 }

@@ -1,0 +1,34 @@
+// Classifies and composites one sheet (post-classification): the sheet holds the slab's mean
+// value (sum v*w / sum w) and its coverage w; the transfer function is applied to the mean,
+// the extinction weighted by the coverage (so the data set's boundary keeps its mass), over
+// the ray's length through the slab; front-to-back "under" blending into the image.
+
+@group(0) @binding(0) var<uniform> fr: Frame;
+@group(0) @binding(1) var sheet: texture_2d<f32>;
+@group(0) @binding(2) var<storage, read> tf: array<vec4<f32>>;
+
+@vertex
+fn fullscreen_vs(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
+    let x = f32((vi << 1u) & 2u) * 2.0 - 1.0;
+    let y = f32(vi & 2u) * 2.0 - 1.0;
+    return vec4<f32>(x, y, 0.5, 1.0);
+}
+
+@fragment
+fn composite_fs(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let sw = textureLoad(sheet, vec2<i32>(pos.xy), 0).xy;
+    if (sw.y <= 1e-6) {
+        discard;
+    }
+    let s = clamp(sw.x / sw.y, 0.0, 1.0);
+    let x = s * f32(fr.tf_entries - 1u);
+    let i0 = min(u32(floor(x)), fr.tf_entries - 2u);
+    let e = mix(tf[i0], tf[i0 + 1u], x - f32(i0));
+    var len = fr.delta_world;
+    if (fr.perspective != 0u) {
+        let ndc = vec2<f32>(pos.x / fr.viewport.x * 2.0 - 1.0, 1.0 - pos.y / fr.viewport.y * 2.0);
+        len = fr.delta_world * length(vec3<f32>(ndc * fr.tan_half, 1.0));
+    }
+    let alpha = 1.0 - exp(-e.a * sw.y * len / fr.length_unit);
+    return vec4<f32>(e.rgb * alpha, alpha);
+}

@@ -1,0 +1,36 @@
+// Per-frame (and per-brick: n, padded) parameters shared by every splat shader; prepended to
+// each shader file. Must match `FrameUniform` in gpu.rs.
+struct Frame {
+    view_proj: mat4x4<f32>,
+    // Row 2 of the view matrix: view depth d = -(row . (p, 1)).
+    depth_row: vec4<f32>,
+    viewport: vec2<f32>,
+    // tan of half the field of view, x and y (perspective).
+    tan_half: vec2<f32>,
+    // Pixels per world unit: orthographic as is, perspective divided by the depth.
+    focal_px: f32,
+    perspective: u32,
+    d0: f32,
+    inv_delta: f32,
+    delta_world: f32,
+    num_slabs: u32,
+    n: u32,
+    padded: u32,
+    radius_slabs: u32,
+    subslices: u32,
+    footprint: u32,
+    tf_entries: u32,
+    kernel_radius: f32,
+    kernel_unit: f32,
+    density_scale: f32,
+    ese_alpha: f32,
+    kernel_radius_world: f32,
+    length_unit: f32,
+    pad0: f32,
+    pad1: f32,
+}
+
+fn view_depth(fr: Frame, p: vec3<f32>) -> f32 {
+    let r = fr.depth_row;
+    return -(r.x * p.x + r.y * p.y + r.z * p.z + r.w);
+}

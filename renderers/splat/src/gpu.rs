@@ -1,0 +1,263 @@
+//! Pipelines, bind group layouts and the per-frame uniform of the splatter.
+
+use render_core::Gpu;
+
+/// Must match `Frame` in `frame.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameUniform {
+    pub view_proj: [[f32; 4]; 4],
+    pub depth_row: [f32; 4],
+    pub viewport: [f32; 2],
+    pub tan_half: [f32; 2],
+    pub focal_px: f32,
+    pub perspective: u32,
+    pub d0: f32,
+    pub inv_delta: f32,
+    pub delta_world: f32,
+    pub num_slabs: u32,
+    pub n: u32,
+    pub padded: u32,
+    pub radius_slabs: u32,
+    pub subslices: u32,
+    pub footprint: u32,
+    pub tf_entries: u32,
+    pub kernel_radius: f32,
+    pub kernel_unit: f32,
+    pub density_scale: f32,
+    pub ese_alpha: f32,
+    pub kernel_radius_world: f32,
+    pub length_unit: f32,
+    pub pad: [f32; 2],
+}
+
+/// Uniform entries addressed with dynamic offsets are this far apart (the largest
+/// `min_uniform_buffer_offset_alignment` wgpu allows).
+pub const UNIFORM_STRIDE: u64 = 256;
+
+pub const SHEET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
+pub const IMAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+pub struct Pipelines {
+    pub compute_layout: wgpu::BindGroupLayout,
+    pub transform: wgpu::ComputePipeline,
+    pub gather: wgpu::ComputePipeline,
+    pub boundaries: wgpu::ComputePipeline,
+    pub bitonic_layout: wgpu::BindGroupLayout,
+    pub bitonic: wgpu::ComputePipeline,
+    pub splat_layout: wgpu::BindGroupLayout,
+    pub slab_layout: wgpu::BindGroupLayout,
+    pub splat: wgpu::RenderPipeline,
+    pub composite_layout: wgpu::BindGroupLayout,
+    pub composite: wgpu::RenderPipeline,
+}
+
+fn uniform(binding: u32, vis: wgpu::ShaderStages, dynamic: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: vis,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: dynamic,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn storage(binding: u32, vis: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: vis,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn float_texture(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+fn with_frame(body: &str) -> String {
+    format!("{}\n{}", include_str!("frame.wgsl"), body)
+}
+
+impl Pipelines {
+    pub fn new(gpu: &Gpu) -> Pipelines {
+        let d = &gpu.device;
+        let c = wgpu::ShaderStages::COMPUTE;
+        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        let pipeline_layout = |label: &str, groups: &[&wgpu::BindGroupLayout]| {
+            let groups: Vec<Option<&wgpu::BindGroupLayout>> =
+                groups.iter().map(|g| Some(*g)).collect();
+            d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &groups,
+                immediate_size: 0,
+            })
+        };
+
+        let compute_layout = layout(
+            "splat buckets",
+            &[
+                uniform(0, c, false),
+                storage(1, c, true),
+                storage(2, c, false),
+                storage(3, c, false),
+                storage(4, c, false),
+                storage(5, c, false),
+            ],
+        );
+        let compute_module = gpu.shader(
+            "splat compute.wgsl",
+            &with_frame(include_str!("compute.wgsl")),
+        );
+        let cpl = pipeline_layout("splat buckets", &[&compute_layout]);
+        let transform =
+            gpu.compute_pipeline("splat transform", Some(&cpl), &compute_module, "transform");
+        let gather = gpu.compute_pipeline("splat gather", Some(&cpl), &compute_module, "gather");
+        let boundaries = gpu.compute_pipeline(
+            "splat boundaries",
+            Some(&cpl),
+            &compute_module,
+            "boundaries",
+        );
+
+        let bitonic_layout = layout(
+            "splat bitonic",
+            &[
+                uniform(0, c, true),
+                storage(1, c, false),
+                storage(2, c, false),
+            ],
+        );
+        let bitonic_module = gpu.shader("splat bitonic.wgsl", include_str!("bitonic.wgsl"));
+        let bpl = pipeline_layout("splat bitonic", &[&bitonic_layout]);
+        let bitonic = gpu.compute_pipeline(
+            "splat bitonic",
+            Some(&bpl),
+            &bitonic_module,
+            "bitonic_stage",
+        );
+
+        let splat_layout = layout(
+            "splat sheet",
+            &[
+                uniform(0, vf, false),
+                storage(1, wgpu::ShaderStages::VERTEX, true),
+                storage(2, wgpu::ShaderStages::FRAGMENT, true),
+                float_texture(3),
+            ],
+        );
+        let slab_layout = layout(
+            "splat slab",
+            &[uniform(0, wgpu::ShaderStages::VERTEX, true)],
+        );
+        let splat_module = gpu.shader("splat splat.wgsl", &with_frame(include_str!("splat.wgsl")));
+        let add = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let splat = gpu.triangle_pipeline(
+            "splat sheet",
+            &pipeline_layout("splat sheet", &[&splat_layout, &slab_layout]),
+            &splat_module,
+            "splat_vs",
+            "splat_fs",
+            SHEET_FORMAT,
+            Some(wgpu::BlendState {
+                color: add,
+                alpha: add,
+            }),
+            wgpu::ColorWrites::RED | wgpu::ColorWrites::GREEN,
+        );
+
+        let composite_layout = layout(
+            "splat composite",
+            &[
+                uniform(0, wgpu::ShaderStages::FRAGMENT, false),
+                float_texture(1),
+                storage(2, wgpu::ShaderStages::FRAGMENT, true),
+            ],
+        );
+        let composite_module = gpu.shader(
+            "splat composite.wgsl",
+            &with_frame(include_str!("composite.wgsl")),
+        );
+        // Front-to-back "under": C += (1 − A_dst) · C_src, premultiplied.
+        let under = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::OneMinusDstAlpha,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let composite = gpu.triangle_pipeline(
+            "splat composite",
+            &pipeline_layout("splat composite", &[&composite_layout]),
+            &composite_module,
+            "fullscreen_vs",
+            "composite_fs",
+            IMAGE_FORMAT,
+            Some(wgpu::BlendState {
+                color: under,
+                alpha: under,
+            }),
+            wgpu::ColorWrites::ALL,
+        );
+        Pipelines {
+            compute_layout,
+            transform,
+            gather,
+            boundaries,
+            bitonic_layout,
+            bitonic,
+            splat_layout,
+            slab_layout,
+            splat,
+            composite_layout,
+            composite,
+        }
+    }
+}
+
+/// Workgroups (x, y) for `threads` threads of 256, split over two dimensions past the
+/// per-dimension limit (shaders rebuild the flat id).
+pub fn workgroups(threads: u32) -> (u32, u32) {
+    let wg = threads.div_ceil(256).max(1);
+    let x = wg.min(32_768);
+    (x, wg.div_ceil(x))
+}
+
+/// The (k, j) stages of a bitonic network over `n` (a power of two) elements.
+pub fn bitonic_stages(n: u32) -> Vec<(u32, u32)> {
+    let mut out = vec![];
+    let mut k = 2;
+    while k <= n {
+        let mut j = k / 2;
+        while j > 0 {
+            out.push((k, j));
+            j /= 2;
+        }
+        k *= 2;
+    }
+    out
+}

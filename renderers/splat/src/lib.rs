@@ -1,0 +1,894 @@
+//! Image-space sheet-buffered splatting on the GPU (Grau & Tost 2007), with the per-slab
+//! buckets built on the GPU (`buckets=gpu`, the paper's pipeline) or on the CPU and uploaded
+//! each frame (`buckets=cpu`, the paper's "CPU FPS" baseline of Table 1).
+//!
+//! Input is a voxel grid: the mesh's own (`TetMesh::source_grid`, volume data sets and
+//! generated volumes) or the mesh resampled onto a grid with `grid` points along its longest
+//! side (the row's counters say `resampled=1`). The relevant voxels (κ > 0 under the transfer
+//! function) are selected once in `prepare`, 16 bytes each (x, y, z, value; §3.2).
+//!
+//! Per frame and brick (§3.1–3.6): view depth per voxel → depth sort (bitonic, the paper's,
+//! or render-core's radix sort) → gather into depth order → bucket boundaries on the GPU →
+//! read back only the bucket-end table (one u32 per slab) → slabs front to back: slab i
+//! clears its sheet, splats the voxels of buckets i − r … i + r with the footprint slice of
+//! their offset from the slab (one table of all slices, `kernel.rs`), then the sheet is
+//! classified (post-classification on the slab's mean value) and composited under the image.
+//! Pixels already opaque discard their splats (early splat elimination, `ese`). Bricks (§4)
+//! split the voxels by octants when they exceed one storage binding (or `brick=N`); they are
+//! drawn in camera order, and kernels crossing a brick face are composited out of order (the
+//! `border_voxels` counter).
+//!
+//! Orthographic and perspective cameras: slabs are planes of constant view depth; a
+//! perspective footprint is scaled by focal length / depth, and each sheet's opacity uses the
+//! ray's length through the slab.
+
+mod buckets;
+mod gpu;
+pub mod kernel;
+pub mod voxels;
+
+use std::time::Instant;
+
+use anyhow::{bail, Context};
+use datasets::TetMesh;
+use render_core::gpu_sort::GpuRadixSort;
+use render_core::{
+    Camera, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics, Prepared, Renderer,
+    Setting,
+};
+
+pub use buckets::{bucket_ends, depth, SlabGeometry};
+use gpu::{FrameUniform, Pipelines, IMAGE_FORMAT, SHEET_FORMAT, UNIFORM_STRIDE};
+use kernel::{FootprintTable, Kernel, SIGMA};
+use voxels::VoxelSet;
+
+/// Where the per-slab buckets are built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Buckets {
+    Cpu,
+    Gpu,
+}
+
+/// The GPU depth sort (with `buckets=gpu`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GpuSort {
+    /// Grau & Tost §3.4 (Govindaraju et al.'s bitonic network).
+    Bitonic,
+    /// render-core's LSD radix sort.
+    Radix,
+}
+
+/// The knobs (every one appears in the `settings` column).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SplatSettings {
+    pub buckets: Buckets,
+    pub sort: GpuSort,
+    /// Kernel radius in grid spacings.
+    pub radius: f64,
+    /// Slab thickness in grid spacings.
+    pub slab: f64,
+    /// Footprint slice texels per side.
+    pub footprint: u32,
+    /// Footprint slices per slab of voxel offset.
+    pub subslices: u32,
+    /// Grid points along the longest side when a mesh without its own grid is resampled.
+    pub grid: usize,
+    /// Largest brick in voxels; `None`: as many as one storage binding holds.
+    pub brick: Option<usize>,
+    /// Early splat elimination.
+    pub ese: bool,
+}
+
+impl Default for SplatSettings {
+    fn default() -> Self {
+        SplatSettings {
+            buckets: Buckets::Gpu,
+            sort: GpuSort::Bitonic,
+            radius: 2.0,
+            slab: 1.0,
+            footprint: 32,
+            subslices: 8,
+            grid: 32,
+            brick: None,
+            ese: true,
+        }
+    }
+}
+
+/// A pixel at least this opaque drops the splats behind it (the error this allows is at most
+/// 1 − ESE_ALPHA per pixel).
+pub const ESE_ALPHA: f32 = 0.999;
+
+/// Transfer function table entries (linear between entries).
+const TF_ENTRIES: usize = 256;
+
+/// Default variants: the paper's pair (Table 1), CPU and GPU buckets.
+pub fn default_variants() -> Vec<Box<dyn Renderer>> {
+    vec![
+        Box::new(Splat::new(SplatSettings {
+            buckets: Buckets::Cpu,
+            ..Default::default()
+        })),
+        Box::new(Splat::new(SplatSettings::default())),
+    ]
+}
+
+/// Every variant `--settings` selects from.
+pub fn all_variants() -> Vec<Box<dyn Renderer>> {
+    let mut out: Vec<Box<dyn Renderer>> = vec![];
+    for buckets in [Buckets::Cpu, Buckets::Gpu] {
+        let sorts: &[GpuSort] = match buckets {
+            Buckets::Cpu => &[GpuSort::Bitonic],
+            Buckets::Gpu => &[GpuSort::Bitonic, GpuSort::Radix],
+        };
+        for &sort in sorts {
+            for (radius, slab) in [(2.0, 1.0), (2.0, 0.5), (1.5, 1.5)] {
+                for grid in [32, 64, 128] {
+                    for ese in [true, false] {
+                        for brick in [None, Some(1_000_000)] {
+                            out.push(Box::new(Splat::new(SplatSettings {
+                                buckets,
+                                sort,
+                                radius,
+                                slab,
+                                grid,
+                                ese,
+                                brick,
+                                ..Default::default()
+                            })));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+struct Targets {
+    width: u32,
+    height: u32,
+    image: wgpu::Texture,
+    image_view: wgpu::TextureView,
+    sheet_view: wgpu::TextureView,
+    bytes: u64,
+}
+
+struct State {
+    set: VoxelSet,
+    table: FootprintTable,
+    pipes: Pipelines,
+    bricks: Vec<wgpu::Buffer>,
+    table_buf: wgpu::Buffer,
+    tf_buf: wgpu::Buffer,
+    frame_buf: wgpu::Buffer,
+    slab_buf: wgpu::Buffer,
+    bitonic_buf: wgpu::Buffer,
+    keys: wgpu::Buffer,
+    vals: wgpu::Buffer,
+    sorted: wgpu::Buffer,
+    ends: wgpu::Buffer,
+    radix: Option<GpuRadixSort>,
+    cpu: buckets::CpuBuckets,
+    max_slabs: u32,
+    /// GPU bytes of the voxel arrays (the paper's 16 bytes per voxel).
+    voxel_bytes: u64,
+    length_unit: f64,
+    ledger: MemoryLedger,
+    frame_bytes: u64,
+    timer: FrameTimer,
+}
+
+/// The splat renderer.
+pub struct Splat {
+    pub settings: SplatSettings,
+    state: Option<State>,
+    targets: Option<Targets>,
+}
+
+/// What one brick of one frame did.
+#[derive(Default)]
+struct BrickStats {
+    slabs: u64,
+    splats: u64,
+    wait_ms: f64,
+    buckets_ms: f64,
+    splat_ms: f64,
+}
+
+impl Splat {
+    pub fn new(settings: SplatSettings) -> Splat {
+        Splat {
+            settings,
+            state: None,
+            targets: None,
+        }
+    }
+
+    /// Every GPU allocation of the prepared data (after `prepare`).
+    pub fn memory(&self) -> Option<&MemoryLedger> {
+        self.state.as_ref().map(|s| &s.ledger)
+    }
+
+    /// The voxels prepared (after `prepare`).
+    pub fn voxels(&self) -> Option<&VoxelSet> {
+        self.state.as_ref().map(|s| &s.set)
+    }
+
+    /// Slab geometry of a camera (the same for every brick of a frame).
+    fn geometry(&self, st: &State, camera: &Camera) -> SlabGeometry {
+        let row = depth_row(camera);
+        let (mut dmin, mut dmax) = (f64::INFINITY, f64::NEG_INFINITY);
+        for c in 0..8 {
+            let p = [0, 1, 2].map(|a| {
+                if c >> a & 1 == 1 {
+                    st.set.max[a]
+                } else {
+                    st.set.min[a]
+                }
+            });
+            let d = depth(row, [p[0] as f32, p[1] as f32, p[2] as f32, 0.0]) as f64;
+            dmin = dmin.min(d);
+            dmax = dmax.max(d);
+        }
+        let unit = st.set.kernel_unit;
+        SlabGeometry::new(
+            dmin,
+            dmax,
+            self.settings.radius * unit,
+            self.settings.slab * unit,
+            st.table.radius_slabs,
+        )
+    }
+
+    /// Builds the bucket table of brick `b` the way the settings say; leaves the sorted voxels
+    /// in `sorted`. Returns the table (and the depth-sorted keys when `want_keys`).
+    fn buckets(
+        &mut self,
+        gpu: &Gpu,
+        b: usize,
+        geom: &SlabGeometry,
+        row: [f32; 4],
+        want_keys: bool,
+        stats: &mut BrickStats,
+    ) -> anyhow::Result<(Vec<u32>, Vec<f32>)> {
+        let st = self.state.as_mut().unwrap();
+        let range = st.set.bricks[b].range.clone();
+        let n = range.len() as u32;
+        let t0 = Instant::now();
+        match self.settings.buckets {
+            Buckets::Cpu => {
+                let ends = st.cpu.run(&st.set.voxels[range], row, geom);
+                gpu.queue
+                    .write_buffer(&st.sorted, 0, bytemuck::cast_slice(&st.cpu.sorted));
+                stats.buckets_ms += t0.elapsed().as_secs_f64() * 1e3;
+                let keys = if want_keys {
+                    st.cpu.sorted_keys.clone()
+                } else {
+                    vec![]
+                };
+                Ok((ends, keys))
+            }
+            Buckets::Gpu => {
+                let padded = match self.settings.sort {
+                    GpuSort::Bitonic => n.next_power_of_two().max(256),
+                    GpuSort::Radix => n,
+                };
+                let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("splat buckets"),
+                    layout: &st.pipes.compute_layout,
+                    entries: &[
+                        entry(0, &st.frame_buf),
+                        entry(1, &st.bricks[b]),
+                        entry(2, &st.keys),
+                        entry(3, &st.vals),
+                        entry(4, &st.sorted),
+                        entry(5, &st.ends),
+                    ],
+                });
+                let mut enc = gpu.device.create_command_encoder(&Default::default());
+                dispatch(&mut enc, &st.pipes.transform, &bind, padded);
+                match self.settings.sort {
+                    GpuSort::Radix => st
+                        .radix
+                        .as_ref()
+                        .context("radix sorter missing")?
+                        .encode(&mut enc, &st.keys, &st.vals, n, false)?,
+                    GpuSort::Bitonic => {
+                        let stages = gpu::bitonic_stages(padded);
+                        let mut params = vec![0u8; stages.len() * UNIFORM_STRIDE as usize];
+                        for (s, &(k, j)) in stages.iter().enumerate() {
+                            let o = s * UNIFORM_STRIDE as usize;
+                            params[o..o + 16]
+                                .copy_from_slice(bytemuck::cast_slice(&[k, j, padded, 0u32]));
+                        }
+                        gpu.queue.write_buffer(&st.bitonic_buf, 0, &params);
+                        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("splat bitonic"),
+                            layout: &st.pipes.bitonic_layout,
+                            entries: &[
+                                wgpu::BindGroupEntry {
+                                    binding: 0,
+                                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                                        buffer: &st.bitonic_buf,
+                                        offset: 0,
+                                        size: wgpu::BufferSize::new(16),
+                                    }),
+                                },
+                                entry(1, &st.keys),
+                                entry(2, &st.vals),
+                            ],
+                        });
+                        let mut pass = enc.begin_compute_pass(&Default::default());
+                        pass.set_pipeline(&st.pipes.bitonic);
+                        let (x, y) = gpu::workgroups(padded);
+                        for s in 0..stages.len() {
+                            pass.set_bind_group(0, &bind, &[(s as u64 * UNIFORM_STRIDE) as u32]);
+                            pass.dispatch_workgroups(x, y, 1);
+                        }
+                    }
+                }
+                dispatch(&mut enc, &st.pipes.gather, &bind, n);
+                dispatch(&mut enc, &st.pipes.boundaries, &bind, n);
+                gpu.queue.submit([enc.finish()]);
+                // Only the small table of bucket ends comes back (§3.5).
+                let tw = Instant::now();
+                let bytes = gpu.read_buffer(&st.ends, 0, geom.num_slabs as u64 * 4)?;
+                let keys = if want_keys {
+                    bytemuck::cast_slice::<u8, f32>(&gpu.read_buffer(&st.keys, 0, n as u64 * 4)?)
+                        .to_vec()
+                } else {
+                    vec![]
+                };
+                stats.wait_ms += tw.elapsed().as_secs_f64() * 1e3;
+                stats.buckets_ms += t0.elapsed().as_secs_f64() * 1e3;
+                Ok((bytemuck::cast_slice(&bytes).to_vec(), keys))
+            }
+        }
+    }
+
+    /// Test hook: the bucket table and the depth-sorted keys of brick 0 for `camera`, built as
+    /// the settings say (GPU: read back from the device).
+    pub fn bucket_table(
+        &mut self,
+        gpu: &Gpu,
+        camera: &Camera,
+    ) -> anyhow::Result<(SlabGeometry, Vec<u32>, Vec<f32>)> {
+        let st = self.state.as_ref().context("prepare first")?;
+        let geom = self.geometry(st, camera);
+        let row = depth_row(camera);
+        self.write_frame(gpu, camera, &geom, 0);
+        let mut stats = BrickStats::default();
+        let (ends, keys) = self.buckets(gpu, 0, &geom, row, true, &mut stats)?;
+        Ok((geom, ends, keys))
+    }
+
+    fn write_frame(&self, gpu: &Gpu, camera: &Camera, geom: &SlabGeometry, brick: usize) {
+        let st = self.state.as_ref().unwrap();
+        let n = st.set.bricks.get(brick).map_or(0, |b| b.range.len()) as u32;
+        let padded = match (self.settings.buckets, self.settings.sort) {
+            (Buckets::Gpu, GpuSort::Bitonic) => n.next_power_of_two().max(256),
+            _ => n,
+        };
+        let (w, h) = (camera.width as f64, camera.height as f64);
+        let (focal, tan_half, persp) = match camera.projection {
+            render_core::Projection::Perspective { fovy_deg } => {
+                let t = (fovy_deg.to_radians() * 0.5).tan();
+                (0.5 * h / t, [(t * w / h) as f32, t as f32], 1)
+            }
+            render_core::Projection::Orthographic => {
+                (h / (2.0 * camera.ortho_half_height), [0.0, 0.0], 0)
+            }
+        };
+        let unit = st.set.kernel_unit;
+        let u = FrameUniform {
+            view_proj: camera.view_proj_f32(),
+            depth_row: depth_row(camera),
+            viewport: [w as f32, h as f32],
+            tan_half,
+            focal_px: focal as f32,
+            perspective: persp,
+            d0: geom.d0,
+            inv_delta: geom.inv_delta,
+            delta_world: (self.settings.slab * unit) as f32,
+            num_slabs: geom.num_slabs,
+            n,
+            padded,
+            radius_slabs: st.table.radius_slabs,
+            subslices: st.table.subslices,
+            footprint: st.table.footprint,
+            tf_entries: TF_ENTRIES as u32,
+            kernel_radius: self.settings.radius as f32,
+            kernel_unit: unit as f32,
+            density_scale: st.set.density_scale as f32,
+            ese_alpha: if self.settings.ese { ESE_ALPHA } else { 2.0 },
+            kernel_radius_world: (self.settings.radius * unit) as f32,
+            length_unit: st.length_unit as f32,
+            pad: [0.0; 2],
+        };
+        gpu.queue
+            .write_buffer(&st.frame_buf, 0, bytemuck::bytes_of(&u));
+    }
+
+    fn ensure_targets(&mut self, gpu: &Gpu, width: u32, height: u32) -> anyhow::Result<()> {
+        if self
+            .targets
+            .as_ref()
+            .is_some_and(|t| t.width == width && t.height == height)
+        {
+            return Ok(());
+        }
+        let mut ledger = MemoryLedger::default();
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let tex = |ledger: &mut MemoryLedger, label: &str, format, usage| {
+            ledger.texture(
+                gpu,
+                Lifetime::PerFrame,
+                &wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size,
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                },
+            )
+        };
+        let both = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let image = tex(
+            &mut ledger,
+            "splat image",
+            IMAGE_FORMAT,
+            both | wgpu::TextureUsages::COPY_SRC,
+        )?;
+        let sheet = tex(&mut ledger, "splat sheet buffer", SHEET_FORMAT, both)?;
+        self.targets = Some(Targets {
+            width,
+            height,
+            image_view: image.create_view(&Default::default()),
+            sheet_view: sheet.create_view(&Default::default()),
+            image,
+            bytes: ledger.per_frame,
+        });
+        Ok(())
+    }
+
+    /// Splats the slabs of one brick (its sorted voxels and bucket table are ready).
+    fn draw_brick(&self, gpu: &Gpu, geom: &SlabGeometry, ends: &[u32], stats: &mut BrickStats) {
+        let st = self.state.as_ref().unwrap();
+        let t = self.targets.as_ref().unwrap();
+        let t0 = Instant::now();
+        let splat_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("splat sheet"),
+            layout: &st.pipes.splat_layout,
+            entries: &[
+                entry(0, &st.frame_buf),
+                entry(1, &st.sorted),
+                entry(2, &st.table_buf),
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&t.image_view),
+                },
+            ],
+        });
+        let slab_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("splat slab"),
+            layout: &st.pipes.slab_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &st.slab_buf,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(16),
+                }),
+            }],
+        });
+        let comp_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("splat composite"),
+            layout: &st.pipes.composite_layout,
+            entries: &[
+                entry(0, &st.frame_buf),
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&t.sheet_view),
+                },
+                entry(2, &st.tf_buf),
+            ],
+        });
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        for i in 0..geom.num_slabs.min(st.max_slabs) {
+            let range = geom.splat_range(ends, i);
+            if range.is_empty() {
+                continue;
+            }
+            stats.slabs += 1;
+            stats.splats += range.len() as u64;
+            {
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("splat slab"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &t.sheet_view,
+                        resolve_target: None,
+                        depth_slice: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    ..Default::default()
+                });
+                pass.set_pipeline(&st.pipes.splat);
+                pass.set_bind_group(0, &splat_bind, &[]);
+                pass.set_bind_group(1, &slab_bind, &[(i as u64 * UNIFORM_STRIDE) as u32]);
+                pass.draw(0..6, range);
+            }
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("splat composite"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &t.image_view,
+                    resolve_target: None,
+                    depth_slice: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            pass.set_pipeline(&st.pipes.composite);
+            pass.set_bind_group(0, &comp_bind, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        stats.splat_ms += t0.elapsed().as_secs_f64() * 1e3;
+    }
+}
+
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}
+
+fn dispatch(
+    enc: &mut wgpu::CommandEncoder,
+    pipeline: &wgpu::ComputePipeline,
+    bind: &wgpu::BindGroup,
+    threads: u32,
+) {
+    if threads == 0 {
+        return;
+    }
+    let mut pass = enc.begin_compute_pass(&Default::default());
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind, &[]);
+    let (x, y) = gpu::workgroups(threads);
+    pass.dispatch_workgroups(x, y, 1);
+}
+
+/// Row 2 of the camera's view matrix (view depth = −row · (p, 1)), in f32.
+fn depth_row(camera: &Camera) -> [f32; 4] {
+    let v = camera.view_f32();
+    [v[0][2], v[1][2], v[2][2], v[3][2]]
+}
+
+fn fmt_len(x: f64) -> String {
+    format!("{x}")
+}
+
+impl Renderer for Splat {
+    fn algorithm(&self) -> &'static str {
+        "splat"
+    }
+
+    fn settings(&self) -> Vec<Setting> {
+        let s = &self.settings;
+        vec![
+            Setting::new(
+                "buckets",
+                match s.buckets {
+                    Buckets::Cpu => "cpu",
+                    Buckets::Gpu => "gpu",
+                },
+            ),
+            Setting::new(
+                "sort",
+                match (s.buckets, s.sort) {
+                    (Buckets::Cpu, _) => "cpu-radix",
+                    (_, GpuSort::Bitonic) => "bitonic",
+                    (_, GpuSort::Radix) => "radix",
+                },
+            ),
+            Setting::new("radius", fmt_len(s.radius)),
+            Setting::new("slab", fmt_len(s.slab)),
+            Setting::new("footprint", format!("{}x{}", s.footprint, s.subslices)),
+            Setting::new("grid", s.grid),
+            Setting::new(
+                "brick",
+                s.brick.map_or("auto".to_string(), |b| b.to_string()),
+            ),
+            Setting::new("ese", if s.ese { "on" } else { "off" }),
+        ]
+    }
+
+    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+        if !gpu.features.contains(wgpu::Features::FLOAT32_BLENDABLE) {
+            bail!(
+                "splat: adapter {} cannot blend into 32-bit float targets (FLOAT32_BLENDABLE)",
+                gpu.adapter.name
+            );
+        }
+        let s = self.settings.clone();
+        if !(s.radius > 0.0 && s.slab > 0.0 && s.footprint >= 2 && s.subslices >= 1) {
+            bail!("splat: radius, slab, footprint and subslices must be positive ({s:?})");
+        }
+        self.state = None;
+        let binding = gpu.max_storage_binding();
+        let cap = (binding / 16) as usize;
+        let cap = s.brick.map_or(cap, |b| b.min(cap));
+        let mut set = VoxelSet::new(mesh, optics, s.grid, cap);
+        set.border_voxels = set.count_border_voxels(s.radius);
+        let table = FootprintTable::new(
+            Kernel::new(s.radius, SIGMA),
+            s.slab,
+            s.subslices,
+            s.footprint,
+        );
+        let mut ledger = MemoryLedger::default();
+        let storage = wgpu::BufferUsages::STORAGE;
+        let bricks: Vec<wgpu::Buffer> = set
+            .bricks
+            .iter()
+            .map(|b| {
+                ledger.buffer_init(
+                    gpu,
+                    "splat voxels (x, y, z, value)",
+                    Lifetime::Persistent,
+                    bytemuck::cast_slice(&set.voxels[b.range.clone()]),
+                    storage,
+                )
+            })
+            .collect::<anyhow::Result<_>>()?;
+        let voxel_bytes = ledger.persistent;
+        let table_buf = ledger.buffer_init(
+            gpu,
+            "splat footprint slices",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&table.values),
+            storage,
+        )?;
+        let tf_buf = ledger.buffer_init(
+            gpu,
+            "splat transfer function",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&optics.tf.rgb_kappa_table(TF_ENTRIES)),
+            storage,
+        )?;
+        // Enough slabs for any view: the voxels' diagonal plus the kernel on both sides.
+        let d = (0..3)
+            .map(|a| (set.max[a] - set.min[a]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let max_slabs =
+            ((d + 2.0 * s.radius * set.kernel_unit) / (s.slab * set.kernel_unit)).ceil() as u32 + 4;
+        let mut slab_params = vec![0u8; max_slabs as usize * UNIFORM_STRIDE as usize];
+        for i in 0..max_slabs as usize {
+            let o = i * UNIFORM_STRIDE as usize;
+            params_u32(&mut slab_params[o..o + 4], i as u32);
+        }
+        let slab_buf = ledger.buffer_init(
+            gpu,
+            "splat slab indices",
+            Lifetime::Persistent,
+            &slab_params,
+            wgpu::BufferUsages::UNIFORM,
+        )?;
+        let frame_buf = ledger.buffer(
+            gpu,
+            "splat frame",
+            Lifetime::PerFrame,
+            std::mem::size_of::<FrameUniform>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        )?;
+        let largest = set.largest_brick().max(1);
+        let padded_max = match (s.buckets, s.sort) {
+            (Buckets::Gpu, GpuSort::Bitonic) => largest.next_power_of_two().max(256),
+            _ => largest,
+        };
+        let stages = gpu::bitonic_stages(padded_max as u32).len().max(1);
+        let bitonic_buf = ledger.buffer(
+            gpu,
+            "splat bitonic stages",
+            Lifetime::PerFrame,
+            stages as u64 * UNIFORM_STRIDE,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        )?;
+        let gpu_side = s.buckets == Buckets::Gpu;
+        let key_len = if gpu_side { padded_max } else { 1 } as u64;
+        let keys = ledger.buffer(
+            gpu,
+            "splat depth keys",
+            Lifetime::PerFrame,
+            key_len * 4,
+            storage | wgpu::BufferUsages::COPY_SRC,
+        )?;
+        let vals = ledger.buffer(
+            gpu,
+            "splat voxel ids",
+            Lifetime::PerFrame,
+            key_len * 4,
+            storage,
+        )?;
+        let sorted = ledger.buffer(
+            gpu,
+            "splat depth-sorted voxels",
+            Lifetime::PerFrame,
+            largest as u64 * 16,
+            storage | wgpu::BufferUsages::COPY_DST,
+        )?;
+        let ends = ledger.buffer(
+            gpu,
+            "splat bucket ends",
+            Lifetime::PerFrame,
+            max_slabs as u64 * 4,
+            storage | wgpu::BufferUsages::COPY_SRC,
+        )?;
+        let radix = if gpu_side && s.sort == GpuSort::Radix {
+            Some(GpuRadixSort::new(gpu, largest as u32, &mut ledger)?)
+        } else {
+            None
+        };
+        let persistent = ledger.persistent;
+        let frame_bytes = ledger.per_frame;
+        self.state = Some(State {
+            set,
+            table,
+            pipes: Pipelines::new(gpu),
+            bricks,
+            table_buf,
+            tf_buf,
+            frame_buf,
+            slab_buf,
+            bitonic_buf,
+            keys,
+            vals,
+            sorted,
+            ends,
+            radix,
+            cpu: Default::default(),
+            max_slabs,
+            voxel_bytes,
+            length_unit: optics.length_unit,
+            ledger,
+            frame_bytes,
+            timer: FrameTimer::new(gpu),
+        });
+        Ok(Prepared {
+            persistent_bytes: persistent,
+            tets: mesh.num_tets() as u64,
+        })
+    }
+
+    fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
+        let st = self
+            .state
+            .as_mut()
+            .context("splat: render before prepare")?;
+        st.timer.start_wall();
+        self.ensure_targets(gpu, camera.width, camera.height)?;
+        let st = self.state.as_ref().unwrap();
+        let geom = self.geometry(st, camera);
+        if geom.num_slabs > st.max_slabs {
+            bail!(
+                "splat: {} slabs needed, {} prepared (camera inside the volume?)",
+                geom.num_slabs,
+                st.max_slabs
+            );
+        }
+        let row = depth_row(camera);
+        let fwd = camera.forward();
+        let order = st.set.brick_order(camera.eye, fwd, camera.is_perspective());
+        let t = self.targets.as_ref().unwrap();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        st.timer.begin(&mut enc);
+        enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("splat clear"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &t.image_view,
+                resolve_target: None,
+                depth_slice: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            ..Default::default()
+        });
+        gpu.queue.submit([enc.finish()]);
+        let mut stats = BrickStats::default();
+        for b in order {
+            if self.state.as_ref().unwrap().set.bricks[b].range.is_empty() {
+                continue;
+            }
+            self.write_frame(gpu, camera, &geom, b);
+            let (ends, _) = self.buckets(gpu, b, &geom, row, false, &mut stats)?;
+            self.draw_brick(gpu, &geom, &ends, &mut stats);
+        }
+        let st = self.state.as_ref().unwrap();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        st.timer.end(&mut enc);
+        gpu.queue.submit([enc.finish()]);
+        let tw = Instant::now();
+        gpu.wait()?;
+        stats.wait_ms += tw.elapsed().as_secs_f64() * 1e3;
+        let total_ms = st.timer.wall_ms();
+        let gpu_ms = st.timer.gpu_ms(gpu)?;
+        let eff = st.set.voxels.len() as f64;
+        let t = self.targets.as_ref().unwrap();
+        Ok(FrameStats {
+            cpu_ms: (total_ms - stats.wait_ms).max(0.0),
+            gpu_ms,
+            total_ms,
+            frame_bytes: st.frame_bytes + t.bytes,
+            stages: vec![
+                ("buckets".into(), stats.buckets_ms),
+                ("splat".into(), stats.splat_ms),
+            ],
+            counters: vec![
+                ("effective_voxels".into(), eff),
+                ("grid_points".into(), st.set.grid_points as f64),
+                ("resampled".into(), st.set.resampled as u8 as f64),
+                ("grid_x".into(), st.set.dims[0] as f64),
+                ("grid_y".into(), st.set.dims[1] as f64),
+                ("grid_z".into(), st.set.dims[2] as f64),
+                ("bricks".into(), st.set.bricks.len() as f64),
+                ("border_voxels".into(), st.set.border_voxels as f64),
+                ("slabs".into(), stats.slabs as f64),
+                ("splats".into(), stats.splats as f64),
+                (
+                    "bytes_per_voxel".into(),
+                    if eff > 0.0 {
+                        st.voxel_bytes as f64 / eff
+                    } else {
+                        0.0
+                    },
+                ),
+                (
+                    "voxels_per_sec".into(),
+                    if total_ms > 0.0 {
+                        eff / (total_ms * 1e-3)
+                    } else {
+                        0.0
+                    },
+                ),
+            ],
+        })
+    }
+
+    fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image> {
+        let t = self
+            .targets
+            .as_ref()
+            .context("splat: read_image before render")?;
+        gpu.read_rgba32f(&t.image)
+    }
+}
+
+fn params_u32(dst: &mut [u8], v: u32) {
+    dst.copy_from_slice(&v.to_le_bytes());
+}
+
+impl std::fmt::Debug for Splat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Splat")
+            .field("settings", &self.settings)
+            .finish()
+    }
+}
