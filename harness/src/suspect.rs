@@ -3,8 +3,8 @@
 //! a mesh where GATOR and fragment PT reach 52 dB went unnoticed).
 //!
 //! Rows are compared per image: same data set, viewpoint and viewport. A row is suspect when
-//! its PSNR is more than [`GAP_DB`] below the best PSNR of that image, or below [`FLOOR_DB`]
-//! outright. Rows without a PSNR (failed, or `--no-reference`) are never suspect: failures are
+//! its PSNR is below [`FLOOR_DB`] outright, or below [`FINE_DB`] and more than [`GAP_DB`] below
+//! the best PSNR of that image. Rows without a PSNR (failed, or `--no-reference`) are never suspect: failures are
 //! reported on their own.
 
 use crate::results::Row;
@@ -17,6 +17,10 @@ pub const GAP_DB: f64 = 20.0;
 
 /// Below this PSNR an image is visibly wrong whatever the others do (RMSE > 0.1 of full scale).
 pub const FLOOR_DB: f64 = 20.0;
+
+/// At or above this PSNR (RMSE ≤ 1 % of full scale, invisible) a row is never suspect: next to
+/// a row at the 99 dB cap, every merely excellent row would otherwise be "20 dB below the best".
+pub const FINE_DB: f64 = 40.0;
 
 fn same_image(a: &Row, b: &Row) -> bool {
     a.dataset == b.dataset
@@ -40,7 +44,7 @@ pub fn reason(row: &Row, others: &[Row]) -> Option<String> {
         return Some(format!("PSNR {psnr:.1} dB is below {FLOOR_DB} dB"));
     }
     match best {
-        Some((bp, b)) if bp - psnr > GAP_DB => Some(format!(
+        Some((bp, b)) if psnr < FINE_DB && bp - psnr > GAP_DB => Some(format!(
             "PSNR {psnr:.1} dB is {:.1} dB below the best on this image ({} {} {bp:.1} dB)",
             bp - psnr,
             b.algorithm,
@@ -106,6 +110,11 @@ mod tests {
             rows[3].suspect
         );
         assert!(rows[3].suspect.contains("gator-pt"));
+        // Next to a row at the 99 dB cap, 45 dB is still fine.
+        rows[4].psnr_db = Some(99.0);
+        rows[3].psnr_db = Some(45.0);
+        assert_eq!(mark_all(&mut rows), 1);
+        assert!(rows[3].suspect.is_empty());
     }
 
     #[test]

@@ -197,30 +197,12 @@ impl Point {
     }
 }
 
-/// Suspect rows (issue 15's rule): PSNR below 20 dB, or more than 20 dB below the best row of
-/// the same data set, viewpoint and viewport — unless at least 40 dB (RMSE ≤ 1 %, invisible),
-/// since next to a row at the 99 dB cap every merely excellent row would be 20 dB "below".
-/// Returns one flag per row.
-/// (When rows carry their own `suspect` column, this should read it.)
+/// Suspect rows ([`crate::suspect`]): the row's own `suspect` column, or — for results
+/// written before the column existed, or rows merged from several runs — the same rule applied
+/// to these rows. One flag per row.
 pub fn suspect_flags(rows: &[Row]) -> Vec<bool> {
-    const ABSOLUTE_DB: f64 = 20.0;
-    const BELOW_BEST_DB: f64 = 20.0;
-    const NEVER_BELOW_DB: f64 = 40.0;
     rows.iter()
-        .map(|r| {
-            let Some(p) = r.psnr_db else { return false };
-            let best = rows
-                .iter()
-                .filter(|o| {
-                    o.dataset == r.dataset
-                        && o.viewpoint == r.viewpoint
-                        && o.width == r.width
-                        && o.height == r.height
-                })
-                .filter_map(|o| o.psnr_db)
-                .fold(f64::NEG_INFINITY, f64::max);
-            p < ABSOLUTE_DB || (p < NEVER_BELOW_DB && p < best - BELOW_BEST_DB)
-        })
+        .map(|r| !r.suspect.is_empty() || crate::suspect::reason(r, rows).is_some())
         .collect()
 }
 
