@@ -124,9 +124,23 @@ const SPARE_FAMILIES: [Family; 2] = [BROWNS, TEALS];
 
 /// Whether `algorithm` is an outside peer (VTK's mappers, issue 13) rather than one of
 /// tetbench's own renderers. Peers are drawn in greys with hollow markers.
-/// (When `algorithms::is_peer` exists, this should call it.)
+/// Names outside the algorithm table that start with `vtk-` (rows from other builds) count too.
 pub fn is_peer(algorithm: &str) -> bool {
-    algorithm.starts_with("vtk-")
+    crate::algorithms::is_peer(algorithm) || algorithm.starts_with("vtk-")
+}
+
+/// Peers share the grey family, so each peer's slots start at its own offset (its place among
+/// the peers × 4): `vtk-pt`, `vtk-raycast` and `vtk-zsweep` never share a style.
+fn peer_slot_offset(algorithm: &str) -> usize {
+    let peers: Vec<&str> = crate::algorithms::PEERS
+        .iter()
+        .flat_map(|(_, names)| names.iter().copied())
+        .collect();
+    let index = peers
+        .iter()
+        .position(|p| *p == algorithm)
+        .unwrap_or((fnv1a(algorithm) % 8) as usize);
+    4 * index
 }
 
 /// The order of variants in legends and CSVs: own algorithms in the table's order, then
@@ -284,8 +298,14 @@ impl StyleBook {
             order.sort();
             let labels = short_labels(&alg, order.iter().map(|(_, s)| s.as_str()));
             let fam = family(&alg);
+            let offset = if is_peer(&alg) {
+                peer_slot_offset(&alg)
+            } else {
+                0
+            };
             let mut taken = [false; SLOTS];
             for (n, ((_, want), s)) in order.iter().enumerate() {
+                let want = &((want + offset) % SLOTS);
                 // More variants than slots wrap around and share; see SLOTS.
                 let slot = if n < SLOTS {
                     (0..SLOTS)
