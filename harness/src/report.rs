@@ -182,6 +182,7 @@ th, td {{ border: 1px solid #ccc; padding: 2px 6px; text-align: right; }}
 th {{ background: #eee; }} td.l, th.l {{ text-align: left; }}
 tr.failed td {{ background: #fdd; }}
 tr.suspect td {{ background: #ffe4b5; }} tr.suspect td:first-child::after {{ content: " ⚠ suspect"; color: #b00; }}
+.suspect figure {{ border: 2px solid #e69500; padding: 3px; }}
 tr.peer td:first-child::after {{ content: " (peer)"; color: #666; font-style: italic; }}
 figure.chart {{ margin: 0 0 14px; font-size: 13px; text-align: left; }}
 figure.chart img {{ width: auto; height: auto; max-width: 100%; background: #fff; object-fit: initial; image-rendering: auto; }}
@@ -254,6 +255,7 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
     }
 
     h.push_str(charts);
+    suspect_section(&mut h, file);
 
     h.push_str("<h2>Summary</h2><p>Mean over viewpoints (min–max in brackets).");
     if file.rows.iter().any(|r| is_peer(&r.algorithm)) {
@@ -547,4 +549,46 @@ mod tests {
         let svg = std::fs::read_to_string(dir.path().join("charts/psnr.svg")).unwrap();
         assert!(svg.contains("@font-face") && svg.contains("DejaVu Sans"));
     }
+}
+
+/// Rows flagged by [`crate::suspect`], each with its heatmap first, then the rendering and the
+/// reference, so a broken renderer is the first picture a reader sees after the charts.
+fn suspect_section(h: &mut String, file: &ResultsFile) {
+    let suspects: Vec<&Row> = file.rows.iter().filter(|r| !r.suspect.is_empty()).collect();
+    if suspects.is_empty() {
+        return;
+    }
+    let _ = write!(
+        h,
+        "<h2>Suspect rows ({})</h2><p>Image error far out of line with the other algorithms on \
+         the same image: a renderer defect, or a mesh or setting the method cannot handle. \
+         Heatmap first, then the rendering and the reference.</p><div class=\"strip suspect\">",
+        suspects.len()
+    );
+    for row in suspects {
+        h.push_str("<figure><div class=pair>");
+        for (path, alt) in [
+            (&row.heatmap, "error heatmap"),
+            (&row.image, "image"),
+            (&row.reference_image, "reference"),
+        ] {
+            if !path.is_empty() {
+                let _ = write!(
+                    h,
+                    "<a href=\"{0}\"><img src=\"{0}\" alt=\"{alt}\" loading=lazy></a>",
+                    esc(path)
+                );
+            }
+        }
+        let _ = write!(
+            h,
+            "</div><figcaption>{} {} on {} {}<br>{}</figcaption></figure>",
+            esc(&row.algorithm),
+            esc(&row.settings),
+            esc(&row.dataset),
+            esc(&row.viewpoint),
+            esc(&row.suspect)
+        );
+    }
+    h.push_str("</div>\n");
 }

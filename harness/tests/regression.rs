@@ -61,7 +61,7 @@ fn merged_shards_equal_one_run_and_compare_finds_no_change() {
             "--algorithms",
             "gator-pt,fragment-pt",
             "--settings",
-            "sort=radix|bucket|gpu",
+            "sort=radix|bucket",
             "--datasets",
             "box:1k,shell:1k",
             "--viewpoints",
