@@ -61,10 +61,12 @@ fn shell_is_a_hollow_sphere_without_slivers_at_every_size() {
         assert_eq!(m.num_tets(), 36 * n * n * layers, "{spec}");
         // Shape before count (see `shell_cells`): within 25 % of the target below 10 k tets,
         // 10 % below 100 k, 5 % from there up.
-        let tolerance = match target {
-            ..10_000 => 0.25,
-            ..100_000 => 0.10,
-            _ => 0.05,
+        let tolerance = if target < 10_000 {
+            0.25
+        } else if target < 100_000 {
+            0.10
+        } else {
+            0.05
         };
         let rel = m.num_tets() as f64 / target as f64 - 1.0;
         assert!(rel.abs() <= tolerance, "{spec}: {} tets", m.num_tets());

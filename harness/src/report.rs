@@ -472,6 +472,48 @@ fn algorithm_cell(name: &str) -> String {
     }
 }
 
+/// Rows flagged by [`crate::suspect`], each with its heatmap first, then the rendering and the
+/// reference, so a broken renderer is the first picture a reader sees after the charts.
+fn suspect_section(h: &mut String, file: &ResultsFile) {
+    let suspects: Vec<&Row> = file.rows.iter().filter(|r| !r.suspect.is_empty()).collect();
+    if suspects.is_empty() {
+        return;
+    }
+    let _ = write!(
+        h,
+        "<h2>Suspect rows ({})</h2><p>Image error far out of line with the other algorithms on \
+         the same image: a renderer defect, or a mesh or setting the method cannot handle. \
+         Heatmap first, then the rendering and the reference.</p><div class=\"strip suspect\">",
+        suspects.len()
+    );
+    for row in suspects {
+        h.push_str("<figure><div class=pair>");
+        for (path, alt) in [
+            (&row.heatmap, "error heatmap"),
+            (&row.image, "image"),
+            (&row.reference_image, "reference"),
+        ] {
+            if !path.is_empty() {
+                let _ = write!(
+                    h,
+                    "<a href=\"{0}\"><img src=\"{0}\" alt=\"{alt}\" loading=lazy></a>",
+                    esc(path)
+                );
+            }
+        }
+        let _ = write!(
+            h,
+            "</div><figcaption>{} {} on {} {}<br>{}</figcaption></figure>",
+            esc(&row.algorithm),
+            esc(&row.settings),
+            esc(&row.dataset),
+            esc(&row.viewpoint),
+            esc(&row.suspect)
+        );
+    }
+    h.push_str("</div>\n");
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -549,46 +591,4 @@ mod tests {
         let svg = std::fs::read_to_string(dir.path().join("charts/psnr.svg")).unwrap();
         assert!(svg.contains("@font-face") && svg.contains("DejaVu Sans"));
     }
-}
-
-/// Rows flagged by [`crate::suspect`], each with its heatmap first, then the rendering and the
-/// reference, so a broken renderer is the first picture a reader sees after the charts.
-fn suspect_section(h: &mut String, file: &ResultsFile) {
-    let suspects: Vec<&Row> = file.rows.iter().filter(|r| !r.suspect.is_empty()).collect();
-    if suspects.is_empty() {
-        return;
-    }
-    let _ = write!(
-        h,
-        "<h2>Suspect rows ({})</h2><p>Image error far out of line with the other algorithms on \
-         the same image: a renderer defect, or a mesh or setting the method cannot handle. \
-         Heatmap first, then the rendering and the reference.</p><div class=\"strip suspect\">",
-        suspects.len()
-    );
-    for row in suspects {
-        h.push_str("<figure><div class=pair>");
-        for (path, alt) in [
-            (&row.heatmap, "error heatmap"),
-            (&row.image, "image"),
-            (&row.reference_image, "reference"),
-        ] {
-            if !path.is_empty() {
-                let _ = write!(
-                    h,
-                    "<a href=\"{0}\"><img src=\"{0}\" alt=\"{alt}\" loading=lazy></a>",
-                    esc(path)
-                );
-            }
-        }
-        let _ = write!(
-            h,
-            "</div><figcaption>{} {} on {} {}<br>{}</figcaption></figure>",
-            esc(&row.algorithm),
-            esc(&row.settings),
-            esc(&row.dataset),
-            esc(&row.viewpoint),
-            esc(&row.suspect)
-        );
-    }
-    h.push_str("</div>\n");
 }
