@@ -236,3 +236,42 @@ fn havs_k6_on_spx_is_close_to_the_reference() {
         }
     }
 }
+
+/// Issue 15: `onion:10k` (nested sliver shells, every tet a sliver) is built to break a small
+/// k-buffer. The exact A-buffer analysis finds the k it needs; the k-buffer's CPU model with
+/// that k is out of order nowhere and close to the reference, while k = 2 is out of order
+/// somewhere and further from it. (CPU only: the model is the twin of the race-free GPU mode.)
+#[test]
+fn the_sliver_onion_needs_more_than_k_2() {
+    let mesh = datasets::generate::from_spec("onion:10k", 1).unwrap();
+    assert_eq!(mesh.quality().slivers, mesh.num_tets());
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    let vp = &fixed_viewpoints()[6];
+    let camera = Camera::fit(&mesh.bounds(), vp, Projection::default(), 64, 64);
+    let geometry = tagged_geometry(&mesh, &optics);
+    let stats = havs::abuffer::kbuffer_stats(&geometry, &camera);
+    eprintln!(
+        "onion:10k at 64²: max k {}, pixels needing k > 2: {}, k > 6: {} of {}",
+        stats.max_k, stats.pixels_k_gt2, stats.pixels_k_gt6, stats.covered_pixels
+    );
+    // Measured: max k 3, 2,204 of 2,226 covered pixels need k > 2 (none k > 6).
+    assert!(stats.max_k > 2, "the onion should need more than k = 2");
+    assert!(
+        stats.pixels_k_gt2 * 2 > stats.covered_pixels,
+        "most onion pixels need k > 2"
+    );
+    let reference = reference::render(&mesh, &optics, &camera);
+    let table = Table3d::build(&optics, 64, 64, mesh.quality().max_edge);
+    let k_needed = (stats.max_k as usize).max(2);
+    let (enough, errors_enough) =
+        model_image(&geometry, &camera, &table, k_needed, TagScheme::Two, false);
+    let (small, errors_small) = model_image(&geometry, &camera, &table, 2, TagScheme::Two, false);
+    let (p_enough, p_small) = (psnr(&enough, &reference), psnr(&small, &reference));
+    eprintln!(
+        "k = {k_needed}: {p_enough:.2} dB, {errors_enough} out-of-order pops; k = 2: {p_small:.2} dB, {errors_small} pops"
+    );
+    assert_eq!(errors_enough, 0, "k = max k needed must sort every pixel");
+    assert!(errors_small > 0);
+    // Measured: 58.1 dB with the k it needs, 32.2 dB with k = 2 (356,488 out-of-order pops).
+    assert!(p_enough > p_small + 20.0, "{p_enough} vs {p_small}");
+}

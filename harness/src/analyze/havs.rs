@@ -190,7 +190,12 @@ fn cpu_name() -> String {
 #[derive(Debug, clap::Args)]
 pub struct KbufferArgs {
     /// Data sets (registry names or files), comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "spx,bluntfin,comb,post")]
+    /// (`onion:10k` is the sliver stress case of issue 15: nested sliver shells.)
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "spx,bluntfin,comb,post,onion:10k"
+    )]
     pub datasets: Vec<String>,
     /// Image size (square), 512 as in the paper.
     #[arg(long, default_value_t = 512)]
