@@ -391,3 +391,53 @@ fn killed_run_keeps_finished_rows() {
     assert_same_rows(&json.rows, &csv[..json.rows.len()]);
     assert!(csv.iter().all(|r| r.ok() && r.tets_per_sec.unwrap() > 0.0));
 }
+
+/// Issue 15: on the default suite's non-convex mesh (`shell:10k`, rebuilt without slivers)
+/// every default variant of every algorithm is at least 40 dB from the exact reference (RMSE ≤
+/// 1 %: `suspect::FINE_DB`, so none is suspect), and the ray caster with the 3D table and no
+/// early termination — exact order, exact segments — reaches 90 dB.
+#[test]
+fn every_algorithm_is_close_to_the_reference_on_the_non_convex_suite_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cache = dir.path().join("cache");
+    run_ok(&[
+        "run",
+        "--datasets",
+        "shell:10k",
+        "--viewpoints",
+        "+x+y+z",
+        "--resolution",
+        "48",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--no-report",
+        "--no-calibrate",
+        "--strict",
+        "--out",
+        out.to_str().unwrap(),
+        "--cache-dir",
+        cache.to_str().unwrap(),
+    ]);
+    let json = ResultsFile::read(&out).unwrap();
+    assert!(!json.rows.is_empty());
+    for r in &json.rows {
+        let p = r.psnr_db.unwrap_or(f64::NAN);
+        eprintln!("{} {}: {p:.1} dB", r.algorithm, r.settings);
+        assert!(
+            p >= 40.0,
+            "{} {}: {p} dB on shell:10k",
+            r.algorithm,
+            r.settings
+        );
+        assert!(r.suspect.is_empty(), "{}: {}", r.algorithm, r.suspect);
+        if r.algorithm == "raycast"
+            && r.settings.contains("table=3d")
+            && r.settings.contains("et=off")
+        {
+            assert!(p >= 90.0, "exact ray caster at {p} dB");
+        }
+    }
+}
