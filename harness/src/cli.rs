@@ -107,6 +107,15 @@ pub struct CompareArgs {
     /// Compare runs from different adapters on calibration-normalised times.
     #[arg(long)]
     pub normalised: bool,
+    /// Test NEW's absolute times, without dividing out the run-wide factor (the median
+    /// change over all groups): for a dedicated machine whose speed does not drift.
+    #[arg(long)]
+    pub no_drift_correction: bool,
+    /// A run-wide factor beyond this (either way) is itself reported as a regression or an
+    /// improvement of every group (default 1.5: the largest drift measured between two runs
+    /// on the 2-core development VM was ×1.25).
+    #[arg(long, default_value_t = 1.5)]
+    pub drift_limit: f64,
     /// Output directory (default: NEW/compare).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -131,12 +140,17 @@ pub struct RunArgs {
     /// Transfer function: a preset (low-opacity, high-opacity) or a ParaView colormap JSON file.
     #[arg(long, value_name = "NAME|FILE", default_value = "low-opacity")]
     pub tf: String,
-    /// Timed frames per viewpoint (default 10; the default suite uses 3).
+    /// Timed frames per viewpoint in each round (default 10; the default suite uses 1).
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
-    /// Untimed warm-up frames before them (default 2; the default suite uses 1).
+    /// Untimed warm-up frames before them, in each round (default 2; the default suite uses 1).
     #[arg(long, value_name = "N")]
     pub warmup: Option<u32>,
+    /// Passes over each data set's variants, so that a row's samples come from separate
+    /// moments (default 1; the default suite uses 3). With more than 1, all variants of a
+    /// data set stay prepared at once.
+    #[arg(long, value_name = "N")]
+    pub rounds: Option<u32>,
     /// Output directory (results, images, report). Earlier results there are replaced.
     #[arg(long, value_name = "DIR", default_value = "out")]
     pub out: PathBuf,
@@ -241,6 +255,10 @@ impl RunArgs {
             anyhow::bail!("--frames must be at least 1");
         }
         let warmup = pick(self.warmup, DEFAULT_SUITE.warmup, suite::STANDARD_WARMUP);
+        let rounds = pick(self.rounds, DEFAULT_SUITE.rounds, suite::STANDARD_ROUNDS);
+        if rounds == 0 {
+            anyhow::bail!("--rounds must be at least 1");
+        }
 
         let known = algorithms::names();
         let mut algorithms: Vec<String> = if self.algorithms.is_empty() {
@@ -295,6 +313,7 @@ impl RunArgs {
             height: resolution,
             frames,
             warmup,
+            rounds,
             tf_spec: self.tf.clone(),
             tf,
             projection: if self.orthographic {
@@ -412,10 +431,13 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
                 threshold: args.threshold,
                 alpha: args.alpha,
                 normalised: args.normalised,
+                drift_correction: !args.no_drift_correction,
+                drift_limit: args.drift_limit,
                 fail_on: args.fail_on,
                 out: args.out.clone().unwrap_or_else(|| args.new.join("compare")),
             };
             anyhow::ensure!(args.threshold >= 1.0, "--threshold must be at least 1");
+            anyhow::ensure!(args.drift_limit >= 1.0, "--drift-limit must be at least 1");
             if crate::compare::run_command(&args.base, &args.new, &opt)? {
                 // The documented CI gate: status 1 without an error message.
                 std::process::exit(1);

@@ -61,7 +61,8 @@ pub struct Row {
     pub cpu_ms_max: Option<f64>,
     pub gpu_ms_min: Option<f64>,
     pub gpu_ms_max: Option<f64>,
-    /// Timed frames (after `warmup` untimed ones).
+    /// Timed frames over all rounds (each round's after `warmup` untimed ones): the number of
+    /// samples.
     pub frames: u32,
     pub warmup: u32,
     /// GPU bytes that live as long as the mesh (bytes_per_tet = this / tets).
@@ -124,8 +125,12 @@ pub struct RunDescription {
     pub viewpoints: String,
     pub width: u32,
     pub height: u32,
+    /// Timed frames per viewpoint in each round.
     pub frames: u32,
     pub warmup: u32,
+    /// Passes over each data set's variants (`run --rounds`; files from before it: 1).
+    #[serde(default = "one_round")]
+    pub rounds: u32,
     pub transfer_function: String,
     pub projection: String,
     pub settings_filter: String,
@@ -136,6 +141,10 @@ pub struct RunDescription {
     /// The runs `report --merge` put together (empty for a plain run).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub merged_from: Vec<crate::shard::MergedRun>,
+}
+
+fn one_round() -> u32 {
+    1
 }
 
 /// The whole of `results.json`.

@@ -37,6 +37,10 @@ pub struct RunConfig {
     pub height: u32,
     pub frames: u32,
     pub warmup: u32,
+    /// Passes over a data set's variants: each pass renders `warmup` + `frames` per viewpoint
+    /// of every variant in turn, so a row's samples come from `rounds` separate moments
+    /// (see [`DatasetContext::run_variants`]). 1: each variant runs alone, then is dropped.
+    pub rounds: u32,
     pub tf_spec: String,
     pub tf: TransferFunction,
     pub projection: Projection,
@@ -365,6 +369,7 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         height: config.height,
         frames: config.frames,
         warmup: config.warmup,
+        rounds: config.rounds,
         transfer_function: config.tf_spec.clone(),
         projection: projection_name(&config.projection),
         settings_filter: config.settings_filter.to_string(),
@@ -440,14 +445,20 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
             references: HashMap::new(),
             reference_mesh: None,
         };
+        let mut renderers = vec![];
         for (name, _) in &plan {
-            let variants = factory(name)?;
-            for mut renderer in variants.into_iter().filter(|r| {
+            renderers.extend(factory(name)?.into_iter().filter(|r| {
                 config.settings_filter.accepts(&r.settings())
                     && in_shard(&label, name, &settings_string(&r.settings()))
-            }) {
-                ctx.run_variant(renderer.as_mut(), &mut writer, &mut progress, &mut outcome)?;
+            }));
+        }
+        if config.rounds <= 1 {
+            // One variant at a time: its GPU memory is freed before the next one prepares.
+            for renderer in renderers {
+                ctx.run_variants(vec![renderer], &mut writer, &mut progress, &mut outcome)?;
             }
+        } else {
+            ctx.run_variants(renderers, &mut writer, &mut progress, &mut outcome)?;
         }
     }
     progress.finish();
@@ -545,7 +556,7 @@ fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Ro
         cpu_ms_max: None,
         gpu_ms_min: None,
         gpu_ms_max: None,
-        frames: c.frames,
+        frames: c.frames * c.rounds.max(1),
         warmup: c.warmup,
         gpu_bytes_persistent: None,
         gpu_bytes_frame: None,
@@ -645,89 +656,104 @@ impl DatasetContext<'_> {
         r
     }
 
-    fn run_variant(
+    /// Measures `renderers` on this data set in `config.rounds` passes. Every variant is
+    /// prepared once; each pass then renders, variant after variant, `warmup` untimed and
+    /// `frames` timed frames per viewpoint, so the samples of one row are taken at `rounds`
+    /// moments seconds apart. On a shared or virtual machine the speed drifts by tens of per
+    /// cent over seconds while the frames of one moment agree to a few per cent: samples from
+    /// one moment are not independent, and `compare`'s test needs independent ones (asv
+    /// interleaves its rounds for the same reason). The last pass also reads each image back
+    /// and writes the row.
+    fn run_variants(
         &mut self,
-        renderer: &mut dyn Renderer,
+        renderers: Vec<Box<dyn Renderer>>,
         writer: &mut ResultsWriter,
         progress: &mut Progress,
         outcome: &mut RunOutcome,
     ) -> anyhow::Result<()> {
         let c = self.config;
-        let what = format!(
-            "{} {} on {}",
-            renderer.algorithm(),
-            settings_string(&renderer.settings()),
-            self.label
-        );
-        progress.activity(&format!("preparing {what}"));
-        let prepared = guarded("prepare", || {
-            renderer.prepare(self.gpu, self.mesh, self.optics)
-        });
-        let prepared = match prepared {
-            Ok(p) => p,
-            Err(e) => {
-                // Every viewpoint of this variant gets a row that says why it is empty.
-                for vp in &c.viewpoints {
-                    let mut row = base_row(self, renderer, vp);
-                    row.error = format!("prepare failed: {e:#}");
-                    progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
-                    writer.push(row)?;
-                    outcome.failed_rows += 1;
-                }
-                return Ok(());
-            }
-        };
-        for vp in &c.viewpoints {
-            let mut row = base_row(self, renderer, vp);
-            row.gpu_bytes_persistent = Some(prepared.persistent_bytes);
-            if let Err(e) = self.measure(renderer, &prepared, vp, &mut row, progress) {
-                row.error = format!("{e:#}");
-                outcome.failed_rows += 1;
-                progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
-            } else if !row.error.is_empty() {
-                // Measured, but without error metrics (the reference failed).
-                outcome.failed_rows += 1;
-                progress.row(&format!(
-                    "{what} {}: {:.2} ms, no reference: {}",
-                    vp.name,
-                    row.total_ms.unwrap_or(f64::NAN),
-                    row.error
-                ));
-            } else {
-                // Against the rows so far; the final flags are set once every row is in.
-                row.suspect = crate::suspect::reason(&row, &writer.file.rows).unwrap_or_default();
-                progress.row(&format!(
-                    "{what} {}: {:.2} ms, {:.3} M tets/s, PSNR {}{}",
-                    vp.name,
-                    row.total_ms.unwrap_or(f64::NAN),
-                    row.tets_per_sec.unwrap_or(f64::NAN) * 1e-6,
-                    row.psnr_db
-                        .map(|p| format!("{p:.2} dB"))
-                        .unwrap_or_else(|| "-".into()),
-                    if row.suspect.is_empty() {
-                        String::new()
-                    } else {
-                        format!("  SUSPECT: {}", row.suspect)
+        let rounds = c.rounds.max(1);
+        let views = c.viewpoints.len();
+        // Per prepared variant: renderer, what prepare gave, frames so far and the first
+        // failure per viewpoint.
+        let mut live = vec![];
+        for mut renderer in renderers {
+            let what = self.describe(renderer.as_ref());
+            progress.activity(&format!("preparing {what}"));
+            match guarded("prepare", || {
+                renderer.prepare(self.gpu, self.mesh, self.optics)
+            }) {
+                Ok(prepared) => live.push((
+                    renderer,
+                    prepared,
+                    vec![Vec::<FrameStats>::new(); views],
+                    vec![None::<String>; views],
+                )),
+                Err(e) => {
+                    // Every viewpoint of this variant gets a row that says why it is empty.
+                    for vp in &c.viewpoints {
+                        let mut row = base_row(self, renderer.as_ref(), vp);
+                        row.error = format!("prepare failed: {e:#}");
+                        progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
+                        writer.push(row)?;
+                        outcome.failed_rows += 1;
                     }
-                ));
+                }
             }
-            writer.push(row)?;
+        }
+        for round in 0..rounds {
+            let last = round + 1 == rounds;
+            for (renderer, prepared, frames, failed) in live.iter_mut() {
+                for (i, vp) in c.viewpoints.iter().enumerate() {
+                    if failed[i].is_none() {
+                        let what = format!("{} {} {}", renderer.algorithm(), self.label, vp.name);
+                        progress.activity(&if rounds > 1 {
+                            format!("{what} (round {}/{rounds})", round + 1)
+                        } else {
+                            what
+                        });
+                        match self.time_frames(renderer.as_mut(), vp) {
+                            Ok(f) => frames[i].extend(f),
+                            Err(e) => failed[i] = Some(format!("{e:#}")),
+                        }
+                    }
+                    if last {
+                        let f = std::mem::take(&mut frames[i]);
+                        let row = self.finish_row(
+                            renderer.as_mut(),
+                            prepared,
+                            vp,
+                            f,
+                            failed[i].take(),
+                            progress,
+                            outcome,
+                            &writer.file.rows,
+                        );
+                        writer.push(row)?;
+                    }
+                }
+            }
         }
         Ok(())
     }
 
-    /// Times one viewpoint and fills `row`; images are written as PNGs beside the results.
-    fn measure(
+    fn describe(&self, renderer: &dyn Renderer) -> String {
+        format!(
+            "{} {} on {}",
+            renderer.algorithm(),
+            settings_string(&renderer.settings()),
+            self.label
+        )
+    }
+
+    /// The warm-up and timed frames of one viewpoint in one round.
+    fn time_frames(
         &mut self,
         renderer: &mut dyn Renderer,
-        prepared: &render_core::Prepared,
         vp: &Viewpoint,
-        row: &mut Row,
-        progress: &Progress,
-    ) -> anyhow::Result<()> {
+    ) -> anyhow::Result<Vec<FrameStats>> {
         let c = self.config;
         let camera = Camera::fit(&self.mesh.bounds(), vp, c.projection, c.width, c.height);
-        progress.activity(&format!("{} {} {}", row.algorithm, self.label, vp.name));
         for _ in 0..c.warmup {
             guarded("render", || renderer.render(self.gpu, &camera))?;
         }
@@ -735,6 +761,77 @@ impl DatasetContext<'_> {
         for _ in 0..c.frames {
             frames.push(guarded("render", || renderer.render(self.gpu, &camera))?);
         }
+        Ok(frames)
+    }
+
+    /// The row of one viewpoint once all its rounds ran (`failure`: the first error of any).
+    #[allow(clippy::too_many_arguments)]
+    fn finish_row(
+        &mut self,
+        renderer: &mut dyn Renderer,
+        prepared: &render_core::Prepared,
+        vp: &Viewpoint,
+        frames: Vec<FrameStats>,
+        failure: Option<String>,
+        progress: &mut Progress,
+        outcome: &mut RunOutcome,
+        rows_so_far: &[Row],
+    ) -> Row {
+        let what = self.describe(renderer);
+        let mut row = base_row(self, renderer, vp);
+        row.gpu_bytes_persistent = Some(prepared.persistent_bytes);
+        let measured = match failure {
+            Some(e) => Err(anyhow!(e)),
+            None => self.measure(renderer, prepared, vp, frames, &mut row, progress),
+        };
+        if let Err(e) = measured {
+            row.error = format!("{e:#}");
+            outcome.failed_rows += 1;
+            progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
+        } else if !row.error.is_empty() {
+            // Measured, but without error metrics (the reference failed).
+            outcome.failed_rows += 1;
+            progress.row(&format!(
+                "{what} {}: {:.2} ms, no reference: {}",
+                vp.name,
+                row.total_ms.unwrap_or(f64::NAN),
+                row.error
+            ));
+        } else {
+            // Against the rows so far; the final flags are set once every row is in.
+            row.suspect = crate::suspect::reason(&row, rows_so_far).unwrap_or_default();
+            progress.row(&format!(
+                "{what} {}: {:.2} ms, {:.3} M tets/s, PSNR {}{}",
+                vp.name,
+                row.total_ms.unwrap_or(f64::NAN),
+                row.tets_per_sec.unwrap_or(f64::NAN) * 1e-6,
+                row.psnr_db
+                    .map(|p| format!("{p:.2} dB"))
+                    .unwrap_or_else(|| "-".into()),
+                if row.suspect.is_empty() {
+                    String::new()
+                } else {
+                    format!("  SUSPECT: {}", row.suspect)
+                }
+            ));
+        }
+        row
+    }
+
+    /// Fills `row` from the timed frames of every round of one viewpoint and the image of
+    /// its last frame (the renderer's target still holds it); images are written as PNGs
+    /// beside the results.
+    fn measure(
+        &mut self,
+        renderer: &mut dyn Renderer,
+        prepared: &render_core::Prepared,
+        vp: &Viewpoint,
+        frames: Vec<FrameStats>,
+        row: &mut Row,
+        progress: &Progress,
+    ) -> anyhow::Result<()> {
+        let c = self.config;
+        let camera = Camera::fit(&self.mesh.bounds(), vp, c.projection, c.width, c.height);
         let image = guarded("read_image", || renderer.read_image(self.gpu))?;
 
         let total = summarize(&frames.iter().map(|f| f.total_ms).collect::<Vec<_>>())

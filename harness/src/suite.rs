@@ -13,6 +13,7 @@ pub struct Suite {
     pub resolution: u32,
     pub frames: u32,
     pub warmup: u32,
+    pub rounds: u32,
 }
 
 pub const DEFAULT_SUITE: Suite = Suite {
@@ -21,8 +22,11 @@ pub const DEFAULT_SUITE: Suite = Suite {
     // An axis view and two cube diagonals of the 14 fixed viewpoints.
     viewpoints: "+x,+x+y+z,-x+y-z",
     resolution: 128,
-    frames: 3,
+    // Three rounds of one timed frame each: three samples per row taken seconds apart, so
+    // that `tetbench compare` tests independent samples (see `run::DatasetContext::run_variants`).
+    frames: 1,
     warmup: 1,
+    rounds: 3,
 };
 
 /// Defaults when data sets are named on the command line: the papers' setting (the 14 fixed
@@ -31,6 +35,7 @@ pub const STANDARD_VIEWPOINTS: &str = "14";
 pub const STANDARD_RESOLUTION: u32 = 512;
 pub const STANDARD_FRAMES: u32 = 10;
 pub const STANDARD_WARMUP: u32 = 2;
+pub const STANDARD_ROUNDS: u32 = 1;
 
 /// `14` (or `fixed`): the 14 fixed viewpoints; `axes` (6) or `diagonals` (8); `orbit:N`: N
 /// frames around the up axis; or a comma-separated list of fixed viewpoint names (`+x,-y,+x+y-z`).

@@ -100,6 +100,46 @@ fn merged_shards_equal_one_run_and_compare_finds_no_change() {
         assert!(!r.image_hash.is_empty() && !r.image_f32.is_empty());
     }
 
+    // Rounds: the same rows in the same order, each with one sample per round.
+    let rounds = {
+        let (o, c) = (p("rounds"), p("cache"));
+        ok(&[
+            "run",
+            "--algorithms",
+            "gator-pt,fragment-pt",
+            "--settings",
+            "sort=radix|bucket",
+            "--datasets",
+            "box:1k,shell:1k",
+            "--viewpoints",
+            "+x,-x-y+z",
+            "--resolution",
+            "16",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+            "--rounds",
+            "3",
+            "--no-report",
+            "--no-calibrate",
+            "--out",
+            &o,
+            "--cache-dir",
+            &c,
+        ]);
+        ResultsFile::read(Path::new(&o)).unwrap()
+    };
+    assert_eq!(rounds.run.rounds, 3);
+    assert_eq!(
+        rounds.rows.iter().map(untimed).collect::<Vec<_>>(),
+        full.rows.iter().map(untimed).collect::<Vec<_>>()
+    );
+    for r in &rounds.rows {
+        assert_eq!(r.samples.total_ms.len(), 3, "one sample per round");
+        assert_eq!(r.frames, 3);
+    }
+
     let out = ok(&[
         "report",
         "--merge",

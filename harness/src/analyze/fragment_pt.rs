@@ -333,6 +333,7 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
             tf: args.tf.clone(),
             frames: Some(args.frames),
             warmup: Some(args.warmup),
+            rounds: None,
             out: args.out.join(format!("res-{res}")),
             settings: args.settings.clone(),
             // Fig. 8 is about speed: no reference images (they dominate at 1024²).

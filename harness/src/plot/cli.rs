@@ -86,8 +86,13 @@ impl PlotArgs {
             ),
             resolution: Some(resolution),
             tf: self.tf.clone(),
-            frames: Some(self.frames.unwrap_or(crate::suite::DEFAULT_SUITE.frames)),
+            // The suite's number of samples, in one round: a sweep's large meshes should not
+            // all stay prepared at once.
+            frames: Some(self.frames.unwrap_or(
+                crate::suite::DEFAULT_SUITE.frames * crate::suite::DEFAULT_SUITE.rounds,
+            )),
             warmup: Some(self.warmup.unwrap_or(crate::suite::DEFAULT_SUITE.warmup)),
+            rounds: None,
             out,
             settings: self.settings.clone(),
             no_reference: self.no_reference,

@@ -261,6 +261,7 @@ impl Session {
             } else {
                 FULL_WARMUP
             }),
+            rounds: None,
             out: out.clone(),
             settings: spec.settings.clone(),
             no_reference: self.quick,
