@@ -2,6 +2,7 @@
 # Runs the default suite in a release build and stores it as a committed baseline:
 # reports/baselines/<adapter>-<YYYY-MM-DD>/ with results.json (samples, image hashes and the
 # backend's calibration in machine.calibration), results.csv, samples.csv and calibration.json.
+# The suite runs with --rounds 5 (README, "Regression tracking": samples from separate moments).
 # No images (the hashes in the rows still show any changed pixel). Extra arguments go to
 # `tetbench run` (e.g. --cache-dir DIR). Replaces a baseline of the same adapter and day.
 set -euo pipefail
@@ -12,7 +13,7 @@ cargo build --release -p harness --bin tetbench
 bin=target/release/tetbench
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-"$bin" run --out "$tmp/run" --no-report "$@"
+"$bin" run --rounds 5 --out "$tmp/run" --no-report "$@"
 # The adapter's name is the first "name" of results.json (machine.adapter.name).
 adapter=$(grep -m1 '"name"' "$tmp/run/results.json" | sed 's/.*"name": *"\(.*\)",*$/\1/')
 slug=$(printf '%s' "$adapter" | tr 'A-Z' 'a-z' | sed 's/[^a-z0-9]\{1,\}/-/g; s/^-//; s/-$//')

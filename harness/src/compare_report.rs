@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use crate::compare::{fmt_p, Comparison, RowComparison, TimeTest};
+use crate::compare::{Comparison, RowComparison, TimeTest};
 use crate::compare_plot::{ratio_plot, Strip};
 
 fn header(c: &Comparison) -> Vec<String> {
@@ -28,6 +28,17 @@ fn header(c: &Comparison) -> Vec<String> {
                 ""
             }
         ),
+        match (c.run_factor, c.drift_corrected) {
+            (Some(f), true) => format!(
+                "run-wide factor: NEW/BASE ×{f:.3} (median over the groups); NEW's total_ms was \
+                 divided by it before the tests, so ratios below are relative to the rest of the \
+                 run (--no-drift-correction: absolute)"
+            ),
+            (Some(f), false) => format!(
+                "run-wide factor: NEW/BASE ×{f:.3} (median over the groups); not divided out"
+            ),
+            (None, _) => "run-wide factor: too few groups to estimate; absolute times tested".into(),
+        },
         format!(
             "outcome: {} — {} regression(s), {} improvement(s), {} other change(s) in {} rows, {} groups",
             c.outcome().to_uppercase(),
@@ -42,12 +53,7 @@ fn header(c: &Comparison) -> Vec<String> {
 
 fn time_cell(t: Option<&TimeTest>) -> String {
     match t {
-        Some(t) => format!(
-            "×{:.3} p={} {}",
-            t.ratio,
-            fmt_p(t.p_value),
-            t.verdict.label()
-        ),
+        Some(t) => format!("×{:.3} p={} {}", t.ratio, t.p_label(), t.verdict.label()),
         None => "-".into(),
     }
 }
@@ -111,7 +117,7 @@ fn markdown(c: &Comparison) -> String {
         }
     }
     s.push_str("\n## Groups (total_ms pooled over viewpoints)\n\n");
-    s.push_str("| algorithm | settings | data set | views | base ms | new ms | ratio | p | verdict |\n|---|---|---|---:|---:|---:|---:|---:|---|\n");
+    s.push_str("| algorithm | settings | data set | views | base ms | new ms | ratio | p (Holm) | verdict |\n|---|---|---|---:|---:|---:|---:|---:|---|\n");
     for g in &c.groups {
         let _ = writeln!(
             s,
@@ -123,7 +129,7 @@ fn markdown(c: &Comparison) -> String {
             g.total.base_median,
             g.total.new_median,
             g.total.ratio,
-            fmt_p(g.total.p_value),
+            g.total.p_label(),
             g.total.verdict.label()
         );
     }
