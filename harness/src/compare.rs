@@ -24,6 +24,10 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
+pub use crate::compare_time::{
+    adjust_family, fmt_p, run_wide_factor, scaled, time_test, TimeTest, Verdict,
+    MIN_GROUPS_FOR_DRIFT,
+};
 use crate::results::{ResultsFile, Row};
 use crate::samples;
 use crate::stats::{holm_adjust, mann_whitney_p, median};
@@ -53,115 +57,6 @@ pub struct CompareOptions {
     pub drift_limit: f64,
     pub fail_on: FailOn,
     pub out: PathBuf,
-}
-
-/// Fewer groups than this give no run-wide factor: a median of one or two groups would be
-/// the change being looked for, not the machine's.
-pub const MIN_GROUPS_FOR_DRIFT: usize = 5;
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Verdict {
-    Faster,
-    Slower,
-    NoChange,
-    TooFewSamples,
-}
-
-impl Verdict {
-    pub fn label(self) -> &'static str {
-        match self {
-            Verdict::Faster => "faster",
-            Verdict::Slower => "slower",
-            Verdict::NoChange => "no change",
-            Verdict::TooFewSamples => "too few samples",
-        }
-    }
-}
-
-/// One time metric of one row (or pooled over a group's viewpoints).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TimeTest {
-    pub metric: String,
-    pub base_median: f64,
-    pub new_median: f64,
-    /// new median / base median.
-    pub ratio: f64,
-    pub p_value: Option<f64>,
-    /// `p_value` after Holm's adjustment over the family of gating tests it belongs to (the
-    /// groups, or the rows' `total_ms`); the verdict uses it when present.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub p_adjusted: Option<f64>,
-    pub verdict: Verdict,
-    /// The samples divided by BASE's median (what the ratio plots show).
-    pub base_ratios: Vec<f64>,
-    pub new_ratios: Vec<f64>,
-}
-
-/// The asv-style decision on two samples of one metric.
-pub fn time_test(metric: &str, base: &[f64], new: &[f64], threshold: f64, alpha: f64) -> TimeTest {
-    let (bm, nm) = (median(base), median(new));
-    let scale = |v: &[f64]| v.iter().map(|x| x / bm).collect::<Vec<_>>();
-    let p = mann_whitney_p(base, new);
-    let ratio = nm / bm;
-    let enough = base.len() >= 2 && new.len() >= 2;
-    TimeTest {
-        metric: metric.to_string(),
-        base_median: bm,
-        new_median: nm,
-        ratio,
-        p_value: p,
-        p_adjusted: None,
-        verdict: decide(enough, ratio, p, threshold, alpha),
-        base_ratios: scale(base),
-        new_ratios: scale(new),
-    }
-}
-
-/// asv's rule: a change needs both p < α and a ratio of medians beyond the threshold.
-fn decide(enough: bool, ratio: f64, p: Option<f64>, threshold: f64, alpha: f64) -> Verdict {
-    let significant = p.is_some_and(|p| p < alpha);
-    if !enough || !ratio.is_finite() {
-        Verdict::TooFewSamples
-    } else if significant && ratio >= threshold {
-        Verdict::Slower
-    } else if significant && ratio <= 1.0 / threshold {
-        Verdict::Faster
-    } else {
-        Verdict::NoChange
-    }
-}
-
-impl TimeTest {
-    /// The p-value as printed: raw, and the Holm-adjusted one that decides when there is one.
-    pub fn p_label(&self) -> String {
-        match self.p_adjusted {
-            Some(a) => format!("{} (Holm {})", fmt_p(self.p_value), fmt_p(Some(a))),
-            None => fmt_p(self.p_value),
-        }
-    }
-
-    /// Decides again with the family-adjusted p-value ([`holm_adjust`]).
-    fn with_family_p(mut self, p_adjusted: Option<f64>, threshold: f64, alpha: f64) -> TimeTest {
-        if self.verdict != Verdict::TooFewSamples {
-            self.p_adjusted = p_adjusted;
-            self.verdict = decide(true, self.ratio, p_adjusted, threshold, alpha);
-        }
-        self
-    }
-}
-
-/// Adjusts the p-values of a family of gating tests together and decides each again.
-fn adjust_family<'a>(tests: impl Iterator<Item = &'a mut TimeTest>, opt: &CompareOptions) {
-    let mut tests: Vec<&mut TimeTest> = tests.collect();
-    let raw: Vec<Option<f64>> = tests
-        .iter()
-        .map(|t| t.p_value.filter(|_| t.verdict != Verdict::TooFewSamples))
-        .collect();
-    for (t, p) in tests.iter_mut().zip(holm_adjust(&raw)) {
-        let adjusted = (**t).clone().with_family_p(p, opt.threshold, opt.alpha);
-        **t = adjusted;
-    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -327,7 +222,8 @@ pub fn compare(
         }
     }
     let heat_dir = opt.out.join("heatmaps");
-    let run_factor = run_wide_factor(&group_tests(&base.rows, &new.rows, opt, 1.0)?);
+    let unscaled = group_tests(&base.rows, &new.rows, opt, 1.0)?;
+    let run_factor = run_wide_factor(unscaled.iter().map(|g| &g.total));
     let scale = match run_factor {
         Some(f) if opt.drift_correction => f,
         _ => 1.0,
@@ -364,7 +260,11 @@ pub fn compare(
         }
     }
     let mut groups = group_tests(&base.rows, &new.rows, opt, scale)?;
-    adjust_family(groups.iter_mut().map(|g| &mut g.total), opt);
+    adjust_family(
+        groups.iter_mut().map(|g| &mut g.total),
+        opt.threshold,
+        opt.alpha,
+    );
     let mut cmp = Comparison {
         base: base_dir.display().to_string(),
         new: new_dir.display().to_string(),
@@ -631,32 +531,6 @@ fn image_change(
 }
 
 /// The pooled `total_ms` test per algorithm × settings × data set.
-/// NEW's samples divided by the run-wide factor (1: unchanged).
-fn scaled(v: Vec<f64>, scale: f64) -> Vec<f64> {
-    if scale == 1.0 {
-        v
-    } else {
-        v.into_iter().map(|x| x / scale).collect()
-    }
-}
-
-/// The median of the groups' ratios, from at least [`MIN_GROUPS_FOR_DRIFT`] groups.
-///
-/// Why: on the 2-core development VM two runs of the same commit a minute apart differ as a
-/// whole by ×0.89–×1.25 (ten pairs of default-suite runs, nothing else running), while the
-/// frames inside one run agree to a few per cent; no test on the samples can tell such a drift
-/// from a change. One renderer made slower leaves the median of 32 groups where it was, so
-/// dividing it out keeps every per-group decision about that group. A change that slows
-/// every algorithm alike shows in the factor itself, judged against `--drift-limit`.
-pub fn run_wide_factor(groups: &[GroupComparison]) -> Option<f64> {
-    let ratios: Vec<f64> = groups
-        .iter()
-        .filter(|g| g.total.verdict != Verdict::TooFewSamples && g.total.ratio.is_finite())
-        .map(|g| g.total.ratio)
-        .collect();
-    (ratios.len() >= MIN_GROUPS_FOR_DRIFT).then(|| median(&ratios))
-}
-
 fn group_tests(
     base: &[Row],
     new: &[Row],
@@ -705,14 +579,6 @@ fn group_tests(
     Ok(out)
 }
 
-pub fn fmt_p(p: Option<f64>) -> String {
-    match p {
-        Some(p) if p < 0.001 => format!("{p:.1e}"),
-        Some(p) => format!("{p:.3}"),
-        None => "-".into(),
-    }
-}
-
 /// `tetbench compare`: prints the table, writes compare.{md,json,html}, returns whether the
 /// `--fail-on` condition was met.
 pub fn run_command(base: &Path, new: &Path, opt: &CompareOptions) -> anyhow::Result<bool> {
@@ -732,40 +598,6 @@ pub fn run_command(base: &Path, new: &Path, opt: &CompareOptions) -> anyhow::Res
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stats::TestRng;
-
-    /// Frame times with 8 % multiplicative noise and occasional 30 % spikes, as on a busy
-    /// machine.
-    fn noisy(rng: &mut TestRng, n: usize, ms: f64) -> Vec<f64> {
-        (0..n)
-            .map(|_| {
-                let spike = if rng.uniform() < 0.1 { 1.3 } else { 1.0 };
-                ms * (1.0 + 0.08 * rng.normal()).max(0.5) * spike
-            })
-            .collect()
-    }
-
-    #[test]
-    fn a_20_percent_slowdown_is_found() {
-        let mut rng = TestRng::new(12);
-        let base = noisy(&mut rng, 10, 10.0);
-        let new = noisy(&mut rng, 10, 12.0);
-        let t = time_test("total_ms", &base, &new, 1.10, 0.05);
-        assert_eq!(t.verdict, Verdict::Slower, "{t:?}");
-        let t = time_test("total_ms", &new, &base, 1.10, 0.05);
-        assert_eq!(t.verdict, Verdict::Faster, "{t:?}");
-    }
-
-    #[test]
-    fn two_samplings_of_one_distribution_show_no_change() {
-        for seed in 1..=20 {
-            let mut rng = TestRng::new(seed);
-            let a = noisy(&mut rng, 10, 10.0);
-            let b = noisy(&mut rng, 10, 10.0);
-            let t = time_test("total_ms", &a, &b, 1.10, 0.05);
-            assert_eq!(t.verdict, Verdict::NoChange, "seed {seed}: {t:?}");
-        }
-    }
 
     /// Writes a one-row results set whose f32 image is `img`, with 5 frames around `ms`.
     fn results_dir(dir: &Path, img: &render_core::Image, ms: f64) {
@@ -942,12 +774,5 @@ mod tests {
             .groups
             .iter()
             .all(|g| g.total.verdict == Verdict::Slower));
-    }
-
-    /// One sample is never enough to decide.
-    #[test]
-    fn one_number_decides_nothing() {
-        let t = time_test("total_ms", &[10.0], &[20.0], 1.10, 0.05);
-        assert_eq!(t.verdict, Verdict::TooFewSamples);
     }
 }

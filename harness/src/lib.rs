@@ -9,6 +9,7 @@ pub mod cli;
 pub mod compare;
 pub mod compare_plot;
 pub mod compare_report;
+pub mod compare_time;
 pub mod datasets_cmd;
 pub mod history;
 pub mod machine;

@@ -3,10 +3,11 @@
 //!
 //! Plan (from `reports/papers/raycast.md`): spx1, blunt and f117 at 512², every tiling from
 //! 1×1 to 6×6, the 2D pre-integration table (Tables 3–5) and the 3D one (Table 6), over the
-//! camera positions (we use the 14 viewpoints). The tables here are generic paper-vs-ours
-//! comparisons from the CSVs; the `raycast` algorithm (issue 9) brings its own analysis
-//! (`tetbench analyze raycast`), to be connected here when it is merged. The setting names
-//! `tiles` (`NxN`) and `table` (`2d|3d`) and the counter `passes` are those issue 9 asks for.
+//! camera positions (we use the 14 viewpoints). The tables here are the paper | ours | ratio
+//! comparisons of `reproduce`; `tetbench analyze raycast RUN_DIR` (`analyze/raycast.rs`) prints
+//! the same four tables for any finished run, with peel layers and steps per ray beside them
+//! and our other data sets as extra rows. Settings `tiles` (`NxN`), `table` (`2d|3d`); counter
+//! `passes`.
 
 use super::papers;
 use super::table::{Cell, CompRow, Comparison, Metric, Ordering};

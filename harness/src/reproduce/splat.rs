@@ -3,9 +3,9 @@
 //! Plan (from `reports/papers/splat.md`): the six voxel volumes of Table 1 (stand-ins with the
 //! paper's dimensions and effective-voxel counts; the originals are not available), the camera
 //! moving (an orbit), CPU-built and GPU-built buckets. Viewport and frames are not stated; we
-//! use 512². The `splat` algorithm (issue 10) brings its own analysis (`tetbench analyze
-//! splat`), to be connected here when merged; the setting `buckets=cpu|gpu` is the one issue 10
-//! asks for.
+//! use 512². `tetbench analyze splat RUN_DIR` (`analyze/splat.rs`) prints Table 1's columns for
+//! whatever volumes a run holds (ironProt, HeadMRVolume); this module compares the paper's six
+//! rows. Setting `buckets=cpu|gpu`.
 
 use datasets::standins::{self, Recipe};
 
