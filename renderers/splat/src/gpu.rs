@@ -109,11 +109,7 @@ impl Pipelines {
         let pipeline_layout = |label: &str, groups: &[&wgpu::BindGroupLayout]| {
             let groups: Vec<Option<&wgpu::BindGroupLayout>> =
                 groups.iter().map(|g| Some(*g)).collect();
-            d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(label),
-                bind_group_layouts: &groups,
-                immediate_size: 0,
-            })
+            render_core::bind::pipeline_layout(gpu, label, &groups)
         };
 
         let compute_layout = layout(
