@@ -566,6 +566,7 @@ fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Ro
         limit_fraction: None,
         bound_by: String::new(),
         normalized_time: None,
+        host_peak_bytes: None,
         error: String::new(),
         samples: Default::default(),
     }
@@ -660,6 +661,8 @@ impl DatasetContext<'_> {
             self.label
         );
         progress.activity(&format!("preparing {what}"));
+        // The first row of a variant carries the prepare's peak (host copies of the mesh).
+        let mut peak_reset = reset_host_peak();
         let prepared = guarded("prepare", || {
             renderer.prepare(self.gpu, self.mesh, self.optics)
         });
@@ -670,6 +673,7 @@ impl DatasetContext<'_> {
                 for vp in &c.viewpoints {
                     let mut row = base_row(self, renderer, vp);
                     row.error = format!("prepare failed: {e:#}");
+                    row.host_peak_bytes = host_peak_bytes(peak_reset);
                     progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
                     writer.push(row)?;
                     outcome.failed_rows += 1;
@@ -680,7 +684,9 @@ impl DatasetContext<'_> {
         for vp in &c.viewpoints {
             let mut row = base_row(self, renderer, vp);
             row.gpu_bytes_persistent = Some(prepared.persistent_bytes);
-            if let Err(e) = self.measure(renderer, &prepared, vp, &mut row, progress) {
+            let measured = self.measure(renderer, &prepared, vp, &mut row, progress);
+            row.host_peak_bytes = host_peak_bytes(peak_reset);
+            if let Err(e) = measured {
                 row.error = format!("{e:#}");
                 outcome.failed_rows += 1;
                 progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
@@ -712,6 +718,7 @@ impl DatasetContext<'_> {
                 ));
             }
             writer.push(row)?;
+            peak_reset = reset_host_peak();
         }
         Ok(())
     }
@@ -808,9 +815,56 @@ impl DatasetContext<'_> {
     }
 }
 
+/// Resets the kernel's peak-resident-set mark (VmHWM) of this process to its current resident
+/// set (`5` into /proc/self/clear_refs, Linux ≥ 4.0); false where that is not possible.
+fn reset_host_peak() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+/// The process's peak resident set since the last [`reset_host_peak`] (VmHWM of
+/// /proc/self/status, in bytes): kept by the kernel, so a short spike between two samples is
+/// not missed. `None` when the reset failed (the mark would be the whole run's) or on systems
+/// without procfs.
+fn host_peak_bytes(was_reset: bool) -> Option<u64> {
+    if !was_reset {
+        return None;
+    }
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    parse_vm_hwm(&status)
+}
+
+fn parse_vm_hwm(status: &str) -> Option<u64> {
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let mut parts = line["VmHWM:".len()..].split_whitespace();
+    let value: u64 = parts.next()?.parse().ok()?;
+    match parts.next() {
+        Some("kB") => Some(value * 1024),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn host_peak_follows_an_allocation_and_resets() {
+        assert_eq!(
+            parse_vm_hwm("Name:\tx\nVmHWM:\t  1234 kB\nVmRSS:\t 12 kB\n"),
+            Some(1234 * 1024)
+        );
+        assert_eq!(parse_vm_hwm("VmRSS: 1 kB"), None);
+        if !reset_host_peak() {
+            return; // no procfs here: the column stays empty, as documented
+        }
+        let before = host_peak_bytes(true).expect("VmHWM after a reset");
+        // 64 MiB touched page by page: the peak must rise by at least most of it.
+        let block = vec![1u8; 64 << 20];
+        let during = host_peak_bytes(true).unwrap();
+        assert!(during >= before + (48 << 20), "{before} → {during}");
+        drop(block);
+        assert!(reset_host_peak());
+    }
 
     #[test]
     fn slugs_keep_viewpoints_distinct_and_paths_safe() {
