@@ -294,7 +294,8 @@ impl ChunkedBuffer {
             get += &format!("    return {name}_0[i];\n}}\n");
             set += &format!("    {name}_0[i] = v;\n}}\n");
         } else {
-            let head = format!("    let c = i / {per}u;\n    let j = i - c * {per}u;\n    switch c {{\n");
+            let head =
+                format!("    let c = i / {per}u;\n    let j = i - c * {per}u;\n    switch c {{\n");
             get += &head;
             set += &head;
             for i in 0..n {

@@ -280,7 +280,11 @@ impl Gpu {
         self.map_and_copy(&staging, waited)
     }
 
-    fn map_and_copy(&self, staging: &wgpu::Buffer, waited: &mut Duration) -> anyhow::Result<Vec<u8>> {
+    fn map_and_copy(
+        &self,
+        staging: &wgpu::Buffer,
+        waited: &mut Duration,
+    ) -> anyhow::Result<Vec<u8>> {
         let (tx, rx) = mpsc::channel();
         staging.map_async(wgpu::MapMode::Read, .., move |r| {
             let _ = tx.send(r);
@@ -355,7 +359,9 @@ impl Gpu {
         let bytes = self.map_and_copy(&staging, &mut waited)?;
         let mut out = Vec::with_capacity((unpadded * h as u64) as usize);
         for y in 0..h as usize {
-            out.extend_from_slice(&bytes[y * padded as usize..y * padded as usize + unpadded as usize]);
+            out.extend_from_slice(
+                &bytes[y * padded as usize..y * padded as usize + unpadded as usize],
+            );
         }
         Ok(out)
     }

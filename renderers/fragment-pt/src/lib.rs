@@ -574,9 +574,7 @@ impl Renderer for FragmentPt {
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
         let mut layout_entries = vec![buffer_entry(0, vf, wgpu::BufferBindingType::Uniform)];
         layout_entries.extend((4..=7).map(|b| buffer_entry(b, vf, ro)));
-        layout_entries.extend(
-            (0..mesh_bindings).map(|i| buffer_entry(MESH_BINDING + i, vf, ro)),
-        );
+        layout_entries.extend((0..mesh_bindings).map(|i| buffer_entry(MESH_BINDING + i, vf, ro)));
         let pass2_layout = gpu
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

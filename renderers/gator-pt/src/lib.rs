@@ -33,10 +33,10 @@ use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context};
 use datasets::TetMesh;
+use render_core::bind::{storage_entry, texture_entry, uniform_entry};
 use render_core::gpu::chunk_ranges;
 pub use render_core::visibility::VisibilityOrder;
 use render_core::visibility::VisibilitySorter;
-use render_core::bind::{storage_entry, texture_entry, uniform_entry};
 use render_core::{
     Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics,
     Prepared, Renderer, Setting,
@@ -644,8 +644,14 @@ impl Renderer for GatorPt {
             });
         st.timer.begin(&mut enc);
         {
-            let mut pass =
-                render_core::bind::color_pass(&mut enc, "gator fans", &target.view, true, true, None);
+            let mut pass = render_core::bind::color_pass(
+                &mut enc,
+                "gator fans",
+                &target.view,
+                true,
+                true,
+                None,
+            );
             pass.set_pipeline(&st.pipeline);
             pass.set_bind_group(0, &st.mesh.g0, &[]);
             pass.set_index_buffer(st.index_buf.slice(..), wgpu::IndexFormat::Uint16);

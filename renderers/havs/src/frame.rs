@@ -393,9 +393,16 @@ impl State {
 mod tests {
     use crate::{Havs, HavsSettings, Mode, SortMode};
     use datasets::TetMesh;
-    use render_core::{Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint};
+    use render_core::{
+        Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint,
+    };
 
-    fn render(gpu: &Gpu, r: &mut Havs, mesh: &TetMesh, cam: &Camera) -> (Image, Vec<(String, f64)>) {
+    fn render(
+        gpu: &Gpu,
+        r: &mut Havs,
+        mesh: &TetMesh,
+        cam: &Camera,
+    ) -> (Image, Vec<(String, f64)>) {
         let tf = TransferFunction::preset("high-opacity").unwrap();
         r.prepare(gpu, mesh, &Optics::for_mesh(tf, mesh)).unwrap();
         let stats = r.render(gpu, cam).unwrap();
@@ -404,7 +411,10 @@ mod tests {
     }
 
     fn counter(c: &[(String, f64)], name: &str) -> f64 {
-        c.iter().find(|(n, _)| n == name).unwrap_or_else(|| panic!("{name} in {c:?}")).1
+        c.iter()
+            .find(|(n, _)| n == name)
+            .unwrap_or_else(|| panic!("{name} in {c:?}"))
+            .1
     }
 
     /// Vertex, face and order arrays split over several storage bindings (forced with 4 KiB

@@ -26,8 +26,7 @@ use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::preintegration::Table3d;
 use render_core::sort::RadixScratch;
 use render_core::{
-    Camera, ChunkedBuffer, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer,
-    Setting,
+    Camera, ChunkedBuffer, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Setting,
 };
 
 pub use kbuffer::{Tag, TagScheme};
@@ -377,11 +376,7 @@ impl Renderer for Havs {
             max_binding,
             storage,
         )?;
-        check_storage_bindings(
-            gpu,
-            "HAVS",
-            6 + verts_buf.bindings() + faces_buf.bindings(),
-        )?;
+        check_storage_bindings(gpu, "HAVS", 6 + verts_buf.bindings() + faces_buf.bindings())?;
         let num_faces = faces.len() as u64;
         let centroids: Vec<[f32; 3]> = faces
             .par_iter()
@@ -635,4 +630,3 @@ impl Renderer for Havs {
         Ok(img)
     }
 }
-

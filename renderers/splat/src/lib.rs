@@ -31,11 +31,11 @@ use std::time::Instant;
 
 use anyhow::{bail, Context};
 use datasets::TetMesh;
-use render_core::gpu_sort::GpuRadixSort;
 use render_core::bind::{color_pass, render_target, whole as entry};
+use render_core::gpu_sort::GpuRadixSort;
 use render_core::{
-    Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics, Prepared, Renderer,
-    Setting,
+    Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics,
+    Prepared, Renderer, Setting,
 };
 
 pub use buckets::{bucket_ends, depth, SlabGeometry};
@@ -363,8 +363,15 @@ impl Splat {
         let row = depth_row(camera);
         self.write_frame(gpu, camera, &geom, 0);
         let mut stats = BrickStats::default();
-        let (ends, keys) =
-            self.buckets(gpu, 0, &geom, row, true, &mut stats, &mut FrameClock::start())?;
+        let (ends, keys) = self.buckets(
+            gpu,
+            0,
+            &geom,
+            row,
+            true,
+            &mut stats,
+            &mut FrameClock::start(),
+        )?;
         Ok((geom, ends, keys))
     }
 
@@ -516,8 +523,14 @@ impl Splat {
                 pass.set_bind_group(1, &slab_bind, &[(i as u64 * UNIFORM_STRIDE) as u32]);
                 pass.draw(0..6, range);
             }
-            let mut pass =
-                color_pass(&mut enc, "splat composite", &t.image_view, false, true, None);
+            let mut pass = color_pass(
+                &mut enc,
+                "splat composite",
+                &t.image_view,
+                false,
+                true,
+                None,
+            );
             pass.set_pipeline(&st.pipes.composite);
             pass.set_bind_group(0, &comp_bind, &[]);
             pass.draw(0..3, 0..1);
@@ -526,7 +539,6 @@ impl Splat {
         stats.splat_ms += t0.elapsed().as_secs_f64() * 1e3;
     }
 }
-
 
 fn dispatch(
     enc: &mut wgpu::CommandEncoder,
