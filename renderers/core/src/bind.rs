@@ -46,6 +46,17 @@ pub fn buffer_entry(
     }
 }
 
+/// The same entry with a dynamic offset (a buffer entry; other entries are returned as given).
+pub fn with_dynamic_offset(mut entry: wgpu::BindGroupLayoutEntry) -> wgpu::BindGroupLayoutEntry {
+    if let wgpu::BindingType::Buffer {
+        has_dynamic_offset, ..
+    } = &mut entry.ty
+    {
+        *has_dynamic_offset = true;
+    }
+    entry
+}
+
 /// A float texture entry (not multisampled).
 pub fn texture_entry(
     binding: u32,
@@ -53,11 +64,26 @@ pub fn texture_entry(
     filterable: bool,
     view_dimension: wgpu::TextureViewDimension,
 ) -> wgpu::BindGroupLayoutEntry {
+    sampled_texture_entry(
+        binding,
+        visibility,
+        wgpu::TextureSampleType::Float { filterable },
+        view_dimension,
+    )
+}
+
+/// A texture entry of any sample type (not multisampled).
+pub fn sampled_texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    sample_type: wgpu::TextureSampleType,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
         ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable },
+            sample_type,
             view_dimension,
             multisampled: false,
         },

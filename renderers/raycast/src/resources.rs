@@ -1,6 +1,7 @@
 //! GPU objects of the ray caster: the bind group layouts and pipelines (created once per
 //! mesh), and the per-viewport traversal buffers, peeling layers and tile parameters.
 
+use render_core::bind;
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::Gpu;
 
@@ -41,29 +42,25 @@ fn buffer_entry(
     ty: wgpu::BufferBindingType,
     dynamic: bool,
 ) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
+    let e = bind::buffer_entry(
         binding,
-        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty,
-            has_dynamic_offset: dynamic,
-            min_binding_size: None,
-        },
-        count: None,
+        wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        ty,
+    );
+    if dynamic {
+        bind::with_dynamic_offset(e)
+    } else {
+        e
     }
 }
 
 fn uint_texture_entry(binding: u32, dim: wgpu::TextureViewDimension) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
+    bind::sampled_texture_entry(
         binding,
-        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Uint,
-            view_dimension: dim,
-            multisampled: false,
-        },
-        count: None,
-    }
+        wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        wgpu::TextureSampleType::Uint,
+        dim,
+    )
 }
 
 const RO: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: true };
