@@ -859,9 +859,11 @@ mod tests {
         }
         let before = host_peak_bytes(true).expect("VmHWM after a reset");
         // 64 MiB touched page by page: the peak must rise by at least most of it.
-        let block = vec![1u8; 64 << 20];
+        // black_box: an allocation that is never read may be optimised away.
+        let block = std::hint::black_box(vec![1u8; 64 << 20]);
         let during = host_peak_bytes(true).unwrap();
         assert!(during >= before + (48 << 20), "{before} → {during}");
+        assert_eq!(std::hint::black_box(&block)[block.len() / 2], 1);
         drop(block);
         assert!(reset_host_peak());
     }
