@@ -243,6 +243,7 @@ impl Splat {
 
     /// Builds the bucket table of brick `b` the way the settings say; leaves the sorted voxels
     /// in `sorted`. Returns the table (and the depth-sorted keys when `want_keys`).
+    #[allow(clippy::too_many_arguments)]
     fn buckets(
         &mut self,
         gpu: &Gpu,
