@@ -103,6 +103,12 @@ pub struct Row {
     pub bound_by: String,
     #[serde(default)]
     pub normalized_time: Option<f64>,
+    /// Peak resident host memory of the process during the row (bytes): the kernel's VmHWM,
+    /// reset before the row (the first row of a variant includes its prepare). On a software
+    /// adapter (lavapipe) GPU buffers live in host memory and are counted here too. Empty where
+    /// the mark cannot be reset (non-Linux) and in files written before it existed.
+    #[serde(default)]
+    pub host_peak_bytes: Option<u64>,
     /// Empty on success; otherwise what went wrong (the metrics are then empty).
     pub error: String,
     /// Per-frame samples: in `results.json` only (`samples.csv` has them one per line).
@@ -349,6 +355,7 @@ pub(crate) fn example_row() -> Row {
         limit_fraction: None,
         bound_by: String::new(),
         normalized_time: None,
+        host_peak_bytes: None,
         error: String::new(),
         samples: FrameSamples::default(),
     }

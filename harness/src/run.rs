@@ -577,6 +577,7 @@ fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Ro
         limit_fraction: None,
         bound_by: String::new(),
         normalized_time: None,
+        host_peak_bytes: None,
         error: String::new(),
         samples: Default::default(),
     }
@@ -680,20 +681,30 @@ impl DatasetContext<'_> {
         for mut renderer in renderers {
             let what = self.describe(renderer.as_ref());
             progress.activity(&format!("preparing {what}"));
-            match guarded("prepare", || {
+            // The first viewpoint's row carries the prepare's peak (host copies of the mesh).
+            let peak_reset = reset_host_peak();
+            let prepared = guarded("prepare", || {
                 renderer.prepare(self.gpu, self.mesh, self.optics)
-            }) {
-                Ok(prepared) => live.push((
-                    renderer,
-                    prepared,
-                    vec![Vec::<FrameStats>::new(); views],
-                    vec![None::<String>; views],
-                )),
+            });
+            let prepare_peak = host_peak_bytes(peak_reset);
+            match prepared {
+                Ok(prepared) => {
+                    let mut peaks = vec![None::<u64>; views];
+                    peaks[0] = prepare_peak;
+                    live.push(Variant {
+                        renderer,
+                        prepared,
+                        frames: vec![Vec::<FrameStats>::new(); views],
+                        failed: vec![None::<String>; views],
+                        peaks,
+                    })
+                }
                 Err(e) => {
                     // Every viewpoint of this variant gets a row that says why it is empty.
                     for vp in &c.viewpoints {
                         let mut row = base_row(self, renderer.as_ref(), vp);
                         row.error = format!("prepare failed: {e:#}");
+                        row.host_peak_bytes = prepare_peak;
                         progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
                         writer.push(row)?;
                         outcome.failed_rows += 1;
@@ -703,33 +714,40 @@ impl DatasetContext<'_> {
         }
         for round in 0..rounds {
             let last = round + 1 == rounds;
-            for (renderer, prepared, frames, failed) in live.iter_mut() {
+            for v in live.iter_mut() {
                 for (i, vp) in c.viewpoints.iter().enumerate() {
-                    if failed[i].is_none() {
-                        let what = format!("{} {} {}", renderer.algorithm(), self.label, vp.name);
+                    // A row's peak: the largest over its viewpoint's frames in every round and
+                    // the final readback (and the prepare, for the first viewpoint).
+                    let peak_reset = reset_host_peak();
+                    if v.failed[i].is_none() {
+                        let what = format!("{} {} {}", v.renderer.algorithm(), self.label, vp.name);
                         progress.activity(&if rounds > 1 {
                             format!("{what} (round {}/{rounds})", round + 1)
                         } else {
                             what
                         });
-                        match self.time_frames(renderer.as_mut(), vp) {
-                            Ok(f) => frames[i].extend(f),
-                            Err(e) => failed[i] = Some(format!("{e:#}")),
+                        match self.time_frames(v.renderer.as_mut(), vp) {
+                            Ok(f) => v.frames[i].extend(f),
+                            Err(e) => v.failed[i] = Some(format!("{e:#}")),
                         }
                     }
                     if last {
-                        let f = std::mem::take(&mut frames[i]);
-                        let row = self.finish_row(
-                            renderer.as_mut(),
-                            prepared,
+                        let f = std::mem::take(&mut v.frames[i]);
+                        let mut row = self.finish_row(
+                            v.renderer.as_mut(),
+                            &v.prepared,
                             vp,
                             f,
-                            failed[i].take(),
+                            v.failed[i].take(),
                             progress,
                             outcome,
                             &writer.file.rows,
                         );
+                        v.peaks[i] = v.peaks[i].max(host_peak_bytes(peak_reset));
+                        row.host_peak_bytes = v.peaks[i];
                         writer.push(row)?;
+                    } else {
+                        v.peaks[i] = v.peaks[i].max(host_peak_bytes(peak_reset));
                     }
                 }
             }
@@ -905,9 +923,68 @@ impl DatasetContext<'_> {
     }
 }
 
+/// One prepared variant of a data set while its rounds run ([`DatasetContext::run_variants`]).
+struct Variant {
+    renderer: Box<dyn Renderer>,
+    prepared: render_core::Prepared,
+    /// Per viewpoint: the timed frames so far, the first failure, the host peak so far.
+    frames: Vec<Vec<FrameStats>>,
+    failed: Vec<Option<String>>,
+    peaks: Vec<Option<u64>>,
+}
+
+/// Resets the kernel's peak-resident-set mark (VmHWM) of this process to its current resident
+/// set (`5` into /proc/self/clear_refs, Linux ≥ 4.0); false where that is not possible.
+fn reset_host_peak() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+/// The process's peak resident set since the last [`reset_host_peak`] (VmHWM of
+/// /proc/self/status, in bytes): kept by the kernel, so a short spike between two samples is
+/// not missed. `None` when the reset failed (the mark would be the whole run's) or on systems
+/// without procfs.
+fn host_peak_bytes(was_reset: bool) -> Option<u64> {
+    if !was_reset {
+        return None;
+    }
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    parse_vm_hwm(&status)
+}
+
+fn parse_vm_hwm(status: &str) -> Option<u64> {
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let mut parts = line["VmHWM:".len()..].split_whitespace();
+    let value: u64 = parts.next()?.parse().ok()?;
+    match parts.next() {
+        Some("kB") => Some(value * 1024),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn host_peak_follows_an_allocation_and_resets() {
+        assert_eq!(
+            parse_vm_hwm("Name:\tx\nVmHWM:\t  1234 kB\nVmRSS:\t 12 kB\n"),
+            Some(1234 * 1024)
+        );
+        assert_eq!(parse_vm_hwm("VmRSS: 1 kB"), None);
+        if !reset_host_peak() {
+            return; // no procfs here: the column stays empty, as documented
+        }
+        let before = host_peak_bytes(true).expect("VmHWM after a reset");
+        // 64 MiB touched page by page: the peak must rise by at least most of it.
+        // black_box: an allocation that is never read may be optimised away.
+        let block = std::hint::black_box(vec![1u8; 64 << 20]);
+        let during = host_peak_bytes(true).unwrap();
+        assert!(during >= before + (48 << 20), "{before} → {during}");
+        assert_eq!(std::hint::black_box(&block)[block.len() / 2], 1);
+        drop(block);
+        assert!(reset_host_peak());
+    }
 
     #[test]
     fn slugs_keep_viewpoints_distinct_and_paths_safe() {

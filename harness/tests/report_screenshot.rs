@@ -65,6 +65,7 @@ fn row(algorithm: &str, settings: &str, dataset: &str, viewpoint: &str, i: usize
         limit_fraction: None,
         bound_by: String::new(),
         normalized_time: None,
+        host_peak_bytes: None,
         suspect: String::new(),
         error: String::new(),
         samples: Default::default(),

@@ -5,7 +5,7 @@
 //! machines), Vulkan/Metal/DX12 on real hardware. Every result row records which.
 
 use std::sync::mpsc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Context};
 use serde::{Deserialize, Serialize};
@@ -251,6 +251,20 @@ impl Gpu {
         offset: u64,
         size: u64,
     ) -> anyhow::Result<Vec<u8>> {
+        let mut waited = Duration::ZERO;
+        self.read_buffer_timed(buffer, offset, size, &mut waited)
+    }
+
+    /// [`Gpu::read_buffer`] that adds the time spent waiting for the map to `waited` (the
+    /// rest, encoding the copy and copying the mapped bytes, is host work; see
+    /// [`crate::FrameClock`]).
+    pub fn read_buffer_timed(
+        &self,
+        buffer: &wgpu::Buffer,
+        offset: u64,
+        size: u64,
+        waited: &mut Duration,
+    ) -> anyhow::Result<Vec<u8>> {
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size,
@@ -259,16 +273,26 @@ impl Gpu {
         });
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
+        // The submit counts as waiting (see FrameClock::submit).
+        let t = Instant::now();
         self.queue.submit([enc.finish()]);
-        self.map_and_copy(&staging)
+        *waited += t.elapsed();
+        self.map_and_copy(&staging, waited)
     }
 
-    fn map_and_copy(&self, staging: &wgpu::Buffer) -> anyhow::Result<Vec<u8>> {
+    fn map_and_copy(
+        &self,
+        staging: &wgpu::Buffer,
+        waited: &mut Duration,
+    ) -> anyhow::Result<Vec<u8>> {
         let (tx, rx) = mpsc::channel();
         staging.map_async(wgpu::MapMode::Read, .., move |r| {
             let _ = tx.send(r);
         });
-        self.wait()?;
+        let t = Instant::now();
+        let r = self.wait();
+        *waited += t.elapsed();
+        r?;
         rx.recv()
             .map_err(|_| anyhow!("readback callback dropped"))?
             .map_err(|e| anyhow!("mapping readback buffer: {e}"))?;
@@ -283,6 +307,19 @@ impl Gpu {
     /// Reads an `Rgba32Float` texture (premultiplied linear) into an [`Image`].
     pub fn read_rgba32f(&self, texture: &wgpu::Texture) -> anyhow::Result<Image> {
         let (w, h) = (texture.width(), texture.height());
+        let bytes = self.read_texture_layer(texture, 0)?;
+        let mut img = Image::new(w, h);
+        img.pixels.copy_from_slice(bytemuck::cast_slice(&bytes));
+        Ok(img)
+    }
+
+    /// Reads layer `layer` of a 2D (array) texture of 16-byte texels, rows unpadded.
+    pub fn read_texture_layer(
+        &self,
+        texture: &wgpu::Texture,
+        layer: u32,
+    ) -> anyhow::Result<Vec<u8>> {
+        let (w, h) = (texture.width(), texture.height());
         let unpadded = w as u64 * 16;
         let padded = unpadded.div_ceil(256) * 256;
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -293,7 +330,16 @@ impl Gpu {
         });
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.copy_texture_to_buffer(
-            texture.as_image_copy(),
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: 0,
+                    z: layer,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
             wgpu::TexelCopyBufferInfo {
                 buffer: &staging,
                 layout: wgpu::TexelCopyBufferLayout {
@@ -309,14 +355,15 @@ impl Gpu {
             },
         );
         self.queue.submit([enc.finish()]);
-        let bytes = self.map_and_copy(&staging)?;
-        let mut img = Image::new(w, h);
+        let mut waited = Duration::ZERO;
+        let bytes = self.map_and_copy(&staging, &mut waited)?;
+        let mut out = Vec::with_capacity((unpadded * h as u64) as usize);
         for y in 0..h as usize {
-            let row = &bytes[y * padded as usize..y * padded as usize + unpadded as usize];
-            let px: &[[f32; 4]] = bytemuck::cast_slice(row);
-            img.pixels[y * w as usize..(y + 1) * w as usize].copy_from_slice(px);
+            out.extend_from_slice(
+                &bytes[y * padded as usize..y * padded as usize + unpadded as usize],
+            );
         }
-        Ok(img)
+        Ok(out)
     }
 }
 
@@ -419,12 +466,11 @@ pub fn chunk_ranges(count: u64, element_bytes: u64, max_binding: u64) -> Vec<std
         .collect()
 }
 
-/// GPU time of a frame from two timestamps, and wall time from CPU clocks.
+/// GPU time of a frame from two timestamps (wall and host time: [`crate::FrameClock`]).
 pub struct FrameTimer {
     query_set: Option<wgpu::QuerySet>,
     resolve: Option<wgpu::Buffer>,
     period_ns: f32,
-    started: Instant,
 }
 
 impl FrameTimer {
@@ -449,18 +495,7 @@ impl FrameTimer {
             query_set,
             resolve,
             period_ns: gpu.queue.get_timestamp_period(),
-            started: Instant::now(),
         }
-    }
-
-    /// Restarts the wall clock (call at the start of the frame, before CPU work).
-    pub fn start_wall(&mut self) {
-        self.started = Instant::now();
-    }
-
-    /// Milliseconds since [`FrameTimer::start_wall`].
-    pub fn wall_ms(&self) -> f64 {
-        self.started.elapsed().as_secs_f64() * 1e3
     }
 
     /// Writes the "begin" timestamp into `encoder` (first command of the frame's GPU work).
@@ -573,9 +608,10 @@ mod device_tests {
         assert_eq!(ledger.persistent, 4000);
         assert!(!gpu.adapter.name.is_empty());
         eprintln!(
-            "adapter: {:?}, timestamps: {}",
+            "adapter: {:?}, timestamps: {}, limits: {:?}",
             gpu.adapter,
-            gpu.has_timestamps()
+            gpu.has_timestamps(),
+            gpu.limits
         );
     }
 }

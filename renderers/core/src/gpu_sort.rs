@@ -61,16 +61,11 @@ pub struct GpuRadixSort {
 }
 
 fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
+    crate::bind::storage_entry(binding, wgpu::ShaderStages::COMPUTE, read_only)
+}
+
+fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    crate::bind::uniform_entry(binding, wgpu::ShaderStages::COMPUTE)
 }
 
 impl GpuRadixSort {
@@ -97,16 +92,7 @@ impl GpuRadixSort {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("radix sort"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                uniform_entry(0),
                 storage_entry(1, true),
                 storage_entry(2, true),
                 storage_entry(3, false),
@@ -115,11 +101,7 @@ impl GpuRadixSort {
                 storage_entry(6, false),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("radix sort"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let pipeline_layout = crate::bind::pipeline_layout(gpu, "radix sort", &[Some(&layout)]);
         let pipeline = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
@@ -365,16 +347,7 @@ impl GpuCentroidKeys {
     pub fn new(gpu: &Gpu, ledger: &mut MemoryLedger) -> anyhow::Result<GpuCentroidKeys> {
         let device = &gpu.device;
         let module = gpu.shader("gpu_sort.wgsl", include_str!("gpu_sort.wgsl"));
-        let uniform = wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
+        let uniform = uniform_entry(0);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("centroid keys"),
             entries: &[
@@ -385,11 +358,8 @@ impl GpuCentroidKeys {
                 storage_entry(4, false),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("centroid keys"),
-            bind_group_layouts: &[None, Some(&layout)],
-            immediate_size: 0,
-        });
+        let pipeline_layout =
+            crate::bind::pipeline_layout(gpu, "centroid keys", &[None, Some(&layout)]);
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("centroid_keys"),
             layout: Some(&pipeline_layout),

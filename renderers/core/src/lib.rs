@@ -2,6 +2,8 @@
 //! model, the headless GPU context with timing and memory accounting, the [`Renderer`] trait,
 //! and the CPU sorts used for visibility ordering.
 
+pub mod bind;
+pub mod frame;
 pub mod gpu;
 pub mod gpu_sort;
 pub mod image;
@@ -12,6 +14,8 @@ pub mod sort;
 pub mod transfer;
 pub mod visibility;
 
+pub use bind::ChunkedBuffer;
+pub use frame::{FrameClock, FrameTimes};
 pub use gpu::{AdapterDescription, FrameTimer, Gpu, Lifetime, MemoryLedger};
 pub use image::Image;
 pub use renderer::{settings_string, FrameStats, Prepared, Renderer, Setting};

@@ -185,6 +185,26 @@ impl Camera {
         self.view().as_mat4().to_cols_array_2d()
     }
 
+    /// Tets with a vertex at or behind the eye plane (clip w ≤ 0 with the f32 matrix the
+    /// shaders use): projected-tetrahedra algorithms cannot draw them (GATOR drops them, the
+    /// fragment PT projection is undefined for them), so rows count them (`tets_behind_eye`).
+    pub fn tets_behind_eye(&self, mesh: &datasets::TetMesh) -> u64 {
+        use rayon::prelude::*;
+        if !self.is_perspective() {
+            return 0;
+        }
+        let m = self.view_proj_f32();
+        let behind: Vec<bool> = mesh
+            .points
+            .par_iter()
+            .map(|p| m[0][3] * p[0] + m[1][3] * p[1] + m[2][3] * p[2] + m[3][3] <= 0.0)
+            .collect();
+        mesh.tets
+            .par_iter()
+            .filter(|t| t.iter().any(|&v| behind[v as usize]))
+            .count() as u64
+    }
+
     pub fn is_perspective(&self) -> bool {
         matches!(self.projection, Projection::Perspective { .. })
     }

@@ -20,16 +20,18 @@
 //!   §3.4); back-to-front premultiplied blending into an `Rgba32Float` target.
 
 pub mod classify;
-
-use std::time::Instant;
+mod frame;
 
 use anyhow::{anyhow, bail, Context};
 use datasets::TetMesh;
+use render_core::bind::{
+    buffer_entry, check_storage_bindings, render_target, whole as storage, ChunkedBuffer,
+};
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::sort;
 use render_core::{Camera, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting};
 
-use classify::{packed_table, ZERO_AREA_REL};
+use classify::packed_table;
 
 /// How pass 2 colours a fragment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -123,6 +125,8 @@ const PSI_SIDE: usize = 256;
 const WORKGROUP: u32 = 64;
 /// Bytes of one pass-1 record (`TetOut` in the shaders).
 const RECORD_BYTES: u64 = 32;
+/// First binding of the chunked vertex, tet and record arrays in both passes.
+const MESH_BINDING: u32 = 10;
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -150,7 +154,11 @@ struct State {
     model_bytes: u64,
     pass1_params: wgpu::Buffer,
     pass2_params: wgpu::Buffer,
-    records: wgpu::Buffer,
+    records: ChunkedBuffer,
+    /// Pass 1's 2D dispatch (workgroups per row, rows).
+    dispatch: (u32, u32),
+    /// Storage bindings the model and records take (issue 14's split).
+    mesh_bindings: u32,
     depths: wgpu::Buffer,
     order: wgpu::Buffer,
     pass1: wgpu::ComputePipeline,
@@ -176,6 +184,8 @@ struct State {
 pub struct FragmentPt {
     pub settings: FragmentPtSettings,
     state: Option<State>,
+    /// Storage binding size to split at instead of the adapter's (tests of the split path).
+    max_binding: Option<u64>,
 }
 
 impl FragmentPt {
@@ -183,7 +193,15 @@ impl FragmentPt {
         FragmentPt {
             settings,
             state: None,
+            max_binding: None,
         }
+    }
+
+    /// Splits the vertex, tet and record arrays at `bytes` per storage binding (rounded down
+    /// to 256) instead of the adapter's limit. Only useful to test the split on small meshes.
+    pub fn with_max_binding(mut self, bytes: u64) -> FragmentPt {
+        self.max_binding = Some(bytes);
+        self
     }
 
     /// GPU bytes of the model alone (tet indices + vertices), the quantity the paper reports as
@@ -203,12 +221,16 @@ impl FragmentPt {
             .state
             .as_mut()
             .ok_or_else(|| anyhow!("fragment-pt: prepare before classify_on_gpu"))?;
-        write_params(gpu, st, camera);
+        frame::write_params(gpu, st, camera);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        encode_pass1(&mut enc, st, None);
+        frame::encode_pass1(&mut enc, st, None);
         gpu.queue.submit([enc.finish()]);
         let n = st.tets as u64;
-        let rec_bytes = gpu.read_buffer(&st.records, 0, n * RECORD_BYTES)?;
+        let mut rec_bytes = Vec::with_capacity((n * RECORD_BYTES) as usize);
+        for (i, b) in st.records.buffers.iter().enumerate() {
+            let len = (n - i as u64 * st.records.per_chunk).min(st.records.per_chunk);
+            rec_bytes.extend(gpu.read_buffer(b, 0, len * RECORD_BYTES)?);
+        }
         let dep_bytes = gpu.read_buffer(&st.depths, 0, n * 4)?;
         let raw: &[[u32; 8]] = bytemuck::cast_slice(&rec_bytes);
         let depths: &[f32] = bytemuck::cast_slice(&dep_bytes);
@@ -284,57 +306,6 @@ fn project_params(st: &State, camera: &Camera) -> classify::ProjectParams {
     }
 }
 
-fn write_params(gpu: &Gpu, st: &State, camera: &Camera) {
-    let p = project_params(st, camera);
-    let p1 = Pass1Params {
-        view_proj: p.view_proj,
-        eye: [
-            p.eye[0],
-            p.eye[1],
-            p.eye[2],
-            if p.perspective { 1.0 } else { 0.0 },
-        ],
-        forward: [p.forward[0], p.forward[1], p.forward[2], 0.0],
-        misc: [
-            p.scalar_min,
-            p.scalar_inv_range,
-            p.inv_length_unit,
-            ZERO_AREA_REL,
-        ],
-        counts: [st.tets, 0, 0, 0],
-    };
-    gpu.queue
-        .write_buffer(&st.pass1_params, 0, bytemuck::bytes_of(&p1));
-    let p2 = Pass2Params {
-        view_proj: p.view_proj,
-        misc: [p.scalar_min, p.scalar_inv_range, EXP_MAX_TAU, 0.0],
-        sizes: [TF_ENTRIES as u32, EXP_ENTRIES as u32, PSI_SIDE as u32, 0],
-    };
-    gpu.queue
-        .write_buffer(&st.pass2_params, 0, bytemuck::bytes_of(&p2));
-}
-
-fn encode_pass1(enc: &mut wgpu::CommandEncoder, st: &State, ts: Option<(&wgpu::QuerySet, u32)>) {
-    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-        label: Some("fragment-pt pass 1"),
-        timestamp_writes: ts.map(|(qs, i)| wgpu::ComputePassTimestampWrites {
-            query_set: qs,
-            beginning_of_pass_write_index: Some(i),
-            end_of_pass_write_index: Some(i + 1),
-        }),
-    });
-    pass.set_pipeline(&st.pass1);
-    pass.set_bind_group(0, &st.pass1_bind, &[]);
-    pass.dispatch_workgroups(st.tets.div_ceil(WORKGROUP), 1, 1);
-}
-
-fn storage(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry {
-        binding,
-        resource: buffer.as_entire_binding(),
-    }
-}
-
 /// Shirley & Tuchman's exponential table: e^(−x) at x = i / (n − 1) · EXP_MAX_TAU.
 fn exp_table() -> Vec<f32> {
     (0..EXP_ENTRIES)
@@ -363,17 +334,30 @@ impl Renderer for FragmentPt {
             );
         }
         let n = mesh.num_tets() as u64;
-        let max_binding = gpu.max_storage_binding();
-        // One dispatch covers at most 65535 workgroups; the largest per-tet array (records, 32 B)
-        // must fit one storage binding. Both allow ~4 M tets on lavapipe (128 MiB bindings).
-        let max_tets = (max_binding / RECORD_BYTES).min(65535 * WORKGROUP as u64);
-        if n > max_tets {
+        let max_binding = match self.max_binding {
+            Some(b) => b.min(gpu.max_storage_binding()) & !255,
+            None => gpu.max_storage_binding(),
+        }
+        .max(256);
+        // Vertices, tets and pass-1 records are split over storage bindings (issue 14); the
+        // centroid depths and the order stay one binding each, because the GPU radix sort and
+        // the CPU upload take them whole (4 B/tet: 33 M tets at lavapipe's 128 MiB).
+        let adapter_binding = gpu.max_storage_binding();
+        if n * 4 > adapter_binding {
             bail!(
-                "fragment-pt: mesh {} has {n} tets; this adapter allows at most {max_tets} \
-                 (storage binding {max_binding} bytes)",
-                mesh.name
+                "fragment-pt: mesh {} has {n} tets; its depth and order arrays need {} bytes \
+                 each in one storage binding, the adapter allows {adapter_binding} bytes \
+                 (max_storage_buffer_binding_size)",
+                mesh.name,
+                n * 4
             );
         }
+        if n > u32::MAX as u64 / 12 {
+            bail!("fragment-pt: {n} tets exceed the 32-bit vertex index range (12 per tet)");
+        }
+        let groups = n.div_ceil(WORKGROUP as u64).max(1);
+        let gx = groups.min(gpu.limits.max_compute_workgroups_per_dimension as u64);
+        let dispatch = (gx as u32, groups.div_ceil(gx) as u32);
         let mut ledger = MemoryLedger::default();
         let storage_use = wgpu::BufferUsages::STORAGE;
         // The model: vertices (xyz + scalar) and tet indices — nothing else persistent per tet.
@@ -384,20 +368,28 @@ impl Renderer for FragmentPt {
             .map(|(p, &s)| [p[0], p[1], p[2], s])
             .collect();
         let tets: Vec<[u32; 4]> = mesh.tets.clone();
-        let vertices = ledger.buffer_init(
+        let vertices = ChunkedBuffer::with_data(
             gpu,
+            &mut ledger,
             "fragment-pt vertices",
             Lifetime::Persistent,
             bytemuck::cast_slice(&verts),
+            16,
+            max_binding,
             storage_use,
         )?;
-        let tet_buf = ledger.buffer_init(
+        drop(verts);
+        let tet_buf = ChunkedBuffer::with_data(
             gpu,
+            &mut ledger,
             "fragment-pt tets",
             Lifetime::Persistent,
             bytemuck::cast_slice(&tets),
+            16,
+            max_binding,
             storage_use,
         )?;
+        drop(tets);
         let model_bytes = ledger.persistent;
         // View-independent tables (small; counted as persistent too).
         let table = ledger.buffer_init(
@@ -434,13 +426,43 @@ impl Renderer for FragmentPt {
             storage_use,
         )?;
         // Per-frame buffers written by pass 1 and the sort.
-        let records = ledger.buffer(
+        let records = ChunkedBuffer::new(
             gpu,
+            &mut ledger,
             "fragment-pt pass-1 records",
             Lifetime::PerFrame,
-            n * RECORD_BYTES,
+            n,
+            RECORD_BYTES,
+            max_binding,
             storage_use | wgpu::BufferUsages::COPY_SRC,
         )?;
+        let mesh_bindings = vertices.bindings() + tet_buf.bindings() + records.bindings();
+        check_storage_bindings(gpu, "fragment-pt pass 2", 4 + mesh_bindings)?;
+        let decls = |records_read_only: bool| {
+            vertices.wgsl("vertices", "vec4<f32>", 0, MESH_BINDING, true)
+                + &tet_buf.wgsl(
+                    "tets",
+                    "vec4<u32>",
+                    0,
+                    MESH_BINDING + vertices.bindings(),
+                    true,
+                )
+                + &records.wgsl(
+                    "records",
+                    "TetOut",
+                    0,
+                    MESH_BINDING + vertices.bindings() + tet_buf.bindings(),
+                    records_read_only,
+                )
+        };
+        let mesh_entries = || {
+            [
+                vertices.bind_entries(MESH_BINDING),
+                tet_buf.bind_entries(MESH_BINDING + vertices.bindings()),
+                records.bind_entries(MESH_BINDING + vertices.bindings() + tet_buf.bindings()),
+            ]
+            .concat()
+        };
         let depths = ledger.buffer(
             gpu,
             "fragment-pt centroid depths",
@@ -471,61 +493,48 @@ impl Renderer for FragmentPt {
             uniform,
         )?;
 
-        let m1 = gpu.shader("fragment-pt pass 1", include_str!("pass1.wgsl"));
+        let m1 = gpu.shader(
+            "fragment-pt pass 1",
+            &(decls(false) + include_str!("pass1.wgsl")),
+        );
         let pass1 = gpu.compute_pipeline("fragment-pt pass 1", None, &m1, "classify");
         let pass1_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("fragment-pt pass 1"),
             layout: &pass1.get_bind_group_layout(0),
             entries: &[
-                storage(0, &pass1_params),
-                storage(1, &vertices),
-                storage(2, &tet_buf),
-                storage(3, &table),
-                storage(4, &records),
-                storage(5, &depths),
-                storage(6, &order),
-            ],
+                vec![
+                    storage(0, &pass1_params),
+                    storage(3, &table),
+                    storage(5, &depths),
+                    storage(6, &order),
+                ],
+                mesh_entries(),
+            ]
+            .concat(),
         });
-        let m2 = gpu.shader("fragment-pt pass 2", include_str!("pass2.wgsl"));
+        let m2 = gpu.shader(
+            "fragment-pt pass 2",
+            &(decls(true) + include_str!("pass2.wgsl")),
+        );
         let fs = match self.settings.shading {
             Shading::Average => "fs_average",
             Shading::Psi => "fs_psi",
         };
         // An explicit layout: each shading mode leaves some tables unused, and an automatic
         // layout would drop their bindings.
-        let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
+        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
+        let mut layout_entries = vec![buffer_entry(0, vf, wgpu::BufferBindingType::Uniform)];
+        layout_entries.extend((4..=7).map(|b| buffer_entry(b, vf, ro)));
+        layout_entries.extend((0..mesh_bindings).map(|i| buffer_entry(MESH_BINDING + i, vf, ro)));
         let pass2_layout = gpu
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fragment-pt pass 2"),
-                entries: &[
-                    entry(0, wgpu::BufferBindingType::Uniform),
-                    entry(1, ro),
-                    entry(2, ro),
-                    entry(3, ro),
-                    entry(4, ro),
-                    entry(5, ro),
-                    entry(6, ro),
-                    entry(7, ro),
-                ],
+                entries: &layout_entries,
             });
-        let pipeline_layout = gpu
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("fragment-pt pass 2"),
-                bind_group_layouts: &[Some(&pass2_layout)],
-                immediate_size: 0,
-            });
+        let pipeline_layout =
+            render_core::bind::pipeline_layout(gpu, "fragment-pt pass 2", &[Some(&pass2_layout)]);
         // Back to front, premultiplied: dst = src + (1 − src.a) · dst.
         let pass2 = gpu.triangle_pipeline(
             "fragment-pt pass 2",
@@ -541,15 +550,16 @@ impl Renderer for FragmentPt {
             label: Some("fragment-pt pass 2"),
             layout: &pass2_layout,
             entries: &[
-                storage(0, &pass2_params),
-                storage(1, &vertices),
-                storage(2, &tet_buf),
-                storage(3, &records),
-                storage(4, &order),
-                storage(5, &tf),
-                storage(6, &expt),
-                storage(7, &psi),
-            ],
+                vec![
+                    storage(0, &pass2_params),
+                    storage(4, &order),
+                    storage(5, &tf),
+                    storage(6, &expt),
+                    storage(7, &psi),
+                ],
+                mesh_entries(),
+            ]
+            .concat(),
         });
         let gpu_sort = if self.settings.sort == SortMode::Gpu {
             Some(render_core::gpu_sort::GpuRadixSort::new(
@@ -593,6 +603,8 @@ impl Renderer for FragmentPt {
             pass1_params,
             pass2_params,
             records,
+            dispatch,
+            mesh_bindings,
             depths,
             order,
             pass1,
@@ -632,163 +644,16 @@ impl Renderer for FragmentPt {
             .as_ref()
             .is_none_or(|(t, _)| t.width() != w || t.height() != h)
         {
-            let tex = st.ledger.texture(
+            st.target = Some(render_target(
                 gpu,
-                Lifetime::PerFrame,
-                &wgpu::TextureDescriptor {
-                    label: Some("fragment-pt target"),
-                    size: wgpu::Extent3d {
-                        width: w,
-                        height: h,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: wgpu::TextureFormat::Rgba32Float,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                    view_formats: &[],
-                },
-            )?;
-            let view = tex.create_view(&Default::default());
-            st.target = Some((tex, view));
+                &mut st.ledger,
+                "fragment-pt target",
+                (w, h),
+                wgpu::TextureFormat::Rgba32Float,
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            )?);
         }
-        let started = Instant::now();
-        write_params(gpu, st, camera);
-        let qs = st.queries.as_ref().map(|(q, _)| q);
-        let mut stages = Vec::new();
-        let mut cpu_ms = 0.0;
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        encode_pass1(&mut enc, st, qs.map(|q| (q, 0)));
-        match sort_mode {
-            SortMode::Gpu => {
-                // Everything on the device: pass 1 wrote the centroid depths (keys) and the tet
-                // ids (payload); sort both in place, far to near, then draw. No readback.
-                let gs = st
-                    .gpu_sort
-                    .as_ref()
-                    .ok_or_else(|| anyhow!("fragment-pt: GPU sort not prepared"))?;
-                gs.encode(&mut enc, &st.depths, &st.order, st.tets, true)?;
-            }
-            _ => {
-                gpu.queue.submit([enc.finish()]);
-                enc = gpu.device.create_command_encoder(&Default::default());
-                let t0 = Instant::now();
-                let keys: Vec<f32> = if sort_mode == SortMode::Mpvonc {
-                    Vec::new()
-                } else {
-                    // The paper reads the centroid depths pass 1 wrote back to the host.
-                    let bytes = gpu.read_buffer(&st.depths, 0, st.tets as u64 * 4)?;
-                    bytemuck::cast_slice(&bytes).to_vec()
-                };
-                let t1 = Instant::now();
-                match sort_mode {
-                    SortMode::Bucket => {
-                        sort::bucket_sort_indices(
-                            &keys,
-                            sort::DEFAULT_SLABS,
-                            true,
-                            &mut st.indices,
-                        );
-                    }
-                    SortMode::Merge => {
-                        sort::merge_sort_indices(&keys, true, &mut st.indices, &mut st.merge)
-                    }
-                    SortMode::Radix => {
-                        sort::radix_sort_indices_descending(&keys, &mut st.indices, &mut st.radix)
-                    }
-                    SortMode::Mpvonc => {
-                        let v = st
-                            .visibility
-                            .as_mut()
-                            .ok_or_else(|| anyhow!("fragment-pt: MPVONC not prepared"))?;
-                        v.back_to_front(&st.mesh, camera, &mut st.indices);
-                    }
-                    SortMode::Gpu => unreachable!(),
-                }
-                if st.indices.len() != st.tets as usize {
-                    bail!(
-                        "fragment-pt: visibility order has {} entries for {} tets",
-                        st.indices.len(),
-                        st.tets
-                    );
-                }
-                let t2 = Instant::now();
-                gpu.queue
-                    .write_buffer(&st.order, 0, bytemuck::cast_slice(&st.indices));
-                let t3 = Instant::now();
-                let ms = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e3;
-                stages.push(("readback".to_string(), ms(t0, t1)));
-                stages.push(("sort".to_string(), ms(t1, t2)));
-                stages.push(("upload".to_string(), ms(t2, t3)));
-                cpu_ms = ms(t0, t3);
-            }
-        }
-        {
-            let (_, view) = st.target.as_ref().expect("target created above");
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("fragment-pt pass 2"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: qs.map(|q| wgpu::RenderPassTimestampWrites {
-                    query_set: q,
-                    beginning_of_pass_write_index: Some(2),
-                    end_of_pass_write_index: Some(3),
-                }),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&st.pass2);
-            pass.set_bind_group(0, &st.pass2_bind, &[]);
-            pass.draw(0..st.tets * 12, 0..1);
-        }
-        if let Some((q, buf)) = &st.queries {
-            enc.resolve_query_set(q, 0..4, buf, 0);
-        }
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait()?;
-        let total_ms = started.elapsed().as_secs_f64() * 1e3;
-        let gpu_ms = match &st.queries {
-            Some((_, buf)) => {
-                let b = gpu.read_buffer(buf, 0, 32)?;
-                let t: &[u64] = bytemuck::cast_slice(&b);
-                let period = gpu.queue.get_timestamp_period() as f64 * 1e-6;
-                let pass1 = t[1].saturating_sub(t[0]) as f64 * period;
-                let pass2 = t[3].saturating_sub(t[2]) as f64 * period;
-                stages.push(("classify".to_string(), pass1));
-                stages.push(("draw".to_string(), pass2));
-                if sort_mode == SortMode::Gpu {
-                    // One submission: pass 1, the device sort and pass 2 back to back.
-                    let all = t[3].saturating_sub(t[0]) as f64 * period;
-                    stages.push(("gpu_sort".to_string(), (all - pass1 - pass2).max(0.0)));
-                    Some(all)
-                } else {
-                    // The readback wait contains pass 1 on the GPU; only the rest is CPU time.
-                    cpu_ms = (cpu_ms - pass1).max(0.0);
-                    Some(pass1 + pass2)
-                }
-            }
-            None => None,
-        };
-        Ok(FrameStats {
-            cpu_ms,
-            gpu_ms,
-            total_ms,
-            frame_bytes: st.ledger.per_frame,
-            stages,
-            counters: vec![(
-                "model_bytes_per_tet".to_string(),
-                st.model_bytes as f64 / st.tets.max(1) as f64,
-            )],
-        })
+        frame::render(gpu, st, camera, sort_mode)
     }
 
     fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image> {

@@ -25,10 +25,9 @@ struct TetOut {
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> vertices: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> tets: array<vec4<u32>>;
+// vertices_at, tets_at, records_set: declared by the Rust (render_core::ChunkedBuffer) at
+// bindings 10.., each array split over as many storage bindings as the mesh needs.
 @group(0) @binding(3) var<storage, read> truth_table: array<u32, 81>;
-@group(0) @binding(4) var<storage, read_write> records: array<TetOut>;
 @group(0) @binding(5) var<storage, read_write> depths: array<f32>;
 // The identity order (tet ids): the payload the GPU-resident sort permutes; the CPU orders
 // overwrite it from the host.
@@ -64,11 +63,12 @@ const TRIANGLES = array<u32, 5>(0u, 3u, 4u, 2u, 1u);
 
 @compute @workgroup_size(64)
 fn classify(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let t = gid.x + params.counts.y;
-    if (gid.x >= params.counts.x) {
+    // 2D dispatch (more than 65535 workgroups of 64 on large meshes): counts.y threads a row.
+    let t = gid.x + gid.y * params.counts.y;
+    if (t >= params.counts.x) {
         return;
     }
-    let tet = tets[t];
+    let tet = tets_at(t);
     var pos: array<vec3<f32>, 4>;
     var sc: array<f32, 4>;
     var clip: array<vec4<f32>, 4>;
@@ -76,7 +76,7 @@ fn classify(@builtin(global_invocation_id) gid: vec3<u32>) {
     var lo = vec2<f32>(3.0e38);
     var hi = vec2<f32>(-3.0e38);
     for (var i = 0u; i < 4u; i++) {
-        let v = vertices[tet[i]];
+        let v = vertices_at(tet[i]);
         pos[i] = v.xyz;
         sc[i] = clamp((v.w - params.misc.x) * params.misc.y, 0.0, 1.0);
         clip[i] = params.view_proj * vec4<f32>(v.xyz, 1.0);
@@ -126,7 +126,7 @@ fn classify(@builtin(global_invocation_id) gid: vec3<u32>) {
     out.s_back = 0.0;
     out.thickness = 0.0;
     if (cls == 0u) {
-        records[t] = out;
+        records_set(t, out);
         return;
     }
     let v0 = perm.x;
@@ -196,5 +196,5 @@ fn classify(@builtin(global_invocation_id) gid: vec3<u32>) {
         out.s_back = sa;
     }
     out.thickness = length(pa - pb) * params.misc.z;
-    records[t] = out;
+    records_set(t, out);
 }

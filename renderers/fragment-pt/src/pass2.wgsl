@@ -28,9 +28,8 @@ struct TetOut {
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> vertices: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> tets: array<vec4<u32>>;
-@group(0) @binding(3) var<storage, read> records: array<TetOut>;
+// vertices_at, tets_at, records_at: declared by the Rust (render_core::ChunkedBuffer) at
+// bindings 10.., split over as many storage bindings as the mesh needs.
 @group(0) @binding(4) var<storage, read> order: array<u32>;
 // Transfer function sampled at n points: rgb chromaticity, a = κ per length unit.
 @group(0) @binding(5) var<storage, read> tf: array<vec4<f32>>;
@@ -52,7 +51,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     let tri = corner / 3u;
     let k = corner % 3u;
     let t = order[slot];
-    let rec = records[t];
+    let rec = records_at(t);
     var out: VsOut;
     let ntri = (rec.fan >> 4u) & 7u;
     if (tri >= ntri) {
@@ -68,7 +67,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     }
     let ri = tri + k - 1u;
     let local = (rec.fan >> (8u + 2u * ri)) & 3u;
-    let v = vertices[tets[t][local]];
+    let v = vertices_at(tets_at(t)[local]);
     let s = clamp((v.w - params.misc.x) * params.misc.y, 0.0, 1.0);
     out.pos = params.view_proj * vec4<f32>(v.xyz, 1.0);
     out.attrs = vec3<f32>(s, s, 0.0);

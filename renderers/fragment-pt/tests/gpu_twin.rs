@@ -5,7 +5,7 @@
 use datasets::TetMesh;
 use fragment_pt::classify::{self, build_table, face_areas_f32};
 use fragment_pt::{FragmentPt, FragmentPtSettings, Shading, SortMode};
-use render_core::{Camera, Gpu, Optics, Projection, TransferFunction, Viewpoint};
+use render_core::{Camera, Gpu, Optics, Projection, Renderer, TransferFunction, Viewpoint};
 
 /// SplitMix64: a small deterministic generator for test inputs.
 struct Rng(u64);
@@ -100,7 +100,7 @@ fn gpu_pass1_matches_cpu_twin() {
             shading: Shading::Average,
             sort: SortMode::Radix,
         });
-        render_core::Renderer::prepare(&mut r, &gpu, &mesh, &optics).unwrap();
+        r.prepare(&gpu, &mesh, &optics).unwrap();
         let params = r.project_params(&camera).unwrap();
         let gpu_out = r.classify_on_gpu(&gpu, &camera).unwrap();
         assert_eq!(gpu_out.len(), mesh.num_tets());
@@ -181,4 +181,47 @@ fn gpu_pass1_matches_cpu_twin() {
         near_threshold < compared / 100,
         "{near_threshold} near the tolerance"
     );
+}
+
+/// Vertices, tets and pass-1 records split over several storage bindings (forced with 4 KiB
+/// bindings) draw exactly the image of one binding each, with a CPU and the GPU sort.
+#[test]
+fn split_bindings_draw_the_same_image() {
+    let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
+    let mesh = datasets::generate::from_spec("box:1k", 1).unwrap();
+    let tf = TransferFunction::preset("high-opacity").unwrap();
+    let optics = Optics::for_mesh(tf, &mesh);
+    let vp = Viewpoint::new("oblique", [0.4, 0.6, 0.7]);
+    let cam = Camera::fit(&mesh.bounds(), &vp, Projection::default(), 48, 48);
+    let counter = |c: &[(String, f64)], name: &str| {
+        c.iter()
+            .find(|(n, _)| n == name)
+            .unwrap_or_else(|| panic!("{name} in {c:?}"))
+            .1
+    };
+    for sort in [SortMode::Merge, SortMode::Gpu] {
+        let s = FragmentPtSettings {
+            shading: Shading::Psi,
+            sort,
+        };
+        let mut images = Vec::new();
+        for r in [
+            FragmentPt::new(s),
+            FragmentPt::new(s).with_max_binding(4096),
+        ] {
+            let mut r = r;
+            r.prepare(&gpu, &mesh, &optics).unwrap();
+            let stats = r.render(&gpu, &cam).unwrap();
+            assert!(stats.cpu_ms <= stats.total_ms, "{stats:?}");
+            assert_eq!(counter(&stats.counters, "tets_behind_eye"), 0.0);
+            images.push((
+                r.read_image(&gpu).unwrap(),
+                counter(&stats.counters, "mesh_bindings"),
+            ));
+        }
+        assert_eq!(images[0].1, 3.0);
+        assert!(images[1].1 >= 9.0, "{}", images[1].1);
+        assert_eq!(images[0].0.pixels, images[1].0.pixels, "{sort:?}");
+        assert!(images[0].0.pixels.iter().any(|p| p[3] > 0.1));
+    }
 }

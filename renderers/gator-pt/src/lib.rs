@@ -33,12 +33,13 @@ use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context};
 use datasets::TetMesh;
+use render_core::bind::{storage_entry, texture_entry, uniform_entry};
 use render_core::gpu::chunk_ranges;
 pub use render_core::visibility::VisibilityOrder;
 use render_core::visibility::VisibilitySorter;
 use render_core::{
-    Camera, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics, Prepared, Renderer,
-    Setting,
+    Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics,
+    Prepared, Renderer, Setting,
 };
 
 pub use classify::{
@@ -174,47 +175,13 @@ struct MeshGpu {
     num_tets: u32,
 }
 
-fn storage_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    read_only: bool,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 fn lut_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
+    texture_entry(
         binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D1,
-            multisampled: false,
-        },
-        count: None,
-    }
+        wgpu::ShaderStages::FRAGMENT,
+        false,
+        wgpu::TextureViewDimension::D1,
+    )
 }
 
 /// A 1D float lookup table texture.
@@ -529,13 +496,11 @@ impl Renderer for GatorPt {
                     uniform_entry(1, wgpu::ShaderStages::VERTEX),
                 ],
             });
-        let layout = gpu
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("gator"),
-                bind_group_layouts: &[Some(&meshgpu.g0_layout), Some(&g1_layout)],
-                immediate_size: 0,
-            });
+        let layout = render_core::bind::pipeline_layout(
+            gpu,
+            "gator",
+            &[Some(&meshgpu.g0_layout), Some(&g1_layout)],
+        );
         // Premultiplied "over", back to front: dst = src + (1 − src_α)·dst.
         let pipeline = gpu.triangle_pipeline(
             "gator",
@@ -640,22 +605,14 @@ impl Renderer for GatorPt {
             .as_ref()
             .is_none_or(|t| t.texture.width() != w || t.texture.height() != h)
         {
-            let desc = wgpu::TextureDescriptor {
-                label: Some("gator target"),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Float,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            };
-            let texture = st.ledger.texture(gpu, Lifetime::PerFrame, &desc)?;
-            let view = texture.create_view(&Default::default());
+            let (texture, view) = render_core::bind::render_target(
+                gpu,
+                &mut st.ledger,
+                "gator target",
+                (w, h),
+                wgpu::TextureFormat::Rgba32Float,
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            )?;
             st.target = Some(Target {
                 texture,
                 view,
@@ -664,17 +621,20 @@ impl Renderer for GatorPt {
         }
 
         // CPU part of the frame: sort keys, radix sort, one upload of the order.
-        st.timer.start_wall();
+        let mut clock = FrameClock::start();
         let t0 = Instant::now();
         let sort = st
             .sorter
             .back_to_front(&st.host_mesh, camera, &mut st.order);
-        let sort_ms = t0.elapsed().as_secs_f64() * 1e3;
+        clock.stage("sort", t0);
         let t1 = Instant::now();
         gpu.queue
             .write_buffer(&st.order_buf, 0, bytemuck::cast_slice(&st.order));
         st.mesh.write_params(gpu, camera, cells);
-        let upload_ms = t1.elapsed().as_secs_f64() * 1e3;
+        clock.stage("upload", t1);
+        if sort.precompute_ms > 0.0 {
+            clock.push_stage("sort_precompute", sort.precompute_ms);
+        }
 
         let target = st.target.as_ref().expect("target created above");
         let mut enc = gpu
@@ -684,22 +644,14 @@ impl Renderer for GatorPt {
             });
         st.timer.begin(&mut enc);
         {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("gator fans"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target.view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = render_core::bind::color_pass(
+                &mut enc,
+                "gator fans",
+                &target.view,
+                true,
+                true,
+                None,
+            );
             pass.set_pipeline(&st.pipeline);
             pass.set_bind_group(0, &st.mesh.g0, &[]);
             pass.set_index_buffer(st.index_buf.slice(..), wgpu::IndexFormat::Uint16);
@@ -715,35 +667,28 @@ impl Renderer for GatorPt {
             }
         }
         st.timer.end(&mut enc);
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait()?;
-        let total_ms = st.timer.wall_ms();
+        clock.submit(gpu, [enc.finish()]);
+        clock.wait(gpu)?;
+        let times = clock.finish();
         let gpu_ms = st.timer.gpu_ms(gpu)?;
         let n = st.order.len() as f64;
-        let mut stages = vec![
-            ("sort".to_string(), sort_ms),
-            ("upload".to_string(), upload_ms),
+        let stages = gpu_ms.map(|g| ("draw".to_string(), g));
+        let counters = vec![
+            ("tets".to_string(), n),
+            ("basis_graph_vertices".to_string(), NODES as f64 * n),
+            ("cycle_breaks".to_string(), sort.cycle_breaks as f64),
+            // Tets with a vertex at or behind the eye: the vertex shader drops them (no
+            // near-plane clipping, as the paper); counted outside the timed frame.
+            (
+                "tets_behind_eye".to_string(),
+                camera.tets_behind_eye(&st.host_mesh) as f64,
+            ),
         ];
-        if sort.precompute_ms > 0.0 {
-            stages.push(("sort_precompute".to_string(), sort.precompute_ms));
-        }
-        if let Some(g) = gpu_ms {
-            stages.push(("draw".to_string(), g));
-        }
-        Ok(FrameStats {
-            cpu_ms: sort_ms + upload_ms,
+        Ok(times.with_stages(stages).stats(
             gpu_ms,
-            total_ms,
-            frame_bytes: st.order.len() as u64 * 4
-                + std::mem::size_of::<Params>() as u64
-                + target.bytes,
-            stages,
-            counters: vec![
-                ("tets".to_string(), n),
-                ("basis_graph_vertices".to_string(), NODES as f64 * n),
-                ("cycle_breaks".to_string(), sort.cycle_breaks as f64),
-            ],
-        })
+            st.order.len() as u64 * 4 + std::mem::size_of::<Params>() as u64 + target.bytes,
+            counters,
+        ))
     }
 
     fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image> {
@@ -834,13 +779,11 @@ pub fn classify_gpu(
             label: Some("gator debug out"),
             entries: &[storage_entry(2, wgpu::ShaderStages::COMPUTE, false)],
         });
-    let layout = gpu
-        .device
-        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gator debug"),
-            bind_group_layouts: &[Some(&mesh.g0_layout), Some(&g1_layout)],
-            immediate_size: 0,
-        });
+    let layout = render_core::bind::pipeline_layout(
+        gpu,
+        "gator debug",
+        &[Some(&mesh.g0_layout), Some(&g1_layout)],
+    );
     let pipeline = gpu.compute_pipeline(
         "gator classify debug",
         Some(&layout),

@@ -35,16 +35,16 @@ struct Uniforms {
 
 struct Pixel {
     color: vec4<f32>,
-    // x: bits of the back depth of the last segment, y: fragments, z: out-of-order pops.
+    // x: bits of the back depth of the last segment, y: fragments, z: out-of-order pops,
+    // w: fragments culled after early ray termination.
     info: vec4<u32>,
 }
 
 @group(0) @binding(0) var<uniform> u: Uniforms;
-// Vertices: xyz, w = normalised scalar + 2 for the copies that boundary faces use (the
-// paper's per-vertex boundary tag).
-@group(0) @binding(1) var<storage, read> verts: array<vec4<f32>>;
-// Three vertex indices per unique face.
-@group(0) @binding(2) var<storage, read> faces: array<u32>;
+// Vertices (`verts_at`): xyz, w = normalised scalar + 2 for the copies that boundary faces
+// use (the paper's per-vertex boundary tag); three vertex indices per unique face
+// (`faces_at`). Both are declared by the Rust (render_core::ChunkedBuffer) at bindings 11..,
+// split over as many storage bindings as the mesh needs.
 // This chunk of the per-frame order: face indices front to back by centroid distance.
 @group(0) @binding(3) var<storage, read> order: array<u32>;
 @group(0) @binding(4) var table: texture_3d<f32>;
@@ -52,8 +52,9 @@ struct Pixel {
 @group(0) @binding(6) var<storage, read_write> pixels: array<Pixel>;
 // K entries per pixel: (v, d); d = 0 marks an empty entry (cleared with clear_buffer).
 @group(0) @binding(7) var<storage, read_write> kentries: array<vec2<f32>>;
-// 0: fragments, 1: out-of-order pops, 2: lists longer than MAX_LIST, 3: nodes appended.
-@group(0) @binding(8) var<storage, read_write> counters: array<atomic<u32>, 4>;
+// 0: fragments, 1: out-of-order pops, 2: lists longer than MAX_LIST, 3: nodes appended,
+// 4: fragments culled by early ray termination (never shaded nor looked up in the table).
+@group(0) @binding(8) var<storage, read_write> counters: array<atomic<u32>, 8>;
 // Race-free mode: head of each pixel's list (node index + 1; 0 = empty) and the nodes
 // (v bits, d bits, submission index, next).
 @group(0) @binding(9) var<storage, read_write> heads: array<atomic<u32>>;
@@ -93,7 +94,7 @@ struct VOut {
 fn vs(@builtin(vertex_index) vi: u32) -> VOut {
     let slot = vi / 3u;
     let face = order[slot];
-    let p = verts[faces[face * 3u + vi % 3u]];
+    let p = verts_at(faces_at(face * 3u + vi % 3u));
     var out: VOut;
     out.pos = u.view_proj * vec4<f32>(p.xyz, 1.0);
     out.world = p.xyz;
@@ -145,15 +146,19 @@ fn store_entries(p: u32, st: ptr<function, KState>) {
 @fragment
 fn fs_kbuffer(in: VOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let p = pixel_index(in.pos);
-    var st = load_state(p);
-    if early_termination() && st.color.a >= u.et_alpha {
+    // §4, early ray termination as the paper's fragment program does it: read the pixel's
+    // accumulated opacity first and stop above the threshold, before the k-buffer is read or
+    // the table sampled. Culled fragments are counted (racing like the other per-pixel counts).
+    if early_termination() && pixels[p].color.a >= u.et_alpha {
+        pixels[p].info.w += 1u;
         return vec4<f32>(0.0);
     }
+    var st = load_state(p);
     let info = pixels[p].info;
     kb_insert(&st, fragment_entry(in.world, in.v, front_facing), two_tags());
     store_entries(p, &st);
     pixels[p].color = st.color;
-    pixels[p].info = vec4<u32>(bitcast<u32>(st.last_back), info.y + 1u, info.z + st.errors, 0u);
+    pixels[p].info = vec4<u32>(bitcast<u32>(st.last_back), info.y + 1u, info.z + st.errors, info.w);
     return vec4<f32>(0.0);
 }
 
@@ -185,6 +190,7 @@ fn drain(@builtin(global_invocation_id) g: vec3<u32>) {
     let info = pixels[p].info;
     atomicAdd(&counters[0], info.y);
     atomicAdd(&counters[1], info.z + st.errors);
+    atomicAdd(&counters[4], info.w);
 }
 
 fn node_entry(n: vec4<u32>) -> vec2<f32> {
@@ -209,6 +215,7 @@ fn resolve_lists(@builtin(global_invocation_id) g: vec3<u32>) {
     let two = two_tags();
     var ids: array<u32, MAX_LIST>;
     var n = 0u;
+    var culled = 0u;
     var cur = atomicLoad(&heads[p]);
     while cur != 0u {
         if n < MAX_LIST {
@@ -237,6 +244,7 @@ fn resolve_lists(@builtin(global_invocation_id) g: vec3<u32>) {
         }
         for (var i = 0u; i < n; i++) {
             if et && st.color.a >= u.et_alpha {
+                culled = n - i;
                 break;
             }
             kb_insert(&st, node_entry(nodes[ids[i]]), two);
@@ -262,6 +270,7 @@ fn resolve_lists(@builtin(global_invocation_id) g: vec3<u32>) {
             first = false;
             last = best;
             if et && st.color.a >= u.et_alpha {
+                culled = n - step;
                 break;
             }
             kb_insert(&st, node_entry(nodes[best_id]), two);
@@ -271,6 +280,7 @@ fn resolve_lists(@builtin(global_invocation_id) g: vec3<u32>) {
         kb_drain(&st, two);
     }
     pixels[p].color = st.color;
-    atomicAdd(&counters[0], n);
+    atomicAdd(&counters[0], n - culled);
     atomicAdd(&counters[1], st.errors);
+    atomicAdd(&counters[4], culled);
 }

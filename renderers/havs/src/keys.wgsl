@@ -13,8 +13,7 @@ struct KeyUniforms {
 }
 
 @group(0) @binding(0) var<uniform> ku: KeyUniforms;
-@group(0) @binding(1) var<storage, read> verts: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> faces: array<u32>;
+// verts_at / faces_at: declared by the Rust (render_core::ChunkedBuffer) at bindings 5..
 @group(0) @binding(3) var<storage, read_write> keys: array<f32>;
 @group(0) @binding(4) var<storage, read_write> ids: array<u32>;
 
@@ -24,7 +23,7 @@ fn face_keys(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroup
     if f >= ku.faces {
         return;
     }
-    let c = (verts[faces[3u * f]].xyz + verts[faces[3u * f + 1u]].xyz + verts[faces[3u * f + 2u]].xyz) / 3.0;
+    let c = (verts_at(faces_at(3u * f)).xyz + verts_at(faces_at(3u * f + 1u)).xyz + verts_at(faces_at(3u * f + 2u)).xyz) / 3.0;
     let rel = c - ku.eye.xyz;
     var d = dot(rel, ku.forward.xyz);
     if ku.eye.w > 0.5 {

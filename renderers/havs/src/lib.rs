@@ -15,18 +15,18 @@
 //! (`kbuffer.wgsl`; CPU twin in [`kbuffer`]).
 
 pub mod abuffer;
+mod frame;
 pub mod kbuffer;
-
-use std::time::Instant;
 
 use anyhow::{bail, Context};
 use datasets::TetMesh;
 use rayon::prelude::*;
+use render_core::bind::{check_storage_bindings, storage_entry, texture_entry, uniform_entry};
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::preintegration::Table3d;
-use render_core::sort::{radix_sort_indices, RadixScratch};
+use render_core::sort::RadixScratch;
 use render_core::{
-    Camera, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Setting,
+    Camera, ChunkedBuffer, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Setting,
 };
 
 pub use kbuffer::{Tag, TagScheme};
@@ -148,6 +148,8 @@ pub fn all_variants() -> Vec<Box<dyn Renderer>> {
 pub struct Havs {
     pub settings: HavsSettings,
     state: Option<State>,
+    /// Storage binding size to split at instead of the adapter's (tests of the split path).
+    max_binding: Option<u64>,
 }
 
 impl Havs {
@@ -155,7 +157,15 @@ impl Havs {
         Havs {
             settings,
             state: None,
+            max_binding: None,
         }
+    }
+
+    /// Splits the vertex, face and order arrays at `bytes` per storage binding (rounded down
+    /// to 256) instead of the adapter's limit. Only useful to test the split on small meshes.
+    pub fn with_max_binding(mut self, bytes: u64) -> Havs {
+        self.max_binding = Some(bytes);
+        self
     }
 
     /// Bytes of every allocation so far (persistent and per frame), for reports.
@@ -215,8 +225,8 @@ struct GpuSortState {
 
 struct State {
     ledger: MemoryLedger,
-    verts: wgpu::Buffer,
-    faces: wgpu::Buffer,
+    verts: ChunkedBuffer,
+    faces: ChunkedBuffer,
     num_faces: u64,
     /// Face centroids for the CPU sort.
     centroids: Vec<[f32; 3]>,
@@ -233,7 +243,8 @@ struct State {
     max_len: f32,
     n_s: u32,
     n_l: u32,
-    tets: u64,
+    /// The adapter cannot filter f32 textures: the table is sampled nearest.
+    table_nearest: bool,
     target: Option<Target>,
     timer: FrameTimer,
     scratch: RadixScratch,
@@ -285,29 +296,23 @@ fn sort_key(eye: [f32; 3], forward: [f32; 3], perspective: bool, c: [f32; 3]) ->
     }
 }
 
-fn shader_source(k: u32) -> String {
+/// First binding of the vertex chunks in the draw/drain layout (faces follow them).
+const MESH_BINDING: u32 = 11;
+/// First binding of the vertex chunks in the GPU key pass (faces follow them).
+const KEY_MESH_BINDING: u32 = 5;
+
+/// WGSL of the chunked vertex and face arrays (`verts_at`, `faces_at`) from binding `first`.
+fn mesh_decls(verts: &ChunkedBuffer, faces: &ChunkedBuffer, first: u32) -> String {
+    verts.wgsl("verts", "vec4<f32>", 0, first, true)
+        + &faces.wgsl("faces", "u32", 0, first + verts.bindings(), true)
+}
+
+fn shader_source(k: u32, decls: &str) -> String {
     format!(
-        "const K: u32 = {k}u;\n{}\n{}",
+        "const K: u32 = {k}u;\n{decls}\n{}\n{}",
         include_str!("havs.wgsl"),
         include_str!("kbuffer.wgsl")
     )
-}
-
-fn storage_entry(
-    binding: u32,
-    read_only: bool,
-    visibility: wgpu::ShaderStages,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
 }
 
 impl Renderer for Havs {
@@ -343,34 +348,35 @@ impl Renderer for Havs {
         }
         let mut ledger = MemoryLedger::default();
         let abuffer::Geometry { verts, faces } = tagged_geometry(mesh, optics);
-        let max_binding = gpu.max_storage_binding();
-        let vert_bytes = verts.len() as u64 * 16;
-        let face_bytes = faces.len() as u64 * 12;
-        if vert_bytes > max_binding || face_bytes > max_binding {
-            bail!(
-                "HAVS: mesh {:?} needs {} vertex bytes and {} face bytes, over one storage binding ({} bytes) of {}",
-                mesh.name,
-                vert_bytes,
-                face_bytes,
-                max_binding,
-                gpu.adapter.name
-            );
+        let max_binding = match self.max_binding {
+            Some(b) => b.min(gpu.max_storage_binding()) & !255,
+            None => gpu.max_storage_binding(),
         }
+        .max(256);
+        // Vertex and face arrays split over as many storage bindings as they need (issue 14);
+        // the shaders read them through the generated `verts_at` / `faces_at`.
         let storage = wgpu::BufferUsages::STORAGE;
-        let verts_buf = ledger.buffer_init(
+        let verts_buf = ChunkedBuffer::with_data(
             gpu,
+            &mut ledger,
             "havs vertices",
             Lifetime::Persistent,
             bytemuck::cast_slice(&verts),
+            16,
+            max_binding,
             storage,
         )?;
-        let faces_buf = ledger.buffer_init(
+        let faces_buf = ChunkedBuffer::with_data(
             gpu,
+            &mut ledger,
             "havs faces",
             Lifetime::Persistent,
             bytemuck::cast_slice(&faces),
+            4,
+            max_binding,
             storage,
         )?;
+        check_storage_bindings(gpu, "HAVS", 6 + verts_buf.bindings() + faces_buf.bindings())?;
         let num_faces = faces.len() as u64;
         let centroids: Vec<[f32; 3]> = faces
             .par_iter()
@@ -423,6 +429,8 @@ impl Renderer for Havs {
             },
         );
         let table_view = tex.create_view(&Default::default());
+        // Without FLOAT32_FILTERABLE the table is sampled nearest: a visible approximation,
+        // so every row of such an adapter carries the counter `table_filter_nearest=1`.
         let filterable = gpu.features.contains(wgpu::Features::FLOAT32_FILTERABLE);
         let filter = if filterable {
             wgpu::FilterMode::Linear
@@ -469,66 +477,43 @@ impl Renderer for Havs {
             gpu,
             "havs counters",
             Lifetime::PerFrame,
-            16,
+            32,
             storage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
         )?;
 
         let all =
             wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let fc = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let mut entries = vec![
+            uniform_entry(0, all),
+            storage_entry(3, all, true),
+            texture_entry(4, fc, filterable, wgpu::TextureViewDimension::D3),
+            wgpu::BindGroupLayoutEntry {
+                binding: 5,
+                visibility: fc,
+                ty: wgpu::BindingType::Sampler(if filterable {
+                    wgpu::SamplerBindingType::Filtering
+                } else {
+                    wgpu::SamplerBindingType::NonFiltering
+                }),
+                count: None,
+            },
+        ];
+        entries.extend((6..=10).map(|b| storage_entry(b, fc, false)));
+        entries.extend(verts_buf.layout_entries(MESH_BINDING, all, true));
+        entries.extend(faces_buf.layout_entries(MESH_BINDING + verts_buf.bindings(), all, true));
         let layout = gpu
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("havs layout"),
-                entries: &[
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 0,
-                        visibility: all,
-                        ty: wgpu::BindingType::Buffer {
-                            ty: wgpu::BufferBindingType::Uniform,
-                            has_dynamic_offset: false,
-                            min_binding_size: None,
-                        },
-                        count: None,
-                    },
-                    storage_entry(1, true, all),
-                    storage_entry(2, true, all),
-                    storage_entry(3, true, all),
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 4,
-                        visibility: fc,
-                        ty: wgpu::BindingType::Texture {
-                            sample_type: wgpu::TextureSampleType::Float { filterable },
-                            view_dimension: wgpu::TextureViewDimension::D3,
-                            multisampled: false,
-                        },
-                        count: None,
-                    },
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 5,
-                        visibility: fc,
-                        ty: wgpu::BindingType::Sampler(if filterable {
-                            wgpu::SamplerBindingType::Filtering
-                        } else {
-                            wgpu::SamplerBindingType::NonFiltering
-                        }),
-                        count: None,
-                    },
-                    storage_entry(6, false, fc),
-                    storage_entry(7, false, fc),
-                    storage_entry(8, false, fc),
-                    storage_entry(9, false, fc),
-                    storage_entry(10, false, fc),
-                ],
+                entries: &entries,
             });
-        let pipeline_layout = gpu
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("havs pipeline layout"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
-        let module = gpu.shader("havs", &shader_source(s.k));
+        let pipeline_layout =
+            render_core::bind::pipeline_layout(gpu, "havs pipeline layout", &[Some(&layout)]);
+        let module = gpu.shader(
+            "havs",
+            &shader_source(s.k, &mesh_decls(&verts_buf, &faces_buf, MESH_BINDING)),
+        );
         let fs_entry = match s.mode {
             Mode::FragmentRace => "fs_kbuffer",
             Mode::RaceFree => "fs_append",
@@ -588,7 +573,7 @@ impl Renderer for Havs {
             max_len: max_len as f32,
             n_s,
             n_l,
-            tets: mesh.num_tets() as u64,
+            table_nearest: !filterable,
             target: None,
             timer: FrameTimer::new(gpu),
             scratch: RadixScratch::default(),
@@ -643,418 +628,5 @@ impl Renderer for Havs {
             *o = [p[0], p[1], p[2], p[3]];
         }
         Ok(img)
-    }
-}
-
-impl GpuSortState {
-    fn new(
-        gpu: &Gpu,
-        ledger: &mut MemoryLedger,
-        verts: &wgpu::Buffer,
-        faces: &wgpu::Buffer,
-        num_faces: u64,
-    ) -> anyhow::Result<GpuSortState> {
-        if num_faces * 4 > gpu.max_storage_binding() {
-            bail!("HAVS GPU sort: {num_faces} keys exceed one storage binding; use sort=cpu-radix");
-        }
-        let usage = wgpu::BufferUsages::STORAGE
-            | wgpu::BufferUsages::COPY_SRC
-            | wgpu::BufferUsages::COPY_DST;
-        let keys = ledger.buffer(
-            gpu,
-            "havs sort keys",
-            Lifetime::PerFrame,
-            num_faces * 4,
-            usage,
-        )?;
-        let ids = ledger.buffer(
-            gpu,
-            "havs sort ids",
-            Lifetime::PerFrame,
-            num_faces * 4,
-            usage,
-        )?;
-        let key_uniforms = ledger.buffer(
-            gpu,
-            "havs key uniforms",
-            Lifetime::PerFrame,
-            std::mem::size_of::<KeyUniforms>() as u64,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        )?;
-        let module = gpu.shader("havs keys", include_str!("keys.wgsl"));
-        let key_pipeline = gpu.compute_pipeline("havs face keys", None, &module, "face_keys");
-        let key_bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("havs keys"),
-            layout: &key_pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: key_uniforms.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: verts.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: faces.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: keys.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: ids.as_entire_binding(),
-                },
-            ],
-        });
-        let sorter = render_core::gpu_sort::GpuRadixSort::new(gpu, num_faces as u32, ledger)?;
-        Ok(GpuSortState {
-            sorter,
-            keys,
-            ids,
-            key_uniforms,
-            key_pipeline,
-            key_bind_group,
-        })
-    }
-}
-
-impl State {
-    /// (Re)creates the per-frame buffers for a `w`×`h` viewport (and, in race-free mode, a node
-    /// pool of `nodes` fragments).
-    fn ensure_target(
-        &mut self,
-        gpu: &Gpu,
-        s: HavsSettings,
-        w: u32,
-        h: u32,
-        nodes: Option<u64>,
-    ) -> anyhow::Result<()> {
-        if let Some(t) = &self.target {
-            if t.width == w && t.height == h && nodes.is_none() {
-                return Ok(());
-            }
-        }
-        // Forget the previous target's bytes before counting the new one.
-        self.ledger.entries.retain(|(label, life, bytes)| {
-            let keep = !label.starts_with("havs target ");
-            if !keep && *life == Lifetime::PerFrame {
-                self.ledger.per_frame -= bytes;
-            }
-            keep
-        });
-        let npx = w as u64 * h as u64;
-        let max_binding = gpu.max_storage_binding();
-        let usage = wgpu::BufferUsages::STORAGE
-            | wgpu::BufferUsages::COPY_SRC
-            | wgpu::BufferUsages::COPY_DST;
-        let pixels = self.ledger.buffer(
-            gpu,
-            "havs target pixels",
-            Lifetime::PerFrame,
-            npx * 32,
-            usage,
-        )?;
-        let (kentries, heads, nodes_buf, node_capacity) = match s.mode {
-            Mode::FragmentRace => {
-                let bytes = npx * s.k as u64 * 8;
-                if bytes > max_binding {
-                    bail!("HAVS: a {w}x{h} k-buffer with k = {} needs {bytes} bytes, over one storage binding", s.k);
-                }
-                let kb = self.ledger.buffer(
-                    gpu,
-                    "havs target k-buffer",
-                    Lifetime::PerFrame,
-                    bytes,
-                    usage,
-                )?;
-                let heads = self.ledger.buffer(
-                    gpu,
-                    "havs target unused heads",
-                    Lifetime::PerFrame,
-                    16,
-                    usage,
-                )?;
-                let nodes = self.ledger.buffer(
-                    gpu,
-                    "havs target unused nodes",
-                    Lifetime::PerFrame,
-                    16,
-                    usage,
-                )?;
-                (kb, heads, nodes, 0)
-            }
-            Mode::RaceFree => {
-                // Start from a pool of 8 fragments per pixel; `render` grows it when a view needs more.
-                let cap = nodes.unwrap_or(npx * 8).max(1024);
-                if cap * 16 > max_binding {
-                    bail!(
-                        "HAVS race-free mode: {cap} fragments need {} bytes of lists, over one storage binding ({max_binding}); \
-                         use mode=fragment-race or a smaller image",
-                        cap * 16
-                    );
-                }
-                let kb = self.ledger.buffer(
-                    gpu,
-                    "havs target unused k-buffer",
-                    Lifetime::PerFrame,
-                    16,
-                    usage,
-                )?;
-                let heads = self.ledger.buffer(
-                    gpu,
-                    "havs target list heads",
-                    Lifetime::PerFrame,
-                    npx * 4,
-                    usage,
-                )?;
-                let nodes = self.ledger.buffer(
-                    gpu,
-                    "havs target fragment lists",
-                    Lifetime::PerFrame,
-                    cap * 16,
-                    usage,
-                )?;
-                (kb, heads, nodes, cap)
-            }
-        };
-        let dummy = self.ledger.texture(
-            gpu,
-            Lifetime::PerFrame,
-            &wgpu::TextureDescriptor {
-                label: Some("havs target attachment"),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::R8Unorm,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            },
-        )?;
-        let dummy_view = dummy.create_view(&Default::default());
-        let bind_groups = self
-            .chunks
-            .iter()
-            .zip(&self.uniforms)
-            .map(|(range, ub)| {
-                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("havs bind group"),
-                    layout: &self.layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: ub.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: self.verts.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: self.faces.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                                buffer: &self.order,
-                                offset: range.start * 4,
-                                size: std::num::NonZeroU64::new(
-                                    (range.end - range.start).max(1) * 4,
-                                ),
-                            }),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 4,
-                            resource: wgpu::BindingResource::TextureView(&self.table_view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 5,
-                            resource: wgpu::BindingResource::Sampler(&self.sampler),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 6,
-                            resource: pixels.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 7,
-                            resource: kentries.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 8,
-                            resource: self.counters.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 9,
-                            resource: heads.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 10,
-                            resource: nodes_buf.as_entire_binding(),
-                        },
-                    ],
-                })
-            })
-            .collect();
-        self.target = Some(Target {
-            width: w,
-            height: h,
-            pixels,
-            kentries,
-            heads,
-            _nodes: nodes_buf,
-            node_capacity,
-            dummy_view,
-            bind_groups,
-        });
-        Ok(())
-    }
-
-    fn frame(&mut self, gpu: &Gpu, s: HavsSettings, camera: &Camera) -> anyhow::Result<FrameStats> {
-        let eye = camera.eye.map(|c| c as f32);
-        let fwd = camera.forward().map(|c| c as f32);
-        let persp = camera.is_perspective();
-        let mut stages = Vec::new();
-        self.timer.start_wall();
-        let t0 = Instant::now();
-
-        // Object space: sort the faces front to back by centroid distance (§5.1).
-        if s.sort == SortMode::CpuRadix {
-            let cents = &self.centroids;
-            self.keys.clear();
-            self.keys
-                .par_extend(cents.par_iter().map(|&c| sort_key(eye, fwd, persp, c)));
-            let tk = t0.elapsed().as_secs_f64() * 1e3;
-            radix_sort_indices(&self.keys, &mut self.sorted, &mut self.scratch);
-            let ts = t0.elapsed().as_secs_f64() * 1e3;
-            gpu.queue
-                .write_buffer(&self.order, 0, bytemuck::cast_slice(&self.sorted));
-            let tu = t0.elapsed().as_secs_f64() * 1e3;
-            stages.push(("keys".to_string(), tk));
-            stages.push(("sort".to_string(), ts - tk));
-            stages.push(("upload".to_string(), tu - ts));
-        }
-        let t = self.target.as_ref().expect("target ensured");
-        let flags = (s.tags == TagScheme::Two) as u32 | ((s.early_termination as u32) << 1);
-        for (range, ub) in self.chunks.iter().zip(&self.uniforms) {
-            let u = Uniforms {
-                view_proj: camera.view_proj_f32(),
-                eye: [eye[0], eye[1], eye[2], persp as u32 as f32],
-                forward: [fwd[0], fwd[1], fwd[2], 0.0],
-                width: t.width,
-                height: t.height,
-                flags,
-                base_face: range.start as u32,
-                max_len: self.max_len,
-                n_s: self.n_s as f32,
-                n_l: self.n_l as f32,
-                node_capacity: t.node_capacity.min(u32::MAX as u64) as u32,
-                et_alpha: kbuffer::EARLY_TERMINATION_ALPHA,
-                _pad: [0; 3],
-            };
-            gpu.queue.write_buffer(ub, 0, bytemuck::bytes_of(&u));
-        }
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        self.timer.begin(&mut enc);
-        if let Some(gs) = &self.gpu_sort {
-            let ku = KeyUniforms {
-                eye: [eye[0], eye[1], eye[2], persp as u32 as f32],
-                forward: [fwd[0], fwd[1], fwd[2], 0.0],
-                faces: self.num_faces as u32,
-                _pad: [0; 3],
-            };
-            gpu.queue
-                .write_buffer(&gs.key_uniforms, 0, bytemuck::bytes_of(&ku));
-            {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("havs keys"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&gs.key_pipeline);
-                pass.set_bind_group(0, &gs.key_bind_group, &[]);
-                let groups = self.num_faces.div_ceil(256) as u32;
-                let max = gpu.limits.max_compute_workgroups_per_dimension;
-                let (gx, gy) = if groups <= max {
-                    (groups, 1)
-                } else {
-                    (max, groups.div_ceil(max))
-                };
-                pass.dispatch_workgroups(gx, gy, 1);
-            }
-            gs.sorter
-                .encode(&mut enc, &gs.keys, &gs.ids, self.num_faces as u32, false)?;
-            enc.copy_buffer_to_buffer(&gs.ids, 0, &self.order, 0, self.num_faces * 4);
-        }
-        enc.clear_buffer(&t.pixels, 0, None);
-        enc.clear_buffer(&self.counters, 0, None);
-        match s.mode {
-            Mode::FragmentRace => enc.clear_buffer(&t.kentries, 0, None),
-            Mode::RaceFree => enc.clear_buffer(&t.heads, 0, None),
-        }
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("havs faces"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &t.dummy_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Discard,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.draw_pipeline);
-            // Chunks in order: the faces stay in sorted order across chunk boundaries.
-            for (range, bg) in self.chunks.iter().zip(&t.bind_groups) {
-                pass.set_bind_group(0, bg, &[]);
-                pass.draw(0..((range.end - range.start) * 3) as u32, 0..1);
-            }
-        }
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("havs drain"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.drain_pipeline);
-            pass.set_bind_group(0, &t.bind_groups[0], &[]);
-            pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
-        }
-        self.timer.end(&mut enc);
-        let cpu_ms = t0.elapsed().as_secs_f64() * 1e3;
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait()?;
-        let total_ms = self.timer.wall_ms();
-        let gpu_ms = self.timer.gpu_ms(gpu)?;
-        let c = gpu.read_buffer(&self.counters, 0, 16)?;
-        let c: &[u32] = bytemuck::cast_slice(&c);
-        let mut counters = vec![
-            ("fragments".to_string(), c[0] as f64),
-            ("kbuffer_out_of_order".to_string(), c[1] as f64),
-        ];
-        if s.mode == Mode::RaceFree {
-            counters.push(("lists_over_512".to_string(), c[2] as f64));
-            counters.push(("nodes".to_string(), c[3] as f64));
-        }
-        counters.push(("faces".to_string(), self.num_faces as f64));
-        let _ = self.tets;
-        Ok(FrameStats {
-            cpu_ms,
-            gpu_ms,
-            total_ms,
-            frame_bytes: self.ledger.per_frame,
-            stages,
-            counters,
-        })
     }
 }

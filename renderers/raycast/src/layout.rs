@@ -12,7 +12,7 @@
 //! `v_{3−i}` lies on face `i`, which is the point the paper's Eq. 1 uses. A neighbour `a_i` is two
 //! integers, as the paper's (t_u, t_v) texture coordinates: here (binding, index in binding),
 //! because a storage binding holds at most 128 MiB on lavapipe (≈ 932 K tets at 144 B), and
-//! larger meshes are split over several bindings ([`MESH_SLOTS`]); a ray walks from any tet to
+//! larger meshes are split over several bindings (up to [`MESH_SLOTS`]); a ray walks from any tet to
 //! any other by following those pairs. The scalar is s(x) = g·x + c (Eq. 2), already normalised
 //! to the transfer function's [0, 1].
 //!
@@ -28,9 +28,37 @@ use render_core::Optics;
 pub const BYTES_PER_TET: u64 = 144;
 /// 16-byte texels per tet.
 pub const TEXELS_PER_TET: usize = 9;
-/// Storage bindings the shaders can address; meshes needing more are refused with an error
-/// (8 × 932 K = 7.4 M tets on lavapipe).
-pub const MESH_SLOTS: usize = 8;
+/// Most storage bindings the mesh may take; the shaders are generated for the bindings a mesh
+/// needs ([`mesh_wgsl`]), and `prepare` also checks the adapter's storage-binding limit
+/// (24 × 932 K = 22 M tets on lavapipe, whose 32 storage buffers per stage leave 26).
+pub const MESH_SLOTS: usize = 24;
+
+/// WGSL of `slots` mesh bindings `mesh0 …` at group 0, bindings 1.., and `texel(c, i)`, the
+/// paper's (t_u, t_v) texture fetch: texel `i` of binding `c`.
+pub fn mesh_wgsl(slots: usize) -> String {
+    let mut s = String::new();
+    for c in 0..slots {
+        s += &format!(
+            "@group(0) @binding({}) var<storage, read> mesh{c}: array<vec4<u32>>;\n",
+            c + 1
+        );
+    }
+    s += "fn texel(c: u32, i: u32) -> vec4<u32> {\n";
+    if slots == 1 {
+        s += "    return mesh0[i];\n}\n";
+        return s;
+    }
+    s += "    switch c {\n";
+    for c in 0..slots {
+        if c + 1 == slots {
+            s += &format!("        default: {{ return mesh{c}[i]; }}\n");
+        } else {
+            s += &format!("        case {c}u: {{ return mesh{c}[i]; }}\n");
+        }
+    }
+    s += "    }\n}\n";
+    s
+}
 /// Marks "no tet": a boundary face's missing neighbour, a ray that left the mesh.
 pub const NONE: u32 = u32::MAX;
 
@@ -98,8 +126,8 @@ impl MeshLayout {
         let chunks_needed = (n as u64).div_ceil(per).max(1);
         if chunks_needed > MESH_SLOTS as u64 {
             anyhow::bail!(
-                "raycast: mesh {} has {n} tets = {} bytes at 144 B/tet, more than {MESH_SLOTS} \
-                 storage bindings of {max_binding} bytes",
+                "raycast: mesh {} has {n} tets = {} bytes at 144 B/tet, needs {chunks_needed} \
+                 storage bindings of {max_binding} bytes, at most {MESH_SLOTS} are bound",
                 mesh.name,
                 n as u64 * BYTES_PER_TET
             );

@@ -7,10 +7,10 @@ use datasets::TetMesh;
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::preintegration::{Table2d, Table3d};
 use render_core::{
-    Camera, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Setting,
+    Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Setting,
 };
 
-use crate::layout::{MeshLayout, TetRef, MESH_SLOTS};
+use crate::layout::{MeshLayout, TetRef};
 use crate::resources::{FrameParams, Pipelines, Target, TileRect, MAX_TILES, STAT_SLOTS};
 use crate::settings::{Mode, RaycastSettings, TableKind};
 use crate::step::{LayerEntry, RayFrame};
@@ -221,50 +221,10 @@ fn read_layer(
     w: u32,
     h: u32,
 ) -> anyhow::Result<Vec<Option<LayerEntry>>> {
-    let unpadded = w as u64 * 16;
-    let padded = unpadded.div_ceil(256) * 256;
-    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("raycast layer readback"),
-        size: padded * h as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    enc.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture: tex,
-            mip_level: 0,
-            origin: wgpu::Origin3d {
-                x: 0,
-                y: 0,
-                z: layer,
-            },
-            aspect: wgpu::TextureAspect::All,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &staging,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded as u32),
-                rows_per_image: Some(h),
-            },
-        },
-        wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-    );
-    gpu.queue.submit([enc.finish()]);
-    let bytes = gpu.read_buffer(&staging, 0, padded * h as u64)?;
-    let mut out = Vec::with_capacity((w * h) as usize);
-    for y in 0..h as usize {
-        let row: &[[u32; 4]] = bytemuck::cast_slice(
-            &bytes[y * padded as usize..y * padded as usize + unpadded as usize],
-        );
-        out.extend(row.iter().map(|&t| LayerEntry::decode(t)));
-    }
-    Ok(out)
+    debug_assert_eq!((tex.width(), tex.height()), (w, h));
+    let bytes = gpu.read_texture_layer(tex, layer)?;
+    let texels: &[[u32; 4]] = bytemuck::cast_slice(&bytes);
+    Ok(texels.iter().map(|&t| LayerEntry::decode(t)).collect())
 }
 
 fn tile_rects(w: u32, h: u32, n: u32) -> ([u32; 2], Vec<TileRect>) {
@@ -297,14 +257,12 @@ impl Renderer for Raycast {
             b.min(gpu.max_storage_binding())
         });
         let layout = MeshLayout::build(mesh, optics, max_binding)?;
-        let needed_storage = (MESH_SLOTS + 6) as u32;
-        if gpu.limits.max_storage_buffers_per_shader_stage < needed_storage {
-            bail!(
-                "raycast: adapter {} allows {} storage buffers per shader stage, {needed_storage} needed",
-                gpu.adapter.name,
-                gpu.limits.max_storage_buffers_per_shader_stage
-            );
-        }
+        let slots = layout.chunks.len();
+        render_core::bind::check_storage_bindings(
+            gpu,
+            &format!("raycast on {} ({} mesh bindings)", gpu.adapter.name, slots),
+            (slots + 6) as u32,
+        )?;
         let mut ledger = MemoryLedger::default();
         let storage = wgpu::BufferUsages::STORAGE;
         let chunk_buffers: Vec<wgpu::Buffer> = layout
@@ -374,19 +332,10 @@ impl Renderer for Raycast {
             std::mem::size_of::<FrameParams>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         )?;
-        let pipes = Pipelines::new(gpu);
-        let mut entries = vec![wgpu::BindGroupEntry {
-            binding: 0,
-            resource: frame_params.as_entire_binding(),
-        }];
-        for slot in 0..MESH_SLOTS {
-            // Unused slots repeat binding 0 (never addressed).
-            let b = &chunk_buffers[slot.min(chunk_buffers.len() - 1)];
-            entries.push(wgpu::BindGroupEntry {
-                binding: slot as u32 + 1,
-                resource: b.as_entire_binding(),
-            });
-        }
+        let pipes = Pipelines::new(gpu, slots);
+        let mut entries = vec![render_core::bind::whole(0, &frame_params)];
+        let refs: Vec<&wgpu::Buffer> = chunk_buffers.iter().collect();
+        entries.extend(render_core::bind::whole_from(1, &refs));
         let mesh_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("raycast frame + mesh"),
             layout: &pipes.mesh_layout,
@@ -494,8 +443,7 @@ fn frame(
     let t = st.target.as_ref().expect("target created above");
     let (tile_size, rects) = tile_rects(w, h, s.tiles);
     let ntiles = rects.len();
-    st.timer.start_wall();
-    let started = Instant::now();
+    let mut clock = FrameClock::start();
     gpu.queue
         .write_buffer(&t.tile_rects, 0, bytemuck::cast_slice(&rects));
     let rf = RayFrame::new(camera, st.layout.origin);
@@ -582,8 +530,9 @@ fn frame(
             &t.occlusion_resolve,
             l as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
         );
-        gpu.queue.submit([enc.finish()]);
-        let q = gpu.read_buffer(
+        clock.submit(gpu, [enc.finish()]);
+        let q = clock.read_buffer(
+            gpu,
             &t.occlusion_resolve,
             l as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
             8,
@@ -598,7 +547,7 @@ fn frame(
         }
         layers_used += 1;
     }
-    let peel_ms = t_peel.elapsed().as_secs_f64() * 1e3;
+    clock.stage("peel", t_peel);
 
     // Rays start at their first entry; active rays are counted per tile.
     params.counts[1] = layers_used;
@@ -623,8 +572,8 @@ fn frame(
         pass.set_bind_group(1, &t.cast_binds[0], &[]);
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
-    gpu.queue.submit([enc.finish()]);
-    let mut counts = read_counts(gpu, &t.tile_counts, ntiles)?;
+    clock.submit(gpu, [enc.finish()]);
+    let mut counts = read_counts(gpu, &mut clock, &t.tile_counts, ntiles)?;
     let mut tile_passes = vec![0u32; ntiles];
     let mut rounds = 0u32;
     // One dispatch per pass covers every listed tile (workgroup z = slot in the list).
@@ -658,12 +607,12 @@ fn frame(
                         pass.dispatch_workgroups(groups[0], groups[1], active.len() as u32);
                     }
                 }
-                gpu.queue.submit([enc.finish()]);
+                clock.submit(gpu, [enc.finish()]);
                 for &tile in &active {
                     tile_passes[tile as usize] += COUNT_EVERY;
                 }
                 rounds += 1;
-                counts = read_counts(gpu, &t.tile_counts, ntiles)?;
+                counts = read_counts(gpu, &mut clock, &t.tile_counts, ntiles)?;
             }
         }
         Mode::Loop => {
@@ -679,7 +628,7 @@ fn frame(
                     pass.set_bind_group(1, &t.cast_binds[0], &[]);
                     pass.dispatch_workgroups(groups[0], groups[1], active.len() as u32);
                 }
-                gpu.queue.submit([enc.finish()]);
+                clock.submit(gpu, [enc.finish()]);
                 for &tile in &active {
                     tile_passes[tile as usize] = 1;
                 }
@@ -688,10 +637,10 @@ fn frame(
     }
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     st.timer.end(&mut enc);
-    gpu.queue.submit([enc.finish()]);
-    let stats_bytes = gpu.read_buffer(&t.stats, 0, STAT_SLOTS as u64 * 4)?;
-    let cast_ms = t_cast.elapsed().as_secs_f64() * 1e3;
-    let total_ms = started.elapsed().as_secs_f64() * 1e3;
+    clock.submit(gpu, [enc.finish()]);
+    let stats_bytes = clock.read_buffer(gpu, &t.stats, 0, STAT_SLOTS as u64 * 4)?;
+    clock.stage("cast", t_cast);
+    let times = clock.finish();
     let gpu_ms = st.timer.gpu_ms(gpu)?;
     let stats: &[u32] = bytemuck::cast_slice(&stats_bytes);
     let entered = stats[STAT_ENTERED] as f64;
@@ -736,17 +685,15 @@ fn frame(
         tile_passes,
         tile_size,
     });
-    Ok(FrameStats {
-        cpu_ms: 0.0,
-        gpu_ms,
-        total_ms,
-        frame_bytes: st.ledger.per_frame + st.target_bytes,
-        stages: vec![("peel".to_string(), peel_ms), ("cast".to_string(), cast_ms)],
-        counters,
-    })
+    Ok(times.stats(gpu_ms, st.ledger.per_frame + st.target_bytes, counters))
 }
 
-fn read_counts(gpu: &Gpu, buf: &wgpu::Buffer, n: usize) -> anyhow::Result<Vec<u32>> {
-    let b = gpu.read_buffer(buf, 0, n as u64 * 4)?;
+fn read_counts(
+    gpu: &Gpu,
+    clock: &mut FrameClock,
+    buf: &wgpu::Buffer,
+    n: usize,
+) -> anyhow::Result<Vec<u32>> {
+    let b = clock.read_buffer(gpu, buf, 0, n as u64 * 4)?;
     Ok(bytemuck::cast_slice(&b).to_vec())
 }

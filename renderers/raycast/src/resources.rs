@@ -1,10 +1,11 @@
 //! GPU objects of the ray caster: the bind group layouts and pipelines (created once per
 //! mesh), and the per-viewport traversal buffers, peeling layers and tile parameters.
 
+use render_core::bind;
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::Gpu;
 
-use crate::layout::MESH_SLOTS;
+use crate::layout::mesh_wgsl;
 
 /// Slots of the statistics buffer (see `STAT_*` in cast.wgsl).
 pub const STAT_SLOTS: usize = 8;
@@ -41,29 +42,25 @@ fn buffer_entry(
     ty: wgpu::BufferBindingType,
     dynamic: bool,
 ) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
+    let e = bind::buffer_entry(
         binding,
-        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty,
-            has_dynamic_offset: dynamic,
-            min_binding_size: None,
-        },
-        count: None,
+        wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        ty,
+    );
+    if dynamic {
+        bind::with_dynamic_offset(e)
+    } else {
+        e
     }
 }
 
 fn uint_texture_entry(binding: u32, dim: wgpu::TextureViewDimension) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
+    bind::sampled_texture_entry(
         binding,
-        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Uint,
-            view_dimension: dim,
-            multisampled: false,
-        },
-        count: None,
-    }
+        wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        wgpu::TextureSampleType::Uint,
+        dim,
+    )
 }
 
 const RO: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: true };
@@ -88,10 +85,11 @@ pub struct Pipelines {
 }
 
 impl Pipelines {
-    pub fn new(gpu: &Gpu) -> Pipelines {
+    /// Layouts and pipelines for a mesh in `slots` storage bindings.
+    pub fn new(gpu: &Gpu, slots: usize) -> Pipelines {
         let dev = &gpu.device;
         let mut mesh_entries = vec![buffer_entry(0, UNIFORM, false)];
-        mesh_entries.extend((1..=MESH_SLOTS as u32).map(|b| buffer_entry(b, RO, false)));
+        mesh_entries.extend((1..=slots as u32).map(|b| buffer_entry(b, RO, false)));
         let mesh_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("raycast frame + mesh"),
             entries: &mesh_entries,
@@ -119,7 +117,7 @@ impl Pipelines {
             label: Some("raycast probe"),
             entries: &[buffer_entry(0, RO, false), buffer_entry(1, RW, false)],
         });
-        let common = include_str!("common.wgsl");
+        let common = format!("{}\n{}", mesh_wgsl(slots), include_str!("common.wgsl"));
         let peel_src = format!("{common}\n{}", include_str!("peel.wgsl"));
         let cast_src = format!("{common}\n{}", include_str!("cast.wgsl"));
         let probe_src = format!("{common}\n{}", include_str!("probe.wgsl"));
@@ -129,11 +127,7 @@ impl Pipelines {
         let layout = |label: &str, groups: &[&wgpu::BindGroupLayout]| {
             let groups: Vec<Option<&wgpu::BindGroupLayout>> =
                 groups.iter().map(|g| Some(*g)).collect();
-            dev.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(label),
-                bind_group_layouts: &groups,
-                immediate_size: 0,
-            })
+            render_core::bind::pipeline_layout(gpu, label, &groups)
         };
         let first_layout = layout("raycast first hit", &[&mesh_layout]);
         let peel_pl = layout("raycast peel", &[&mesh_layout, &peel_layout]);

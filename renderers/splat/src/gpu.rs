@@ -1,5 +1,6 @@
 //! Pipelines, bind group layouts and the per-frame uniform of the splatter.
 
+use render_core::bind::{self, storage_entry as storage};
 use render_core::Gpu;
 
 /// Must match `Frame` in `frame.wgsl`.
@@ -53,42 +54,21 @@ pub struct Pipelines {
 }
 
 fn uniform(binding: u32, vis: wgpu::ShaderStages, dynamic: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: vis,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: dynamic,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn storage(binding: u32, vis: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: vis,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
+    let e = bind::uniform_entry(binding, vis);
+    if dynamic {
+        bind::with_dynamic_offset(e)
+    } else {
+        e
     }
 }
 
 fn float_texture(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
+    bind::texture_entry(
         binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
+        wgpu::ShaderStages::FRAGMENT,
+        false,
+        wgpu::TextureViewDimension::D2,
+    )
 }
 
 fn with_frame(body: &str) -> String {
@@ -109,11 +89,7 @@ impl Pipelines {
         let pipeline_layout = |label: &str, groups: &[&wgpu::BindGroupLayout]| {
             let groups: Vec<Option<&wgpu::BindGroupLayout>> =
                 groups.iter().map(|g| Some(*g)).collect();
-            d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(label),
-                bind_group_layouts: &groups,
-                immediate_size: 0,
-            })
+            render_core::bind::pipeline_layout(gpu, label, &groups)
         };
 
         let compute_layout = layout(

@@ -31,10 +31,11 @@ use std::time::Instant;
 
 use anyhow::{bail, Context};
 use datasets::TetMesh;
+use render_core::bind::{color_pass, render_target, whole as entry};
 use render_core::gpu_sort::GpuRadixSort;
 use render_core::{
-    Camera, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics, Prepared, Renderer,
-    Setting,
+    Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics,
+    Prepared, Renderer, Setting,
 };
 
 pub use buckets::{bucket_ends, depth, SlabGeometry};
@@ -191,7 +192,6 @@ pub struct Splat {
 struct BrickStats {
     slabs: u64,
     splats: u64,
-    wait_ms: f64,
     buckets_ms: f64,
     splat_ms: f64,
 }
@@ -243,6 +243,7 @@ impl Splat {
 
     /// Builds the bucket table of brick `b` the way the settings say; leaves the sorted voxels
     /// in `sorted`. Returns the table (and the depth-sorted keys when `want_keys`).
+    #[allow(clippy::too_many_arguments)]
     fn buckets(
         &mut self,
         gpu: &Gpu,
@@ -251,6 +252,7 @@ impl Splat {
         row: [f32; 4],
         want_keys: bool,
         stats: &mut BrickStats,
+        clock: &mut FrameClock,
     ) -> anyhow::Result<(Vec<u32>, Vec<f32>)> {
         let st = self.state.as_mut().unwrap();
         let range = st.set.bricks[b].range.clone();
@@ -330,17 +332,20 @@ impl Splat {
                 }
                 dispatch(&mut enc, &st.pipes.gather, &bind, n);
                 dispatch(&mut enc, &st.pipes.boundaries, &bind, n);
-                gpu.queue.submit([enc.finish()]);
+                clock.submit(gpu, [enc.finish()]);
                 // Only the small table of bucket ends comes back (§3.5).
-                let tw = Instant::now();
-                let bytes = gpu.read_buffer(&st.ends, 0, geom.num_slabs as u64 * 4)?;
+                let bytes = clock.read_buffer(gpu, &st.ends, 0, geom.num_slabs as u64 * 4)?;
                 let keys = if want_keys {
-                    bytemuck::cast_slice::<u8, f32>(&gpu.read_buffer(&st.keys, 0, n as u64 * 4)?)
-                        .to_vec()
+                    bytemuck::cast_slice::<u8, f32>(&clock.read_buffer(
+                        gpu,
+                        &st.keys,
+                        0,
+                        n as u64 * 4,
+                    )?)
+                    .to_vec()
                 } else {
                     vec![]
                 };
-                stats.wait_ms += tw.elapsed().as_secs_f64() * 1e3;
                 stats.buckets_ms += t0.elapsed().as_secs_f64() * 1e3;
                 Ok((bytemuck::cast_slice(&bytes).to_vec(), keys))
             }
@@ -359,7 +364,15 @@ impl Splat {
         let row = depth_row(camera);
         self.write_frame(gpu, camera, &geom, 0);
         let mut stats = BrickStats::default();
-        let (ends, keys) = self.buckets(gpu, 0, &geom, row, true, &mut stats)?;
+        let (ends, keys) = self.buckets(
+            gpu,
+            0,
+            &geom,
+            row,
+            true,
+            &mut stats,
+            &mut FrameClock::start(),
+        )?;
         Ok((geom, ends, keys))
     }
 
@@ -419,40 +432,28 @@ impl Splat {
             return Ok(());
         }
         let mut ledger = MemoryLedger::default();
-        let size = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
-        let tex = |ledger: &mut MemoryLedger, label: &str, format, usage| {
-            ledger.texture(
-                gpu,
-                Lifetime::PerFrame,
-                &wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size,
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                },
-            )
-        };
         let both = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-        let image = tex(
+        let (image, image_view) = render_target(
+            gpu,
             &mut ledger,
             "splat image",
+            (width, height),
             IMAGE_FORMAT,
             both | wgpu::TextureUsages::COPY_SRC,
         )?;
-        let sheet = tex(&mut ledger, "splat sheet buffer", SHEET_FORMAT, both)?;
+        let (_, sheet_view) = render_target(
+            gpu,
+            &mut ledger,
+            "splat sheet buffer",
+            (width, height),
+            SHEET_FORMAT,
+            both,
+        )?;
         self.targets = Some(Targets {
             width,
             height,
-            image_view: image.create_view(&Default::default()),
-            sheet_view: sheet.create_view(&Default::default()),
+            image_view,
+            sheet_view,
             image,
             bytes: ledger.per_frame,
         });
@@ -460,7 +461,14 @@ impl Splat {
     }
 
     /// Splats the slabs of one brick (its sorted voxels and bucket table are ready).
-    fn draw_brick(&self, gpu: &Gpu, geom: &SlabGeometry, ends: &[u32], stats: &mut BrickStats) {
+    fn draw_brick(
+        &self,
+        gpu: &Gpu,
+        geom: &SlabGeometry,
+        ends: &[u32],
+        stats: &mut BrickStats,
+        clock: &mut FrameClock,
+    ) {
         let st = self.state.as_ref().unwrap();
         let t = self.targets.as_ref().unwrap();
         let t0 = Instant::now();
@@ -510,50 +518,26 @@ impl Splat {
             stats.slabs += 1;
             stats.splats += range.len() as u64;
             {
-                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("splat slab"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &t.sheet_view,
-                        resolve_target: None,
-                        depth_slice: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    ..Default::default()
-                });
+                let mut pass = color_pass(&mut enc, "splat slab", &t.sheet_view, true, true, None);
                 pass.set_pipeline(&st.pipes.splat);
                 pass.set_bind_group(0, &splat_bind, &[]);
                 pass.set_bind_group(1, &slab_bind, &[(i as u64 * UNIFORM_STRIDE) as u32]);
                 pass.draw(0..6, range);
             }
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("splat composite"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &t.image_view,
-                    resolve_target: None,
-                    depth_slice: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Load,
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                ..Default::default()
-            });
+            let mut pass = color_pass(
+                &mut enc,
+                "splat composite",
+                &t.image_view,
+                false,
+                true,
+                None,
+            );
             pass.set_pipeline(&st.pipes.composite);
             pass.set_bind_group(0, &comp_bind, &[]);
             pass.draw(0..3, 0..1);
         }
-        gpu.queue.submit([enc.finish()]);
+        clock.submit(gpu, [enc.finish()]);
         stats.splat_ms += t0.elapsed().as_secs_f64() * 1e3;
-    }
-}
-
-fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry {
-        binding,
-        resource: buffer.as_entire_binding(),
     }
 }
 
@@ -777,11 +761,10 @@ impl Renderer for Splat {
     }
 
     fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
-        let st = self
-            .state
-            .as_mut()
+        self.state
+            .as_ref()
             .context("splat: render before prepare")?;
-        st.timer.start_wall();
+        let mut clock = FrameClock::start();
         self.ensure_targets(gpu, camera.width, camera.height)?;
         let st = self.state.as_ref().unwrap();
         let geom = self.geometry(st, camera);
@@ -798,50 +781,34 @@ impl Renderer for Splat {
         let t = self.targets.as_ref().unwrap();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         st.timer.begin(&mut enc);
-        enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("splat clear"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &t.image_view,
-                resolve_target: None,
-                depth_slice: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            ..Default::default()
-        });
-        gpu.queue.submit([enc.finish()]);
+        color_pass(&mut enc, "splat clear", &t.image_view, true, true, None);
+        clock.submit(gpu, [enc.finish()]);
         let mut stats = BrickStats::default();
         for b in order {
             if self.state.as_ref().unwrap().set.bricks[b].range.is_empty() {
                 continue;
             }
             self.write_frame(gpu, camera, &geom, b);
-            let (ends, _) = self.buckets(gpu, b, &geom, row, false, &mut stats)?;
-            self.draw_brick(gpu, &geom, &ends, &mut stats);
+            let (ends, _) = self.buckets(gpu, b, &geom, row, false, &mut stats, &mut clock)?;
+            self.draw_brick(gpu, &geom, &ends, &mut stats, &mut clock);
         }
         let st = self.state.as_ref().unwrap();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         st.timer.end(&mut enc);
-        gpu.queue.submit([enc.finish()]);
-        let tw = Instant::now();
-        gpu.wait()?;
-        stats.wait_ms += tw.elapsed().as_secs_f64() * 1e3;
-        let total_ms = st.timer.wall_ms();
+        clock.submit(gpu, [enc.finish()]);
+        clock.wait(gpu)?;
+        let times = clock.finish().with_stages([
+            ("buckets".into(), stats.buckets_ms),
+            ("splat".into(), stats.splat_ms),
+        ]);
+        let total_ms = times.total_ms;
         let gpu_ms = st.timer.gpu_ms(gpu)?;
         let eff = st.set.voxels.len() as f64;
         let t = self.targets.as_ref().unwrap();
-        Ok(FrameStats {
-            cpu_ms: (total_ms - stats.wait_ms).max(0.0),
+        Ok(times.stats(
             gpu_ms,
-            total_ms,
-            frame_bytes: st.frame_bytes + t.bytes,
-            stages: vec![
-                ("buckets".into(), stats.buckets_ms),
-                ("splat".into(), stats.splat_ms),
-            ],
-            counters: vec![
+            st.frame_bytes + t.bytes,
+            vec![
                 ("effective_voxels".into(), eff),
                 ("grid_points".into(), st.set.grid_points as f64),
                 ("resampled".into(), st.set.resampled as u8 as f64),
@@ -869,7 +836,7 @@ impl Renderer for Splat {
                     },
                 ),
             ],
-        })
+        ))
     }
 
     fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image> {

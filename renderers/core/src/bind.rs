@@ -1,0 +1,427 @@
+//! The wgpu boilerplate every renderer repeated: bind-group layout entries, bind-group entries,
+//! render targets, and arrays split across storage bindings ([`ChunkedBuffer`], issue 14).
+//!
+//! A storage binding covers at most `max_storage_buffer_binding_size` bytes (128 MiB on
+//! lavapipe), so a 20 M-tet mesh's arrays (320 MB of tet indices, 640 MB of pass-1 records)
+//! never fit one. [`ChunkedBuffer`] uploads such an array as several buffers of at most one
+//! binding each and writes the WGSL that declares them and reads element `i` from the right
+//! one (`NAME_at(i)`), so shaders index the whole array as before; a mesh that fits one
+//! binding gets one buffer and the same shader code path.
+
+use crate::gpu::{Gpu, Lifetime, MemoryLedger};
+
+/// A uniform buffer entry of a bind-group layout.
+pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(binding, visibility, wgpu::BufferBindingType::Uniform)
+}
+
+/// A storage buffer entry of a bind-group layout.
+pub fn storage_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    read_only: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(
+        binding,
+        visibility,
+        wgpu::BufferBindingType::Storage { read_only },
+    )
+}
+
+/// A buffer entry of any binding type.
+pub fn buffer_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    ty: wgpu::BufferBindingType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// The same entry with a dynamic offset (a buffer entry; other entries are returned as given).
+pub fn with_dynamic_offset(mut entry: wgpu::BindGroupLayoutEntry) -> wgpu::BindGroupLayoutEntry {
+    if let wgpu::BindingType::Buffer {
+        has_dynamic_offset, ..
+    } = &mut entry.ty
+    {
+        *has_dynamic_offset = true;
+    }
+    entry
+}
+
+/// A float texture entry (not multisampled).
+pub fn texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    filterable: bool,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    sampled_texture_entry(
+        binding,
+        visibility,
+        wgpu::TextureSampleType::Float { filterable },
+        view_dimension,
+    )
+}
+
+/// A texture entry of any sample type (not multisampled).
+pub fn sampled_texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    sample_type: wgpu::TextureSampleType,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A bind-group entry binding a whole buffer.
+pub fn whole(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}
+
+/// Bind-group entries `first, first + 1, …` binding whole buffers.
+pub fn whole_from<'a>(first: u32, buffers: &[&'a wgpu::Buffer]) -> Vec<wgpu::BindGroupEntry<'a>> {
+    buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| whole(first + i as u32, b))
+        .collect()
+}
+
+/// A pipeline layout of bind-group layouts `groups` (group `i` = `groups[i]`; `None` leaves a
+/// group unused).
+pub fn pipeline_layout(
+    gpu: &Gpu,
+    label: &str,
+    groups: &[Option<&wgpu::BindGroupLayout>],
+) -> wgpu::PipelineLayout {
+    gpu.device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: groups,
+            immediate_size: 0,
+        })
+}
+
+/// A 2D texture of `w`×`h` recorded in `ledger` as per-frame memory, and its default view.
+pub fn render_target(
+    gpu: &Gpu,
+    ledger: &mut MemoryLedger,
+    label: &str,
+    (w, h): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> anyhow::Result<(wgpu::Texture, wgpu::TextureView)> {
+    let texture = ledger.texture(
+        gpu,
+        Lifetime::PerFrame,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        },
+    )?;
+    let view = texture.create_view(&Default::default());
+    Ok((texture, view))
+}
+
+/// Begins a render pass into one colour attachment, cleared to transparent black first when
+/// `clear`, kept (`store`) or thrown away after the pass (a dummy attachment of passes that
+/// write storage only), with optional timestamps.
+pub fn color_pass<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    view: &wgpu::TextureView,
+    clear: bool,
+    store: bool,
+    timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+) -> wgpu::RenderPass<'e> {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: if clear {
+                    wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+                } else {
+                    wgpu::LoadOp::Load
+                },
+                store: if store {
+                    wgpu::StoreOp::Store
+                } else {
+                    wgpu::StoreOp::Discard
+                },
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// Fails, with the figures, when a pipeline needs more storage bindings per shader stage than
+/// the adapter has.
+pub fn check_storage_bindings(gpu: &Gpu, label: &str, needed: u32) -> anyhow::Result<()> {
+    let max = gpu.limits.max_storage_buffers_per_shader_stage;
+    if needed > max {
+        anyhow::bail!(
+            "{label}: needs {needed} storage bindings in one shader stage, the adapter allows \
+             {max} (max_storage_buffers_per_shader_stage; each binding holds at most {} bytes)",
+            gpu.max_storage_binding()
+        );
+    }
+    Ok(())
+}
+
+/// An array of fixed-size elements split across buffers of at most one storage binding each.
+pub struct ChunkedBuffer {
+    pub buffers: Vec<wgpu::Buffer>,
+    /// Elements per buffer (the last may hold fewer).
+    pub per_chunk: u64,
+    /// Elements in all.
+    pub len: u64,
+    pub elem_bytes: u64,
+}
+
+impl ChunkedBuffer {
+    /// Elements per chunk for `elem_bytes`-byte elements under `max_binding` bytes.
+    pub fn per_chunk(elem_bytes: u64, max_binding: u64) -> u64 {
+        (max_binding / elem_bytes.max(1)).max(1)
+    }
+
+    /// Uploads `data` (whole elements of `elem_bytes`) in chunks of at most `max_binding`
+    /// bytes; every buffer is recorded in `ledger` under `label`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_data(
+        gpu: &Gpu,
+        ledger: &mut MemoryLedger,
+        label: &str,
+        lifetime: Lifetime,
+        data: &[u8],
+        elem_bytes: u64,
+        max_binding: u64,
+        usage: wgpu::BufferUsages,
+    ) -> anyhow::Result<ChunkedBuffer> {
+        let len = data.len() as u64 / elem_bytes;
+        debug_assert_eq!(len * elem_bytes, data.len() as u64);
+        let per = Self::per_chunk(elem_bytes, max_binding);
+        let buffers = crate::gpu::chunk_ranges(len.max(1), elem_bytes, per * elem_bytes)
+            .into_iter()
+            .map(|r| {
+                let lo = (r.start * elem_bytes).min(data.len() as u64) as usize;
+                let hi = (r.end * elem_bytes).min(data.len() as u64) as usize;
+                ledger.buffer_init(gpu, label, lifetime, &data[lo..hi], usage)
+            })
+            .collect::<anyhow::Result<_>>()?;
+        Ok(ChunkedBuffer {
+            buffers,
+            per_chunk: per,
+            len,
+            elem_bytes,
+        })
+    }
+
+    /// `len` uninitialised elements (written on the GPU) in chunks of at most `max_binding`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        gpu: &Gpu,
+        ledger: &mut MemoryLedger,
+        label: &str,
+        lifetime: Lifetime,
+        len: u64,
+        elem_bytes: u64,
+        max_binding: u64,
+        usage: wgpu::BufferUsages,
+    ) -> anyhow::Result<ChunkedBuffer> {
+        let per = Self::per_chunk(elem_bytes, max_binding);
+        let buffers = crate::gpu::chunk_ranges(len.max(1), elem_bytes, per * elem_bytes)
+            .into_iter()
+            .map(|r| ledger.buffer(gpu, label, lifetime, (r.end - r.start) * elem_bytes, usage))
+            .collect::<anyhow::Result<_>>()?;
+        Ok(ChunkedBuffer {
+            buffers,
+            per_chunk: per,
+            len,
+            elem_bytes,
+        })
+    }
+
+    /// Storage bindings this array takes.
+    pub fn bindings(&self) -> u32 {
+        self.buffers.len() as u32
+    }
+
+    /// Layout entries `first ..` for the chunks.
+    pub fn layout_entries(
+        &self,
+        first: u32,
+        visibility: wgpu::ShaderStages,
+        read_only: bool,
+    ) -> Vec<wgpu::BindGroupLayoutEntry> {
+        (0..self.bindings())
+            .map(|i| storage_entry(first + i, visibility, read_only))
+            .collect()
+    }
+
+    /// Bind-group entries `first ..` for the chunks.
+    pub fn bind_entries(&self, first: u32) -> Vec<wgpu::BindGroupEntry<'_>> {
+        let refs: Vec<&wgpu::Buffer> = self.buffers.iter().collect();
+        whole_from(first, &refs)
+    }
+
+    /// WGSL declaring the chunks as `NAME_0 …` at `@group(group) @binding(first ..)` and
+    /// `fn NAME_at(i: u32) -> TY` (and `fn NAME_set(i: u32, v: TY)` when writable).
+    pub fn wgsl(&self, name: &str, ty: &str, group: u32, first: u32, read_only: bool) -> String {
+        let access = if read_only { "read" } else { "read_write" };
+        let n = self.bindings();
+        let mut s = String::new();
+        for i in 0..n {
+            s += &format!(
+                "@group({group}) @binding({}) var<storage, {access}> {name}_{i}: array<{ty}>;\n",
+                first + i
+            );
+        }
+        let per = self.per_chunk.min(u32::MAX as u64);
+        let mut get = format!("fn {name}_at(i: u32) -> {ty} {{\n");
+        let mut set = format!("fn {name}_set(i: u32, v: {ty}) {{\n");
+        if n == 1 {
+            get += &format!("    return {name}_0[i];\n}}\n");
+            set += &format!("    {name}_0[i] = v;\n}}\n");
+        } else {
+            let head =
+                format!("    let c = i / {per}u;\n    let j = i - c * {per}u;\n    switch c {{\n");
+            get += &head;
+            set += &head;
+            for i in 0..n {
+                let case = if i + 1 == n {
+                    "default".to_string()
+                } else {
+                    format!("case {i}u")
+                };
+                get += &format!("        {case}: {{ return {name}_{i}[j]; }}\n");
+                set += &format!("        {case}: {{ {name}_{i}[j] = v; }}\n");
+            }
+            get += "    }\n}\n";
+            set += "    }\n}\n";
+        }
+        s += &get;
+        if !read_only {
+            s += &set;
+        }
+        s
+    }
+
+    /// Writes host data starting at element `first` (may span chunks).
+    pub fn write(&self, gpu: &Gpu, first: u64, data: &[u8]) {
+        let n = data.len() as u64 / self.elem_bytes;
+        let mut done = 0u64;
+        while done < n {
+            let e = first + done;
+            let c = (e / self.per_chunk) as usize;
+            let local = e - c as u64 * self.per_chunk;
+            let take = (self.per_chunk - local).min(n - done);
+            let lo = (done * self.elem_bytes) as usize;
+            let hi = ((done + take) * self.elem_bytes) as usize;
+            gpu.queue
+                .write_buffer(&self.buffers[c], local * self.elem_bytes, &data[lo..hi]);
+            done += take;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The generated accessor covers chunk boundaries like `chunk_ranges` does.
+    #[test]
+    fn wgsl_accessor_has_one_case_per_chunk() {
+        let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
+        let mut ledger = MemoryLedger::default();
+        let data: Vec<u32> = (0..10).collect();
+        let c = ChunkedBuffer::with_data(
+            &gpu,
+            &mut ledger,
+            "t",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&data),
+            4,
+            16,
+            wgpu::BufferUsages::STORAGE,
+        )
+        .unwrap();
+        assert_eq!((c.bindings(), c.per_chunk, c.len), (3, 4, 10));
+        assert_eq!(ledger.persistent, 16 + 16 + 16);
+        let w = c.wgsl("x", "u32", 0, 5, true);
+        assert!(w.contains("@binding(7) var<storage, read> x_2"), "{w}");
+        assert!(w.contains("case 1u: { return x_1[j]; }"), "{w}");
+        assert!(w.contains("default: { return x_2[j]; }"), "{w}");
+        assert!(!w.contains("x_set"));
+        // The generated WGSL compiles and reads every element from the right chunk.
+        let src = format!(
+            "{}@group(0) @binding(0) var<storage, read_write> out: array<u32>;\n\
+             @compute @workgroup_size(1) fn main() {{ for (var i = 0u; i < 10u; i++) {{ out[i] = x_at(i); }} }}",
+            c.wgsl("x", "u32", 0, 1, true)
+        );
+        let module = gpu.shader("chunk test", &src);
+        let pipe = gpu.compute_pipeline("chunk test", None, &module, "main");
+        let out = ledger
+            .buffer(
+                &gpu,
+                "out",
+                Lifetime::PerFrame,
+                40,
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            )
+            .unwrap();
+        let mut entries = vec![whole(0, &out)];
+        entries.extend(c.bind_entries(1));
+        let bg = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &pipe.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipe);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let back = gpu.read_buffer(&out, 0, 40).unwrap();
+        assert_eq!(bytemuck::cast_slice::<u8, u32>(&back), &data[..]);
+    }
+}

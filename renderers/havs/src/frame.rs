@@ -1,0 +1,467 @@
+//! HAVS per frame: the GPU key pass of the `gpu-radix` sort, the per-viewport targets, and
+//! one frame (object-space sort, face raster into the k-buffers, drain), timed with
+//! [`FrameClock`] (issue 14: one definition of `cpu_ms` for every renderer).
+
+use std::time::Instant;
+
+use anyhow::bail;
+use rayon::prelude::*;
+use render_core::bind::whole;
+use render_core::gpu::{Lifetime, MemoryLedger};
+use render_core::sort::radix_sort_indices;
+use render_core::{Camera, ChunkedBuffer, FrameClock, FrameStats, Gpu};
+
+use super::{
+    kbuffer, mesh_decls, sort_key, GpuSortState, HavsSettings, KeyUniforms, Mode, SortMode, State,
+    TagScheme, Target, Uniforms, KEY_MESH_BINDING, MESH_BINDING,
+};
+
+impl GpuSortState {
+    pub(super) fn new(
+        gpu: &Gpu,
+        ledger: &mut MemoryLedger,
+        verts: &ChunkedBuffer,
+        faces: &ChunkedBuffer,
+        num_faces: u64,
+    ) -> anyhow::Result<GpuSortState> {
+        let max = gpu.max_storage_binding();
+        if num_faces * 4 > max {
+            bail!(
+                "HAVS GPU sort: {num_faces} face keys need {} bytes in one storage binding, the \
+                 adapter allows {max} bytes (max_storage_buffer_binding_size; the device radix \
+                 sort is not split); use sort=cpu-radix",
+                num_faces * 4
+            );
+        }
+        let usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let keys = ledger.buffer(
+            gpu,
+            "havs sort keys",
+            Lifetime::PerFrame,
+            num_faces * 4,
+            usage,
+        )?;
+        let ids = ledger.buffer(
+            gpu,
+            "havs sort ids",
+            Lifetime::PerFrame,
+            num_faces * 4,
+            usage,
+        )?;
+        let key_uniforms = ledger.buffer(
+            gpu,
+            "havs key uniforms",
+            Lifetime::PerFrame,
+            std::mem::size_of::<KeyUniforms>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        )?;
+        let source = mesh_decls(verts, faces, KEY_MESH_BINDING) + include_str!("keys.wgsl");
+        let module = gpu.shader("havs keys", &source);
+        let key_pipeline = gpu.compute_pipeline("havs face keys", None, &module, "face_keys");
+        let key_bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("havs keys"),
+            layout: &key_pipeline.get_bind_group_layout(0),
+            entries: &[
+                vec![whole(0, &key_uniforms), whole(3, &keys), whole(4, &ids)],
+                verts.bind_entries(KEY_MESH_BINDING),
+                faces.bind_entries(KEY_MESH_BINDING + verts.bindings()),
+            ]
+            .concat(),
+        });
+        let sorter = render_core::gpu_sort::GpuRadixSort::new(gpu, num_faces as u32, ledger)?;
+        Ok(GpuSortState {
+            sorter,
+            keys,
+            ids,
+            key_uniforms,
+            key_pipeline,
+            key_bind_group,
+        })
+    }
+}
+
+impl State {
+    /// (Re)creates the per-frame buffers for a `w`×`h` viewport (and, in race-free mode, a node
+    /// pool of `nodes` fragments).
+    pub(super) fn ensure_target(
+        &mut self,
+        gpu: &Gpu,
+        s: HavsSettings,
+        w: u32,
+        h: u32,
+        nodes: Option<u64>,
+    ) -> anyhow::Result<()> {
+        if let Some(t) = &self.target {
+            if t.width == w && t.height == h && nodes.is_none() {
+                return Ok(());
+            }
+        }
+        // Forget the previous target's bytes before counting the new one.
+        self.ledger.entries.retain(|(label, life, bytes)| {
+            let keep = !label.starts_with("havs target ");
+            if !keep && *life == Lifetime::PerFrame {
+                self.ledger.per_frame -= bytes;
+            }
+            keep
+        });
+        let npx = w as u64 * h as u64;
+        let max_binding = gpu.max_storage_binding();
+        let usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let pixels = self.ledger.buffer(
+            gpu,
+            "havs target pixels",
+            Lifetime::PerFrame,
+            npx * 32,
+            usage,
+        )?;
+        let (kentries, heads, nodes_buf, node_capacity) = match s.mode {
+            Mode::FragmentRace => {
+                let bytes = npx * s.k as u64 * 8;
+                if bytes > max_binding {
+                    bail!("HAVS: a {w}x{h} k-buffer with k = {} needs {bytes} bytes, over one storage binding", s.k);
+                }
+                let kb = self.ledger.buffer(
+                    gpu,
+                    "havs target k-buffer",
+                    Lifetime::PerFrame,
+                    bytes,
+                    usage,
+                )?;
+                let heads = self.ledger.buffer(
+                    gpu,
+                    "havs target unused heads",
+                    Lifetime::PerFrame,
+                    16,
+                    usage,
+                )?;
+                let nodes = self.ledger.buffer(
+                    gpu,
+                    "havs target unused nodes",
+                    Lifetime::PerFrame,
+                    16,
+                    usage,
+                )?;
+                (kb, heads, nodes, 0)
+            }
+            Mode::RaceFree => {
+                // Start from a pool of 8 fragments per pixel; `render` grows it when a view needs more.
+                let cap = nodes.unwrap_or(npx * 8).max(1024);
+                if cap * 16 > max_binding {
+                    bail!(
+                        "HAVS race-free mode: {cap} fragments need {} bytes of lists, over one storage binding ({max_binding}); \
+                         use mode=fragment-race or a smaller image",
+                        cap * 16
+                    );
+                }
+                let kb = self.ledger.buffer(
+                    gpu,
+                    "havs target unused k-buffer",
+                    Lifetime::PerFrame,
+                    16,
+                    usage,
+                )?;
+                let heads = self.ledger.buffer(
+                    gpu,
+                    "havs target list heads",
+                    Lifetime::PerFrame,
+                    npx * 4,
+                    usage,
+                )?;
+                let nodes = self.ledger.buffer(
+                    gpu,
+                    "havs target fragment lists",
+                    Lifetime::PerFrame,
+                    cap * 16,
+                    usage,
+                )?;
+                (kb, heads, nodes, cap)
+            }
+        };
+        let (_, dummy_view) = render_core::bind::render_target(
+            gpu,
+            &mut self.ledger,
+            "havs target attachment",
+            (w, h),
+            wgpu::TextureFormat::R8Unorm,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )?;
+        let bind_groups = self
+            .chunks
+            .iter()
+            .zip(&self.uniforms)
+            .map(|(range, ub)| {
+                let mesh = [
+                    self.verts.bind_entries(MESH_BINDING),
+                    self.faces
+                        .bind_entries(MESH_BINDING + self.verts.bindings()),
+                ]
+                .concat();
+                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("havs bind group"),
+                    layout: &self.layout,
+                    entries: &[
+                        vec![whole(0, ub)],
+                        vec![wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                                buffer: &self.order,
+                                offset: range.start * 4,
+                                size: std::num::NonZeroU64::new(
+                                    (range.end - range.start).max(1) * 4,
+                                ),
+                            }),
+                        }],
+                        vec![
+                            wgpu::BindGroupEntry {
+                                binding: 4,
+                                resource: wgpu::BindingResource::TextureView(&self.table_view),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 5,
+                                resource: wgpu::BindingResource::Sampler(&self.sampler),
+                            },
+                        ],
+                        render_core::bind::whole_from(
+                            6,
+                            &[&pixels, &kentries, &self.counters, &heads, &nodes_buf],
+                        ),
+                        mesh,
+                    ]
+                    .concat(),
+                })
+            })
+            .collect();
+        self.target = Some(Target {
+            width: w,
+            height: h,
+            pixels,
+            kentries,
+            heads,
+            _nodes: nodes_buf,
+            node_capacity,
+            dummy_view,
+            bind_groups,
+        });
+        Ok(())
+    }
+
+    pub(super) fn frame(
+        &mut self,
+        gpu: &Gpu,
+        s: HavsSettings,
+        camera: &Camera,
+    ) -> anyhow::Result<FrameStats> {
+        let eye = camera.eye.map(|c| c as f32);
+        let fwd = camera.forward().map(|c| c as f32);
+        let persp = camera.is_perspective();
+        let mut clock = FrameClock::start();
+
+        // Object space: sort the faces front to back by centroid distance (§5.1).
+        if s.sort == SortMode::CpuRadix {
+            let t = Instant::now();
+            let cents = &self.centroids;
+            self.keys.clear();
+            self.keys
+                .par_extend(cents.par_iter().map(|&c| sort_key(eye, fwd, persp, c)));
+            clock.stage("keys", t);
+            let t = Instant::now();
+            radix_sort_indices(&self.keys, &mut self.sorted, &mut self.scratch);
+            clock.stage("sort", t);
+            let t = Instant::now();
+            gpu.queue
+                .write_buffer(&self.order, 0, bytemuck::cast_slice(&self.sorted));
+            clock.stage("upload", t);
+        }
+        let t = self.target.as_ref().expect("target ensured");
+        let flags = (s.tags == TagScheme::Two) as u32 | ((s.early_termination as u32) << 1);
+        for (range, ub) in self.chunks.iter().zip(&self.uniforms) {
+            let u = Uniforms {
+                view_proj: camera.view_proj_f32(),
+                eye: [eye[0], eye[1], eye[2], persp as u32 as f32],
+                forward: [fwd[0], fwd[1], fwd[2], 0.0],
+                width: t.width,
+                height: t.height,
+                flags,
+                base_face: range.start as u32,
+                max_len: self.max_len,
+                n_s: self.n_s as f32,
+                n_l: self.n_l as f32,
+                node_capacity: t.node_capacity.min(u32::MAX as u64) as u32,
+                et_alpha: kbuffer::EARLY_TERMINATION_ALPHA,
+                _pad: [0; 3],
+            };
+            gpu.queue.write_buffer(ub, 0, bytemuck::bytes_of(&u));
+        }
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        self.timer.begin(&mut enc);
+        if let Some(gs) = &self.gpu_sort {
+            let ku = KeyUniforms {
+                eye: [eye[0], eye[1], eye[2], persp as u32 as f32],
+                forward: [fwd[0], fwd[1], fwd[2], 0.0],
+                faces: self.num_faces as u32,
+                _pad: [0; 3],
+            };
+            gpu.queue
+                .write_buffer(&gs.key_uniforms, 0, bytemuck::bytes_of(&ku));
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("havs keys"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&gs.key_pipeline);
+                pass.set_bind_group(0, &gs.key_bind_group, &[]);
+                let groups = self.num_faces.div_ceil(256) as u32;
+                let max = gpu.limits.max_compute_workgroups_per_dimension;
+                let (gx, gy) = if groups <= max {
+                    (groups, 1)
+                } else {
+                    (max, groups.div_ceil(max))
+                };
+                pass.dispatch_workgroups(gx, gy, 1);
+            }
+            gs.sorter
+                .encode(&mut enc, &gs.keys, &gs.ids, self.num_faces as u32, false)?;
+            enc.copy_buffer_to_buffer(&gs.ids, 0, &self.order, 0, self.num_faces * 4);
+        }
+        enc.clear_buffer(&t.pixels, 0, None);
+        enc.clear_buffer(&self.counters, 0, None);
+        match s.mode {
+            Mode::FragmentRace => enc.clear_buffer(&t.kentries, 0, None),
+            Mode::RaceFree => enc.clear_buffer(&t.heads, 0, None),
+        }
+        {
+            let mut pass = render_core::bind::color_pass(
+                &mut enc,
+                "havs faces",
+                &t.dummy_view,
+                true,
+                false,
+                None,
+            );
+            pass.set_pipeline(&self.draw_pipeline);
+            // Chunks in order: the faces stay in sorted order across chunk boundaries.
+            for (range, bg) in self.chunks.iter().zip(&t.bind_groups) {
+                pass.set_bind_group(0, bg, &[]);
+                pass.draw(0..((range.end - range.start) * 3) as u32, 0..1);
+            }
+        }
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("havs drain"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.drain_pipeline);
+            pass.set_bind_group(0, &t.bind_groups[0], &[]);
+            pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
+        }
+        self.timer.end(&mut enc);
+        clock.submit(gpu, [enc.finish()]);
+        clock.wait(gpu)?;
+        let times = clock.finish();
+        let gpu_ms = self.timer.gpu_ms(gpu)?;
+        let c = gpu.read_buffer(&self.counters, 0, 32)?;
+        let c: &[u32] = bytemuck::cast_slice(&c);
+        let mut counters = vec![
+            ("fragments".to_string(), c[0] as f64),
+            ("kbuffer_out_of_order".to_string(), c[1] as f64),
+            // Fragments that reached an opaque pixel and were dropped before the k-buffer and
+            // the table (early ray termination, §4).
+            ("et_culled_fragments".to_string(), c[4] as f64),
+        ];
+        if s.mode == Mode::RaceFree {
+            counters.push(("lists_over_512".to_string(), c[2] as f64));
+            counters.push(("nodes".to_string(), c[3] as f64));
+        }
+        counters.push(("faces".to_string(), self.num_faces as f64));
+        counters.push((
+            "table_filter_nearest".to_string(),
+            self.table_nearest as u8 as f64,
+        ));
+        counters.push((
+            "mesh_bindings".to_string(),
+            (self.verts.bindings() + self.faces.bindings()) as f64,
+        ));
+        Ok(times.stats(gpu_ms, self.ledger.per_frame, counters))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Havs, HavsSettings, Mode, SortMode};
+    use datasets::TetMesh;
+    use render_core::{
+        Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint,
+    };
+
+    fn render(
+        gpu: &Gpu,
+        r: &mut Havs,
+        mesh: &TetMesh,
+        cam: &Camera,
+    ) -> (Image, Vec<(String, f64)>) {
+        let tf = TransferFunction::preset("high-opacity").unwrap();
+        r.prepare(gpu, mesh, &Optics::for_mesh(tf, mesh)).unwrap();
+        let stats = r.render(gpu, cam).unwrap();
+        assert!(stats.cpu_ms <= stats.total_ms, "{stats:?}");
+        (r.read_image(gpu).unwrap(), stats.counters)
+    }
+
+    fn counter(c: &[(String, f64)], name: &str) -> f64 {
+        c.iter()
+            .find(|(n, _)| n == name)
+            .unwrap_or_else(|| panic!("{name} in {c:?}"))
+            .1
+    }
+
+    /// Vertex, face and order arrays split over several storage bindings (forced with 4 KiB
+    /// bindings) give exactly the image of one binding each, for both sorts; the race-free mode
+    /// makes the comparison deterministic. Early termination only moves fragments from
+    /// `fragments` to `et_culled_fragments`.
+    #[test]
+    fn split_bindings_render_the_same_image() {
+        let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
+        let mesh = datasets::generate::from_spec("box:1k", 1).unwrap();
+        let vp = Viewpoint::new("oblique", [0.4, 0.6, 0.7]);
+        let cam = Camera::fit(&mesh.bounds(), &vp, Projection::default(), 48, 48);
+        for sort in [SortMode::CpuRadix, SortMode::GpuRadix] {
+            let s = HavsSettings {
+                sort,
+                mode: Mode::RaceFree,
+                ..Default::default()
+            };
+            let (whole, cw) = render(&gpu, &mut Havs::new(s), &mesh, &cam);
+            let mut split_r = Havs::new(s).with_max_binding(4096);
+            let (split, cs) = render(&gpu, &mut split_r, &mesh, &cam);
+            assert_eq!(counter(&cw, "mesh_bindings"), 2.0);
+            assert!(counter(&cs, "mesh_bindings") >= 5.0, "{cs:?}");
+            let orders = split_r
+                .ledger()
+                .unwrap()
+                .entries
+                .iter()
+                .filter(|e| e.0 == "havs uniforms")
+                .count();
+            assert!(orders >= 2, "the order buffer is bound in {orders} chunks");
+            assert_eq!(whole.pixels, split.pixels, "{sort:?}");
+            assert!(whole.pixels.iter().any(|p| p[3] > 0.1));
+            let (_, no_et) = render(
+                &gpu,
+                &mut Havs::new(HavsSettings {
+                    early_termination: false,
+                    ..s
+                }),
+                &mesh,
+                &cam,
+            );
+            assert_eq!(counter(&no_et, "et_culled_fragments"), 0.0);
+            assert_eq!(
+                counter(&cw, "fragments") + counter(&cw, "et_culled_fragments"),
+                counter(&no_et, "fragments")
+            );
+        }
+    }
+}
