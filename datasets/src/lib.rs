@@ -2,6 +2,8 @@
 //! formats the papers' data sets come in, deterministic generators, and a registry of named
 //! data sets resolved from a data directory.
 
+pub mod cells;
+pub mod dataset;
 pub mod error;
 pub mod gen_volume;
 pub mod generate;
@@ -9,6 +11,7 @@ pub mod load;
 pub mod mesh;
 pub mod mhd;
 pub mod plot3d;
+pub mod read_util;
 pub mod registry;
 pub mod split;
 pub mod standins;
@@ -19,7 +22,7 @@ pub mod vtk_xml;
 pub mod write_vtu;
 
 pub use error::{ErrorKind, LoadError, Location};
-pub use load::{Dataset, LoadOptions, Plot3dField};
+pub use dataset::{Dataset, LoadOptions, Plot3dField};
 pub use mesh::{
     Aabb, BoundaryFace, QualityStats, RepairReport, TetMesh, UniqueFaces, NO_NEIGHBOUR, TET_FACES,
 };

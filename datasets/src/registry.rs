@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::{ErrorKind, LoadError};
-use crate::load::{Dataset, LoadOptions, Plot3dField};
+use crate::dataset::{Dataset, LoadOptions, Plot3dField};
 
 /// Where public copies of the files live (shown when one is missing).
 const VTK_DATA: &str =

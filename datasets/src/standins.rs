@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use crate::error::{ErrorKind, LoadError};
 use crate::generate::{Field, FieldEval};
-use crate::load::{Dataset, LoadOptions};
+use crate::dataset::{Dataset, LoadOptions};
 use crate::registry::{Entry, Registry};
 use crate::volume::{hex_cell_tets, VoxelGrid};
 use crate::TetMesh;

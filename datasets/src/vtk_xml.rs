@@ -11,7 +11,7 @@
 //! refuses raw appended data, ParaView's and our writer's default layout, and its errors carry
 //! no position (measurements in the README, "Dependencies").
 //!
-//! Non-tetrahedral cells are split into conforming tets by [`crate::load::cell_to_tets`] (shared
+//! Non-tetrahedral cells are split into conforming tets by [`crate::cells::cell_to_tets`] (shared
 //! with the legacy reader); cell data is
 //! averaged to the points when a file has no point data (with a warning in the repair report).
 
@@ -24,7 +24,7 @@ use quick_xml::events::{BytesStart, Event};
 use rayon::prelude::*;
 
 use crate::error::{ErrorKind, LoadError, Location};
-use crate::load::{Dataset, LoadOptions};
+use crate::dataset::{Dataset, LoadOptions};
 use crate::mesh::TetMesh;
 use crate::volume::{structured_tets, VoxelGrid};
 
@@ -849,7 +849,7 @@ impl<'a> XmlFile<'a> {
                         verts.push((v as usize + base) as u32);
                     }
                     let code = u32::try_from(types[c]).unwrap_or(u32::MAX);
-                    crate::load::cell_to_tets(code, &verts, &mut tets).map_err(|k| {
+                    crate::cells::cell_to_tets(code, &verts, &mut tets).map_err(|k| {
                         let k = match k {
                             ErrorKind::UnknownCellType(s) => {
                                 ErrorKind::UnknownCellType(format!("{s} (cell {c})"))
