@@ -4,7 +4,7 @@
 An edge A -> B is a `use crate::B...` or a `crate::B::` path in A's source (comments
 stripped). `crate::Name` for a name the crate root re-exports (`pub use m::{Name}` in lib.rs)
 counts as an edge to `m`. Two graphs are printed: the library code alone, and with the
-`#[cfg(test)]` modules included. A folder module (`m/mod.rs`, `m/x.rs`) counts as one node `m`.
+`#[cfg(test)]` modules (and `tests.rs` files) included. A folder module (`m/mod.rs`, `m/x.rs`) counts as one node `m`.
 
 Usage: scripts/module_cycles.py [datasets/src]
 """
@@ -94,7 +94,10 @@ def main():
         if rel == Path("lib.rs"):
             continue
         mod = rel.parts[0].removesuffix(".rs")
-        body, tests = split_tests(strip_comments(f.read_text()))
+        if rel.name == "tests.rs":  # a folder module's `#[cfg(test)] mod tests;`
+            body, tests = "", strip_comments(f.read_text())
+        else:
+            body, tests = split_tests(strip_comments(f.read_text()))
         for part, graphs in ((body, (lib_graph, all_graph)), (tests, (all_graph,))):
             for seg in use_targets(part):
                 target = seg if seg in modules else reexp.get(seg)

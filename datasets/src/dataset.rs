@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use crate::volume::VoxelGrid;
+use crate::grid::VoxelGrid;
 use crate::TetMesh;
 
 /// Which PLOT3D Q quantity becomes the point scalar.

@@ -7,6 +7,7 @@ pub mod dataset;
 pub mod error;
 pub mod gen_volume;
 pub mod generate;
+pub mod grid;
 pub mod load;
 pub mod mesh;
 pub mod mhd;
@@ -21,9 +22,9 @@ pub mod vtk_legacy;
 pub mod vtk_xml;
 pub mod write_vtu;
 
-pub use error::{ErrorKind, LoadError, Location};
 pub use dataset::{Dataset, LoadOptions, Plot3dField};
+pub use error::{ErrorKind, LoadError, Location};
+pub use grid::VoxelGrid;
 pub use mesh::{
     Aabb, BoundaryFace, QualityStats, RepairReport, TetMesh, UniqueFaces, NO_NEIGHBOUR, TET_FACES,
 };
-pub use volume::VoxelGrid;

@@ -15,8 +15,8 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::error::{ErrorKind, LoadError, Location};
 use crate::dataset::{Dataset, LoadOptions, Plot3dField};
+use crate::error::{ErrorKind, LoadError, Location};
 use crate::read_util::{self as util, ByteOrder};
 use crate::volume::structured_tets;
 use crate::TetMesh;

@@ -8,8 +8,8 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::error::{ErrorKind, LoadError};
 use crate::dataset::{Dataset, LoadOptions, Plot3dField};
+use crate::error::{ErrorKind, LoadError};
 
 /// Where public copies of the files live (shown when one is missing).
 const VTK_DATA: &str =

@@ -13,9 +13,9 @@
 
 use rayon::prelude::*;
 
+use crate::dataset::{Dataset, LoadOptions};
 use crate::error::{ErrorKind, LoadError};
 use crate::generate::{Field, FieldEval};
-use crate::dataset::{Dataset, LoadOptions};
 use crate::registry::{Entry, Registry};
 use crate::volume::{hex_cell_tets, VoxelGrid};
 use crate::TetMesh;

@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use crate::error::{ErrorKind, LoadError};
 use crate::dataset::{Dataset, LoadOptions};
-use crate::read_util::{self as util};
+use crate::error::{ErrorKind, LoadError};
+use crate::read_util as util;
 use crate::TetMesh;
 
 /// Name of the TOFF scalar.

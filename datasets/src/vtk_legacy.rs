@@ -20,9 +20,9 @@
 
 use std::path::Path;
 
-use crate::error::{ErrorKind, LoadError, Location};
 use crate::cells;
 use crate::dataset::{Dataset, LoadOptions};
+use crate::error::{ErrorKind, LoadError, Location};
 use crate::read_util::{self as util, ByteOrder};
 use crate::volume::{structured_tets, VoxelGrid};
 use crate::TetMesh;
