@@ -4,6 +4,7 @@
 
 pub mod cells;
 pub mod dataset;
+pub mod entry;
 pub mod error;
 pub mod gen_volume;
 pub mod generate;
