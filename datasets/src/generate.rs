@@ -652,7 +652,7 @@ const HEX_FACES: [[usize; 4]; 6] = [
 /// vertex of smallest global index (Dompierre et al. 1999's rule). The faces incident to the
 /// apex are cut through the apex, which is their smallest vertex too, so every face follows
 /// the same global rule and neighbouring cells conform. (The readers' split,
-/// [`crate::load::cell_to_tets`], uses the same rule but takes 5 tets when it can; the shell
+/// [`crate::cells::cell_to_tets`], uses the same rule but takes 5 tets when it can; the shell
 /// wants a fixed 6 per cell so its size is predictable: 36·n²·m.)
 fn hex_six_tets(v: [u32; 8], out: &mut Vec<[u32; 4]>) {
     let apex = (0..8).min_by_key(|&i| v[i]).unwrap_or(0);

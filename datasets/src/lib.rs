@@ -2,13 +2,18 @@
 //! formats the papers' data sets come in, deterministic generators, and a registry of named
 //! data sets resolved from a data directory.
 
+pub mod cells;
+pub mod dataset;
+pub mod entry;
 pub mod error;
 pub mod gen_volume;
 pub mod generate;
+pub mod grid;
 pub mod load;
 pub mod mesh;
 pub mod mhd;
 pub mod plot3d;
+pub mod read_util;
 pub mod registry;
 pub mod split;
 pub mod standins;
@@ -18,9 +23,9 @@ pub mod vtk_legacy;
 pub mod vtk_xml;
 pub mod write_vtu;
 
+pub use dataset::{Dataset, LoadOptions, Plot3dField};
 pub use error::{ErrorKind, LoadError, Location};
-pub use load::{Dataset, LoadOptions, Plot3dField};
+pub use grid::VoxelGrid;
 pub use mesh::{
     Aabb, BoundaryFace, QualityStats, RepairReport, TetMesh, UniqueFaces, NO_NEIGHBOUR, TET_FACES,
 };
-pub use volume::VoxelGrid;

@@ -140,7 +140,7 @@ pub struct TetMesh {
     /// point `i` is grid point `i` (same position and value; x fastest), and the tets split
     /// the grid's cells (every cell, or for generated volumes with compact support only the
     /// cells with a non-zero corner: see `crate::gen_volume`). Other renderers ignore it.
-    pub source_grid: Option<std::sync::Arc<crate::volume::VoxelGrid>>,
+    pub source_grid: Option<std::sync::Arc<crate::grid::VoxelGrid>>,
     cache: DerivedCache,
 }
 

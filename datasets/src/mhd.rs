@@ -6,8 +6,9 @@
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+use crate::dataset::{Dataset, LoadOptions};
 use crate::error::{ErrorKind, LoadError, Location};
-use crate::load::{self, ByteOrder, Dataset, LoadOptions};
+use crate::read_util::{self as util, ByteOrder};
 use crate::volume::{structured_tets, VoxelGrid};
 use crate::TetMesh;
 
@@ -134,7 +135,7 @@ fn parse_header(b: &[u8], path: &Path) -> Result<Header, LoadError> {
                     return Err(syntax("3 positive integers"));
                 }
                 let d = [v[0], v[1], v[2]];
-                load::grid_count(d).map_err(err)?;
+                util::grid_count(d).map_err(err)?;
                 dims = Some(d);
             }
             "elementspacing" => spacing = Some(reals(3)?),
@@ -234,27 +235,79 @@ fn convert(raw: &[u8], e: ElementType, order: ByteOrder) -> Vec<f32> {
         ElementType::U16 => conv!(u16, 2),
         ElementType::I32 => conv!(i32, 4),
         ElementType::U32 => conv!(u32, 4),
-        ElementType::F32 => load::f32s(raw, order),
+        ElementType::F32 => util::f32s(raw, order),
         ElementType::F64 => conv!(f64, 8),
     }
 }
 
 /// Reads a MetaImage header and its data.
 pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
-    if let Some(name) = &options.scalar {
-        if name != SCALAR_NAME {
-            return Err(LoadError::new(
-                path,
-                ErrorKind::MissingArray {
-                    name: name.clone(),
-                    available: vec![SCALAR_NAME.into()],
-                },
-            ));
+    check_scalar(path, options)?;
+    let header_bytes = util::read_file(path)?;
+    let h = parse_header(&header_bytes, path)?;
+    let (dims, need) = image_size(&h, path)?;
+    // The data: its own file or the rest of this one; the size is checked before reading.
+    match h.data_file.clone() {
+        Err(local_at) => decode(path, h, dims, need, path, &header_bytes, local_at),
+        Ok(p) => {
+            let meta = std::fs::metadata(&p).map_err(|e| {
+                LoadError::new(
+                    &p,
+                    ErrorKind::Io(format!(
+                        "the MetaImage data file named by {}: {e}",
+                        path.display()
+                    )),
+                )
+            })?;
+            if !h.compressed && meta.len() < need as u64 {
+                return Err(truncated_data_file(&p, &h, dims, need, meta.len()));
+            }
+            let data = util::read_file(&p)?;
+            decode(path, h, dims, need, &p, &data, 0)
         }
     }
-    let header_bytes = load::read_file(path)?;
-    let mut h = parse_header(&header_bytes, path)?;
-    let n = load::grid_count(h.dims).map_err(|k| LoadError::new(path, k))?;
+}
+
+/// The in-memory twin of [`read`] (used by the fuzz target): `header` is the `.mhd`/`.mha`
+/// file at `path`; `data` stands for the contents of the data file the header names (ignored
+/// when the header says `ElementDataFile = LOCAL`, whose data follows the header).
+pub fn from_bytes(
+    header: &[u8],
+    data: &[u8],
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<Dataset, LoadError> {
+    check_scalar(path, options)?;
+    let h = parse_header(header, path)?;
+    let (dims, need) = image_size(&h, path)?;
+    match h.data_file.clone() {
+        Err(local_at) => decode(path, h, dims, need, path, header, local_at),
+        Ok(p) => {
+            if !h.compressed && (data.len() as u64) < need as u64 {
+                return Err(truncated_data_file(&p, &h, dims, need, data.len() as u64));
+            }
+            decode(path, h, dims, need, &p, data, 0)
+        }
+    }
+}
+
+/// The image has one scalar, [`SCALAR_NAME`]: any other requested name is an error.
+fn check_scalar(path: &Path, options: &LoadOptions) -> Result<(), LoadError> {
+    match &options.scalar {
+        Some(name) if name != SCALAR_NAME => Err(LoadError::new(
+            path,
+            ErrorKind::MissingArray {
+                name: name.clone(),
+                available: vec![SCALAR_NAME.into()],
+            },
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The grid dimensions and the byte count of the uncompressed image data.
+fn image_size(h: &Header, path: &Path) -> Result<([usize; 3], usize), LoadError> {
+    let n = util::grid_count(h.dims).map_err(|k| LoadError::new(path, k))?;
     let dims = h.dims.map(|d| d as usize);
     if dims.iter().any(|&d| d < 2) {
         return Err(LoadError::new(
@@ -265,43 +318,33 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
             )),
         ));
     }
-    let need = n * h.element.size();
-    // The data: its own file or the rest of this one; the size is checked before reading.
-    let (data_path, bytes, start): (PathBuf, std::borrow::Cow<[u8]>, usize) = match &h.data_file {
-        Err(local_at) => (
-            path.to_path_buf(),
-            std::borrow::Cow::Borrowed(&header_bytes[..]),
-            *local_at,
-        ),
-        Ok(p) => {
-            let meta = std::fs::metadata(p).map_err(|e| {
-                LoadError::new(
-                    p,
-                    ErrorKind::Io(format!(
-                        "the MetaImage data file named by {}: {e}",
-                        path.display()
-                    )),
-                )
-            })?;
-            if !h.compressed && meta.len() < need as u64 {
-                return Err(LoadError::at(
-                    p,
-                    Location::Byte(meta.len()),
-                    ErrorKind::Truncated {
-                        expected: format!(
-                            "{need} bytes of {:?} for a {}×{}×{} image, the file has {}",
-                            h.element,
-                            dims[0],
-                            dims[1],
-                            dims[2],
-                            meta.len()
-                        ),
-                    },
-                ));
-            }
-            (p.clone(), std::borrow::Cow::Owned(load::read_file(p)?), 0)
-        }
-    };
+    Ok((dims, n * h.element.size()))
+}
+
+fn truncated_data_file(p: &Path, h: &Header, dims: [usize; 3], need: usize, len: u64) -> LoadError {
+    LoadError::at(
+        p,
+        Location::Byte(len),
+        ErrorKind::Truncated {
+            expected: format!(
+                "{need} bytes of {:?} for a {}×{}×{} image, the file has {len}",
+                h.element, dims[0], dims[1], dims[2],
+            ),
+        },
+    )
+}
+
+/// Decodes the image data (`bytes[start..]`, from `data_path`) and builds the data set of the
+/// header at `path`.
+fn decode(
+    path: &Path,
+    mut h: Header,
+    dims: [usize; 3],
+    need: usize,
+    data_path: &Path,
+    bytes: &[u8],
+    start: usize,
+) -> Result<Dataset, LoadError> {
     let avail = bytes.len() - start;
     let raw: std::borrow::Cow<[u8]> = if h.compressed {
         let mut out = Vec::with_capacity(need.min(avail.saturating_mul(64)));
@@ -310,7 +353,7 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
             .read_to_end(&mut out)
             .map_err(|e| {
                 LoadError::at(
-                    &data_path,
+                    data_path,
                     Location::Byte(start as u64),
                     ErrorKind::Invalid(format!("zlib data: {e}")),
                 )
@@ -327,11 +370,7 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
                     found: out.len() as u64,
                 }
             };
-            return Err(LoadError::at(
-                &data_path,
-                Location::Byte(start as u64),
-                kind,
-            ));
+            return Err(LoadError::at(data_path, Location::Byte(start as u64), kind));
         }
         std::borrow::Cow::Owned(out)
     } else {
@@ -343,7 +382,7 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
         };
         if off > bytes.len() || bytes.len() - off < need {
             return Err(LoadError::at(
-                &data_path,
+                data_path,
                 Location::Byte(bytes.len() as u64),
                 ErrorKind::Truncated {
                     expected: format!(
@@ -361,10 +400,7 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
                 bytes.len() - off - need
             ));
         }
-        match bytes {
-            std::borrow::Cow::Borrowed(b) => std::borrow::Cow::Borrowed(&b[off..off + need]),
-            std::borrow::Cow::Owned(ref b) => std::borrow::Cow::Owned(b[off..off + need].to_vec()),
-        }
+        std::borrow::Cow::Borrowed(&bytes[off..off + need])
     };
     let values = convert(&raw, h.element, h.order);
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
@@ -373,7 +409,7 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
         } else {
             ByteOrder::Big
         };
-        let kind = if load::looks_byte_swapped(&values, &convert(&raw, h.element, other)) {
+        let kind = if util::looks_byte_swapped(&values, &convert(&raw, h.element, other)) {
             ErrorKind::ByteOrder(format!("voxel {i} is {} with the header's byte order ({:?}-endian) but the data reads as sane values in the other order: fix BinaryDataByteOrderMSB", values[i], h.order))
         } else {
             ErrorKind::NonFinite {
@@ -383,12 +419,12 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
             }
         };
         return Err(LoadError::at(
-            &data_path,
+            data_path,
             Location::Byte((i * h.element.size()) as u64),
             kind,
         ));
     }
-    let points = load::grid_points(dims, h.origin, h.spacing);
+    let points = util::grid_points(dims, h.origin, h.spacing);
     let volume = VoxelGrid {
         dims,
         spacing: h.spacing,
@@ -397,7 +433,7 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
         scalar_name: SCALAR_NAME.into(),
     };
     let mut mesh = TetMesh::new(
-        load::stem_name(path),
+        util::stem_name(path),
         points,
         values,
         SCALAR_NAME,
@@ -483,5 +519,43 @@ mod tests {
         let err = read(&p, &LoadOptions::default()).unwrap_err();
         assert!(matches!(err.kind, ErrorKind::ByteOrder(_)), "{err}");
         assert_eq!(err.path, dir.path().join("f.raw"));
+    }
+
+    /// The fuzz target's seeds, split as the target splits them (first two bytes: the header
+    /// length), all read, and `from_bytes` agrees with `read` on files.
+    #[test]
+    fn fuzz_seeds_read_in_memory() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/mhd");
+        let mut n = 0;
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            let b = std::fs::read(&p).unwrap();
+            let rest = &b[2..];
+            let split = u16::from_le_bytes([b[0], b[1]]) as usize % (rest.len() + 1);
+            let (header, data) = rest.split_at(split);
+            let ds = from_bytes(header, data, Path::new("seed.mhd"), &LoadOptions::default())
+                .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+            assert_eq!(
+                ds.mesh.num_points(),
+                ds.volume.as_ref().unwrap().num_voxels()
+            );
+            // The same bytes as files.
+            let tmp = tempfile::tempdir().unwrap();
+            let text = String::from_utf8_lossy(header);
+            let data_name = text
+                .lines()
+                .find_map(|l| l.strip_prefix("ElementDataFile = "))
+                .unwrap();
+            if data_name != "LOCAL" {
+                write(tmp.path(), data_name, data);
+            }
+            let hp = write(tmp.path(), "seed.mhd", header);
+            assert_eq!(
+                read(&hp, &LoadOptions::default()).unwrap().mesh.scalars,
+                ds.mesh.scalars
+            );
+            n += 1;
+        }
+        assert_eq!(n, 12);
     }
 }

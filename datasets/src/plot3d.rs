@@ -15,8 +15,9 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::dataset::{Dataset, LoadOptions, Plot3dField};
 use crate::error::{ErrorKind, LoadError, Location};
-use crate::load::{self, ByteOrder, Dataset, LoadOptions, Plot3dField};
+use crate::read_util::{self as util, ByteOrder};
 use crate::volume::structured_tets;
 use crate::TetMesh;
 
@@ -25,7 +26,7 @@ pub const GAMMA: f64 = 1.4;
 
 /// Reads an XYZ grid file and its Q file (`options.q_file`, else [`q_path_for`]).
 pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
-    let xyz = load::read_file(path)?;
+    let xyz = util::read_file(path)?;
     let q_path = match &options.q_file {
         Some(q) => q.clone(),
         None => q_path_for(path).ok_or_else(|| {
@@ -62,7 +63,7 @@ pub fn q_path_for(xyz: &Path) -> Option<PathBuf> {
 
 /// The data set name: the XYZ file stem without its `xyz`.
 fn grid_name(path: &Path) -> String {
-    let stem = load::stem_name(path);
+    let stem = util::stem_name(path);
     let lower = stem.to_ascii_lowercase();
     match lower.rfind("xyz") {
         Some(i) if stem.len() > 3 => format!("{}{}", &stem[..i], &stem[i + 3..]),
@@ -218,7 +219,7 @@ fn sniff(b: &[u8], len: u64, kind: FileKind) -> Result<Layout, SniffError> {
                 if d.iter().any(|&x| x < 1) {
                     continue;
                 }
-                let n = match load::grid_count(d.map(|x| x as u64)) {
+                let n = match util::grid_count(d.map(|x| x as u64)) {
                     Ok(n) => n as u64,
                     Err(_) => {
                         overflow.get_or_insert(d);
@@ -335,9 +336,9 @@ pub(crate) fn sniff_xyz_header(head: &[u8], len: u64) -> bool {
 fn block(b: &[u8], l: &Layout, at: usize, n: usize) -> Vec<f32> {
     let raw = &b[at..at + n * l.prec];
     if l.prec == 4 {
-        load::f32s(raw, l.order)
+        util::f32s(raw, l.order)
     } else {
-        load::f64s(raw, l.order)
+        util::f64s(raw, l.order)
             .into_iter()
             .map(|v| v as f32)
             .collect()
@@ -365,7 +366,7 @@ fn check_finite(
         },
         ..*l
     };
-    if load::looks_byte_swapped(values, &block(b, &other, at, values.len())) {
+    if util::looks_byte_swapped(values, &block(b, &other, at, values.len())) {
         return Err(LoadError::at(
             path,
             Location::Byte((at + i * l.prec) as u64),
@@ -428,7 +429,7 @@ pub fn from_bytes(
     let mut warnings = Vec::new();
     if gl.iblank {
         let at = gl.data_at + 3 * n * gl.prec;
-        let ib = load::i32s(&xyz[at..at + 4 * n], gl.order);
+        let ib = util::i32s(&xyz[at..at + 4 * n], gl.order);
         let blanked = ib.iter().filter(|&&v| v == 0).count();
         let fringe = ib.iter().filter(|&&v| v < 0).count();
         // Blanked points stay: the papers' tet counts include every cell of the grid.

@@ -8,8 +8,8 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::dataset::{Dataset, LoadOptions, Plot3dField};
 use crate::error::{ErrorKind, LoadError};
-use crate::load::{Dataset, LoadOptions, Plot3dField};
 
 /// Where public copies of the files live (shown when one is missing).
 const VTK_DATA: &str =
@@ -17,18 +17,7 @@ const VTK_DATA: &str =
 const VISTRAILS: &str =
     "the VisTrails examples (https://github.com/VisTrails/VisTrails, examples/data/spx.vtk)";
 
-/// One named data set.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Entry {
-    pub name: String,
-    pub description: String,
-    /// Files it needs, relative to the data directory (empty for generators).
-    pub files: Vec<String>,
-    /// All files present (always true for generators).
-    pub present: bool,
-    /// Which papers used it / what it stands in for.
-    pub paper: &'static str,
-}
+pub use crate::entry::Entry;
 
 /// A named file data set.
 struct Named {
@@ -286,12 +275,13 @@ impl Registry {
                     source: key.to_string(),
                 })
             }
-            Source::StandIn => crate::standins::resolve(self, key, options).unwrap_or_else(|| {
-                Err(LoadError::new(
-                    key,
-                    ErrorKind::Io("not a stand-in or split modifier".into()),
-                ))
-            }),
+            Source::StandIn => crate::standins::resolve(&|k, o| self.resolve(k, o), key, options)
+                .unwrap_or_else(|| {
+                    Err(LoadError::new(
+                        key,
+                        ErrorKind::Io("not a stand-in or split modifier".into()),
+                    ))
+                }),
         }
     }
 

@@ -13,10 +13,10 @@
 
 use rayon::prelude::*;
 
+use crate::dataset::{Dataset, LoadOptions};
+use crate::entry::Entry;
 use crate::error::{ErrorKind, LoadError};
 use crate::generate::{Field, FieldEval};
-use crate::load::{Dataset, LoadOptions};
-use crate::registry::{Entry, Registry};
 use crate::volume::{hex_cell_tets, VoxelGrid};
 use crate::TetMesh;
 
@@ -250,18 +250,22 @@ pub fn entries(named: &[Entry]) -> Vec<Entry> {
         .collect()
 }
 
+/// How a stand-in loads the data set it is derived from (the registry's `resolve`, passed in
+/// so that this module does not depend on the registry that depends on it).
+pub type ResolveBase<'a> = &'a dyn Fn(&str, &LoadOptions) -> Result<Dataset, LoadError>;
+
 /// Resolves a name of this module or a `BASE@splitN` modifier; `None` when `key` is neither.
 pub fn resolve(
-    registry: &Registry,
+    resolve_base: ResolveBase,
     key: &str,
     options: &LoadOptions,
 ) -> Option<Result<Dataset, LoadError>> {
     if let Some((base, modifier)) = key.rsplit_once('@') {
         let levels = crate::split::parse_modifier(modifier)?;
-        return Some(split_dataset(registry, key, base, levels, options));
+        return Some(split_dataset(resolve_base, key, base, levels, options));
     }
     let s = find(key)?;
-    Some(build(registry, s, options).map(|mut ds| {
+    Some(build(resolve_base, s, options).map(|mut ds| {
         ds.mesh.name = s.name.to_string();
         ds.source = format!("{} ({})", s.name, s.description);
         ds
@@ -288,15 +292,13 @@ fn derived_error(key: &str, e: LoadError) -> LoadError {
 }
 
 fn split_dataset(
-    registry: &Registry,
+    resolve_base: ResolveBase,
     key: &str,
     base: &str,
     levels: u32,
     options: &LoadOptions,
 ) -> Result<Dataset, LoadError> {
-    let ds = registry
-        .resolve(base, options)
-        .map_err(|e| derived_error(key, e))?;
+    let ds = resolve_base(base, options).map_err(|e| derived_error(key, e))?;
     let mut mesh = crate::split::split(&ds.mesh, levels).map_err(|k| LoadError::new(key, k))?;
     mesh.name = key.to_string();
     Ok(Dataset {
@@ -306,7 +308,11 @@ fn split_dataset(
     })
 }
 
-fn build(registry: &Registry, s: &StandIn, options: &LoadOptions) -> Result<Dataset, LoadError> {
+fn build(
+    resolve_base: ResolveBase,
+    s: &StandIn,
+    options: &LoadOptions,
+) -> Result<Dataset, LoadError> {
     let err = |k: ErrorKind| LoadError::new(s.name, k);
     if let Some(want) = &options.scalar {
         if matches!(
@@ -320,7 +326,9 @@ fn build(registry: &Registry, s: &StandIn, options: &LoadOptions) -> Result<Data
         }
     }
     match s.recipe {
-        Recipe::Split { base, levels } => split_dataset(registry, s.name, base, levels, options),
+        Recipe::Split { base, levels } => {
+            split_dataset(resolve_base, s.name, base, levels, options)
+        }
         Recipe::Fuel => {
             let grid = fuel_volume();
             let mesh = six_tet_mesh(&grid).map_err(err)?;
@@ -331,9 +339,7 @@ fn build(registry: &Registry, s: &StandIn, options: &LoadOptions) -> Result<Data
             })
         }
         Recipe::Resampled { base, n } => {
-            let ds = registry
-                .resolve(base, options)
-                .map_err(|e| derived_error(s.name, e))?;
+            let ds = resolve_base(base, options).map_err(|e| derived_error(s.name, e))?;
             let Some(vol) = ds.volume else {
                 return Err(err(ErrorKind::Invalid(format!(
                     "{base} is not a voxel volume, cannot resample it"

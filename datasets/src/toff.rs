@@ -4,8 +4,9 @@
 
 use std::path::Path;
 
+use crate::dataset::{Dataset, LoadOptions};
 use crate::error::{ErrorKind, LoadError};
-use crate::load::{self, Dataset, LoadOptions};
+use crate::read_util as util;
 use crate::TetMesh;
 
 /// Name of the TOFF scalar.
@@ -13,7 +14,7 @@ pub const SCALAR_NAME: &str = "scalar";
 
 /// Reads a TOFF file.
 pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
-    let bytes = load::read_file(path)?;
+    let bytes = util::read_file(path)?;
     from_bytes(&bytes, path, options)
 }
 
@@ -55,7 +56,7 @@ impl<'a> Tokens<'a> {
         (self.pos > start).then(|| (start, &self.b[start..self.pos]))
     }
     fn err(&self, at: usize, kind: ErrorKind) -> LoadError {
-        LoadError::at(self.path, load::line_of(self.b, at), kind)
+        LoadError::at(self.path, util::line_of(self.b, at), kind)
     }
     fn expect(&mut self, what: impl FnOnce() -> String) -> Result<(usize, &'a str), LoadError> {
         let Some((at, t)) = self.next() else {
@@ -219,7 +220,7 @@ pub fn from_bytes(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<Da
             },
         ));
     }
-    let mesh = TetMesh::new(load::stem_name(path), points, scalars, SCALAR_NAME, tets).map_err(
+    let mesh = TetMesh::new(util::stem_name(path), points, scalars, SCALAR_NAME, tets).map_err(
         |k| match k {
             ErrorKind::EmptyMesh(_) => t.err(nt_at, k),
             k => LoadError::new(path, k),

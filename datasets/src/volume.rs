@@ -4,37 +4,13 @@
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use crate::error::ErrorKind;
 use crate::mesh::{cross, dot, sub, TetMesh};
 
-/// A regular grid of values at the grid points (VTK "point data" layout: x fastest).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct VoxelGrid {
-    /// Number of grid points along x, y, z.
-    pub dims: [usize; 3],
-    pub spacing: [f64; 3],
-    pub origin: [f64; 3],
-    /// `dims[0] * dims[1] * dims[2]` values, x fastest.
-    pub values: Vec<f32>,
-    pub scalar_name: String,
-}
+pub use crate::grid::VoxelGrid;
 
 impl VoxelGrid {
-    pub fn index(&self, i: usize, j: usize, k: usize) -> usize {
-        i + self.dims[0] * (j + self.dims[1] * k)
-    }
-    pub fn num_voxels(&self) -> usize {
-        self.dims.iter().product()
-    }
-
-    /// Position of grid point (i, j, k).
-    pub fn point(&self, i: usize, j: usize, k: usize) -> [f64; 3] {
-        let ijk = [i, j, k];
-        [0, 1, 2].map(|a| self.origin[a] + ijk[a] as f64 * self.spacing[a])
-    }
-
     /// The volume as a tet mesh: grid points become mesh points (same order, same values) and
     /// each cell 5 tets ([`structured_tets`]); a 68³ volume gives 67³·5 = 1,503,815 tets.
     pub fn to_tets(&self) -> Result<TetMesh, ErrorKind> {

@@ -20,14 +20,16 @@
 
 use std::path::Path;
 
+use crate::cells;
+use crate::dataset::{Dataset, LoadOptions};
 use crate::error::{ErrorKind, LoadError, Location};
-use crate::load::{self, ByteOrder, Dataset, LoadOptions};
+use crate::read_util::{self as util, ByteOrder};
 use crate::volume::{structured_tets, VoxelGrid};
 use crate::TetMesh;
 
 /// Reads a legacy VTK file.
 pub fn read(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
-    let bytes = load::read_file(path)?;
+    let bytes = util::read_file(path)?;
     from_bytes(&bytes, path, options)
 }
 
@@ -181,7 +183,7 @@ impl<'a> Parser<'a> {
         if self.binary {
             Location::Byte(at as u64)
         } else {
-            load::line_of(self.b, at)
+            util::line_of(self.b, at)
         }
     }
     fn err(&self, at: usize, kind: ErrorKind) -> LoadError {
@@ -359,8 +361,8 @@ impl<'a> Parser<'a> {
             let raw = &self.b[start..start + n * ty.size()];
             self.pos += raw.len();
             let values: Vec<f32> = match ty {
-                DataType::F32 => load::f32s(raw, ByteOrder::Big),
-                DataType::F64 => load::f64s(raw, ByteOrder::Big)
+                DataType::F32 => util::f32s(raw, ByteOrder::Big),
+                DataType::F64 => util::f64s(raw, ByteOrder::Big)
                     .into_iter()
                     .map(|v| v as f32)
                     .collect(),
@@ -1035,13 +1037,13 @@ impl VtkFile {
                     // Located only on error: finding an ASCII value's offset re-reads the block.
                     let at = || p.value_pos(*tstart, c, DataType::I32);
                     let t32 = u32::try_from(t).unwrap_or(u32::MAX);
-                    if load::vtk_cell_size(t32).is_none()
+                    if cells::vtk_cell_size(t32).is_none()
                         && p.binary
                         && swapped_i64_plausible(t, DataType::I32, 81)
                     {
                         return Err(p.err(at(), byte_order_error("cell type", t)));
                     }
-                    load::cell_to_tets(t32, ids, &mut tets).map_err(|k| {
+                    cells::cell_to_tets(t32, ids, &mut tets).map_err(|k| {
                         let k = match k {
                             ErrorKind::UnknownCellType(s) if t32 == u32::MAX => {
                                 ErrorKind::UnknownCellType(format!(
@@ -1083,7 +1085,7 @@ impl VtkFile {
                         },
                     )
                 })?;
-                let n = load::grid_count(dims).map_err(|k| p.err(dat, k))?;
+                let n = util::grid_count(dims).map_err(|k| p.err(dat, k))?;
                 let d = dims.map(|x| x as usize);
                 let n_cells = d
                     .iter()
@@ -1155,7 +1157,7 @@ impl VtkFile {
                             let origin = self.origin.unwrap_or([0.0; 3]);
                             let spacing = self.spacing.unwrap_or([1.0; 3]);
                             regular = Some((d, origin, spacing));
-                            load::grid_points(d, origin, spacing)
+                            util::grid_points(d, origin, spacing)
                         } else {
                             let mut axes: Vec<&Vec<f32>> = Vec::with_capacity(3);
                             for a in 0..3 {
@@ -1283,7 +1285,7 @@ impl VtkFile {
                         },
                     ));
                 }
-                let mut values = load::tuple_magnitudes(&arr.values, arr.ncomp);
+                let mut values = util::tuple_magnitudes(&arr.values, arr.ncomp);
                 if arr.ncomp > 1 {
                     warnings.push(format!(
                         "array {} has {} components: its magnitude is the scalar",
@@ -1298,7 +1300,7 @@ impl VtkFile {
                     values = match (&self.cells, kind) {
                         (Some(cells), Kind::Unstructured) => {
                             let conn: Vec<u32> = cells.conn.iter().map(|&v| v as u32).collect();
-                            load::cell_data_to_points(points.len(), &cells.offsets, &conn, &values)
+                            cells::cell_data_to_points(points.len(), &cells.offsets, &conn, &values)
                         }
                         _ => structured_cell_to_points(
                             regular
@@ -1324,7 +1326,7 @@ impl VtkFile {
             values: scalars.clone(),
             scalar_name: scalar_name.clone(),
         });
-        let mut mesh = TetMesh::new(load::stem_name(path), points, scalars, scalar_name, tets)
+        let mut mesh = TetMesh::new(util::stem_name(path), points, scalars, scalar_name, tets)
             .map_err(|k| LoadError::new(path, k))?;
         mesh.repair.warnings.extend(warnings);
         Ok(Dataset {

@@ -518,8 +518,9 @@ struct DatasetContext<'a> {
     mesh: &'a TetMesh,
     optics: &'a Optics,
     label: String,
-    /// Reference image per viewpoint (or why there is none), rendered on first need.
-    references: HashMap<String, Result<(Image, String), String>>,
+    /// Reference image per viewpoint with its PNG path and lost-ray count (or why there is
+    /// none), rendered on first need.
+    references: HashMap<String, Result<(Image, String, u64), String>>,
     /// The reference renderer's per-mesh data (planes, boundary bins), built on the first
     /// cache miss and shared by every viewpoint (0.3 s per view saved on Blunt Fin).
     reference_mesh: Option<reference::Prepared<'a>>,
@@ -624,14 +625,15 @@ impl DatasetContext<'_> {
         (self.config.out.join(&rel), rel)
     }
 
-    /// The reference image for `vp` and its PNG's path relative to OUT (rendered or read from
-    /// the cache on first need, then kept for every variant).
+    /// The reference image for `vp`, its PNG's path relative to OUT and how many of its rays
+    /// the reference lost (rendered or read from the cache on first need, then kept for every
+    /// variant).
     fn reference(
         &mut self,
         vp: &Viewpoint,
         camera: &Camera,
         progress: &Progress,
-    ) -> Result<(Image, String), String> {
+    ) -> Result<(Image, String, u64), String> {
         if let Some(r) = self.references.get(&vp.name) {
             return r.clone();
         }
@@ -641,16 +643,16 @@ impl DatasetContext<'_> {
         let (mesh, optics) = (self.mesh, self.optics);
         let prepared = &mut self.reference_mesh;
         let r = guarded("the reference renderer", || {
-            let img = match reference::read_cached(mesh, optics, camera, cache) {
-                Some(img) => img,
+            let r = match reference::read_cached_reference(mesh, optics, camera, cache) {
+                Some(r) => r,
                 None => prepared
                     .get_or_insert_with(|| reference::Prepared::new(mesh))
-                    .render_cached(optics, camera, cache)?,
+                    .render_cached_reference(optics, camera, cache)?,
             };
             std::fs::create_dir_all(&dir)
                 .with_context(|| format!("cannot create {}", dir.display()))?;
-            img.save_png(&dir.join("reference.png"))?;
-            Ok((img, format!("{rel}/reference.png")))
+            r.image.save_png(&dir.join("reference.png"))?;
+            Ok((r.image, format!("{rel}/reference.png"), r.lost_rays))
         })
         .map_err(|e| format!("reference for {} {}: {e:#}", self.label, vp.name));
         self.references.insert(vp.name.clone(), r.clone());
@@ -899,7 +901,14 @@ impl DatasetContext<'_> {
 
         if c.reference {
             match self.reference(vp, &camera, progress) {
-                Ok((reference, ref_path)) => {
+                Ok((reference, ref_path, lost_rays)) => {
+                    // Rays the reference could not follow to their end (0 on sound meshes).
+                    let lost = format!("reference_lost_rays={lost_rays}");
+                    row.counters = if row.counters.is_empty() {
+                        lost
+                    } else {
+                        format!("{};{lost}", row.counters)
+                    };
                     let e = metrics::compare(&image, &reference)?;
                     row.rmse = Some(e.rmse);
                     row.psnr_db = Some(e.psnr_db);

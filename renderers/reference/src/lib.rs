@@ -21,19 +21,27 @@
 //! at the first boundary face they cross.
 //!
 //! [`dense_sampling`] is an independent brute-force integrator (point location at small steps)
-//! used only to test this one; [`render_cached`] keeps images on disk.
+//! used only to test this one (`dense.rs`); [`render_cached`] keeps images on disk, keyed by
+//! the reference code's own hash ([`CODE_HASH`], `cache.rs`). [`RenderStats::lost_rays`] counts
+//! the rays whose walk could not be continued; the cache keeps that count with the image.
 
 // `!(x > 0.0)` is used on purpose: it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
-
-use std::io::Write;
-use std::path::{Path, PathBuf};
 
 use datasets::{TetMesh, NO_NEIGHBOUR, TET_FACES};
 use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 use render_core::preintegration::{composite_front_to_back, SegmentIntegrator};
 use render_core::{Camera, Image, Optics, Ray};
+
+mod cache;
+mod dense;
+
+pub use cache::{
+    cache_file, cache_key_for, read_cached, read_cached_reference, render_cached,
+    render_cached_reference, Reference, CODE_HASH,
+};
+pub use dense::dense_sampling;
 
 /// Rays stop once their opacity exceeds this (nothing behind can change a pixel by > 1e-9).
 pub const OPAQUE: f64 = 1.0 - 1e-9;
@@ -61,6 +69,13 @@ pub struct RenderStats {
     pub face_tests: u64,
     /// Rays that stopped early at opacity > 1 − 1e-9.
     pub terminated: u64,
+    /// Pixel rays at least one of whose walks ended early, not by leaving the mesh: point
+    /// location found only already-visited tets continuing the ray (the visit stamps that keep
+    /// each tet to one walk per ray blocked it), so the rest of that walk's path is missing
+    /// from the pixel unless a later entry hit covers it. Opacity termination and leaving
+    /// through the boundary (including grazing entries that integrate nothing) are normal
+    /// exits; the walk has no other way to end.
+    pub lost_rays: u64,
 }
 
 impl RenderStats {
@@ -73,6 +88,7 @@ impl RenderStats {
         self.skipped_entries += o.skipped_entries;
         self.face_tests += o.face_tests;
         self.terminated += o.terminated;
+        self.lost_rays += o.lost_rays;
     }
 }
 
@@ -102,6 +118,17 @@ pub struct Prepared<'m> {
     bfaces: Vec<BFace>,
     /// Bounding-box diagonal: the scale of every tolerance.
     scale: f64,
+}
+
+/// How point location after a stall or an unnamed exit ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Relocation {
+    /// The unvisited tet the ray stays in longest.
+    Found(usize),
+    /// No tet around the point continues the ray: it leaves the mesh here.
+    Exit,
+    /// Only tets this ray already walked continue it: the walk cannot go on (a lost ray).
+    Blocked,
 }
 
 /// Face planes, vertex heights and the linear scalar of one tet.
@@ -233,7 +260,8 @@ impl<'m> Prepared<'m> {
 
     /// Locates where the ray continues at parameter `t` after stalling in tet `from`: among
     /// the tets sharing the smallest sub-simplex of `from` that the point lies on, the
-    /// unvisited one the ray stays in longest.
+    /// unvisited one the ray stays in longest ([`Relocation::Found`]); when there is none, whether
+    /// some visited tet would have continued the ray ([`Relocation::Blocked`]) or none does.
     fn relocate(
         &self,
         from: usize,
@@ -242,7 +270,7 @@ impl<'m> Prepared<'m> {
         d: DVec3,
         stamps: &[u32],
         ray_id: u32,
-    ) -> Option<usize> {
+    ) -> Relocation {
         let x = o + d * t;
         let tet = self.mesh.tets[from];
         let mut lam = [0.0; 4];
@@ -254,30 +282,36 @@ impl<'m> Prepared<'m> {
         let mut k = order.iter().take_while(|&&i| lam[i] > 1e-10).count().max(1);
         let eps_progress = 1e-12 * self.scale;
         let eps_entry = 1e-8 * self.scale;
+        let mut blocked = false;
         loop {
             let verts: Vec<u32> = order[..k].iter().map(|&i| tet[i]).collect();
             let pivot = *verts.iter().min_by_key(|&&v| self.star(v).len()).unwrap();
             let mut best: Option<(usize, f64)> = None;
             for &c in self.star(pivot) {
                 let c = c as usize;
-                if stamps[c] == ray_id || !verts.iter().all(|v| self.mesh.tets[c].contains(v)) {
+                if !verts.iter().all(|v| self.mesh.tets[c].contains(v)) {
                     continue;
                 }
                 if let Some((a, b, _)) = self.interval(c, o, d) {
-                    if a <= t + eps_entry
-                        && b > t + eps_progress
-                        && best.is_none_or(|(_, bb)| b > bb)
-                    {
-                        best = Some((c, b));
+                    if a <= t + eps_entry && b > t + eps_progress {
+                        if stamps[c] == ray_id {
+                            blocked = true;
+                        } else if best.is_none_or(|(_, bb)| b > bb) {
+                            best = Some((c, b));
+                        }
                     }
                 }
             }
             if let Some((c, _)) = best {
-                return Some(c);
+                return Relocation::Found(c);
             }
             // Widen to the next smaller sub-simplex only if the point is really close to it.
             if k == 1 || lam[order[k - 1]] > 1e-6 {
-                return None;
+                return if blocked {
+                    Relocation::Blocked
+                } else {
+                    Relocation::Exit
+                };
             }
             k -= 1;
         }
@@ -325,6 +359,7 @@ impl<'m> Prepared<'m> {
         let mut acc = [0.0f64; 4];
         let mut t_done = f64::NEG_INFINITY;
         let mut walks = 0u64;
+        let mut lost = false;
         let hits = std::mem::take(&mut scratch.hits);
         'entries: for &(t_hit, start) in &hits {
             if t_hit < t_done - eps_behind {
@@ -339,7 +374,7 @@ impl<'m> Prepared<'m> {
             let mut walk_counted = false;
             loop {
                 scratch.stamps[cur] = ray_id;
-                let next = match self.interval(cur, o, d) {
+                let relocated = match self.interval(cur, o, d) {
                     Some((_, b, exit)) if b > t_cur + eps_progress => {
                         let x0 = o + d * t_cur;
                         let x1 = o + d * b;
@@ -360,25 +395,39 @@ impl<'m> Prepared<'m> {
                         }
                         let nb = self.mesh.adjacency()[cur][exit];
                         if nb != NO_NEIGHBOUR && scratch.stamps[nb as usize] != ray_id {
-                            Some(nb as usize)
+                            Relocation::Found(nb as usize)
                         } else {
                             // A boundary exit, unless the ray leaves near an edge or vertex
                             // into a tet the adjacency does not name.
-                            self.relocate(cur, t_cur, o, d, &scratch.stamps, ray_id)
-                                .inspect(|_| stats.relocations += 1)
+                            match self.relocate(cur, t_cur, o, d, &scratch.stamps, ray_id) {
+                                Relocation::Found(n) => {
+                                    stats.relocations += 1;
+                                    Relocation::Found(n)
+                                }
+                                other => other,
+                            }
                         }
                     }
-                    _ => self
-                        .relocate(cur, t_cur, o, d, &scratch.stamps, ray_id)
-                        .inspect(|_| stats.relocations += 1),
+                    _ => match self.relocate(cur, t_cur, o, d, &scratch.stamps, ray_id) {
+                        Relocation::Found(n) => {
+                            stats.relocations += 1;
+                            Relocation::Found(n)
+                        }
+                        other => other,
+                    },
                 };
-                match next {
-                    Some(n) => cur = n,
-                    None => break,
+                match relocated {
+                    Relocation::Found(n) => cur = n,
+                    Relocation::Exit => break,
+                    Relocation::Blocked => {
+                        lost = true;
+                        break;
+                    }
                 }
             }
         }
         scratch.hits = hits;
+        stats.lost_rays += lost as u64;
         if walks > 0 {
             stats.rays_hit += 1;
             stats.reentries += walks - 1;
@@ -502,23 +551,6 @@ impl<'m> Prepared<'m> {
             faces,
         }
     }
-
-    /// [`render_cached`] with this prepared mesh.
-    pub fn render_cached(
-        &self,
-        optics: &Optics,
-        camera: &Camera,
-        cache_dir: &Path,
-    ) -> anyhow::Result<Image> {
-        let key = cache_key(self.mesh, optics, camera);
-        let path = cache_path(cache_dir, &key);
-        if let Some(img) = read_cache(&path, &key, camera.width, camera.height) {
-            return Ok(img);
-        }
-        let (img, _) = self.render(optics, camera);
-        write_cache(&path, &key, &img)?;
-        Ok(img)
-    }
 }
 
 struct Bins {
@@ -560,337 +592,92 @@ pub fn render_with_stats(mesh: &TetMesh, optics: &Optics, camera: &Camera) -> (I
     Prepared::new(mesh).render(optics, camera)
 }
 
-// ---------------------------------------------------------------------------------------------
-// On-disk cache
-// ---------------------------------------------------------------------------------------------
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use render_core::TransferFunction;
 
-const CACHE_MAGIC: &[u8; 8] = b"TBREF\x00\x00\x01";
-/// Bumped whenever the renderer's output could change for the same inputs.
-const CACHE_VERSION: u32 = 1;
-
-/// blake3 of the JSON of everything the image depends on.
-fn cache_key(mesh: &TetMesh, optics: &Optics, camera: &Camera) -> [u8; 32] {
-    let json = serde_json::json!({
-        "version": CACHE_VERSION,
-        "mesh": mesh.content_hash(),
-        "optics": optics,
-        "camera": camera,
-        "size": [camera.width, camera.height],
-    });
-    *blake3::hash(json.to_string().as_bytes()).as_bytes()
-}
-
-fn cache_path(dir: &Path, key: &[u8; 32]) -> PathBuf {
-    let hex: String = key[..16].iter().map(|b| format!("{b:02x}")).collect();
-    dir.join(format!("{hex}.tbref"))
-}
-
-/// Reads a cached image; any mismatch (magic, key, size, length, checksum) gives `None`.
-fn read_cache(path: &Path, key: &[u8; 32], w: u32, h: u32) -> Option<Image> {
-    let bytes = std::fs::read(path).ok()?;
-    let n = (w as usize) * (h as usize) * 16;
-    let header = 8 + 32 + 8;
-    if bytes.len() != header + n + 32 || &bytes[..8] != CACHE_MAGIC || &bytes[8..40] != key {
-        return None;
-    }
-    let (fw, fh) = (
-        u32::from_le_bytes(bytes[40..44].try_into().ok()?),
-        u32::from_le_bytes(bytes[44..48].try_into().ok()?),
-    );
-    if (fw, fh) != (w, h) {
-        return None;
-    }
-    let payload = &bytes[header..header + n];
-    if blake3::hash(payload).as_bytes() != &bytes[header + n..] {
-        return None;
-    }
-    let pixels = payload
-        .chunks_exact(16)
-        .map(|c| {
-            std::array::from_fn(|k| f32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap()))
-        })
-        .collect::<Vec<[f32; 4]>>();
-    if pixels.iter().flatten().any(|v| !v.is_finite()) {
-        return None;
-    }
-    Some(Image {
-        width: w,
-        height: h,
-        pixels,
-    })
-}
-
-fn write_cache(path: &Path, key: &[u8; 32], img: &Image) -> anyhow::Result<()> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|e| {
-        anyhow::anyhow!(
-            "cannot create reference cache directory {}: {e}",
-            dir.display()
+    /// Two tets sharing the face z = 0 (one above, one below) and a ray straight down through
+    /// that face's interior.
+    fn stacked_pair() -> TetMesh {
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.25, 0.25, 1.0],
+            [0.25, 0.25, -1.0],
+        ];
+        let scalars = vec![0.0, 1.0, 0.5, 0.2, 0.8];
+        TetMesh::new(
+            "pair",
+            points,
+            scalars,
+            "s",
+            vec![[0, 1, 2, 3], [0, 1, 2, 4]],
         )
-    })?;
-    let mut payload = Vec::with_capacity(img.pixels.len() * 16);
-    for p in &img.pixels {
-        for v in p {
-            payload.extend_from_slice(&v.to_le_bytes());
+        .unwrap()
+    }
+
+    /// Traces the ray down through (0.2, 0.3); `pre_visit` tets are stamped as already walked
+    /// by this ray before it starts (a synthetic stand-in for a walk that came back).
+    fn trace_down(mesh: &TetMesh, pre_visit: &[usize]) -> RenderStats {
+        let prepared = Prepared::new(mesh);
+        let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), mesh);
+        let integ = SegmentIntegrator::new(&optics.tf);
+        let faces: Vec<u32> = (0..prepared.bfaces.len() as u32).collect();
+        let mut scratch = Scratch::new(mesh.num_tets());
+        for &t in pre_visit {
+            scratch.stamps[t] = scratch.ray_id + 1;
         }
-    }
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-    let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(CACHE_MAGIC)?;
-        f.write_all(key)?;
-        f.write_all(&img.width.to_le_bytes())?;
-        f.write_all(&img.height.to_le_bytes())?;
-        f.write_all(&payload)?;
-        f.write_all(blake3::hash(&payload).as_bytes())?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    };
-    write().map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        anyhow::anyhow!("cannot write reference cache file {}: {e}", path.display())
-    })
-}
-
-/// The reference image, from `cache_dir` when a valid file for exactly this mesh (content
-/// hash), camera, optics and size exists; otherwise rendered and stored. Damaged or
-/// mismatched files are re-rendered and replaced, never trusted.
-pub fn render_cached(
-    mesh: &TetMesh,
-    optics: &Optics,
-    camera: &Camera,
-    cache_dir: &Path,
-) -> anyhow::Result<Image> {
-    let key = cache_key(mesh, optics, camera);
-    let path = cache_path(cache_dir, &key);
-    if let Some(img) = read_cache(&path, &key, camera.width, camera.height) {
-        return Ok(img);
-    }
-    let img = render(mesh, optics, camera);
-    write_cache(&path, &key, &img)?;
-    Ok(img)
-}
-
-/// The cached reference image for these inputs, if a valid one exists (nothing is rendered).
-pub fn read_cached(
-    mesh: &TetMesh,
-    optics: &Optics,
-    camera: &Camera,
-    cache_dir: &Path,
-) -> Option<Image> {
-    let key = cache_key(mesh, optics, camera);
-    read_cache(
-        &cache_path(cache_dir, &key),
-        &key,
-        camera.width,
-        camera.height,
-    )
-}
-
-/// Where [`render_cached`] keeps the image for these inputs.
-pub fn cache_file(mesh: &TetMesh, optics: &Optics, camera: &Camera, cache_dir: &Path) -> PathBuf {
-    cache_path(cache_dir, &cache_key(mesh, optics, camera))
-}
-
-// ---------------------------------------------------------------------------------------------
-// Dense sampling (independent brute-force integrator, for tests)
-// ---------------------------------------------------------------------------------------------
-
-/// A uniform grid over the mesh bounds listing the tets whose boxes overlap each cell.
-struct Locator<'m> {
-    mesh: &'m TetMesh,
-    min: DVec3,
-    cell: DVec3,
-    dims: [usize; 3],
-    offsets: Vec<u32>,
-    tets: Vec<u32>,
-}
-
-impl<'m> Locator<'m> {
-    fn new(mesh: &'m TetMesh) -> Locator<'m> {
-        let b = mesh.bounds();
-        let min = DVec3::from(b.min);
-        let ext = DVec3::from(b.extent()).max(DVec3::splat(1e-30));
-        let n = (mesh.num_tets() as f64).cbrt().ceil().max(1.0);
-        let longest = ext.max_element();
-        let dims = [0, 1, 2].map(|a| ((ext[a] / longest * n).ceil() as usize).clamp(1, 256));
-        let cell = DVec3::new(
-            ext.x / dims[0] as f64,
-            ext.y / dims[1] as f64,
-            ext.z / dims[2] as f64,
-        );
-        let ncell = dims[0] * dims[1] * dims[2];
-        let range = |t: usize| {
-            let p = mesh.tet_points(t).map(DVec3::from);
-            let lo = p[0].min(p[1]).min(p[2]).min(p[3]);
-            let hi = p[0].max(p[1]).max(p[2]).max(p[3]);
-            let c = |x: DVec3| {
-                [0, 1, 2].map(|a| {
-                    (((x[a] - min[a]) / cell[a]).floor().max(0.0) as usize).min(dims[a] - 1)
-                })
-            };
-            (c(lo), c(hi))
+        let ray = Ray {
+            origin: [0.2, 0.3, 5.0],
+            dir: [0.0, 0.0, -1.0],
         };
-        let mut counts = vec![0u32; ncell + 1];
-        for t in 0..mesh.num_tets() {
-            let (lo, hi) = range(t);
-            for k in lo[2]..=hi[2] {
-                for j in lo[1]..=hi[1] {
-                    for i in lo[0]..=hi[0] {
-                        counts[i + dims[0] * (j + dims[1] * k) + 1] += 1;
-                    }
-                }
-            }
-        }
-        for i in 1..counts.len() {
-            counts[i] += counts[i - 1];
-        }
-        let mut fill = counts.clone();
-        let mut tets = vec![0u32; counts[ncell] as usize];
-        for t in 0..mesh.num_tets() {
-            let (lo, hi) = range(t);
-            for k in lo[2]..=hi[2] {
-                for j in lo[1]..=hi[1] {
-                    for i in lo[0]..=hi[0] {
-                        let c = i + dims[0] * (j + dims[1] * k);
-                        tets[fill[c] as usize] = t as u32;
-                        fill[c] += 1;
-                    }
-                }
-            }
-        }
-        Locator {
-            mesh,
-            min,
-            cell,
-            dims,
-            offsets: counts,
-            tets,
-        }
+        let mut stats = RenderStats::default();
+        prepared.trace(&integ, &optics, &ray, &faces, &mut scratch, &mut stats);
+        stats
     }
 
-    /// The interpolated scalar at `x`, or `None` outside the mesh (barycentric coordinates by
-    /// Cramer's rule, tolerance 1e-12).
-    fn scalar_at(&self, x: DVec3) -> Option<f64> {
-        let mut c = [0usize; 3];
-        for a in 0..3 {
-            let f = (x[a] - self.min[a]) / self.cell[a];
-            if !(f >= -1e-9 && f <= self.dims[a] as f64 + 1e-9) {
-                return None;
-            }
-            c[a] = (f.floor().max(0.0) as usize).min(self.dims[a] - 1);
-        }
-        let cell = c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2]);
-        for &t in &self.tets[self.offsets[cell] as usize..self.offsets[cell + 1] as usize] {
-            let p = self.mesh.tet_points(t as usize).map(DVec3::from);
-            let (e1, e2, e3, r) = (p[1] - p[0], p[2] - p[0], p[3] - p[0], x - p[0]);
-            let det = e1.dot(e2.cross(e3));
-            let l1 = r.dot(e2.cross(e3)) / det;
-            let l2 = e1.dot(r.cross(e3)) / det;
-            let l3 = e1.dot(e2.cross(r)) / det;
-            let l0 = 1.0 - l1 - l2 - l3;
-            let tol = -1e-12;
-            if l0 >= tol && l1 >= tol && l2 >= tol && l3 >= tol {
-                let s = self.mesh.tets[t as usize].map(|v| self.mesh.scalars[v as usize] as f64);
-                return Some(l0 * s[0] + l1 * s[1] + l2 * s[2] + l3 * s[3]);
-            }
-        }
-        None
+    #[test]
+    fn a_walk_through_both_tets_is_not_lost() {
+        let stats = trace_down(&stacked_pair(), &[]);
+        assert_eq!((stats.rays_hit, stats.segments, stats.lost_rays), (1, 2, 0));
     }
-}
 
-/// Brute-force integration for tests: each pixel ray is marched in steps of `step_world`
-/// through the mesh's bounding box; the scalar is found by point location at each step's
-/// midpoint and the ray equation integrated with the midpoint rule (per step, opacity
-/// 1 − exp(−κ·h) and colour c·opacity). Where a step enters or leaves the mesh the crossing is
-/// found by bisection, so the boundary costs no first-order error; steps that start and end
-/// outside are probed at eighths for thin corners of the mesh. Error O(step²).
-pub fn dense_sampling(mesh: &TetMesh, optics: &Optics, camera: &Camera, step_world: f64) -> Image {
-    let loc = Locator::new(mesh);
-    let b = mesh.bounds();
-    let pad = 1e-9 * b.diagonal();
-    let (bmin, bmax) = (DVec3::from(b.min) - pad, DVec3::from(b.max) + pad);
-    let (w, h) = (camera.width, camera.height);
-    let mut pixels = vec![[0f32; 4]; (w * h) as usize];
-    pixels.par_iter_mut().enumerate().for_each(|(i, px)| {
-        let ray = camera.pixel_ray(i as u32 % w, i as u32 / w);
-        let (o, d) = (DVec3::from(ray.origin), DVec3::from(ray.dir));
-        // Slab test against the bounding box.
-        let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
-        for a in 0..3 {
-            if d[a].abs() < 1e-300 {
-                if o[a] < bmin[a] || o[a] > bmax[a] {
-                    return;
-                }
-                continue;
-            }
-            let (ta, tb) = ((bmin[a] - o[a]) / d[a], (bmax[a] - o[a]) / d[a]);
-            t0 = t0.max(ta.min(tb));
-            t1 = t1.min(ta.max(tb));
-        }
-        if !(t1 > t0) {
-            return;
-        }
-        let at = |t: f64| loc.scalar_at(o + d * t);
-        let inside = |t: f64| at(t).is_some();
-        let mut acc = [0.0f64; 4];
-        let add = |ta: f64, tb: f64, acc: &mut [f64; 4]| {
-            if let Some(s) = at(0.5 * (ta + tb)) {
-                let s = optics.normalise(s);
-                let a = 1.0 - (-optics.tf.kappa_at(s) * (tb - ta) / optics.length_unit).exp();
-                let c = optics.tf.color_at(s);
-                composite_front_to_back(acc, [c[0] * a, c[1] * a, c[2] * a, a]);
-            }
-        };
-        let crossing = |mut lo: f64, mut hi: f64, lo_inside: bool| {
-            for _ in 0..60 {
-                let m = 0.5 * (lo + hi);
-                if inside(m) == lo_inside {
-                    lo = m;
-                } else {
-                    hi = m;
-                }
-            }
-            0.5 * (lo + hi)
-        };
-        let n = ((t1 - t0) / step_world).ceil().max(1.0) as usize;
-        let hstep = (t1 - t0) / n as f64;
-        let mut prev_in = inside(t0);
-        for k in 0..n {
-            let (ta, tb) = (t0 + k as f64 * hstep, t0 + (k + 1) as f64 * hstep);
-            let next_in = inside(tb);
-            match (prev_in, next_in) {
-                (true, true) => add(ta, tb, &mut acc),
-                (false, false) => {
-                    // A corner of the mesh thinner than a step: probe inside the step, so
-                    // pieces longer than an eighth of a step are not missed.
-                    if let Some(m) = (1..8)
-                        .map(|q| ta + q as f64 * hstep / 8.0)
-                        .find(|&t| inside(t))
-                    {
-                        let (c0, c1) = (crossing(ta, m, false), crossing(m, tb, true));
-                        add(c0, c1, &mut acc);
-                    }
-                }
-                (true, false) => {
-                    let tc = crossing(ta, tb, true);
-                    add(ta, tc, &mut acc);
-                }
-                (false, true) => {
-                    let tc = crossing(ta, tb, false);
-                    add(tc, tb, &mut acc);
-                }
-            }
-            prev_in = next_in;
-            if acc[3] > OPAQUE {
-                break;
-            }
-        }
-        *px = acc.map(|v| v as f32);
-    });
-    Image {
-        width: w,
-        height: h,
-        pixels,
+    #[test]
+    fn a_walk_blocked_by_a_visited_tet_is_a_lost_ray() {
+        let mesh = stacked_pair();
+        // The lower tet is already stamped: the walk leaves the upper tet into it, point
+        // location finds only that visited tet continuing the ray, and the walk ends there.
+        let lower = (0..2)
+            .find(|&t| mesh.tet_points(t).iter().any(|p| p[2] < 0.0))
+            .unwrap();
+        let stats = trace_down(&mesh, &[lower]);
+        assert_eq!((stats.rays_hit, stats.segments, stats.lost_rays), (1, 1, 1));
+        // The upper tet stamped instead: its only entry is skipped, nothing is walked and
+        // nothing is lost (the lower tet has no entry face on this ray).
+        let stats = trace_down(&mesh, &[1 - lower]);
+        assert_eq!((stats.segments, stats.lost_rays), (0, 0));
+    }
+
+    #[test]
+    fn leaving_through_the_boundary_is_a_normal_exit() {
+        // The upper tet alone: the ray leaves through the boundary face z = 0.
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.25, 0.25, 1.0],
+        ];
+        let mesh = TetMesh::new(
+            "one",
+            points,
+            vec![0.0, 1.0, 0.5, 0.2],
+            "s",
+            vec![[0, 1, 2, 3]],
+        )
+        .unwrap();
+        let stats = trace_down(&mesh, &[]);
+        assert_eq!((stats.rays_hit, stats.segments, stats.lost_rays), (1, 1, 0));
     }
 }

@@ -210,11 +210,15 @@ fn rays_through_vertices_edges_and_faces() {
         cams.push(cam);
     }
     let worst = check(&mesh, &o, &cams, 1e-5);
-    let total: u64 = cams
+    let stats: Vec<_> = cams
         .iter()
-        .map(|c| render_with_stats(&mesh, &o, c).1.relocations)
-        .sum();
-    eprintln!("degenerate rays: worst {worst:e}, {total} relocations");
+        .map(|c| render_with_stats(&mesh, &o, c).1)
+        .collect();
+    let total: u64 = stats.iter().map(|s| s.relocations).sum();
+    // Every relocation found its tet: on this conforming grid no walk is blocked.
+    let lost: u64 = stats.iter().map(|s| s.lost_rays).sum();
+    eprintln!("degenerate rays: worst {worst:e}, {total} relocations, {lost} lost rays");
+    assert_eq!(lost, 0);
 }
 
 #[test]
@@ -342,4 +346,38 @@ fn agrees_with_dense_sampling_on_spx() {
     // within 1e-5 itself (at 1/3000 it is off by 2.3e-5 on some pixels; the reference is not).
     let worst = check_with_step(&mesh, &o, &cams, 1e-5, 20000.0);
     eprintln!("spx: worst {worst:e}");
+}
+
+/// SPX at 128² from +x: the lost-ray count the cache returns is the one the walk counted, and
+/// the image is the uncached one. The count itself is printed (it depends on the mesh).
+#[test]
+fn lost_rays_on_spx_survive_the_cache() {
+    let Some(dir) = datasets::registry::test_data_file("spx.vtk")
+        .and_then(|p| p.parent().map(std::path::PathBuf::from))
+    else {
+        return;
+    };
+    let registry = datasets::registry::Registry::new(Some(dir));
+    let mesh = registry
+        .resolve("spx", &datasets::LoadOptions::default())
+        .unwrap()
+        .mesh;
+    let o = optics(&mesh, "low-opacity");
+    let vp = fixed_viewpoints()
+        .into_iter()
+        .find(|v| v.name == "+x")
+        .unwrap();
+    let cam = Camera::fit(&mesh.bounds(), &vp, Projection::default(), 128, 128);
+    let (img, stats) = render_with_stats(&mesh, &o, &cam);
+    let cache = tempfile::tempdir().unwrap();
+    let fresh = reference::render_cached_reference(&mesh, &o, &cam, cache.path()).unwrap();
+    let read = reference::read_cached_reference(&mesh, &o, &cam, cache.path()).unwrap();
+    assert_eq!(fresh.image, img);
+    assert_eq!(read, fresh);
+    assert_eq!(read.lost_rays, stats.lost_rays);
+    assert!(stats.lost_rays <= stats.rays_hit);
+    eprintln!(
+        "spx +x 128²: {} lost rays of {} hit ({} relocations)",
+        stats.lost_rays, stats.rays_hit, stats.relocations
+    );
 }
