@@ -5,6 +5,7 @@
 pub mod gpu;
 pub mod gpu_sort;
 pub mod image;
+pub mod image_error;
 pub mod preintegration;
 pub mod renderer;
 pub mod scene;
