@@ -7,28 +7,13 @@
 use std::sync::Arc;
 
 use datasets::{TetMesh, VoxelGrid};
+use render_core::image_error::psnr;
 use render_core::transfer::{ColorPoint, KappaPoint};
 use render_core::{Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint};
 use splat::{bucket_ends, Buckets, GpuSort, Splat, SplatSettings};
 
 fn gpu() -> Gpu {
     Gpu::new().expect("a wgpu adapter (lavapipe: apt-get install mesa-vulkan-drivers)")
-}
-
-fn psnr(a: &Image, b: &Image) -> f64 {
-    let mut se = 0.0;
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        for c in 0..3 {
-            let d = p[c].clamp(0.0, 1.0) as f64 - q[c].clamp(0.0, 1.0) as f64;
-            se += d * d;
-        }
-    }
-    let mse = se / (a.pixels.len() * 3) as f64;
-    if mse == 0.0 {
-        99.0
-    } else {
-        -10.0 * mse.log10()
-    }
 }
 
 fn max_diff(a: &Image, b: &Image) -> f32 {
