@@ -3,6 +3,7 @@
 //! and the CPU sorts used for visibility ordering.
 
 pub mod gpu;
+pub mod gpu_layout;
 pub mod gpu_sort;
 pub mod image;
 pub mod image_error;
