@@ -209,10 +209,13 @@ fn every_row_of_a_small_run_of_all_algorithms_has_consistent_times() {
     assert!(rows.iter().all(|r| r.psnr_db.is_some_and(f64::is_finite)));
 }
 
+/// Makes one frame's reported times wrong.
+type Fault = fn(&mut FrameStats);
+
 /// A renderer whose reported times are wrong in one chosen way.
 struct BadTimes {
     inner: Box<dyn Renderer>,
-    fault: fn(&mut FrameStats),
+    fault: Fault,
 }
 
 impl Renderer for BadTimes {
@@ -237,7 +240,7 @@ impl Renderer for BadTimes {
 
 #[test]
 fn a_negative_nan_or_inconsistent_time_is_caught() {
-    let faults: [(&str, fn(&mut FrameStats)); 5] = [
+    let faults: [(&str, Fault); 5] = [
         ("negative cpu_ms", |s| s.cpu_ms = -1.0),
         ("NaN total_ms", |s| s.total_ms = f64::NAN),
         ("cpu_ms > total_ms", |s| s.cpu_ms = s.total_ms + 1.0),
