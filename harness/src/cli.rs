@@ -4,13 +4,13 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
-use render_core::{Projection, TransferFunction};
 
-use crate::algorithms::{self, SettingsFilter};
+use crate::algorithms;
 use crate::analyze::{self, AnalyzeCommand};
 use crate::datasets_cmd::{self, DatasetsCommand};
+pub use crate::plan::default_cache_dir;
+use crate::plan::RunPlan;
 use crate::run::{self, RunConfig};
-use crate::suite::{self, DEFAULT_SUITE};
 
 #[derive(Debug, Parser)]
 #[command(
@@ -191,151 +191,39 @@ pub struct RunArgs {
     pub peers: Vec<String>,
 }
 
-/// The reference cache: `--cache-dir`, `$TETBENCH_CACHE`, `$XDG_CACHE_HOME/tetbench`,
-/// `~/.cache/tetbench`, or (no home) `OUT/.reference-cache`.
-pub fn default_cache_dir(out: &std::path::Path) -> PathBuf {
-    let env = |k: &str| {
-        std::env::var_os(k)
-            .filter(|v| !v.is_empty())
-            .map(PathBuf::from)
-    };
-    env("TETBENCH_CACHE")
-        .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("tetbench")))
-        .or_else(|| env("HOME").map(|d| d.join(".cache").join("tetbench")))
-        .unwrap_or_else(|| out.join(".reference-cache"))
-}
-
 impl RunArgs {
-    /// Checks the arguments and fills in defaults: the default suite's when no data set is
-    /// named, the papers' standard otherwise.
+    /// The plain run request these arguments describe.
+    pub fn to_plan(&self) -> RunPlan {
+        RunPlan {
+            algorithms: self.algorithms.clone(),
+            datasets: self.datasets.clone(),
+            viewpoints: self.viewpoints.clone(),
+            resolution: self.resolution,
+            tf: self.tf.clone(),
+            frames: self.frames,
+            warmup: self.warmup,
+            rounds: self.rounds,
+            out: self.out.clone(),
+            settings: self.settings.clone(),
+            no_reference: self.no_reference,
+            cache_dir: self.cache_dir.clone(),
+            orthographic: self.orthographic,
+            scalar: self.scalar.clone(),
+            no_report: self.no_report,
+            strict: self.strict,
+            shard: self.shard.clone(),
+            no_calibrate: self.no_calibrate,
+            peers: self.peers.clone(),
+        }
+    }
+
+    /// [`RunPlan::to_config`] of [`Self::to_plan`].
     pub fn to_config(
         &self,
         data_dir: Option<PathBuf>,
         command_line: Vec<String>,
     ) -> anyhow::Result<RunConfig> {
-        let suite_mode = self.datasets.is_empty();
-        let datasets: Vec<String> = if suite_mode {
-            DEFAULT_SUITE
-                .datasets
-                .iter()
-                .map(|s| s.to_string())
-                .collect()
-        } else {
-            self.datasets
-                .iter()
-                .map(|s| s.trim().to_string())
-                .filter(|s| !s.is_empty())
-                .collect()
-        };
-        if datasets.is_empty() {
-            anyhow::bail!("--datasets is empty");
-        }
-        let pick = |given: Option<u32>, suite: u32, standard: u32| {
-            given.unwrap_or(if suite_mode { suite } else { standard })
-        };
-        let viewpoint_spec = self.viewpoints.clone().unwrap_or_else(|| {
-            if suite_mode {
-                DEFAULT_SUITE.viewpoints
-            } else {
-                suite::STANDARD_VIEWPOINTS
-            }
-            .to_string()
-        });
-        let viewpoints = suite::parse_viewpoints(&viewpoint_spec)?;
-        let resolution = pick(
-            self.resolution,
-            DEFAULT_SUITE.resolution,
-            suite::STANDARD_RESOLUTION,
-        );
-        if !(1..=16384).contains(&resolution) {
-            anyhow::bail!("--resolution {resolution}: must be between 1 and 16384 pixels");
-        }
-        let frames = pick(self.frames, DEFAULT_SUITE.frames, suite::STANDARD_FRAMES);
-        if frames == 0 {
-            anyhow::bail!("--frames must be at least 1");
-        }
-        let warmup = pick(self.warmup, DEFAULT_SUITE.warmup, suite::STANDARD_WARMUP);
-        let rounds = pick(self.rounds, DEFAULT_SUITE.rounds, suite::STANDARD_ROUNDS);
-        if rounds == 0 {
-            anyhow::bail!("--rounds must be at least 1");
-        }
-
-        let known = algorithms::names();
-        let mut algorithms: Vec<String> = if self.algorithms.is_empty() {
-            // "All" means tetbench's own; peers come with --peers or by name.
-            known
-                .iter()
-                .filter(|n| !algorithms::is_peer(n))
-                .map(|s| s.to_string())
-                .collect()
-        } else {
-            self.algorithms
-                .iter()
-                .map(|s| s.trim().to_string())
-                .filter(|s| !s.is_empty())
-                .collect()
-        };
-        for a in &algorithms {
-            if !known.contains(&a.as_str()) {
-                anyhow::bail!(
-                    "--algorithms: unknown algorithm {a:?}; known: {}",
-                    known.join(", ")
-                );
-            }
-        }
-        for group in self
-            .peers
-            .iter()
-            .map(|s| s.trim())
-            .filter(|s| !s.is_empty())
-        {
-            for name in
-                algorithms::peer_group(group).map_err(|e| anyhow::anyhow!("--peers: {e}"))?
-            {
-                if !algorithms.iter().any(|a| a == name) {
-                    algorithms.push(name.to_string());
-                }
-            }
-        }
-        if algorithms.is_empty() {
-            anyhow::bail!("--algorithms is empty; known: {}", known.join(", "));
-        }
-
-        let tf = TransferFunction::load(&self.tf)
-            .map_err(|e| anyhow::anyhow!("--tf {:?}: {e:#}", self.tf))?;
-        let settings_filter = SettingsFilter::parse(self.settings.as_deref().unwrap_or(""))?;
-        Ok(RunConfig {
-            algorithms,
-            datasets,
-            viewpoint_spec,
-            viewpoints,
-            width: resolution,
-            height: resolution,
-            frames,
-            warmup,
-            rounds,
-            tf_spec: self.tf.clone(),
-            tf,
-            projection: if self.orthographic {
-                Projection::Orthographic
-            } else {
-                Projection::default()
-            },
-            cache_dir: self
-                .cache_dir
-                .clone()
-                .unwrap_or_else(|| default_cache_dir(&self.out)),
-            out: self.out.clone(),
-            data_dir,
-            reference: !self.no_reference,
-            settings_filter,
-            scalar: self.scalar.clone(),
-            command_line,
-            report: !self.no_report,
-            strict: self.strict,
-            shard: self.shard.as_deref().map(str::parse).transpose()?,
-            calibrate: !self.no_calibrate,
-        })
+        self.to_plan().to_config(data_dir, command_line)
     }
 }
 

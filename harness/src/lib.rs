@@ -14,6 +14,8 @@ pub mod datasets_cmd;
 pub mod history;
 pub mod machine;
 pub mod metrics;
+pub mod papers;
+pub mod plan;
 pub mod plot;
 pub mod report;
 pub mod reproduce;

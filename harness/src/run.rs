@@ -851,6 +851,10 @@ impl DatasetContext<'_> {
         progress: &Progress,
     ) -> anyhow::Result<()> {
         let c = self.config;
+        if let Some(problem) = frames.iter().find_map(frame_time_problem) {
+            // A NaN would also make results.json unreadable (JSON has no NaN).
+            anyhow::bail!("the renderer reported an impossible frame time: {problem}");
+        }
         let camera = Camera::fit(&self.mesh.bounds(), vp, c.projection, c.width, c.height);
         let image = guarded("read_image", || renderer.read_image(self.gpu))?;
 
@@ -929,6 +933,23 @@ impl DatasetContext<'_> {
             }
         }
         Ok(())
+    }
+}
+
+/// What is wrong with a frame's times, if anything: every time finite and non-negative, and the
+/// CPU part of a frame no longer than the frame (README, "Result columns").
+fn frame_time_problem(f: &FrameStats) -> Option<String> {
+    let ok = |v: f64| v.is_finite() && v >= 0.0;
+    if !ok(f.total_ms) {
+        Some(format!("total_ms = {}", f.total_ms))
+    } else if !ok(f.cpu_ms) {
+        Some(format!("cpu_ms = {}", f.cpu_ms))
+    } else if f.cpu_ms > f.total_ms {
+        Some(format!("cpu_ms {} > total_ms {}", f.cpu_ms, f.total_ms))
+    } else if let Some(g) = f.gpu_ms.filter(|g| !ok(*g)) {
+        Some(format!("gpu_ms = {g}"))
+    } else {
+        None
     }
 }
 

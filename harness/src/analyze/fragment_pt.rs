@@ -28,8 +28,8 @@ pub const TABLE1_DATASETS: [&str; 4] = ["spx", "bluntfin", "comb", "post"];
 
 /// The paper's Table 1 (fps, K tets/s) for a registry data set, if the paper has it.
 fn paper_table1(dataset: &str) -> Option<(Option<f64>, Option<f64>)> {
-    let name = crate::reproduce::papers::paper_name("fragment-pt", dataset)?;
-    let t = crate::reproduce::papers::table("fragment-pt_table1").ok()?;
+    let name = crate::papers::paper_name("fragment-pt", dataset)?;
+    let t = crate::papers::table("fragment-pt_table1").ok()?;
     Some((
         t.value(name, "fps"),
         t.value(name, "tets_per_sec").map(|v| v / 1e3),
@@ -38,7 +38,7 @@ fn paper_table1(dataset: &str) -> Option<(Option<f64>, Option<f64>)> {
 
 /// The paper's Table 2 fps on Blunt and Post for one of its rows.
 fn paper_table2(row: &str) -> Option<(f64, f64)> {
-    let t = crate::reproduce::papers::table("fragment-pt_table2").ok()?;
+    let t = crate::papers::table("fragment-pt_table2").ok()?;
     Some((t.value(row, "blunt_fps")?, t.value(row, "post_fps")?))
 }
 
@@ -325,7 +325,7 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
     let mut points: Vec<SweepPoint> = vec![];
     let mut adapter = String::new();
     for &res in &args.resolutions {
-        let run_args = crate::cli::RunArgs {
+        let plan = crate::plan::RunPlan {
             algorithms: args.algorithms.clone(),
             datasets: args.datasets.clone(),
             viewpoints: Some(args.viewpoints.clone()),
@@ -347,7 +347,7 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
             no_calibrate: false,
             peers: vec![],
         };
-        let config = run_args.to_config(
+        let config = plan.to_config(
             ctx.data_dir.clone(),
             vec!["tetbench analyze resolution".into()],
         )?;

@@ -30,9 +30,7 @@ pub const PAPER_RATE_RANGE_TETS_PER_SEC: (f64, f64) = (1.0e6, 6.0e6);
 
 /// A cell of a HAVS paper table (`havs_tableN.csv`), `None` where the paper has none.
 fn paper_value(table: &str, row: &str, column: &str) -> Option<f64> {
-    crate::reproduce::papers::table(table)
-        .ok()?
-        .value(row, column)
+    crate::papers::table(table).ok()?.value(row, column)
 }
 
 /// The paper's Table 1 name of one of our sorts.

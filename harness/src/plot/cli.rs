@@ -8,7 +8,7 @@ use anyhow::Context;
 
 use super::data::Inputs;
 use super::Kind;
-use crate::cli::RunArgs;
+use crate::plan::RunPlan;
 
 #[derive(Debug, clap::Args)]
 pub struct PlotArgs {
@@ -75,8 +75,8 @@ pub fn expand_sizes(spec: &str) -> Vec<String> {
 }
 
 impl PlotArgs {
-    fn run_args(&self, datasets: Vec<String>, resolution: u32, out: PathBuf) -> RunArgs {
-        RunArgs {
+    fn run_args(&self, datasets: Vec<String>, resolution: u32, out: PathBuf) -> RunPlan {
+        RunPlan {
             algorithms: self.algorithms.clone(),
             datasets,
             viewpoints: Some(
@@ -110,7 +110,7 @@ impl PlotArgs {
 
 /// Runs one sweep step; failures of rows are reported and kept (they are plotted as missing).
 fn measure(
-    args: RunArgs,
+    args: RunPlan,
     data_dir: Option<PathBuf>,
     command_line: &[String],
 ) -> anyhow::Result<PathBuf> {

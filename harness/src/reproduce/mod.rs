@@ -23,7 +23,7 @@ use crate::results::{ResultsFile, Row};
 pub mod fragment_pt;
 pub mod gator;
 pub mod havs;
-pub mod papers;
+pub use crate::papers;
 pub mod raycast;
 pub mod splat;
 pub mod table;
@@ -161,14 +161,7 @@ impl Measured {
     }
 }
 
-/// Value of `key` in a settings string `k=v;k=v`.
-pub fn setting<'a>(settings: &'a str, key: &str) -> Option<&'a str> {
-    settings.split(';').find_map(|kv| {
-        kv.split_once('=')
-            .filter(|(k, _)| *k == key)
-            .map(|(_, v)| v)
-    })
-}
+pub use crate::papers::setting;
 
 /// The aggregate of `algorithm` on `dataset` whose settings include every `want` pair.
 pub fn find<'a>(
@@ -245,7 +238,7 @@ impl Session {
         };
         let datasets: Vec<String> = spec.datasets.iter().map(|d| self.dataset(d)).collect();
         let out = self.dir.join("runs").join(&spec.name);
-        let args = crate::cli::RunArgs {
+        let args = crate::plan::RunPlan {
             algorithms: algorithms.clone(),
             datasets: datasets.clone(),
             viewpoints: Some(viewpoints.clone()),

@@ -331,6 +331,18 @@ struct KeyParams {
     pad: u32,
 }
 
+/// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
+/// for the layout test (`tests/gpu_layouts.rs`).
+#[doc(hidden)]
+pub fn gpu_layouts() -> Vec<crate::gpu_layout::RustLayout> {
+    vec![
+        crate::rust_layout!(Params => "gpu_sort.wgsl::Params" { n, shift, num_tiles, flags }),
+        crate::rust_layout!(KeyParams => "gpu_sort.wgsl::KeyParams" {
+            eye, perspective, forward, count, point_stride, verts, value_base, pad
+        }),
+    ]
+}
+
 /// Computes sort keys on the GPU, the pass before [`GpuRadixSort::encode`]: for each primitive
 /// (tet: 4 vertex indices, face: 3) the centroid's [`crate::Camera::sort_distance`] (in f32) as
 /// key and the primitive's id as value. Points are read from a caller's f32 storage buffer with

@@ -5,8 +5,10 @@
 pub mod bind;
 pub mod frame;
 pub mod gpu;
+pub mod gpu_layout;
 pub mod gpu_sort;
 pub mod image;
+pub mod image_error;
 pub mod preintegration;
 pub mod renderer;
 pub mod scene;

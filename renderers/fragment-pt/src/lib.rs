@@ -146,6 +146,16 @@ struct Pass2Params {
     sizes: [u32; 4],
 }
 
+/// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
+/// for the layout test (`tests/gpu_layouts.rs`).
+#[doc(hidden)]
+pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
+    vec![
+        render_core::rust_layout!(Pass1Params => "pass1.wgsl::Params" { view_proj, eye, forward, misc, counts }),
+        render_core::rust_layout!(Pass2Params => "pass2.wgsl::Params" { view_proj, misc, sizes }),
+    ]
+}
+
 /// Everything uploaded by `prepare`.
 struct State {
     mesh: TetMesh,

@@ -166,6 +166,21 @@ struct Params {
     exp_size: u32,
 }
 
+/// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
+/// for the layout test (`tests/gpu_layouts.rs`).
+#[doc(hidden)]
+pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
+    vec![
+        render_core::rust_layout!(Params => "gator.wgsl::Params" {
+            view_proj, tets_per_chunk, points_per_chunk, num_tets, cells, inv_length_unit,
+            tau_max, tf_size, exp_size
+        }),
+        render_core::rust_layout!(GpuClassification => "gator.wgsl::DebugRecord" {
+            case, class, thick_vertex, ndc_thickness, length, s_front, s_back
+        }),
+    ]
+}
+
 /// Layouts, pipelines and the mesh on the GPU (shared by the renderer and the debug path).
 struct MeshGpu {
     g0_layout: wgpu::BindGroupLayout,

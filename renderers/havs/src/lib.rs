@@ -172,6 +172,64 @@ impl Havs {
     pub fn ledger(&self) -> Option<&MemoryLedger> {
         self.state.as_ref().map(|s| &s.ledger)
     }
+
+    /// Per pixel of the last frame (row-major), as `fs_kbuffer` counted them in
+    /// `mode=fragment-race`: `[fragments the k-buffer took in, out-of-order pops before the
+    /// drain pass]` (`Pixel.info.y`, `.z` of `havs.wgsl`). For the test that holds the racy
+    /// pass to its CPU twin ([`kbuffer`]); race-free mode keeps no per-pixel counts (zeros).
+    pub fn read_pixel_counts(&self, gpu: &Gpu) -> anyhow::Result<Vec<[u32; 2]>> {
+        let t = self
+            .state
+            .as_ref()
+            .and_then(|s| s.target.as_ref())
+            .context("HAVS: read_pixel_counts before render")?;
+        let n = t.width as u64 * t.height as u64;
+        let bytes = gpu.read_buffer(&t.pixels, 0, n * 32)?;
+        let px: &[[u32; 8]] = bytemuck::cast_slice(&bytes);
+        Ok(px.iter().map(|p| [p[5], p[6]]).collect())
+    }
+
+    /// Per pixel of the last frame (row-major), in `mode=race-free`: the fragments `fs_append`
+    /// stored, as `(v, d, submission index)` in list order (v = scalar + 2·tag, d = distance
+    /// along the ray, as `fragment_entry` in `havs.wgsl` computes them). For the test that
+    /// streams the GPU's own fragments through the CPU twin ([`kbuffer`]).
+    pub fn read_fragment_lists(&self, gpu: &Gpu) -> anyhow::Result<Vec<Vec<(f32, f32, u32)>>> {
+        let st = self
+            .state
+            .as_ref()
+            .context("HAVS: read_fragment_lists before prepare")?;
+        let t = st
+            .target
+            .as_ref()
+            .context("HAVS: read_fragment_lists before render")?;
+        if self.settings.mode != Mode::RaceFree {
+            bail!("HAVS: fragment lists exist in mode=race-free only");
+        }
+        let npx = t.width as u64 * t.height as u64;
+        let heads: Vec<u32> =
+            bytemuck::cast_slice(&gpu.read_buffer(&t.heads, 0, npx * 4)?).to_vec();
+        let used: u32 = bytemuck::cast_slice::<u8, u32>(&gpu.read_buffer(&st.counters, 12, 4)?)[0];
+        let used = (used as u64).min(t.node_capacity);
+        let nodes: Vec<[u32; 4]> = if used == 0 {
+            vec![]
+        } else {
+            bytemuck::cast_slice(&gpu.read_buffer(&t._nodes, 0, used * 16)?).to_vec()
+        };
+        let mut lists = Vec::with_capacity(heads.len());
+        for &h in &heads {
+            let mut list = vec![];
+            let mut cur = h;
+            while cur != 0 {
+                let n = nodes
+                    .get(cur as usize - 1)
+                    .context("HAVS: a fragment list points past the nodes written")?;
+                list.push((f32::from_bits(n[0]), f32::from_bits(n[1]), n[2]));
+                cur = n[3];
+            }
+            lists.push(list);
+        }
+        Ok(lists)
+    }
 }
 
 #[repr(C)]
@@ -199,6 +257,19 @@ struct KeyUniforms {
     forward: [f32; 4],
     faces: u32,
     _pad: [u32; 3],
+}
+
+/// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
+/// for the layout test (`tests/gpu_layouts.rs`).
+#[doc(hidden)]
+pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
+    vec![
+        render_core::rust_layout!(Uniforms => "havs.wgsl::Uniforms" {
+            view_proj, eye, forward, width, height, flags, base_face, max_len, n_s, n_l,
+            node_capacity, et_alpha, _pad
+        }),
+        render_core::rust_layout!(KeyUniforms => "keys.wgsl::KeyUniforms" { eye, forward, faces, _pad }),
+    ]
 }
 
 /// Per-frame buffers for one viewport size.

@@ -37,6 +37,18 @@ pub struct TileRect {
     pub end: [u32; 2],
 }
 
+/// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
+/// for the layout test (`tests/gpu_layouts.rs`).
+#[doc(hidden)]
+pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
+    vec![
+        render_core::rust_layout!(FrameParams => "common.wgsl::Frame" {
+            o0, ox, oy, d0, dx, dy, view_proj, size, counts, misc, table
+        }),
+        render_core::rust_layout!(TileRect => "cast.wgsl::TileRect" { origin, end }),
+    ]
+}
+
 fn buffer_entry(
     binding: u32,
     ty: wgpu::BufferBindingType,

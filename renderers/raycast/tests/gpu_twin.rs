@@ -12,28 +12,13 @@ use datasets::TetMesh;
 use raycast::layout::{MeshLayout, TetRef, BYTES_PER_TET};
 use raycast::step;
 use raycast::{Mode, Raycast, RaycastSettings, TableKind, COUNT_EVERY};
+use render_core::image_error::psnr;
 use render_core::{
     fixed_viewpoints, Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction,
 };
 
 fn gpu() -> Gpu {
     Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)")
-}
-
-fn psnr(a: &Image, b: &Image) -> f64 {
-    let mut se = 0.0;
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        for c in 0..3 {
-            let d = p[c].clamp(0.0, 1.0) as f64 - q[c].clamp(0.0, 1.0) as f64;
-            se += d * d;
-        }
-    }
-    let mse = se / (a.pixels.len() * 3) as f64;
-    if mse == 0.0 {
-        99.0
-    } else {
-        -10.0 * mse.log10()
-    }
 }
 
 fn exact() -> RaycastSettings {

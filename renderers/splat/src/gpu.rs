@@ -32,6 +32,20 @@ pub struct FrameUniform {
     pub pad: [f32; 2],
 }
 
+/// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
+/// for the layout test (`tests/gpu_layouts.rs`).
+#[doc(hidden)]
+pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
+    vec![
+        render_core::rust_layout!(FrameUniform => "frame.wgsl::Frame" {
+            view_proj, depth_row, viewport, tan_half, focal_px, perspective, d0, inv_delta,
+            delta_world, num_slabs, n, padded, radius_slabs, subslices, footprint, tf_entries,
+            kernel_radius, kernel_unit, density_scale, ese_alpha, kernel_radius_world,
+            length_unit, pad
+        }),
+    ]
+}
+
 /// Uniform entries addressed with dynamic offsets are this far apart (the largest
 /// `min_uniform_buffer_offset_alignment` wgpu allows).
 pub const UNIFORM_STRIDE: u64 = 256;

@@ -24,6 +24,8 @@
 
 mod buckets;
 mod gpu;
+#[doc(hidden)]
+pub use gpu::gpu_layouts;
 pub mod kernel;
 pub mod voxels;
 

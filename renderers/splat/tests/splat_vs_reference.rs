@@ -7,28 +7,13 @@
 use std::sync::Arc;
 
 use datasets::{TetMesh, VoxelGrid};
+use render_core::image_error::psnr;
 use render_core::transfer::{ColorPoint, KappaPoint};
 use render_core::{Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint};
 use splat::{bucket_ends, Buckets, GpuSort, Splat, SplatSettings};
 
 fn gpu() -> Gpu {
     Gpu::new().expect("a wgpu adapter (lavapipe: apt-get install mesa-vulkan-drivers)")
-}
-
-fn psnr(a: &Image, b: &Image) -> f64 {
-    let mut se = 0.0;
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        for c in 0..3 {
-            let d = p[c].clamp(0.0, 1.0) as f64 - q[c].clamp(0.0, 1.0) as f64;
-            se += d * d;
-        }
-    }
-    let mse = se / (a.pixels.len() * 3) as f64;
-    if mse == 0.0 {
-        99.0
-    } else {
-        -10.0 * mse.log10()
-    }
 }
 
 fn max_diff(a: &Image, b: &Image) -> f32 {
@@ -237,7 +222,12 @@ fn smooth_volume_agrees_with_the_reference_of_its_tet_split() {
         // (σ = 0.65 voxel) smooths the piecewise-linear field of the tets, and each slab is
         // classified by its mean value rather than integrated through the transfer function.
         // Measured on lavapipe: 46.7 dB perspective, 46.3 dB orthographic; bricked
-        // (3,000 voxels a brick) vs whole 66 dB. Bounds 3 dB below the measurements (bricks: 60 dB).
+        // (3,000 voxels a brick) vs whole 66 dB. Bounds 3 dB below the measurements (bricks: 60 dB):
+        // empirical bound (no a-priori error bound for this approximation is derived here);
+        // safe because the rendering is deterministic on an adapter and f32 rounding
+        // differences between drivers move the RMSE by far less than the 3 dB (×1.41 RMSE)
+        // margin, while the defects the test exists for (a wrong order, classification or table
+        // coordinate, missing tets) cost tens of dB.
         assert!(p > 43.0, "{name}: {p:.2} dB");
         assert!(p_brick > 60.0, "{name} bricked: {p_brick:.2} dB");
     }
@@ -266,6 +256,11 @@ fn resampled_mesh_is_close_to_the_reference() {
     let p = psnr(&img, &reference);
     eprintln!("box:3k resampled on 32 points: PSNR {p:.2} dB");
     // Measured on lavapipe: 34.2 dB (the resampling adds its own error: 32 points across a
-    // box of ~8 tets per side, and points outside the mesh are not splatted). Bound 3 dB below.
+    // box of ~8 tets per side, and points outside the mesh are not splatted). Bound 3 dB below:
+    // empirical bound (no a-priori error bound for this approximation is derived here); safe
+    // because the rendering is deterministic on an adapter and f32 rounding differences between
+    // drivers move the RMSE by far less than the 3 dB (×1.41 RMSE) margin, while the defects
+    // the test exists for (a wrong order, classification or table coordinate, missing tets)
+    // cost tens of dB.
     assert!(p > 31.0, "{p:.2} dB");
 }

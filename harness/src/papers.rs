@@ -9,67 +9,67 @@ use anyhow::{anyhow, Context};
 pub const CSVS: &[(&str, &str)] = &[
     (
         "havs_table1",
-        include_str!("../../../reports/papers/havs_table1.csv"),
+        include_str!("../../reports/papers/havs_table1.csv"),
     ),
     (
         "havs_table2",
-        include_str!("../../../reports/papers/havs_table2.csv"),
+        include_str!("../../reports/papers/havs_table2.csv"),
     ),
     (
         "havs_table3",
-        include_str!("../../../reports/papers/havs_table3.csv"),
+        include_str!("../../reports/papers/havs_table3.csv"),
     ),
     (
         "havs_table4",
-        include_str!("../../../reports/papers/havs_table4.csv"),
+        include_str!("../../reports/papers/havs_table4.csv"),
     ),
     (
         "havs_table5",
-        include_str!("../../../reports/papers/havs_table5.csv"),
+        include_str!("../../reports/papers/havs_table5.csv"),
     ),
     (
         "gator_table1",
-        include_str!("../../../reports/papers/gator_table1.csv"),
+        include_str!("../../reports/papers/gator_table1.csv"),
     ),
     (
         "gator_table2",
-        include_str!("../../../reports/papers/gator_table2.csv"),
+        include_str!("../../reports/papers/gator_table2.csv"),
     ),
     (
         "gator_table3",
-        include_str!("../../../reports/papers/gator_table3.csv"),
+        include_str!("../../reports/papers/gator_table3.csv"),
     ),
     (
         "fragment-pt_table1",
-        include_str!("../../../reports/papers/fragment-pt_table1.csv"),
+        include_str!("../../reports/papers/fragment-pt_table1.csv"),
     ),
     (
         "fragment-pt_table2",
-        include_str!("../../../reports/papers/fragment-pt_table2.csv"),
+        include_str!("../../reports/papers/fragment-pt_table2.csv"),
     ),
     (
         "raycast_table3",
-        include_str!("../../../reports/papers/raycast_table3.csv"),
+        include_str!("../../reports/papers/raycast_table3.csv"),
     ),
     (
         "raycast_table4",
-        include_str!("../../../reports/papers/raycast_table4.csv"),
+        include_str!("../../reports/papers/raycast_table4.csv"),
     ),
     (
         "raycast_table5",
-        include_str!("../../../reports/papers/raycast_table5.csv"),
+        include_str!("../../reports/papers/raycast_table5.csv"),
     ),
     (
         "raycast_table6",
-        include_str!("../../../reports/papers/raycast_table6.csv"),
+        include_str!("../../reports/papers/raycast_table6.csv"),
     ),
     (
         "splat_table1",
-        include_str!("../../../reports/papers/splat_table1.csv"),
+        include_str!("../../reports/papers/splat_table1.csv"),
     ),
 ];
 
-const UNCERTAIN: &str = include_str!("../../../reports/papers/uncertain.csv");
+const UNCERTAIN: &str = include_str!("../../reports/papers/uncertain.csv");
 
 /// One paper table: header and rows of text cells (empty = not given by the paper).
 #[derive(Debug, Clone)]
@@ -168,11 +168,11 @@ pub fn paper_tets_per_sec(
     };
     match algorithm {
         "gator-pt" => {
-            let v = super::setting(settings, "variant")?;
+            let v = setting(settings, "variant")?;
             let col = format!("{v}_tets_per_sec");
             get("gator", "gator_table3", &col).map(|x| ("GATOR Table 3", x))
         }
-        "havs" if super::setting(settings, "k") == Some("2") => {
+        "havs" if setting(settings, "k") == Some("2") => {
             get("havs", "havs_table4", "tets_per_sec").map(|x| ("HAVS Table 4 (k=2)", x))
         }
         "fragment-pt" => get("fragment-pt", "fragment-pt_table1", "tets_per_sec")
@@ -248,6 +248,15 @@ pub fn uncertain_cells() -> anyhow::Result<Vec<[String; 4]>> {
         out.push(std::array::from_fn(|i| r.get(i).unwrap_or("").to_string()));
     }
     Ok(out)
+}
+
+/// Value of `key` in a settings string `k=v;k=v`.
+pub fn setting<'a>(settings: &'a str, key: &str) -> Option<&'a str> {
+    settings.split(';').find_map(|kv| {
+        kv.split_once('=')
+            .filter(|(k, _)| *k == key)
+            .map(|(_, v)| v)
+    })
 }
 
 #[cfg(test)]

@@ -1,0 +1,208 @@
+//! What to run, before checking: the plain form of a `tetbench run`, built by the command
+//! line ([`crate::cli::RunArgs`]), the analyses' sweeps, `tetbench reproduce` and
+//! `tetbench plot --sweep`, and turned into a checked [`RunConfig`] by [`RunPlan::to_config`].
+//!
+//! It lives outside `cli` so that the analyses and the paper runs do not depend on the command
+//! line's argument struct (which depends on them to dispatch).
+
+use std::path::PathBuf;
+
+use render_core::{Projection, TransferFunction};
+
+use crate::algorithms::{self, SettingsFilter};
+use crate::run::RunConfig;
+use crate::suite::{self, DEFAULT_SUITE};
+
+/// A run as asked for: `None` and empty lists mean "the default" (the default suite's when no
+/// data set is named, the papers' standard otherwise).
+#[derive(Debug, Clone, Default)]
+pub struct RunPlan {
+    /// Algorithms (empty: all of tetbench's own).
+    pub algorithms: Vec<String>,
+    /// Data set names, generator specs or files (empty: the default suite).
+    pub datasets: Vec<String>,
+    /// Viewpoint spec as `--viewpoints`.
+    pub viewpoints: Option<String>,
+    /// Square viewport size in pixels.
+    pub resolution: Option<u32>,
+    /// Transfer function preset or ParaView JSON file.
+    pub tf: String,
+    pub frames: Option<u32>,
+    pub warmup: Option<u32>,
+    /// Passes over each data set's variants (`run --rounds`); `None`: 1, the suite 3.
+    pub rounds: Option<u32>,
+    pub out: PathBuf,
+    /// Settings filter as `--settings`.
+    pub settings: Option<String>,
+    pub no_reference: bool,
+    pub cache_dir: Option<PathBuf>,
+    pub orthographic: bool,
+    pub scalar: Option<String>,
+    pub no_report: bool,
+    pub strict: bool,
+    /// `i/N` as `--shard`.
+    pub shard: Option<String>,
+    pub no_calibrate: bool,
+    /// Peer groups as `--peers`.
+    pub peers: Vec<String>,
+}
+
+impl RunPlan {
+    /// A plan with every default: the low-opacity transfer function, output in `out`, no report.
+    pub fn new(out: PathBuf) -> Self {
+        Self {
+            tf: "low-opacity".into(),
+            out,
+            no_report: true,
+            ..Self::default()
+        }
+    }
+}
+
+/// The reference cache: `--cache-dir`, `$TETBENCH_CACHE`, `$XDG_CACHE_HOME/tetbench`,
+/// `~/.cache/tetbench`, or (no home) `OUT/.reference-cache`.
+pub fn default_cache_dir(out: &std::path::Path) -> PathBuf {
+    let env = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    env("TETBENCH_CACHE")
+        .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("tetbench")))
+        .or_else(|| env("HOME").map(|d| d.join(".cache").join("tetbench")))
+        .unwrap_or_else(|| out.join(".reference-cache"))
+}
+
+impl RunPlan {
+    /// Checks the plan and fills in defaults: the default suite's when no data set is
+    /// named, the papers' standard otherwise. Errors name the `tetbench run` option at fault.
+    pub fn to_config(
+        &self,
+        data_dir: Option<PathBuf>,
+        command_line: Vec<String>,
+    ) -> anyhow::Result<RunConfig> {
+        let suite_mode = self.datasets.is_empty();
+        let datasets: Vec<String> = if suite_mode {
+            DEFAULT_SUITE
+                .datasets
+                .iter()
+                .map(|s| s.to_string())
+                .collect()
+        } else {
+            self.datasets
+                .iter()
+                .map(|s| s.trim().to_string())
+                .filter(|s| !s.is_empty())
+                .collect()
+        };
+        if datasets.is_empty() {
+            anyhow::bail!("--datasets is empty");
+        }
+        let pick = |given: Option<u32>, suite: u32, standard: u32| {
+            given.unwrap_or(if suite_mode { suite } else { standard })
+        };
+        let viewpoint_spec = self.viewpoints.clone().unwrap_or_else(|| {
+            if suite_mode {
+                DEFAULT_SUITE.viewpoints
+            } else {
+                suite::STANDARD_VIEWPOINTS
+            }
+            .to_string()
+        });
+        let viewpoints = suite::parse_viewpoints(&viewpoint_spec)?;
+        let resolution = pick(
+            self.resolution,
+            DEFAULT_SUITE.resolution,
+            suite::STANDARD_RESOLUTION,
+        );
+        if !(1..=16384).contains(&resolution) {
+            anyhow::bail!("--resolution {resolution}: must be between 1 and 16384 pixels");
+        }
+        let frames = pick(self.frames, DEFAULT_SUITE.frames, suite::STANDARD_FRAMES);
+        if frames == 0 {
+            anyhow::bail!("--frames must be at least 1");
+        }
+        let warmup = pick(self.warmup, DEFAULT_SUITE.warmup, suite::STANDARD_WARMUP);
+        let rounds = pick(self.rounds, DEFAULT_SUITE.rounds, suite::STANDARD_ROUNDS);
+        if rounds == 0 {
+            anyhow::bail!("--rounds must be at least 1");
+        }
+
+        let known = algorithms::names();
+        let mut algorithms: Vec<String> = if self.algorithms.is_empty() {
+            // "All" means tetbench's own; peers come with --peers or by name.
+            known
+                .iter()
+                .filter(|n| !algorithms::is_peer(n))
+                .map(|s| s.to_string())
+                .collect()
+        } else {
+            self.algorithms
+                .iter()
+                .map(|s| s.trim().to_string())
+                .filter(|s| !s.is_empty())
+                .collect()
+        };
+        for a in &algorithms {
+            if !known.contains(&a.as_str()) {
+                anyhow::bail!(
+                    "--algorithms: unknown algorithm {a:?}; known: {}",
+                    known.join(", ")
+                );
+            }
+        }
+        for group in self
+            .peers
+            .iter()
+            .map(|s| s.trim())
+            .filter(|s| !s.is_empty())
+        {
+            for name in
+                algorithms::peer_group(group).map_err(|e| anyhow::anyhow!("--peers: {e}"))?
+            {
+                if !algorithms.iter().any(|a| a == name) {
+                    algorithms.push(name.to_string());
+                }
+            }
+        }
+        if algorithms.is_empty() {
+            anyhow::bail!("--algorithms is empty; known: {}", known.join(", "));
+        }
+
+        let tf = TransferFunction::load(&self.tf)
+            .map_err(|e| anyhow::anyhow!("--tf {:?}: {e:#}", self.tf))?;
+        let settings_filter = SettingsFilter::parse(self.settings.as_deref().unwrap_or(""))?;
+        Ok(RunConfig {
+            algorithms,
+            datasets,
+            viewpoint_spec,
+            viewpoints,
+            width: resolution,
+            height: resolution,
+            frames,
+            warmup,
+            rounds,
+            tf_spec: self.tf.clone(),
+            tf,
+            projection: if self.orthographic {
+                Projection::Orthographic
+            } else {
+                Projection::default()
+            },
+            cache_dir: self
+                .cache_dir
+                .clone()
+                .unwrap_or_else(|| default_cache_dir(&self.out)),
+            out: self.out.clone(),
+            data_dir,
+            reference: !self.no_reference,
+            settings_filter,
+            scalar: self.scalar.clone(),
+            command_line,
+            report: !self.no_report,
+            strict: self.strict,
+            shard: self.shard.as_deref().map(str::parse).transpose()?,
+            calibrate: !self.no_calibrate,
+        })
+    }
+}
