@@ -3,6 +3,7 @@
 //! data sets resolved from a data directory.
 
 pub mod cells;
+pub mod data_dir;
 pub mod dataset;
 pub mod entry;
 pub mod error;

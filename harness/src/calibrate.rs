@@ -25,7 +25,6 @@ use std::time::Instant;
 
 use anyhow::Context;
 use render_core::Gpu;
-use serde::{Deserialize, Serialize};
 
 use crate::machine::MachineInfo;
 use crate::results::Row;
@@ -43,56 +42,7 @@ const COPY_BYTES: u64 = 32 << 20;
 const SORT_KEYS: usize = 1 << 20;
 const REPS: usize = 5;
 
-/// The backend's figures, stored in every run's machine record.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Calibration {
-    pub version: u32,
-    pub adapter: String,
-    pub driver: String,
-    pub cpu_model: String,
-    pub cpu_cores: usize,
-    pub date_utc: String,
-    /// Wall time the measurement took.
-    pub seconds: f64,
-    /// Sub-pixel triangles (no fragment) set up and rasterised per second.
-    pub triangles_per_sec: f64,
-    /// Blended fragments per second into `fill_format`.
-    pub fill_fragments_per_sec: f64,
-    pub fill_format: String,
-    /// f32 FMA throughput, GFLOP/s (1 FMA = 2 FLOPs).
-    pub compute_gflops: f64,
-    /// Storage-to-storage copy, bytes read + bytes written per second.
-    pub copy_bytes_per_sec: f64,
-    /// `render_core::sort::radix_sort_indices` on 2^20 f32 keys.
-    pub sort_keys_per_sec: f64,
-}
-
-impl Calibration {
-    /// The lines `tetbench calibrate` prints.
-    pub fn describe(&self) -> String {
-        format!(
-            "adapter           {} ({})\ncpu               {} ({} cores)\n\
-             triangle setup    {:.2} M triangles/s (sub-pixel, no fragments)\n\
-             fill rate         {:.1} M fragments/s (blended, {})\n\
-             compute           {:.2} GFLOP/s (f32 FMA)\n\
-             storage copy      {:.2} GB/s (read + write)\n\
-             CPU radix sort    {:.1} M keys/s (2^20 f32 keys)\n\
-             measured in {:.1} s on {}",
-            self.adapter,
-            self.driver,
-            self.cpu_model,
-            self.cpu_cores,
-            self.triangles_per_sec * 1e-6,
-            self.fill_fragments_per_sec * 1e-6,
-            self.fill_format,
-            self.compute_gflops,
-            self.copy_bytes_per_sec * 1e-9,
-            self.sort_keys_per_sec * 1e-6,
-            self.seconds,
-            self.date_utc
-        )
-    }
-}
+pub use crate::machine::Calibration;
 
 fn driver_of(gpu: &Gpu) -> String {
     let a = &gpu.adapter;
@@ -112,7 +62,7 @@ pub fn cache_path(cache_dir: &Path, gpu: &Gpu, machine: &MachineInfo) -> PathBuf
     let hex = blake3::hash(key.as_bytes()).to_hex();
     cache_dir.join("calibration").join(format!(
         "{}-{}.json",
-        crate::run::slug(&gpu.adapter.name),
+        crate::names::slug(&gpu.adapter.name),
         &hex[..16]
     ))
 }

@@ -86,7 +86,7 @@ pub enum Command {
     },
     /// Draw comparison charts (speed-error, scaling, resolution, bars, all) from any results,
     /// or run a sweep first (--sweep).
-    Plot(crate::plot::cli::PlotArgs),
+    Plot(crate::plot_cli::PlotArgs),
 }
 
 #[derive(Debug, Clone, clap::Args)]
@@ -326,7 +326,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             };
             anyhow::ensure!(args.threshold >= 1.0, "--threshold must be at least 1");
             anyhow::ensure!(args.drift_limit >= 1.0, "--drift-limit must be at least 1");
-            if crate::compare::run_command(&args.base, &args.new, &opt)? {
+            if crate::compare_report::run_command(&args.base, &args.new, &opt)? {
                 // The documented CI gate: status 1 without an error message.
                 std::process::exit(1);
             }
@@ -345,7 +345,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             out,
             threshold,
         } => crate::history::run_command(&dirs, &out, threshold, 0.05),
-        Command::Plot(args) => crate::plot::cli::run(args, cli.data_dir, command_line),
+        Command::Plot(args) => crate::plot_cli::run(args, cli.data_dir, command_line),
     }
 }
 

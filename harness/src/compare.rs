@@ -498,7 +498,7 @@ fn image_change(
             samples::row_image(new_dir, n),
         ) {
             let (bi, ni) = (samples::read_f32_image(&bp)?, samples::read_f32_image(&np)?);
-            let d = crate::compare_plot::image_difference(&bi, &ni)?;
+            let d = image_difference(&bi, &ni)?;
             c.changed_pixels = Some(d.changed_pixels);
             c.max_abs_difference = Some(d.max_abs);
             c.pixels_changed = Some(d.changed_pixels > 0);
@@ -507,10 +507,10 @@ fn image_change(
                     .with_context(|| format!("cannot create {}", heat_dir.display()))?;
                 let name = format!(
                     "{}__{}__{}__{}.png",
-                    crate::run::slug(&b.dataset),
-                    crate::run::viewpoint_slug(&b.viewpoint),
-                    crate::run::slug(&b.algorithm),
-                    crate::run::slug(&b.settings)
+                    crate::names::slug(&b.dataset),
+                    crate::names::viewpoint_slug(&b.viewpoint),
+                    crate::names::slug(&b.algorithm),
+                    crate::names::slug(&b.settings)
                 );
                 let path = heat_dir.join(&name);
                 d.heatmap
@@ -579,103 +579,67 @@ fn group_tests(
     Ok(out)
 }
 
-/// `tetbench compare`: prints the table, writes compare.{md,json,html}, returns whether the
-/// `--fail-on` condition was met.
-pub fn run_command(base: &Path, new: &Path, opt: &CompareOptions) -> anyhow::Result<bool> {
-    let cmp = compare(base, new, opt)?;
-    std::fs::create_dir_all(&opt.out)
-        .with_context(|| format!("cannot create {}", opt.out.display()))?;
-    print!("{}", crate::compare_report::terminal(&cmp));
-    crate::compare_report::write_outputs(&cmp, &opt.out)?;
-    println!("wrote {}/compare.{{md,json,html}}", opt.out.display());
-    Ok(match opt.fail_on {
-        FailOn::Never => false,
-        FailOn::Regression => !cmp.regressions.is_empty(),
-        FailOn::Change => cmp.outcome() != "no change",
+/// Where two renderings of the same row differ.
+pub struct ImageDifference {
+    /// Pixels with any channel not bit-identical.
+    pub changed_pixels: u64,
+    pub max_abs: f64,
+    /// Black where identical; changed pixels on a log ramp from 1e-7 (a last-bit change still
+    /// shows) to 0.25 and above.
+    pub heatmap: image::RgbImage,
+}
+
+pub fn image_difference(
+    base: &render_core::Image,
+    new: &render_core::Image,
+) -> anyhow::Result<ImageDifference> {
+    if (base.width, base.height) != (new.width, new.height) {
+        anyhow::bail!(
+            "images differ in size: {}x{} vs {}x{}",
+            base.width,
+            base.height,
+            new.width,
+            new.height
+        );
+    }
+    let mut heat = image::RgbImage::new(base.width, base.height);
+    let (mut changed, mut max_abs) = (0u64, 0.0f64);
+    let (lo, hi) = (1e-7f64.ln(), 0.25f64.ln());
+    for (i, (a, b)) in base.pixels.iter().zip(&new.pixels).enumerate() {
+        if a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()) {
+            continue;
+        }
+        changed += 1;
+        let d = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| {
+                let d = (*x as f64 - *y as f64).abs();
+                if d.is_nan() {
+                    1.0
+                } else {
+                    d
+                }
+            })
+            .fold(0.0, f64::max);
+        max_abs = max_abs.max(d);
+        let t = ((d.max(1e-7).ln() - lo) / (hi - lo)).clamp(0.0, 1.0);
+        heat.put_pixel(
+            i as u32 % base.width,
+            i as u32 / base.width,
+            image::Rgb(crate::metrics::ramp(t)),
+        );
+    }
+    Ok(ImageDifference {
+        changed_pixels: changed,
+        max_abs,
+        heatmap: heat,
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Writes a one-row results set whose f32 image is `img`, with 5 frames around `ms`.
-    fn results_dir(dir: &Path, img: &render_core::Image, ms: f64) {
-        std::fs::create_dir_all(dir.join("images")).unwrap();
-        let mut row = crate::results::example_row();
-        row.algorithm = "havs".into();
-        row.settings = "k=2".into();
-        row.dataset = "box:1k".into();
-        row.viewpoint = "+x".into();
-        row.total_ms = Some(ms);
-        row.psnr_db = Some(60.0);
-        row.gpu_bytes = Some(1000);
-        row.samples.total_ms = (0..5).map(|i| ms + 0.01 * i as f64).collect();
-        row.image_f32 = "images/a.f32.zz".into();
-        samples::write_f32_image(&dir.join(&row.image_f32), img).unwrap();
-        row.image_hash = samples::image_hash(img);
-        let file = ResultsFile {
-            schema_version: crate::results::SCHEMA_VERSION,
-            machine: crate::machine::MachineInfo::collect(),
-            run: Default::default(),
-            finished_utc: None,
-            rows: vec![row],
-            errors: vec![],
-        };
-        crate::results::write_json(dir, &file).unwrap();
-    }
-
-    /// Rendering is deterministic, so a single changed pixel — far below what PSNR or an
-    /// 8-bit PNG shows — is reported, with its heatmap; identical runs show no change.
-    #[test]
-    fn a_one_pixel_image_change_is_reported() {
-        let tmp = tempfile::tempdir().unwrap();
-        let mut img = render_core::Image::new(16, 16);
-        img.pixels
-            .iter_mut()
-            .for_each(|p| *p = [0.2, 0.3, 0.4, 0.5]);
-        let mut changed = img.clone();
-        changed.pixels[37][2] = f32::from_bits(changed.pixels[37][2].to_bits() + 1);
-        let (a, b, c) = (
-            tmp.path().join("a"),
-            tmp.path().join("b"),
-            tmp.path().join("c"),
-        );
-        results_dir(&a, &img, 10.0);
-        results_dir(&b, &img, 10.0);
-        results_dir(&c, &changed, 10.0);
-        let opt = |out: &str| CompareOptions {
-            threshold: 1.10,
-            alpha: 0.05,
-            normalised: false,
-            drift_correction: true,
-            drift_limit: 1.5,
-            fail_on: FailOn::Change,
-            out: tmp.path().join(out),
-        };
-        let same = compare(&a, &b, &opt("ab")).unwrap();
-        assert_eq!(same.outcome(), "no change", "{same:#?}");
-        assert!(!run_command(&a, &b, &opt("ab")).unwrap());
-        let diff = compare(&a, &c, &opt("ac")).unwrap();
-        let row = &diff.rows[0];
-        let image = row.image.as_ref().unwrap();
-        assert_eq!(image.changed_pixels, Some(1));
-        assert_eq!(image.pixels_changed, Some(true));
-        assert_eq!(image.verdict, "changed");
-        assert_eq!(row.status, "changed");
-        assert_eq!(diff.outcome(), "changed");
-        // fail-on change gates it; the outputs name the heatmap.
-        assert!(run_command(&a, &c, &opt("ac")).unwrap());
-        assert!(tmp.path().join("ac").join(&image.heatmap).is_file());
-        for f in [
-            "compare.md",
-            "compare.json",
-            "compare.html",
-            "charts/ratio_rows.png",
-        ] {
-            assert!(tmp.path().join("ac").join(f).is_file(), "{f}");
-        }
-    }
 
     /// Eight groups of 9 noisy samples each; group i's times are scaled by `factors[i]`.
     fn groups_dir(dir: &Path, factors: &[f64], seed: u64) {

@@ -7,65 +7,11 @@ use anyhow::{anyhow, Context};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use render_core::Image;
 
 use crate::compare::Verdict;
 use crate::plot::draw::{register_font, FONT};
 
-/// Where two renderings of the same row differ.
-pub struct ImageDifference {
-    /// Pixels with any channel not bit-identical.
-    pub changed_pixels: u64,
-    pub max_abs: f64,
-    /// Black where identical; changed pixels on a log ramp from 1e-7 (a last-bit change still
-    /// shows) to 0.25 and above.
-    pub heatmap: image::RgbImage,
-}
-
-pub fn image_difference(base: &Image, new: &Image) -> anyhow::Result<ImageDifference> {
-    if (base.width, base.height) != (new.width, new.height) {
-        anyhow::bail!(
-            "images differ in size: {}x{} vs {}x{}",
-            base.width,
-            base.height,
-            new.width,
-            new.height
-        );
-    }
-    let mut heat = image::RgbImage::new(base.width, base.height);
-    let (mut changed, mut max_abs) = (0u64, 0.0f64);
-    let (lo, hi) = (1e-7f64.ln(), 0.25f64.ln());
-    for (i, (a, b)) in base.pixels.iter().zip(&new.pixels).enumerate() {
-        if a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()) {
-            continue;
-        }
-        changed += 1;
-        let d = a
-            .iter()
-            .zip(b)
-            .map(|(x, y)| {
-                let d = (*x as f64 - *y as f64).abs();
-                if d.is_nan() {
-                    1.0
-                } else {
-                    d
-                }
-            })
-            .fold(0.0, f64::max);
-        max_abs = max_abs.max(d);
-        let t = ((d.max(1e-7).ln() - lo) / (hi - lo)).clamp(0.0, 1.0);
-        heat.put_pixel(
-            i as u32 % base.width,
-            i as u32 / base.width,
-            image::Rgb(crate::metrics::ramp(t)),
-        );
-    }
-    Ok(ImageDifference {
-        changed_pixels: changed,
-        max_abs,
-        heatmap: heat,
-    })
-}
+pub use crate::compare::{image_difference, ImageDifference};
 
 /// One strip of a ratio plot.
 pub struct Strip {

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use crate::compare::{Comparison, RowComparison, TimeTest};
+use crate::compare::{CompareOptions, Comparison, FailOn, RowComparison, TimeTest};
 use crate::compare_plot::{ratio_plot, Strip};
 
 fn header(c: &Comparison) -> Vec<String> {
@@ -289,4 +289,106 @@ pub fn write_outputs(c: &Comparison, out: &Path) -> anyhow::Result<()> {
         c.threshold,
     )?;
     write("compare.html", html(c))
+}
+
+/// `tetbench compare`: prints the table, writes compare.{md,json,html}, returns whether the
+/// `--fail-on` condition was met.
+pub fn run_command(base: &Path, new: &Path, opt: &CompareOptions) -> anyhow::Result<bool> {
+    let cmp = crate::compare::compare(base, new, opt)?;
+    std::fs::create_dir_all(&opt.out)
+        .with_context(|| format!("cannot create {}", opt.out.display()))?;
+    print!("{}", terminal(&cmp));
+    write_outputs(&cmp, &opt.out)?;
+    println!("wrote {}/compare.{{md,json,html}}", opt.out.display());
+    Ok(match opt.fail_on {
+        FailOn::Never => false,
+        FailOn::Regression => !cmp.regressions.is_empty(),
+        FailOn::Change => cmp.outcome() != "no change",
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compare::compare;
+    use crate::results::ResultsFile;
+    use crate::samples;
+
+    /// Writes a one-row results set whose f32 image is `img`, with 5 frames around `ms`.
+    fn results_dir(dir: &Path, img: &render_core::Image, ms: f64) {
+        std::fs::create_dir_all(dir.join("images")).unwrap();
+        let mut row = crate::results::example_row();
+        row.algorithm = "havs".into();
+        row.settings = "k=2".into();
+        row.dataset = "box:1k".into();
+        row.viewpoint = "+x".into();
+        row.total_ms = Some(ms);
+        row.psnr_db = Some(60.0);
+        row.gpu_bytes = Some(1000);
+        row.samples.total_ms = (0..5).map(|i| ms + 0.01 * i as f64).collect();
+        row.image_f32 = "images/a.f32.zz".into();
+        samples::write_f32_image(&dir.join(&row.image_f32), img).unwrap();
+        row.image_hash = samples::image_hash(img);
+        let file = ResultsFile {
+            schema_version: crate::results::SCHEMA_VERSION,
+            machine: crate::machine::MachineInfo::collect(),
+            run: Default::default(),
+            finished_utc: None,
+            rows: vec![row],
+            errors: vec![],
+        };
+        crate::results::write_json(dir, &file).unwrap();
+    }
+
+    /// Rendering is deterministic, so a single changed pixel — far below what PSNR or an
+    /// 8-bit PNG shows — is reported, with its heatmap; identical runs show no change.
+    #[test]
+    fn a_one_pixel_image_change_is_reported() {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut img = render_core::Image::new(16, 16);
+        img.pixels
+            .iter_mut()
+            .for_each(|p| *p = [0.2, 0.3, 0.4, 0.5]);
+        let mut changed = img.clone();
+        changed.pixels[37][2] = f32::from_bits(changed.pixels[37][2].to_bits() + 1);
+        let (a, b, c) = (
+            tmp.path().join("a"),
+            tmp.path().join("b"),
+            tmp.path().join("c"),
+        );
+        results_dir(&a, &img, 10.0);
+        results_dir(&b, &img, 10.0);
+        results_dir(&c, &changed, 10.0);
+        let opt = |out: &str| CompareOptions {
+            threshold: 1.10,
+            alpha: 0.05,
+            normalised: false,
+            drift_correction: true,
+            drift_limit: 1.5,
+            fail_on: FailOn::Change,
+            out: tmp.path().join(out),
+        };
+        let same = compare(&a, &b, &opt("ab")).unwrap();
+        assert_eq!(same.outcome(), "no change", "{same:#?}");
+        assert!(!run_command(&a, &b, &opt("ab")).unwrap());
+        let diff = compare(&a, &c, &opt("ac")).unwrap();
+        let row = &diff.rows[0];
+        let image = row.image.as_ref().unwrap();
+        assert_eq!(image.changed_pixels, Some(1));
+        assert_eq!(image.pixels_changed, Some(true));
+        assert_eq!(image.verdict, "changed");
+        assert_eq!(row.status, "changed");
+        assert_eq!(diff.outcome(), "changed");
+        // fail-on change gates it; the outputs name the heatmap.
+        assert!(run_command(&a, &c, &opt("ac")).unwrap());
+        assert!(tmp.path().join("ac").join(&image.heatmap).is_file());
+        for f in [
+            "compare.md",
+            "compare.json",
+            "compare.html",
+            "charts/ratio_rows.png",
+        ] {
+            assert!(tmp.path().join("ac").join(f).is_file(), "{f}");
+        }
+    }
 }

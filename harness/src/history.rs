@@ -280,8 +280,8 @@ pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> 
     for (alg, ds) in &pairs {
         let name = format!(
             "history_{}_{}.png",
-            crate::run::slug(alg),
-            crate::run::slug(ds)
+            crate::names::slug(alg),
+            crate::names::slug(ds)
         );
         chart(&charts.join(&name), &h, alg, ds)?;
         let _ = write!(html, "<h2>{alg} on {ds}</h2><img src=\"charts/{name}\">");

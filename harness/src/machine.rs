@@ -27,7 +27,7 @@ pub struct MachineInfo {
     /// The backend's micro-benchmark figures (`tetbench calibrate`); `None` with
     /// `--no-calibrate` and in files of schema 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub calibration: Option<crate::calibrate::Calibration>,
+    pub calibration: Option<Calibration>,
 }
 
 impl MachineInfo {
@@ -139,6 +139,57 @@ pub fn iso8601_utc(t: SystemTime) -> String {
         rem / 60 % 60,
         rem % 60
     )
+}
+
+/// The backend's figures, stored in every run's machine record.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Calibration {
+    pub version: u32,
+    pub adapter: String,
+    pub driver: String,
+    pub cpu_model: String,
+    pub cpu_cores: usize,
+    pub date_utc: String,
+    /// Wall time the measurement took.
+    pub seconds: f64,
+    /// Sub-pixel triangles (no fragment) set up and rasterised per second.
+    pub triangles_per_sec: f64,
+    /// Blended fragments per second into `fill_format`.
+    pub fill_fragments_per_sec: f64,
+    pub fill_format: String,
+    /// f32 FMA throughput, GFLOP/s (1 FMA = 2 FLOPs).
+    pub compute_gflops: f64,
+    /// Storage-to-storage copy, bytes read + bytes written per second.
+    pub copy_bytes_per_sec: f64,
+    /// `render_core::sort::radix_sort_indices` on 2^20 f32 keys.
+    pub sort_keys_per_sec: f64,
+}
+
+impl Calibration {
+    /// The lines `tetbench calibrate` prints.
+    pub fn describe(&self) -> String {
+        format!(
+            "adapter           {} ({})\ncpu               {} ({} cores)\n\
+             triangle setup    {:.2} M triangles/s (sub-pixel, no fragments)\n\
+             fill rate         {:.1} M fragments/s (blended, {})\n\
+             compute           {:.2} GFLOP/s (f32 FMA)\n\
+             storage copy      {:.2} GB/s (read + write)\n\
+             CPU radix sort    {:.1} M keys/s (2^20 f32 keys)\n\
+             measured in {:.1} s on {}",
+            self.adapter,
+            self.driver,
+            self.cpu_model,
+            self.cpu_cores,
+            self.triangles_per_sec * 1e-6,
+            self.fill_fragments_per_sec * 1e-6,
+            self.fill_format,
+            self.compute_gflops,
+            self.copy_bytes_per_sec * 1e-9,
+            self.sort_keys_per_sec * 1e-6,
+            self.seconds,
+            self.date_utc
+        )
+    }
 }
 
 #[cfg(test)]

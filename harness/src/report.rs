@@ -13,25 +13,8 @@ use crate::algorithms::is_peer;
 use crate::metrics::{HEATMAP_MAX_ERROR, ONE_STEP, PSNR_CAP_DB};
 use crate::results::{ResultsFile, Row};
 
-/// Mean, minimum and maximum over the viewpoints of a group.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Spread {
-    pub mean: f64,
-    pub min: f64,
-    pub max: f64,
-}
-
-pub fn spread(values: impl Iterator<Item = f64>) -> Option<Spread> {
-    let v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return None;
-    }
-    Some(Spread {
-        mean: v.iter().sum::<f64>() / v.len() as f64,
-        min: v.iter().copied().fold(f64::INFINITY, f64::min),
-        max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-    })
-}
+pub use crate::names::series_label;
+pub use crate::stats::{spread, Spread};
 
 /// One algorithm × settings × data set, over its viewpoints (the papers average over the 14
 /// fixed viewpoints, HAVS §6).
@@ -61,14 +44,6 @@ impl Aggregate {
     /// `algorithm settings` as one label.
     pub fn series(&self) -> String {
         series_label(&self.algorithm, &self.settings)
-    }
-}
-
-pub fn series_label(algorithm: &str, settings: &str) -> String {
-    if settings.is_empty() {
-        algorithm.to_string()
-    } else {
-        format!("{algorithm} {settings}")
     }
 }
 

@@ -10,7 +10,7 @@
 use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{anyhow, Context};
@@ -20,6 +20,8 @@ use render_core::{
     settings_string, Camera, FrameStats, Gpu, Image, Optics, Projection, Renderer,
     TransferFunction, Viewpoint,
 };
+
+pub use crate::names::{dataset_label, slug, viewpoint_slug};
 
 use crate::algorithms::SettingsFilter;
 use crate::machine::MachineInfo;
@@ -84,28 +86,6 @@ impl RunOutcome {
     pub fn all_ok(&self) -> bool {
         self.failed_rows == 0 && self.errors.is_empty()
     }
-}
-
-/// Turns a name into something safe for file names and URLs: `box:20k` → `box_20k`,
-/// `variant=linear;order=radix` → `variant_linear_order_radix`.
-pub fn slug(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            'a'..='z' | 'A'..='Z' | '0'..='9' | '.' | '-' => out.push(c),
-            _ => out.push('_'),
-        }
-    }
-    if out.chars().all(|c| c == '.') {
-        out.insert(0, '_');
-    }
-    out
-}
-
-/// A viewpoint's folder name: `+` → `p`, `-` → `m` (`+x-y` → `pxmy`), so that the names stay
-/// distinct and no folder starts with a dash.
-pub fn viewpoint_slug(name: &str) -> String {
-    slug(&name.replace('+', "p").replace('-', "m"))
 }
 
 fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
@@ -196,18 +176,6 @@ impl Progress {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
         }
-    }
-}
-
-/// A data set's label in rows: the name as given (`spx`, `box:20k`), or a file's name.
-pub fn dataset_label(spec: &str) -> String {
-    let p = Path::new(spec);
-    if spec.contains(std::path::MAIN_SEPARATOR) || spec.contains('/') {
-        p.file_name()
-            .map(|f| f.to_string_lossy().into_owned())
-            .unwrap_or_else(|| spec.to_string())
-    } else {
-        spec.to_string()
     }
 }
 
@@ -946,10 +914,8 @@ fn frame_time_problem(f: &FrameStats) -> Option<String> {
         Some(format!("cpu_ms = {}", f.cpu_ms))
     } else if f.cpu_ms > f.total_ms {
         Some(format!("cpu_ms {} > total_ms {}", f.cpu_ms, f.total_ms))
-    } else if let Some(g) = f.gpu_ms.filter(|g| !ok(*g)) {
-        Some(format!("gpu_ms = {g}"))
     } else {
-        None
+        f.gpu_ms.filter(|g| !ok(*g)).map(|g| format!("gpu_ms = {g}"))
     }
 }
 

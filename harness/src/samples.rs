@@ -10,134 +10,17 @@
 //!   row also carries the blake3 hash of the raw pixels (`image_hash`), so a results set
 //!   without the image files (a committed baseline) still tells exactly whether an image changed.
 
-use std::fs::File;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, Context};
-use render_core::{FrameStats, Image};
-use serde::{Deserialize, Serialize};
+use render_core::Image;
 
 use crate::results::Row;
 
-pub const SAMPLES_CSV: &str = "samples.csv";
-
-/// Per-frame measurements of one row, in frame order. `gpu_ms` is empty when the adapter has no
-/// timestamp queries.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct FrameSamples {
-    pub total_ms: Vec<f64>,
-    pub cpu_ms: Vec<f64>,
-    #[serde(default)]
-    pub gpu_ms: Vec<f64>,
-}
-
-impl FrameSamples {
-    pub fn is_empty(&self) -> bool {
-        self.total_ms.is_empty() && self.cpu_ms.is_empty() && self.gpu_ms.is_empty()
-    }
-
-    pub fn from_frames(frames: &[FrameStats]) -> FrameSamples {
-        let gpu: Option<Vec<f64>> = frames.iter().map(|f| f.gpu_ms).collect();
-        FrameSamples {
-            total_ms: frames.iter().map(|f| f.total_ms).collect(),
-            cpu_ms: frames.iter().map(|f| f.cpu_ms).collect(),
-            gpu_ms: gpu.unwrap_or_default(),
-        }
-    }
-
-    /// The samples of a time metric by its column name (`total_ms`, `cpu_ms`, `gpu_ms`).
-    pub fn metric(&self, name: &str) -> &[f64] {
-        match name {
-            "total_ms" => &self.total_ms,
-            "cpu_ms" => &self.cpu_ms,
-            "gpu_ms" => &self.gpu_ms,
-            _ => &[],
-        }
-    }
-}
-
-/// One line of `samples.csv`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SampleLine {
-    pub algorithm: String,
-    pub settings: String,
-    pub dataset: String,
-    pub viewpoint: String,
-    pub width: u32,
-    pub height: u32,
-    pub adapter: String,
-    /// 0-based index of the timed frame.
-    pub frame: u32,
-    /// `total_ms`, `cpu_ms` or `gpu_ms`.
-    pub metric: String,
-    pub ms: f64,
-}
-
-/// The long-format lines of one row.
-pub fn sample_lines(row: &Row) -> Vec<SampleLine> {
-    let mut out = vec![];
-    for metric in ["total_ms", "cpu_ms", "gpu_ms"] {
-        for (i, &ms) in row.samples.metric(metric).iter().enumerate() {
-            out.push(SampleLine {
-                algorithm: row.algorithm.clone(),
-                settings: row.settings.clone(),
-                dataset: row.dataset.clone(),
-                viewpoint: row.viewpoint.clone(),
-                width: row.width,
-                height: row.height,
-                adapter: row.adapter.clone(),
-                frame: i as u32,
-                metric: metric.to_string(),
-                ms,
-            });
-        }
-    }
-    out
-}
-
-/// Appends to `samples.csv` as rows finish (header written on creation).
-pub struct SamplesWriter {
-    csv: csv::Writer<File>,
-}
-
-impl SamplesWriter {
-    pub fn create(dir: &Path) -> anyhow::Result<SamplesWriter> {
-        let path = dir.join(SAMPLES_CSV);
-        let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
-        let mut csv = csv::WriterBuilder::new().has_headers(false).from_writer(f);
-        csv.write_record([
-            "algorithm",
-            "settings",
-            "dataset",
-            "viewpoint",
-            "width",
-            "height",
-            "adapter",
-            "frame",
-            "metric",
-            "ms",
-        ])?;
-        csv.flush()?;
-        Ok(SamplesWriter { csv })
-    }
-
-    pub fn push(&mut self, row: &Row) -> anyhow::Result<()> {
-        for line in sample_lines(row) {
-            self.csv.serialize(line)?;
-        }
-        self.csv.flush().context("writing samples.csv")
-    }
-}
-
-/// Writes `samples.csv` for a whole results set (used by `report --merge`).
-pub fn write_samples_csv(dir: &Path, rows: &[Row]) -> anyhow::Result<()> {
-    let mut w = SamplesWriter::create(dir)?;
-    for r in rows {
-        w.push(r)?;
-    }
-    Ok(())
-}
+pub use crate::results::{
+    sample_lines, write_samples_csv, FrameSamples, SampleLine, SamplesWriter, SAMPLES_CSV,
+};
 
 // ---------------------------------------------------------------------------------------------
 // Exact f32 images

@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use anyhow::{anyhow, Context};
-use serde::{Deserialize, Serialize};
 
+pub use crate::results::MergedRun;
 use crate::results::{self, ResultsFile, Row, RunDescription};
 
 /// Shard `index` (1-based) of `count`.
@@ -81,17 +81,6 @@ pub fn select(shard: Shard, units: &[Unit]) -> HashSet<Unit> {
         .filter(|(s, _)| *s == shard.index)
         .map(|(_, u)| u.clone())
         .collect()
-}
-
-/// Where the rows of a merged results set came from.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MergedRun {
-    pub dir: String,
-    pub shard: Option<String>,
-    pub adapter: Option<String>,
-    pub git_commit: Option<String>,
-    pub date_utc: String,
-    pub rows: usize,
 }
 
 /// The parts of a run description that must agree for results to be merged.
@@ -217,7 +206,7 @@ pub fn sort_like_a_run(rows: &mut [Row], run: &RunDescription) {
     let labels: Vec<String> = run
         .datasets
         .iter()
-        .map(|d| crate::run::dataset_label(d))
+        .map(|d| crate::names::dataset_label(d))
         .collect();
     let viewpoints: Vec<String> = crate::suite::parse_viewpoints(&run.viewpoints)
         .map(|v| v.into_iter().map(|v| v.name).collect())

@@ -108,6 +108,26 @@ fn u_distribution(m: usize, n: usize) -> Vec<f64> {
     std::mem::take(&mut table[m][n])
 }
 
+/// Mean, minimum and maximum over the viewpoints of a group.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spread {
+    pub mean: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+pub fn spread(values: impl Iterator<Item = f64>) -> Option<Spread> {
+    let v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    Some(Spread {
+        mean: v.iter().sum::<f64>() / v.len() as f64,
+        min: v.iter().copied().fold(f64::INFINITY, f64::min),
+        max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    })
+}
+
 /// Holm–Bonferroni step-down adjustment of a family of p-values (`None` stays `None` and is
 /// not counted in the family). `compare` tests 32 groups in the default suite: at α = 0.05
 /// without a correction, 1.6 of them would be called "slower" by chance alone on an unchanged

@@ -7,7 +7,7 @@ use crate::mesh::TetMesh;
 use crate::write_vtu::{vtu_bytes, VtuFormat, VtuOptions};
 
 fn data_file(name: &str) -> Option<std::path::PathBuf> {
-    crate::registry::test_data_file(name)
+    crate::data_dir::test_data_file(name)
 }
 
 fn parse(text: &str) -> Result<Dataset, LoadError> {

@@ -273,7 +273,7 @@ pub fn run_kbuffer(args: KbufferArgs, ctx: &super::Context) -> anyhow::Result<()
         if let Some(s) = worst {
             let path = args
                 .out
-                .join(format!("havs_fig6_{}.png", crate::run::slug(spec)));
+                .join(format!("havs_fig6_{}.png", crate::names::slug(spec)));
             s.k_map_image()
                 .save(&path)
                 .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;

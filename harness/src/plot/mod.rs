@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 
 pub mod bars;
-pub mod cli;
+
 pub mod data;
 pub mod draw;
 pub mod lines;
@@ -304,7 +304,7 @@ mod tests {
         for d in ["box:10k", "box:100k"] {
             let recs: Vec<speed_error::Record> = read_csv(
                 &dir.path()
-                    .join(format!("speed_error_{}.csv", crate::run::slug(d))),
+                    .join(format!("speed_error_{}.csv", crate::names::slug(d))),
             );
             for r in &recs {
                 let t = direct(&rows, &r.algorithm, &r.settings, d, |r| r.tets_per_sec);

@@ -304,12 +304,12 @@ pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<V
             let records = records(&part, book);
             let tets = part.first().map(|p| p.tets).unwrap_or(0);
             let viewpoints = part.iter().map(|p| p.rows).max().unwrap_or(0);
-            let mut stem = format!("speed_error_{}", crate::run::slug(&dataset));
+            let mut stem = format!("speed_error_{}", crate::names::slug(&dataset));
             if many_sizes {
                 stem.push_str(&format!("_{width}x{height}"));
             }
             if !alg.is_empty() {
-                stem.push_str(&format!("_{}", crate::run::slug(&alg)));
+                stem.push_str(&format!("_{}", crate::names::slug(&alg)));
             }
             let title = format!(
                 "Speed vs error — {dataset}{} ({} tets, {width}×{height})",

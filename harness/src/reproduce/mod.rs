@@ -303,7 +303,7 @@ impl Session {
         measured.errors.extend(outcome.errors.iter().cloned());
         for mut row in file.rows {
             if let Some((plan, _)) = self.substitutes.iter().find(|(_, s)| {
-                crate::run::slug(s) == crate::run::slug(&row.dataset) || *s == row.dataset
+                crate::names::slug(s) == crate::names::slug(&row.dataset) || *s == row.dataset
             }) {
                 row.dataset = plan.clone();
             }

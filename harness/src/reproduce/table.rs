@@ -541,7 +541,7 @@ pub fn write_charts(dir: &Path, c: &Comparison) -> anyhow::Result<Vec<String>> {
         if !bars.iter().any(|(_, p, _)| p.is_some()) || !bars.iter().any(|(_, _, o)| o.is_some()) {
             continue;
         }
-        let name = format!("{}_{}.png", c.key, crate::run::slug(&m.name));
+        let name = format!("{}_{}.png", c.key, crate::names::slug(&m.name));
         let path = dir.join(&name);
         let title = format!("{} — {}", c.title, m.name);
         draw_bars(&path, &title, &m.name, &bars)

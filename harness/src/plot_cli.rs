@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use super::data::Inputs;
-use super::Kind;
 use crate::plan::RunPlan;
+use crate::plot::data::Inputs;
+use crate::plot::Kind;
 
 #[derive(Debug, clap::Args)]
 pub struct PlotArgs {
@@ -210,7 +210,7 @@ pub fn run(
         anyhow::bail!("--datasets, --resolution and --no-reference only apply with --sweep");
     }
     let inputs = Inputs::read(&sources)?;
-    let charts = super::write_charts(&args.out, &inputs, args.kind)
+    let charts = crate::plot::write_charts(&args.out, &inputs, args.kind)
         .with_context(|| format!("drawing charts into {}", args.out.display()))?;
     for (k, why) in &charts.skipped {
         eprintln!(
@@ -222,7 +222,7 @@ pub fn run(
         anyhow::bail!("nothing to plot from {} row(s)", inputs.rows.len());
     }
     if !charts.fits.is_empty() {
-        let md = super::scaling::fits_markdown(&charts.fits);
+        let md = crate::plot::scaling::fits_markdown(&charts.fits);
         let path = args.out.join("scaling_fits.md");
         std::fs::write(&path, &md).with_context(|| format!("cannot write {}", path.display()))?;
         print!("{md}");
@@ -231,7 +231,7 @@ pub fn run(
     Ok(())
 }
 
-fn print_files(dir: &Path, files: &[super::ChartFile]) {
+fn print_files(dir: &Path, files: &[crate::plot::ChartFile]) {
     for f in files {
         println!(
             "{}  {}.{{png,svg,csv}}",
