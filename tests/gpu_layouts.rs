@@ -43,10 +43,41 @@ struct Member {
     size: usize,
 }
 
+/// The declarations of `source` a struct's layout can depend on: its `struct`, `const` and
+/// `alias` items. The renderers prepend generated code (the chunked storage accessors of
+/// `render_core::bind::ChunkedBuffer`, `const K`) to their WGSL at pipeline creation, so the
+/// functions of a file alone do not parse; the layout never depends on them.
+fn type_declarations(source: &str) -> String {
+    let mut out = String::new();
+    let mut rest = source;
+    while let Some(i) = ["struct ", "const ", "alias "]
+        .iter()
+        .filter_map(|k| {
+            rest.match_indices(k)
+                .find(|(i, _)| *i == 0 || rest.as_bytes()[i - 1] == b'\n')
+                .map(|(i, _)| i)
+        })
+        .min()
+    {
+        let item = &rest[i..];
+        let end = if item.starts_with("struct ") {
+            item.find('}').map(|e| e + 1)
+        } else {
+            item.find(';').map(|e| e + 1)
+        }
+        .unwrap_or(item.len());
+        out.push_str(&item[..end]);
+        out.push('\n');
+        rest = &item[end..];
+    }
+    out
+}
+
 /// Size and members of WGSL struct `name` in `source`, as naga lays it out.
 fn wgsl_layout(file: &str, source: &str, name: &str) -> (usize, Vec<Member>) {
-    let module = naga::front::wgsl::parse_str(source)
-        .unwrap_or_else(|e| panic!("{file}: {}", e.emit_to_string(source)));
+    let decls = type_declarations(source);
+    let module = naga::front::wgsl::parse_str(&decls)
+        .unwrap_or_else(|e| panic!("{file}: {}", e.emit_to_string(&decls)));
     let gctx = module.to_ctx();
     for (_, ty) in module.types.iter() {
         if ty.name.as_deref() != Some(name) {

@@ -1,7 +1,7 @@
 //! The paper's knobs as typed settings, and the variants the harness runs.
 
 use anyhow::anyhow;
-use render_core::{Renderer, Setting};
+use render_core::Setting;
 
 /// Which pre-integration table composites a segment (§2.2, §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,13 +98,14 @@ impl RaycastSettings {
 /// Peeling-layer limits `--settings layers=…` can choose.
 pub const LAYER_CHOICES: [u32; 4] = [4, 8, 16, 32];
 
-/// The default variants (the default suite runs each, so they are kept to two): the paper's
-/// configuration (5×5 tiles, 2D table, one pass per step, early termination) and the
-/// exact-order image (3D table, no early termination) in the modern looping mode. Every other
-/// combination is reachable with `--settings` (e.g. `tiles=1x1|5x5;table=2d|3d;mode=passes|loop`).
-pub fn default_variants() -> Vec<Box<dyn Renderer>> {
+/// The settings of the default variants (the default suite runs each, so they are kept to
+/// two): the paper's configuration (5×5 tiles, 2D table, one pass per step, early termination)
+/// and the exact-order image (3D table, no early termination) in the modern looping mode. Every
+/// other combination is reachable with `--settings` (e.g.
+/// `tiles=1x1|5x5;table=2d|3d;mode=passes|loop`).
+pub fn default_settings() -> Vec<RaycastSettings> {
     let base = RaycastSettings::default();
-    [
+    vec![
         base,
         RaycastSettings {
             table: TableKind::ThreeD,
@@ -113,26 +114,23 @@ pub fn default_variants() -> Vec<Box<dyn Renderer>> {
             ..base
         },
     ]
-    .into_iter()
-    .map(|s| Box::new(crate::Raycast::new(s)) as Box<dyn Renderer>)
-    .collect()
 }
 
 /// Every combination: tiles 1…6 × table × mode × et × layers.
-pub fn all_variants() -> Vec<Box<dyn Renderer>> {
-    let mut v: Vec<Box<dyn Renderer>> = Vec::new();
+pub fn all_settings() -> Vec<RaycastSettings> {
+    let mut v = Vec::new();
     for tiles in 1..=6 {
         for table in [TableKind::TwoD, TableKind::ThreeD] {
             for mode in [Mode::Passes, Mode::Loop] {
-                for et in [true, false] {
+                for early_termination in [true, false] {
                     for max_layers in LAYER_CHOICES {
-                        v.push(Box::new(crate::Raycast::new(RaycastSettings {
+                        v.push(RaycastSettings {
                             tiles,
                             table,
                             mode,
-                            early_termination: et,
+                            early_termination,
                             max_layers,
-                        })));
+                        });
                     }
                 }
             }
