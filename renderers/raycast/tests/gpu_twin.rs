@@ -254,6 +254,10 @@ fn images_match_the_reference_on_a_non_convex_mesh_in_both_modes_and_across_bind
         "shell:20k 3D table, et=off: {p:.2} dB, counters {:?}",
         stats.counters
     );
+    // Empirical floor, issue 9's acceptance bound for the exact-order 3D table: what remains
+    // is table resolution and f32 (measured 65–99 dB over 14 views at 512² on spx, Blunt Fin
+    // and Post, README). It catches a broken walk or table; single steps are checked exactly
+    // against the CPU twin above, pass counts per pixel too.
     assert!(p >= 45.0, "{p:.2} dB");
     let mut looped = Raycast::new(RaycastSettings {
         mode: Mode::Loop,
@@ -276,6 +280,9 @@ fn images_match_the_reference_on_a_non_convex_mesh_in_both_modes_and_across_bind
         "shell:20k 2D table, et=on: {p2:.2} dB, counters {:?}",
         stats_2d.counters
     );
+    // Empirical floor for the 2D table (fixed-length entries scaled by the segment length)
+    // with early termination at 0.95: an approximation whose error depends on the mesh; on this
+    // smooth shell it stays above 50 dB, so a drop below means the 2D path broke.
     assert!(p2 >= 50.0, "{p2:.2} dB");
 }
 
@@ -297,5 +304,6 @@ fn spx_matches_the_reference() {
         "spx 3D table, et=off: {p:.2} dB, counters {:?}",
         stats.counters
     );
+    // The same empirical floor as on the shell (issue 9's 45 dB for the exact-order image).
     assert!(p >= 45.0, "{p:.2} dB");
 }
