@@ -915,7 +915,9 @@ fn frame_time_problem(f: &FrameStats) -> Option<String> {
     } else if f.cpu_ms > f.total_ms {
         Some(format!("cpu_ms {} > total_ms {}", f.cpu_ms, f.total_ms))
     } else {
-        f.gpu_ms.filter(|g| !ok(*g)).map(|g| format!("gpu_ms = {g}"))
+        f.gpu_ms
+            .filter(|g| !ok(*g))
+            .map(|g| format!("gpu_ms = {g}"))
     }
 }
 
