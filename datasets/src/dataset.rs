@@ -65,3 +65,16 @@ pub struct Dataset {
     /// Where it came from (file path or generator spec).
     pub source: String,
 }
+
+impl Dataset {
+    /// Keeps a regular volume's grid with its mesh ([`TetMesh::source_grid`]) when the mesh's
+    /// points are the grid's points in grid order (every volume split this crate makes), so
+    /// that voxel renderers splat the exact voxels instead of resampling the tets.
+    pub fn attach_grid(&mut self) {
+        if let Some(grid) = &self.volume {
+            if self.mesh.source_grid.is_none() && grid.num_voxels() == self.mesh.num_points() {
+                self.mesh.source_grid = Some(std::sync::Arc::new(grid.clone()));
+            }
+        }
+    }
+}

@@ -6,11 +6,9 @@
 //! * `vol:N` or `vol:NXxNYxNZ` — a sum of seeded compact bumps, normalised to [0, 1], that
 //!   fills about half the box; optional `:eff=COUNT` (exactly COUNT voxels above 0, see below)
 //!   and `:seed=N`.
-//! * `standin:NAME` — stand-ins for the volumes of Grau & Tost's Table 1 (Lobster, Engine,
-//!   BostonTeapot, Aneurism, Bonsai, StagBeetle), which are not available here: the same grid
-//!   dimensions and the same count of effective voxels (voxels above 0, i.e. the selected voxels
-//!   under any transfer function with κ(0) = 0), with a generated field. Only their sizes stand
-//!   in for the originals; their pictures do not.
+//!
+//! The stand-ins for Grau & Tost's Table 1 volumes (`lobster` … `stagbeetle`, also spelled
+//! `standin:NAME`) live with the other stand-ins in [`crate::standins`].
 //!
 //! The field is exactly 0 outside the bumps (each bump is (1 − r²/ρ²)³, C² smooth). With
 //! `eff=COUNT` the field is shifted down so that exactly the COUNT largest voxels stay above 0:
@@ -34,16 +32,6 @@ use crate::TetMesh;
 /// The largest tet split a generated volume may have (16 bytes per tet, plus the checks).
 pub const MAX_VOLUME_TETS: usize = 60_000_000;
 
-/// Grau & Tost 2007, Table 1: name, grid dimensions, effective voxels (as printed: "233K").
-pub const TABLE1_STANDINS: [(&str, [usize; 3], usize); 6] = [
-    ("lobster", [324, 301, 56], 233_000),
-    ("engine", [256, 256, 128], 1_300_000),
-    ("bostonteapot", [256, 256, 178], 4_900_000),
-    ("aneurism", [256, 256, 256], 169_000),
-    ("bonsai", [256, 256, 256], 1_300_000),
-    ("stagbeetle", [832, 832, 494], 13_800_000),
-];
-
 /// A parsed volume spec.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VolumeSpec {
@@ -53,7 +41,7 @@ pub struct VolumeSpec {
     pub seed: u64,
 }
 
-/// Whether `s` names a generated volume (`vol:…`, `standin:…`).
+/// Whether `s` names a generated volume (`vol:…`).
 pub fn is_volume_spec(s: &str) -> bool {
     let head = s
         .split(':')
@@ -61,7 +49,7 @@ pub fn is_volume_spec(s: &str) -> bool {
         .unwrap_or("")
         .trim()
         .to_ascii_lowercase();
-    s.contains(':') && (head == "vol" || head == "standin")
+    s.contains(':') && head == "vol"
 }
 
 fn syntax(expected: &str, found: &str) -> ErrorKind {
@@ -71,25 +59,12 @@ fn syntax(expected: &str, found: &str) -> ErrorKind {
     }
 }
 
-/// Parses `vol:64`, `vol:128x96x64:eff=100k:seed=3`, `standin:lobster`.
+/// Parses `vol:64`, `vol:128x96x64:eff=100k:seed=3`.
 pub fn parse_volume_spec(spec: &str) -> Result<VolumeSpec, ErrorKind> {
     let mut parts = spec.split(':').map(str::trim);
-    let head = parts.next().unwrap_or("").to_ascii_lowercase();
+    parts.next(); // "vol"
     let size = parts.next().unwrap_or("").to_ascii_lowercase();
-    let mut out = if head == "standin" {
-        let (_, dims, eff) = TABLE1_STANDINS
-            .iter()
-            .find(|(n, _, _)| *n == size)
-            .ok_or_else(|| {
-                let names: Vec<&str> = TABLE1_STANDINS.iter().map(|s| s.0).collect();
-                syntax(&format!("a Table 1 volume: {}", names.join(", ")), &size)
-            })?;
-        VolumeSpec {
-            dims: *dims,
-            effective: Some(*eff),
-            seed: 1,
-        }
-    } else {
+    let mut out = {
         let dims: Vec<usize> = size
             .split('x')
             .map(|d| d.parse::<usize>().ok().filter(|&d| (2..=4096).contains(&d)))
@@ -310,19 +285,10 @@ mod tests {
         assert_eq!(s.dims, [16; 3]);
         let s = parse_volume_spec("vol:20x12x8:eff=300:seed=4").unwrap();
         assert_eq!((s.dims, s.effective, s.seed), ([20, 12, 8], Some(300), 4));
-        let s = parse_volume_spec("standin:Lobster").unwrap();
-        assert_eq!((s.dims, s.effective), ([324, 301, 56], Some(233_000)));
-        for bad in [
-            "vol:1",
-            "vol:8x8",
-            "vol:abc",
-            "standin:teapot",
-            "vol:8:eff=9999",
-            "vol:8:x=1",
-        ] {
+        for bad in ["vol:1", "vol:8x8", "vol:abc", "vol:8:eff=9999", "vol:8:x=1"] {
             assert!(parse_volume_spec(bad).is_err(), "{bad}");
         }
-        assert!(is_volume_spec("vol:8") && is_volume_spec("standin:bonsai"));
+        assert!(is_volume_spec("vol:8") && !is_volume_spec("standin:bonsai"));
         assert!(!is_volume_spec("box:1k"));
     }
 

@@ -39,13 +39,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Dataset, LoadError> {
         Format::MetaImage => crate::mhd::read(path, options),
     }?;
     ds.source = path.display().to_string();
-    // A regular volume's mesh is its tet split with the grid's points in grid order: keep the
-    // grid with the mesh, so voxel renderers splat the exact voxels.
-    if let Some(grid) = &ds.volume {
-        if grid.num_voxels() == ds.mesh.num_points() {
-            ds.mesh.source_grid = Some(std::sync::Arc::new(grid.clone()));
-        }
-    }
+    ds.attach_grid();
     Ok(ds)
 }
 

@@ -124,7 +124,7 @@ enum Source {
     File(PathBuf),
     /// A stand-in or `NAME@splitN` ([`crate::standins`]).
     StandIn,
-    /// A generated volume (`vol:N`, `standin:NAME`, [`crate::gen_volume`]).
+    /// A generated volume (`vol:N`, [`crate::gen_volume`]).
     Volume,
 }
 
@@ -182,18 +182,6 @@ impl Registry {
             present: true,
             paper: "regular volume for splatting (Grau & Tost 2007)",
         });
-        for (name, dims, eff) in crate::gen_volume::TABLE1_STANDINS {
-            out.push(Entry {
-                name: format!("standin:{name}"),
-                description: format!(
-                    "generated volume {}×{}×{} with {eff} effective voxels",
-                    dims[0], dims[1], dims[2]
-                ),
-                files: vec![],
-                present: true,
-                paper: "stand-in for a Grau & Tost 2007 Table 1 volume (size only)",
-            });
-        }
         out
     }
 

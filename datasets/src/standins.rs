@@ -189,39 +189,58 @@ pub const STANDINS: &[StandIn] = &[
         name: "teapot",
         recipe: Recipe::Volume { dims: [256, 256, 178], effective: 4_900_000 },
         paper: "splatting Table 1 BostonTeapot (256²×178, 4.9 M effective voxels)",
-        description: "stand-in volume: 256×256×178, exactly 4,900,000 non-empty voxels",
+        description: "stand-in volume: 256×256×178, exactly 4,900,000 non-empty voxels; tets split only the cubes with a non-empty corner",
         generated: true,
     },
     StandIn {
         name: "aneurism",
         recipe: Recipe::Volume { dims: [256, 256, 256], effective: 169_000 },
         paper: "splatting Table 1 Aneurism (256³, 169 K effective voxels)",
-        description: "stand-in volume: 256³, exactly 169,000 non-empty voxels",
+        description: "stand-in volume: 256³, exactly 169,000 non-empty voxels; tets split only the cubes with a non-empty corner",
         generated: true,
     },
     StandIn {
         name: "bonsai",
         recipe: Recipe::Volume { dims: [256, 256, 256], effective: 1_300_000 },
         paper: "splatting Table 1 Bonsai (256³, 1.3 M effective voxels)",
-        description: "stand-in volume: 256³, exactly 1,300,000 non-empty voxels",
+        description: "stand-in volume: 256³, exactly 1,300,000 non-empty voxels; tets split only the cubes with a non-empty corner",
         generated: true,
     },
     StandIn {
         name: "stagbeetle",
         recipe: Recipe::Volume { dims: [832, 832, 494], effective: 13_800_000 },
         paper: "splatting Table 1 StagBeetle (832²×494, 13.8 M effective voxels)",
-        description: "stand-in volume: 832×832×494, exactly 13,800,000 non-empty voxels",
+        description: "stand-in volume: 832×832×494, exactly 13,800,000 non-empty voxels; tets split only the cubes with a non-empty corner",
         generated: true,
     },
 ];
 
-/// A volume's 6-tet mesh is built only up to this many tets (beyond, only the voxel grid is
-/// useful and the loader says so).
+/// A volume's 6-tet split covers every cube up to this many tets; beyond, only the cubes of
+/// the support (see [`volume_tet_mesh`]).
 pub const MAX_VOLUME_MESH_TETS: usize = 60_000_000;
 
-/// The stand-in called `name` (case-insensitive), if any.
+/// The most tets a support split may have: 16 B each, so 2.4 GB of tets, and about twice that
+/// while [`TetMesh::new`] checks their orientation. The largest stand-in (StagBeetle, 13.8 M
+/// effective voxels) stays below it.
+pub const MAX_SUPPORT_MESH_TETS: usize = 150_000_000;
+
+/// Other spellings of stand-ins: the papers' own names where ours are shorter.
+const ALIASES: [(&str, &str); 1] = [("bostonteapot", "teapot")];
+
+/// The stand-in called `name` (case-insensitive, optionally written `standin:NAME`, or by an
+/// alias such as the paper's `BostonTeapot`), if any.
 pub fn find(name: &str) -> Option<&'static StandIn> {
-    STANDINS.iter().find(|s| s.name.eq_ignore_ascii_case(name))
+    let bare = match name.get(..8) {
+        Some(head) if head.eq_ignore_ascii_case("standin:") => &name[8..],
+        _ => name,
+    };
+    let canonical = ALIASES
+        .iter()
+        .find(|(alias, _)| alias.eq_ignore_ascii_case(bare))
+        .map_or(bare, |(_, n)| n);
+    STANDINS
+        .iter()
+        .find(|s| s.name.eq_ignore_ascii_case(canonical))
 }
 
 /// Whether `name` is a generated stand-in (rows on it are marked in reports).
@@ -268,6 +287,7 @@ pub fn resolve(
     Some(build(resolve_base, s, options).map(|mut ds| {
         ds.mesh.name = s.name.to_string();
         ds.source = format!("{} ({})", s.name, s.description);
+        ds.attach_grid();
         ds
     }))
 }
@@ -359,19 +379,8 @@ fn build(
             source: String::new(),
         }),
         Recipe::Volume { dims, effective } => {
-            let cells: usize = dims.iter().map(|d| d - 1).product();
-            if cells * 6 > MAX_VOLUME_MESH_TETS {
-                return Err(err(ErrorKind::Invalid(format!(
-                    "the {}×{}×{} volume would give {} tets (more than {MAX_VOLUME_MESH_TETS}); \
-                     renderers that splat voxels take it from datasets::standins::splat_volume",
-                    dims[0],
-                    dims[1],
-                    dims[2],
-                    cells * 6
-                ))));
-            }
             let grid = splat_volume(dims, effective, seed_of(s.name));
-            let mesh = six_tet_mesh(&grid).map_err(err)?;
+            let mesh = volume_tet_mesh(&grid).map_err(err)?;
             Ok(Dataset {
                 mesh,
                 volume: Some(grid),
@@ -418,8 +427,63 @@ pub fn kuhn_cell_tets(dims: [usize; 3], i: usize, j: usize, k: usize) -> [[u32; 
     })
 }
 
-/// A voxel grid as a tet mesh, 6 tets per cube ([`kuhn_cell_tets`]).
+/// A voxel grid as a tet mesh, 6 tets per cube ([`kuhn_cell_tets`]), every cube.
 pub fn six_tet_mesh(grid: &VoxelGrid) -> Result<TetMesh, ErrorKind> {
+    kuhn_mesh(grid, |_, _, _| true)
+}
+
+/// A generated volume's tet mesh: every cube ([`six_tet_mesh`]) while that stays within
+/// [`MAX_VOLUME_MESH_TETS`]; beyond it only the support, the cubes with a non-zero corner. The
+/// cubes left out hold 0 at all eight corners, so under a transfer function with κ(0) = 0 (the
+/// one that defines a stand-in's effective voxels) both meshes give the same image with the
+/// same camera and optics (a run fits those to the mesh's bounds, so it frames the support;
+/// `tests/roundtrip_generated.rs` checks the images agree). Under one
+/// with κ(0) > 0 the data set *is* the support: the splatter splats only grid points that a tet
+/// uses, so every algorithm still draws the same data. Points stay the whole grid, in grid
+/// order, which is what lets [`TetMesh::source_grid`] stand for them.
+pub fn volume_tet_mesh(grid: &VoxelGrid) -> Result<TetMesh, ErrorKind> {
+    volume_tet_mesh_within(grid, MAX_VOLUME_MESH_TETS)
+}
+
+/// [`volume_tet_mesh`] with the full split's limit as a parameter (0: always the support).
+pub fn volume_tet_mesh_within(grid: &VoxelGrid, full_limit: usize) -> Result<TetMesh, ErrorKind> {
+    let d = grid.dims;
+    let cubes: usize = d.iter().map(|x| x.saturating_sub(1)).product();
+    if cubes * 6 <= full_limit {
+        return six_tet_mesh(grid);
+    }
+    let nonzero = |i: usize, j: usize, k: usize| {
+        (0..8).any(|b| {
+            grid.values[grid.index(i + (b & 1), j + (b >> 1 & 1), k + (b >> 2 & 1))] != 0.0
+        })
+    };
+    let support: usize = (0..d[2] - 1)
+        .into_par_iter()
+        .map(|k| {
+            (0..d[1] - 1)
+                .flat_map(|j| (0..d[0] - 1).map(move |i| (i, j)))
+                .filter(|&(i, j)| nonzero(i, j, k))
+                .count()
+        })
+        .sum();
+    if support * 6 > MAX_SUPPORT_MESH_TETS {
+        return Err(ErrorKind::Invalid(format!(
+            "the {}×{}×{} volume's support split would have {} tets (more than \
+             {MAX_SUPPORT_MESH_TETS})",
+            d[0],
+            d[1],
+            d[2],
+            support * 6
+        )));
+    }
+    kuhn_mesh(grid, nonzero)
+}
+
+/// The 6-tet split of the cubes `keep` accepts, with every grid point a mesh point.
+fn kuhn_mesh(
+    grid: &VoxelGrid,
+    keep: impl Fn(usize, usize, usize) -> bool + Sync,
+) -> Result<TetMesh, ErrorKind> {
     let d = grid.dims;
     let (nx, ny) = (d[0], d[1]);
     let points: Vec<[f32; 3]> = (0..grid.num_voxels())
@@ -433,10 +497,12 @@ pub fn six_tet_mesh(grid: &VoxelGrid) -> Result<TetMesh, ErrorKind> {
     let tets: Vec<[u32; 4]> = (0..c[2])
         .into_par_iter()
         .flat_map_iter(|k| {
-            let mut out = Vec::with_capacity(c[0] * c[1] * 6);
+            let mut out = Vec::new();
             for j in 0..c[1] {
                 for i in 0..c[0] {
-                    out.extend_from_slice(&kuhn_cell_tets(d, i, j, k));
+                    if keep(i, j, k) {
+                        out.extend_from_slice(&kuhn_cell_tets(d, i, j, k));
+                    }
                 }
             }
             out
@@ -708,6 +774,53 @@ mod tests {
                 assert!(!m.is_convex(), "{shape:?}");
             }
         }
+    }
+
+    #[test]
+    fn large_volumes_split_only_their_support() {
+        let g = splat_volume([12, 10, 9], 40, 3);
+        let full = volume_tet_mesh_within(&g, usize::MAX).unwrap();
+        assert_eq!(full.num_tets(), 11 * 9 * 8 * 6);
+        let sparse = volume_tet_mesh_within(&g, 0).unwrap();
+        let support = (0..8)
+            .flat_map(|k| (0..9).flat_map(move |j| (0..11).map(move |i| (i, j, k))))
+            .filter(|&(i, j, k)| {
+                (0..8).any(|b| {
+                    g.values[g.index(i + (b & 1), j + (b >> 1 & 1), k + (b >> 2 & 1))] != 0.0
+                })
+            })
+            .count();
+        assert!(support > 0 && support < 11 * 9 * 8);
+        assert_eq!(sparse.num_tets(), support * 6);
+        // Every grid point stays a mesh point, in grid order, so the grid can stand for them.
+        assert_eq!(sparse.num_points(), g.num_voxels());
+        assert_eq!(
+            sparse.points[g.index(3, 2, 1)],
+            g.point(3, 2, 1).map(|c| c as f32)
+        );
+        assert_eq!(sparse.repair.degenerate_dropped, 0);
+        // Each non-zero voxel is a vertex of some tet of the support.
+        let mut used = vec![false; g.num_voxels()];
+        sparse
+            .tets
+            .iter()
+            .flatten()
+            .for_each(|&v| used[v as usize] = true);
+        assert!(g.values.iter().zip(&used).all(|(&v, &u)| v == 0.0 || u));
+    }
+
+    #[test]
+    fn standins_answer_to_the_papers_spellings() {
+        for name in [
+            "teapot",
+            "standin:teapot",
+            "BostonTeapot",
+            "standin:BostonTeapot",
+        ] {
+            assert_eq!(find(name).map(|s| s.name), Some("teapot"), "{name}");
+        }
+        assert_eq!(find("standin:lobster").map(|s| s.name), Some("lobster"));
+        assert!(find("standin:").is_none() && find("standin:nothing").is_none());
     }
 
     #[test]

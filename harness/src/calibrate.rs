@@ -316,14 +316,6 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
 // Roofline
 // ---------------------------------------------------------------------------------------------
 
-/// A counter of the row (`name=value;…`).
-fn counter(row: &Row, name: &str) -> Option<f64> {
-    row.counters.split(';').find_map(|kv| {
-        let (k, v) = kv.split_once('=')?;
-        (k == name).then(|| v.parse().ok()).flatten()
-    })
-}
-
 fn setting<'a>(row: &'a Row, key: &str) -> Option<&'a str> {
     row.settings.split(';').find_map(|kv| {
         let (k, v) = kv.split_once('=')?;
@@ -336,11 +328,12 @@ fn setting<'a>(row: &'a Row, key: &str) -> Option<&'a str> {
 /// graph (Wylie et al. 2002 §4), fragment PT 4 triangles per tet (Marroquim et al. 2006 §3.2,
 /// `tets·12` vertices), HAVS each unique face once (Callahan et al. 2005 §4, the `faces` counter).
 fn triangles(row: &Row) -> Option<f64> {
-    counter(row, "triangles").or_else(|| match row.algorithm.as_str() {
-        "gator-pt" | "fragment-pt" => Some(4.0 * row.tets as f64),
-        "havs" => counter(row, "faces"),
-        _ => None,
-    })
+    row.counter("triangles")
+        .or_else(|| match row.algorithm.as_str() {
+            "gator-pt" | "fragment-pt" => Some(4.0 * row.tets as f64),
+            "havs" => row.counter("faces"),
+            _ => None,
+        })
 }
 
 /// Keys the row sorts on the CPU per frame (none for the GPU-resident sorts).
@@ -350,7 +343,7 @@ fn cpu_sort_keys(row: &Row) -> Option<f64> {
         return None;
     }
     match row.algorithm.as_str() {
-        "havs" => counter(row, "faces"),
+        "havs" => row.counter("faces"),
         "gator-pt" | "fragment-pt" => Some(row.tets as f64),
         _ => None,
     }
@@ -361,7 +354,7 @@ fn cpu_sort_keys(row: &Row) -> Option<f64> {
 /// and size — a ray through the mesh yields one PT fragment per tet it crosses, i.e. about one
 /// per face crossing, which is what HAVS counts.
 fn fragments(row: &Row, rows: &[Row]) -> Option<f64> {
-    counter(row, "fragments").or_else(|| {
+    row.counter("fragments").or_else(|| {
         rows.iter()
             .filter(|r| {
                 r.algorithm == "havs"
@@ -369,7 +362,7 @@ fn fragments(row: &Row, rows: &[Row]) -> Option<f64> {
                     && r.viewpoint == row.viewpoint
                     && (r.width, r.height) == (row.width, row.height)
             })
-            .find_map(|r| counter(r, "fragments"))
+            .find_map(|r| r.counter("fragments"))
             .filter(|_| matches!(row.algorithm.as_str(), "gator-pt" | "fragment-pt"))
     })
 }

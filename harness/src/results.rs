@@ -116,6 +116,14 @@ pub struct Row {
 }
 
 impl Row {
+    /// A counter of the row (`name=value;…` in `counters`), if present and numeric.
+    pub fn counter(&self, name: &str) -> Option<f64> {
+        self.counters.split(';').find_map(|kv| {
+            let (k, v) = kv.split_once('=')?;
+            (k.trim() == name).then(|| v.trim().parse().ok()).flatten()
+        })
+    }
+
     pub fn ok(&self) -> bool {
         self.error.is_empty()
     }

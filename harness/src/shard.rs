@@ -93,6 +93,27 @@ fn matrix_of(r: &RunDescription) -> RunDescription {
     }
 }
 
+/// The matrix without its algorithms: runs that agree on it but measured other algorithms
+/// (e.g. a slow peer run on its own) complete each other when they ran on one adapter.
+fn matrix_but_algorithms(r: &RunDescription) -> RunDescription {
+    RunDescription {
+        algorithms: vec![],
+        ..matrix_of(r)
+    }
+}
+
+/// The adapter a file's rows ran on (name, driver and — for software adapters — the CPU),
+/// for the same-machine check.
+fn adapter_of(f: &ResultsFile) -> Option<(String, String, String)> {
+    f.machine.adapter.as_ref().map(|a| {
+        (
+            a.name.clone(),
+            a.driver.clone(),
+            f.machine.cpu_model.clone(),
+        )
+    })
+}
+
 /// A row's identity in the matrix (one per adapter: runs of several machines sit side by side).
 fn row_key(r: &Row) -> (String, String, String, String, u32, u32, String) {
     (
@@ -118,17 +139,36 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> anyhow::Result<ResultsFile> {
         .map(|d| ResultsFile::read(d))
         .collect::<anyhow::Result<_>>()?;
     let first = &files[0];
-    let matrix = matrix_of(&first.run);
+    let mut matrix = matrix_of(&first.run);
     for (f, d) in files.iter().zip(dirs).skip(1) {
-        if matrix_of(&f.run) != matrix {
-            anyhow::bail!(
-                "{} was run with a different matrix than {} (algorithms, data sets, viewpoints, \
-                 size, frames, transfer function or settings differ); only shards of one run \
-                 (or the same run on several machines) can be merged",
-                d.display(),
-                dirs[0].display()
-            );
+        if matrix_of(&f.run) == matrix {
+            continue;
         }
+        if matrix_but_algorithms(&f.run) == matrix_but_algorithms(&matrix) {
+            // Complementary algorithms: only meaningful side by side on one adapter.
+            anyhow::ensure!(
+                adapter_of(f) == adapter_of(first),
+                "{} measured other algorithms than {} on another adapter ({:?} vs {:?}); runs of \
+                 different algorithms can be merged only from one machine",
+                d.display(),
+                dirs[0].display(),
+                adapter_of(f),
+                adapter_of(first)
+            );
+            for a in &f.run.algorithms {
+                if !matrix.algorithms.contains(a) {
+                    matrix.algorithms.push(a.clone());
+                }
+            }
+            continue;
+        }
+        anyhow::bail!(
+            "{} was run with a different matrix than {} (data sets, viewpoints, size, frames, \
+             transfer function or settings differ); only shards of one run, the same run on \
+             several machines, or runs of other algorithms on one machine can be merged",
+            d.display(),
+            dirs[0].display()
+        );
     }
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut seen: HashMap<_, PathBuf> = HashMap::new();

@@ -193,3 +193,87 @@ fn merged_shards_equal_one_run_and_compare_finds_no_change() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("calibration"));
 }
+
+/// A slow algorithm (a VTK peer, say) run on its own completes a run of the others: same data
+/// sets, viewpoints, size, frames and transfer function on one machine merge into one matrix.
+#[test]
+fn runs_of_other_algorithms_on_one_machine_merge() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = |s: &str| tmp.path().join(s).to_str().unwrap().to_string();
+    let run = |out: &str, algorithm: &str, viewpoints: &str| {
+        let (o, c) = (p(out), p("cache"));
+        ok(&[
+            "run",
+            "--algorithms",
+            algorithm,
+            "--datasets",
+            "box:1k",
+            "--viewpoints",
+            viewpoints,
+            "--resolution",
+            "16",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+            "--no-report",
+            "--no-calibrate",
+            "--out",
+            &o,
+            "--cache-dir",
+            &c,
+        ]);
+        ResultsFile::read(Path::new(&o)).unwrap()
+    };
+    let gator = run("gator", "gator-pt", "+x");
+    let fpt = run("fpt", "fragment-pt", "+x");
+    ok(&[
+        "report",
+        "--merge",
+        &p("gator"),
+        &p("fpt"),
+        "--out",
+        &p("both"),
+    ]);
+    let both = ResultsFile::read(&tmp.path().join("both")).unwrap();
+    assert_eq!(both.run.algorithms, ["gator-pt", "fragment-pt"]);
+    assert_eq!(both.rows.len(), gator.rows.len() + fpt.rows.len());
+    let mut want: Vec<String> = gator.rows.iter().chain(&fpt.rows).map(untimed).collect();
+    let mut got: Vec<String> = both.rows.iter().map(untimed).collect();
+    want.sort();
+    got.sort();
+    assert_eq!(got, want);
+
+    // Other viewpoints are another matrix: refused, naming both directories.
+    run("other-view", "fragment-pt", "+y");
+    let o = tetbench(&[
+        "report",
+        "--merge",
+        &p("gator"),
+        &p("other-view"),
+        "--out",
+        &p("bad"),
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("different matrix") && err.contains("other-view"),
+        "{err}"
+    );
+
+    // Other algorithms from another machine: refused.
+    let mut elsewhere = fpt.clone();
+    elsewhere.machine.cpu_model = "Some Other CPU".into();
+    std::fs::create_dir_all(tmp.path().join("elsewhere")).unwrap();
+    harness::results::write_json(&tmp.path().join("elsewhere"), &elsewhere).unwrap();
+    let o = tetbench(&[
+        "report",
+        "--merge",
+        &p("gator"),
+        &p("elsewhere"),
+        "--out",
+        &p("bad2"),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("one machine"));
+}

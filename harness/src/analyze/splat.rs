@@ -3,8 +3,8 @@
 //! `splat` rows of a finished run, with the paper's figures (`reports/papers/splat_table1.csv`)
 //! beside ours.
 //!
-//! The paper's six volumes are not available: `standin:NAME` data sets (generated, see
-//! `datasets::gen_volume`) have the same grid dimensions and effective-voxel counts (under a
+//! The paper's six volumes are not available: the stand-ins `lobster` … `stagbeetle` (also
+//! spelled `standin:NAME`; generated, see `datasets::standins`) have the same grid dimensions and effective-voxel counts (under a
 //! transfer function with κ(0) = 0), so only the amount of work stands in, not the pictures.
 //! ironProt and HeadMRVolume are real volumes the paper did not use.
 
@@ -50,13 +50,6 @@ pub fn run(args: Args, _ctx: &super::Context) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn counter(r: &Row, key: &str) -> Option<f64> {
-    r.counters.split(';').find_map(|kv| {
-        let (k, v) = kv.split_once('=')?;
-        (k.trim() == key).then(|| v.trim().parse().ok()).flatten()
-    })
-}
-
 fn setting<'a>(r: &'a Row, key: &str) -> Option<&'a str> {
     r.settings.split(';').find_map(|kv| {
         let (k, v) = kv.split_once('=')?;
@@ -83,10 +76,13 @@ fn fmt(v: Option<f64>, digits: usize) -> String {
     v.map_or("–".into(), |x| format!("{x:.digits$}"))
 }
 
-/// The paper's row for a data set name (`standin:lobster` ↔ Lobster).
+/// The paper's row for a stand-in's data set name (`lobster`, `standin:lobster`, `teapot` ↔
+/// BostonTeapot): both sides go through the stand-ins' own name lookup.
 fn paper_row<'a>(paper: &'a [PaperRow], dataset: &str) -> Option<&'a PaperRow> {
-    let name = dataset.strip_prefix("standin:")?;
-    paper.iter().find(|p| p.dataset.eq_ignore_ascii_case(name))
+    let ours = datasets::standins::find(dataset)?;
+    paper
+        .iter()
+        .find(|p| datasets::standins::find(&p.dataset).is_some_and(|s| s.name == ours.name))
 }
 
 /// One line of our table.
@@ -141,9 +137,9 @@ pub fn lines(rows: &[Row]) -> Vec<Line> {
             };
             let first = g[0];
             let dims = match (
-                counter(first, "grid_x"),
-                counter(first, "grid_y"),
-                counter(first, "grid_z"),
+                first.counter("grid_x"),
+                first.counter("grid_y"),
+                first.counter("grid_z"),
             ) {
                 (Some(x), Some(y), Some(z)) => Some([x as u64, y as u64, z as u64]),
                 _ => None,
@@ -152,12 +148,12 @@ pub fn lines(rows: &[Row]) -> Vec<Line> {
                 dataset,
                 settings,
                 dims,
-                effective: counter(first, "effective_voxels"),
+                effective: first.counter("effective_voxels"),
                 cpu_fps: fps("cpu", None),
                 gpu_fps: fps("gpu", Some("bitonic")).or_else(|| fps("gpu", Some("radix"))),
                 gpu_radix_fps: fps("gpu", Some("radix")),
                 psnr: mean(g.iter().filter_map(|r| r.psnr_db)),
-                bytes_per_voxel: counter(first, "bytes_per_voxel"),
+                bytes_per_voxel: first.counter("bytes_per_voxel"),
             }
         })
         .collect()
@@ -303,6 +299,8 @@ mod tests {
         assert_eq!(p[0].dataset, "Lobster");
         assert!((p[0].gpu_buckets_fps / p[0].cpu_buckets_fps - 2.68).abs() < 0.01);
         assert!(paper_row(&p, "standin:stagbeetle").is_some());
+        assert_eq!(paper_row(&p, "teapot").unwrap().dataset, "BostonTeapot");
+        assert_eq!(paper_row(&p, "lobster").unwrap().dataset, "Lobster");
         assert!(paper_row(&p, "ironprot").is_none());
     }
 }

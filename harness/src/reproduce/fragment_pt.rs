@@ -66,6 +66,7 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
             datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
             viewpoints: "orbit:14".into(),
             resolution: 512,
+            tf: None,
             settings: Some(FRAGMENT_SETTINGS.into()),
         },
         &mut m,
@@ -79,25 +80,13 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
                 datasets: vec!["bluntfin".into(), "post".into()],
                 viewpoints: "orbit:14".into(),
                 resolution: 512,
+                tf: None,
                 settings: (!settings.is_empty()).then(|| settings.to_string()),
             },
             &mut m,
         )?;
     }
     Ok(tables(&m, &x))
-}
-
-/// A counter of the first row of `algorithm` on `dataset` (`name=value` in `counters`).
-fn counter(m: &Measured, algorithm: &str, dataset: &str, name: &str) -> Option<f64> {
-    m.rows
-        .iter()
-        .filter(|r| r.algorithm == algorithm && r.dataset == dataset)
-        .find_map(|r| {
-            r.counters.split(';').find_map(|kv| {
-                let (k, v) = kv.split_once('=')?;
-                (k.trim() == name).then(|| v.trim().parse().ok()).flatten()
-            })
-        })
 }
 
 fn want(settings: &str) -> Vec<(&str, &str)> {
@@ -138,7 +127,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
                 cell("tets_per_sec", tps),
             ],
         });
-        let model = counter(m, "fragment-pt", d, "model_bytes_per_tet");
+        let model = m.counter("fragment-pt", d, "model_bytes_per_tet");
         let layout = size.map(|s| 16.0 + 16.0 * s.1 as f64 / s.2 as f64);
         bytes_rows.push(CompRow {
             label: format!("{paper} ({d})"),

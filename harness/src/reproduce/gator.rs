@@ -80,6 +80,7 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
             datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
             viewpoints: "14".into(),
             resolution: 512,
+            tf: None,
             settings: Some("variant=constant|linear".into()),
         },
         &mut m,

@@ -110,6 +110,8 @@ pub struct RunSpec {
     /// Viewpoints in the full run (the quick run uses [`QUICK_VIEWPOINTS`]).
     pub viewpoints: String,
     pub resolution: u32,
+    /// The transfer function (a preset name); `None` is the suite's `low-opacity`.
+    pub tf: Option<&'static str>,
     pub settings: Option<String>,
 }
 
@@ -135,6 +137,14 @@ pub struct Measured {
 impl Measured {
     pub fn aggregates(&self) -> Vec<Aggregate> {
         aggregate(&self.rows)
+    }
+
+    /// A counter of the first row of `algorithm` on `dataset` that has it.
+    pub fn counter(&self, algorithm: &str, dataset: &str, name: &str) -> Option<f64> {
+        self.rows
+            .iter()
+            .filter(|r| r.algorithm == algorithm && r.dataset == dataset)
+            .find_map(|r| r.counter(name))
     }
 
     /// Why `algorithm` has no value on `dataset`: not built, a failed row's error, a data set
@@ -243,7 +253,7 @@ impl Session {
             datasets: datasets.clone(),
             viewpoints: Some(viewpoints.clone()),
             resolution: Some(self.resolution(spec.resolution)),
-            tf: "low-opacity".into(),
+            tf: spec.tf.unwrap_or("low-opacity").into(),
             frames: Some(if self.quick {
                 QUICK_FRAMES
             } else {
@@ -268,10 +278,11 @@ impl Session {
             peers: vec![],
         };
         let command = format!(
-            "tetbench run --algorithms {} --datasets {} --viewpoints {viewpoints} --resolution {}{}{}",
+            "tetbench run --algorithms {} --datasets {} --viewpoints {viewpoints} --resolution {}{}{}{}",
             algorithms.join(","),
             datasets.join(","),
             self.resolution(spec.resolution),
+            spec.tf.map(|t| format!(" --tf {t}")).unwrap_or_default(),
             spec.settings
                 .as_ref()
                 .map(|s| format!(" --settings '{s}'"))

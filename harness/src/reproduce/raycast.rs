@@ -38,6 +38,7 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
             resolution: 512,
             // The paper's configuration only: one pass per ray step (§2.3) and early ray
             // termination as in its code (opacity 0.95). Our `mode=loop` is not in its tables.
+            tf: None,
             settings: Some(format!(
                 "tiles={};table=2d|3d;mode=passes;et=on",
                 TILINGS.join("|")

@@ -137,7 +137,7 @@ pub enum TransferError {
 }
 
 /// Names accepted by [`TransferFunction::preset`], the default first.
-pub const PRESET_NAMES: [&str; 2] = ["low-opacity", "high-opacity"];
+pub const PRESET_NAMES: [&str; 3] = ["low-opacity", "high-opacity", "zero-floor"];
 
 /// Default scale K of the ParaView opacity mapping κ = o·K (see
 /// [`TransferFunction::from_paraview_json`]): K is the bounding-box diagonal over ParaView's
@@ -166,13 +166,23 @@ impl TransferFunction {
     ///   half of the light behind it.
     /// * `high-opacity`: the same colours with ten times the extinction (2 … 50 per diagonal):
     ///   rays saturate within a few cells, which exercises early ray termination.
+    /// * `zero-floor`: `low-opacity` with κ(0) = 0, so a voxel of value 0 (the scalar range's
+    ///   minimum) is empty: the splatter's effective voxels are then exactly the non-zero ones,
+    ///   which is how the Table 1 stand-ins of Grau & Tost are counted (§5).
     pub fn preset(name: &str) -> Option<TransferFunction> {
-        let kappa_low = [(0.0, 0.2), (0.25, 0.8), (0.5, 1.5), (0.75, 3.0), (1.0, 5.0)];
-        let scale = match name {
-            "low-opacity" => 1.0,
-            "high-opacity" => 10.0,
+        let (scale, floor) = match name {
+            "low-opacity" => (1.0, 0.2),
+            "high-opacity" => (10.0, 0.2),
+            "zero-floor" => (1.0, 0.0),
             _ => return None,
         };
+        let kappa_low = [
+            (0.0, floor),
+            (0.25, 0.8),
+            (0.5, 1.5),
+            (0.75, 3.0),
+            (1.0, 5.0),
+        ];
         Some(TransferFunction {
             name: name.to_string(),
             color: RAINBOW
