@@ -156,6 +156,8 @@ impl Pipelines {
                 storage(1, wgpu::ShaderStages::VERTEX, true),
                 storage(2, wgpu::ShaderStages::FRAGMENT, true),
                 float_texture(3),
+                // Fragments dropped by early splat elimination (counted, not timed).
+                storage(4, wgpu::ShaderStages::FRAGMENT, false),
             ],
         );
         let slab_layout = layout(

@@ -171,6 +171,8 @@ struct State {
     vals: wgpu::Buffer,
     sorted: wgpu::Buffer,
     ends: wgpu::Buffer,
+    /// One u32: splat fragments dropped by early splat elimination this frame.
+    ese_dropped: wgpu::Buffer,
     radix: Option<GpuRadixSort>,
     cpu: buckets::CpuBuckets,
     max_slabs: u32,
@@ -485,6 +487,7 @@ impl Splat {
                     binding: 3,
                     resource: wgpu::BindingResource::TextureView(&t.image_view),
                 },
+                entry(4, &st.ese_dropped),
             ],
         });
         let slab_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -726,6 +729,13 @@ impl Renderer for Splat {
             max_slabs as u64 * 4,
             storage | wgpu::BufferUsages::COPY_SRC,
         )?;
+        let ese_dropped = ledger.buffer(
+            gpu,
+            "splat early-elimination count",
+            Lifetime::PerFrame,
+            4,
+            storage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        )?;
         let radix = if gpu_side && s.sort == GpuSort::Radix {
             Some(GpuRadixSort::new(gpu, largest as u32, &mut ledger)?)
         } else {
@@ -747,6 +757,7 @@ impl Renderer for Splat {
             vals,
             sorted,
             ends,
+            ese_dropped,
             radix,
             cpu: Default::default(),
             max_slabs,
@@ -783,6 +794,7 @@ impl Renderer for Splat {
         let t = self.targets.as_ref().unwrap();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         st.timer.begin(&mut enc);
+        enc.clear_buffer(&st.ese_dropped, 0, None);
         color_pass(&mut enc, "splat clear", &t.image_view, true, true, None);
         clock.submit(gpu, [enc.finish()]);
         let mut stats = BrickStats::default();
@@ -805,6 +817,12 @@ impl Renderer for Splat {
         ]);
         let total_ms = times.total_ms;
         let gpu_ms = st.timer.gpu_ms(gpu)?;
+        // Counter readback, after the timed frame.
+        let ese_dropped = u32::from_le_bytes(
+            gpu.read_buffer(&st.ese_dropped, 0, 4)?[..4]
+                .try_into()
+                .expect("4 bytes read"),
+        );
         let eff = st.set.voxels.len() as f64;
         let t = self.targets.as_ref().unwrap();
         Ok(times.stats(
@@ -821,6 +839,9 @@ impl Renderer for Splat {
                 ("border_voxels".into(), st.set.border_voxels as f64),
                 ("slabs".into(), stats.slabs as f64),
                 ("splats".into(), stats.splats as f64),
+                // Early splat elimination drops these; each pixel it touches is already at
+                // least ESE_ALPHA opaque, so it changes that pixel by at most 1 − ESE_ALPHA.
+                ("ese_dropped_fragments".into(), ese_dropped as f64),
                 (
                     "bytes_per_voxel".into(),
                     if eff > 0.0 {

@@ -10,6 +10,8 @@ struct Slab {
 @group(0) @binding(1) var<storage, read> sorted_in: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> table: array<f32>;
 @group(0) @binding(3) var image_tex: texture_2d<f32>;
+// Splat fragments early splat elimination dropped (the row's `ese_dropped_fragments`).
+@group(0) @binding(4) var<storage, read_write> ese_dropped: atomic<u32>;
 @group(1) @binding(0) var<uniform> slab: Slab;
 
 struct SplatOut {
@@ -87,6 +89,7 @@ fn splat_fs(in: SplatOut) -> @location(0) vec4<f32> {
     if (fr.ese_alpha <= 1.0) {
         let a = textureLoad(image_tex, vec2<i32>(in.pos.xy), 0).a;
         if (a >= fr.ese_alpha) {
+            atomicAdd(&ese_dropped, 1u);
             discard;
         }
     }

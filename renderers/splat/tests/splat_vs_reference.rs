@@ -264,3 +264,37 @@ fn resampled_mesh_is_close_to_the_reference() {
     // cost tens of dB.
     assert!(p > 31.0, "{p:.2} dB");
 }
+
+/// Early splat elimination drops splat fragments behind pixels already at least `ESE_ALPHA`
+/// opaque, and counts them: with `ese=off` nothing is dropped; with it on, under a
+/// high-opacity transfer function, fragments are dropped and no channel moves by more than
+/// the transmittance left behind such a pixel, 1 − ESE_ALPHA (premultiplied colour ≤ 1).
+#[test]
+fn early_splat_elimination_counts_what_it_drops() {
+    let gpu = gpu();
+    let mesh = volume("vol:24");
+    let optics = Optics::for_mesh(TransferFunction::preset("high-opacity").unwrap(), &mesh);
+    let cam = camera(&mesh, "+x+y+z", [1.0, 1.0, 1.0], Projection::default(), 64);
+    let frame = |ese: bool| {
+        let mut r = Splat::new(SplatSettings {
+            ese,
+            ..Default::default()
+        });
+        r.prepare(&gpu, &mesh, &optics).unwrap();
+        let stats = r.render(&gpu, &cam).unwrap();
+        let dropped = stats
+            .counters
+            .iter()
+            .find(|(k, _)| k == "ese_dropped_fragments")
+            .map(|(_, v)| *v)
+            .expect("ese_dropped_fragments counter");
+        (r.read_image(&gpu).unwrap(), dropped)
+    };
+    let (on, dropped_on) = frame(true);
+    let (off, dropped_off) = frame(false);
+    assert_eq!(dropped_off, 0.0);
+    assert!(dropped_on > 0.0, "nothing dropped: is any pixel opaque?");
+    let d = max_diff(&on, &off);
+    eprintln!("ese: {dropped_on} fragments dropped, largest channel change {d:.2e}");
+    assert!(d <= 1.0 - splat::ESE_ALPHA + 1e-5, "{d}");
+}
