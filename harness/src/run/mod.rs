@@ -1,0 +1,501 @@
+//! The run loop: every data set × algorithm variant × viewpoint, measured and compared with the
+//! exact reference, each row written the moment it is done.
+//!
+//! Per data set the mesh is loaded once and each renderer prepares it once; per viewpoint the
+//! renderer draws `warmup` untimed frames, then `frames` timed ones, then its image is read back
+//! (outside the timing) and compared with the reference. A failure in one row (out of GPU
+//! memory, a device error, even a panic in a renderer) is recorded in that row and the run goes
+//! on; finished rows are never lost.
+
+use std::collections::HashMap;
+use std::io::IsTerminal;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{anyhow, Context};
+use datasets::TetMesh;
+use indicatif::{ProgressBar, ProgressStyle};
+use render_core::{
+    settings_string, Camera, FrameStats, Gpu, Image, Optics, Projection, Renderer,
+    TransferFunction, Viewpoint,
+};
+
+pub use crate::names::{dataset_label, slug, viewpoint_slug};
+
+use crate::algorithms::SettingsFilter;
+use crate::machine::MachineInfo;
+use crate::metrics::{self, summarize};
+use crate::results::{ResultsWriter, Row, RunDescription};
+
+mod measure;
+use measure::DatasetContext;
+
+/// Everything a run needs, already parsed and checked.
+#[derive(Debug, Clone)]
+pub struct RunConfig {
+    pub algorithms: Vec<String>,
+    pub datasets: Vec<String>,
+    pub viewpoint_spec: String,
+    pub viewpoints: Vec<Viewpoint>,
+    pub width: u32,
+    pub height: u32,
+    pub frames: u32,
+    pub warmup: u32,
+    /// Passes over a data set's variants: each pass renders `warmup` + `frames` per viewpoint
+    /// of every variant in turn, so a row's samples come from `rounds` separate moments
+    /// (see [`DatasetContext::run_variants`]). 1: each variant runs alone, then is dropped.
+    pub rounds: u32,
+    pub tf_spec: String,
+    pub tf: TransferFunction,
+    pub projection: Projection,
+    pub out: PathBuf,
+    pub data_dir: Option<PathBuf>,
+    /// Where reference images are cached between runs.
+    pub cache_dir: PathBuf,
+    /// Compare with the reference (and write heatmaps); off with `--no-reference`.
+    pub reference: bool,
+    pub settings_filter: SettingsFilter,
+    pub scalar: Option<String>,
+    pub command_line: Vec<String>,
+    /// Write the HTML report and charts at the end.
+    pub report: bool,
+    /// Make suspect rows ([`crate::suspect`]) an error (non-zero exit), for CI.
+    pub strict: bool,
+    /// Run only this part of the matrix (`--shard i/N`, see [`crate::shard`]).
+    pub shard: Option<crate::shard::Shard>,
+    /// Calibrate the backend (or reuse the cached figures) and add the roofline columns.
+    pub calibrate: bool,
+}
+
+/// Makes the variants of an algorithm by name (normally
+/// [`crate::algorithms::selected_variants`] with the run's filter; tests pass their own).
+pub type VariantFactory<'a> = &'a dyn Fn(&str) -> anyhow::Result<Vec<Box<dyn Renderer>>>;
+
+/// What a finished run produced.
+#[derive(Debug, Clone, Default)]
+pub struct RunOutcome {
+    pub rows: usize,
+    pub failed_rows: usize,
+    /// Rows whose image error is out of line with the others on the same image
+    /// ([`crate::suspect`]): measured, but probably a renderer defect.
+    pub suspect_rows: Vec<String>,
+    /// Failures that are not one row (a data set that did not load, a missing reference).
+    pub errors: Vec<String>,
+    pub seconds: f64,
+}
+
+impl RunOutcome {
+    pub fn all_ok(&self) -> bool {
+        self.failed_rows == 0 && self.errors.is_empty()
+    }
+}
+
+fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        s.to_string()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".into()
+    }
+}
+
+/// Runs `f`, turning a panic into an error so one faulty row cannot end the run.
+fn guarded<T>(what: &str, f: impl FnOnce() -> anyhow::Result<T>) -> anyhow::Result<T> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(r) => r,
+        Err(p) => Err(anyhow!("{what} panicked: {}", panic_message(p))),
+    }
+}
+
+/// Progress bar on a terminal, plain log lines otherwise (CI logs, pipes).
+struct Progress {
+    bar: Option<ProgressBar>,
+    done: u64,
+    total: u64,
+}
+
+impl Progress {
+    fn new(total: u64) -> Progress {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let b = ProgressBar::new(total);
+            b.set_style(
+                ProgressStyle::with_template(
+                    "{elapsed_precise} [{bar:30}] {pos}/{len} rows  {msg}",
+                )
+                .expect("valid template")
+                .progress_chars("=> "),
+            );
+            b
+        });
+        Progress {
+            bar,
+            done: 0,
+            total,
+        }
+    }
+
+    fn status(&self, msg: &str) {
+        match &self.bar {
+            Some(b) => b.set_message(msg.to_string()),
+            None => eprintln!("tetbench: {msg}"),
+        }
+    }
+
+    /// Shows what is being measured on the bar only (log mode prints one line per row).
+    fn activity(&self, msg: &str) {
+        if let Some(b) = &self.bar {
+            b.set_message(msg.to_string());
+        }
+    }
+
+    fn log(&self, line: &str) {
+        match &self.bar {
+            Some(b) => b.println(line),
+            None => eprintln!("{line}"),
+        }
+    }
+
+    fn row(&mut self, line: &str) {
+        self.done += 1;
+        match &self.bar {
+            Some(b) => {
+                b.println(line);
+                b.inc(1);
+            }
+            None => eprintln!("[{}/{}] {line}", self.done, self.total),
+        }
+    }
+
+    fn skip(&mut self, n: u64) {
+        self.done += n;
+        if let Some(b) = &self.bar {
+            b.inc(n);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+fn projection_name(p: &Projection) -> String {
+    match p {
+        Projection::Perspective { fovy_deg } => format!("perspective{fovy_deg}"),
+        Projection::Orthographic => "orthographic".into(),
+    }
+}
+
+/// The variants of every asked-for algorithm that pass the settings filter, checked before any
+/// work starts: unknown algorithms, unknown filter keys and filters that leave nothing are
+/// errors here, not after an hour of measuring.
+fn plan_variants(
+    config: &RunConfig,
+    factory: VariantFactory,
+) -> anyhow::Result<Vec<(String, usize)>> {
+    let mut all_settings = vec![];
+    let mut kept = vec![];
+    for name in &config.algorithms {
+        let variants = factory(name)?;
+        let n = variants
+            .iter()
+            .filter(|r| config.settings_filter.accepts(&r.settings()))
+            .count();
+        all_settings.extend(variants.iter().map(|r| r.settings()));
+        // The filter may have selected nothing of this algorithm; its keys still exist.
+        if let Ok(defaults) = crate::algorithms::variants(name) {
+            all_settings.extend(defaults.iter().map(|r| r.settings()));
+        }
+        kept.push((name.clone(), n));
+    }
+    let unknown = config.settings_filter.unknown_keys(&all_settings);
+    if !unknown.is_empty() {
+        let mut keys: Vec<&str> = all_settings.iter().flatten().map(|s| s.key).collect();
+        keys.sort();
+        keys.dedup();
+        anyhow::bail!(
+            "--settings: no algorithm has the setting(s) {}; known: {}",
+            unknown.join(", "),
+            keys.join(", ")
+        );
+    }
+    // A value no variant of an asked-for algorithm has is a typo that would silently drop the
+    // algorithm from the run (issue 18): refuse it, naming what the algorithm offers. An
+    // algorithm without the key at all keeps its defaults.
+    for (name, n) in &kept {
+        let Ok(all) = crate::algorithms::all_variants(name) else {
+            continue; // not in the table (tests pass their own factories)
+        };
+        let offered: Vec<render_core::Setting> = all.iter().flat_map(|r| r.settings()).collect();
+        for (key, values) in &config.settings_filter.terms {
+            let mut has: Vec<&str> = vec![];
+            for s in offered.iter().filter(|s| s.key == key) {
+                if !has.contains(&s.value.as_str()) {
+                    has.push(&s.value);
+                }
+            }
+            if has.is_empty() {
+                continue;
+            }
+            let unknown: Vec<&str> = values
+                .iter()
+                .map(String::as_str)
+                .filter(|v| !has.contains(v))
+                .collect();
+            if !unknown.is_empty() {
+                anyhow::bail!(
+                    "--settings {key}={}: {name} has no variant with {key}={}; it offers {key}={}",
+                    values.join("|"),
+                    unknown.join("|"),
+                    has.join("|")
+                );
+            }
+        }
+        if *n == 0 {
+            let variants: Vec<String> =
+                all.iter().map(|r| settings_string(&r.settings())).collect();
+            anyhow::bail!(
+                "--settings {} leaves no variant of {name} to run: each value exists, but no \
+                 variant combines them; its variants are:\n  {}",
+                config.settings_filter,
+                variants.join("\n  ")
+            );
+        }
+    }
+    if kept.iter().all(|(_, n)| *n == 0) {
+        anyhow::bail!(
+            "--settings {} leaves no variant of {} to run",
+            config.settings_filter,
+            config.algorithms.join(", ")
+        );
+    }
+    Ok(kept)
+}
+
+/// Checks every data set name before anything is measured, so that a typo fails at once with
+/// what to do instead of after the other data sets' rows.
+fn check_datasets(config: &RunConfig) -> anyhow::Result<()> {
+    let registry = datasets::registry::Registry::new(config.data_dir.clone());
+    let problems: Vec<String> = config
+        .datasets
+        .iter()
+        .filter_map(|spec| registry.check(spec).err().map(|e| format!("  {spec}: {e}")))
+        .collect();
+    if !problems.is_empty() {
+        anyhow::bail!(
+            "--datasets: {} of {} cannot be used, nothing was measured:\n{}\n\
+             (`tetbench datasets list` shows the named data sets and generators; named ones are \
+             read from the data directory: --data-dir DIR or TETBENCH_DATA)",
+            problems.len(),
+            config.datasets.len(),
+            problems.join("\n")
+        );
+    }
+    Ok(())
+}
+
+/// Runs the whole plan, writing `results.csv`, `results.json`, images and (if asked) the
+/// report into `config.out`.
+pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOutcome> {
+    let started = Instant::now();
+    let plan = plan_variants(config, factory)?;
+    check_datasets(config)?;
+    let variants_total: usize = plan.iter().map(|(_, n)| n).sum();
+
+    let gpu = Gpu::new()?;
+    let mut machine = MachineInfo::collect();
+    machine.adapter = Some(gpu.adapter.clone());
+    if config.calibrate {
+        let t0 = Instant::now();
+        let (cal, cached) =
+            crate::calibrate::cached_or_measure(&gpu, &machine, &config.cache_dir, false)
+                .context("calibrating the backend (skip with --no-calibrate)")?;
+        if !cached {
+            eprintln!(
+                "tetbench: calibrated the backend in {:.1} s (cached for later runs)",
+                t0.elapsed().as_secs_f64()
+            );
+        }
+        machine.calibration = Some(cal);
+    }
+    // The (data set, algorithm, settings) units this shard runs; `None`: all.
+    let shard_units = match config.shard {
+        Some(shard) => Some(crate::shard::select(shard, &matrix_units(config, factory)?)),
+        None => None,
+    };
+    let in_shard = |label: &str, alg: &str, settings: &str| {
+        shard_units
+            .as_ref()
+            .is_none_or(|u| u.contains(&(label.to_string(), alg.to_string(), settings.to_string())))
+    };
+    let description = RunDescription {
+        command_line: config.command_line.clone(),
+        algorithms: config.algorithms.clone(),
+        datasets: config.datasets.clone(),
+        viewpoints: config.viewpoint_spec.clone(),
+        width: config.width,
+        height: config.height,
+        frames: config.frames,
+        warmup: config.warmup,
+        rounds: config.rounds,
+        transfer_function: config.tf_spec.clone(),
+        projection: projection_name(&config.projection),
+        settings_filter: config.settings_filter.to_string(),
+        reference: config.reference,
+        shard: config.shard.map(|s| s.to_string()),
+        merged_from: vec![],
+    };
+    let mut writer = ResultsWriter::create(&config.out, machine, description)?;
+    let units_total = match &shard_units {
+        Some(u) => u.len(),
+        None => config.datasets.len() * variants_total,
+    };
+    let mut progress = Progress::new((units_total * config.viewpoints.len()) as u64);
+    progress.log(&format!(
+        "tetbench: {} on {} ({}, {}); writing {}",
+        config.algorithms.join(","),
+        gpu.adapter.name,
+        gpu.adapter.backend,
+        gpu.adapter.device_type,
+        config.out.display()
+    ));
+
+    let registry = datasets::registry::Registry::new(config.data_dir.clone());
+    let load_options = datasets::LoadOptions {
+        scalar: config.scalar.clone(),
+        ..Default::default()
+    };
+    let mut outcome = RunOutcome::default();
+
+    for spec in &config.datasets {
+        let label = dataset_label(spec);
+        if shard_units
+            .as_ref()
+            .is_some_and(|u| !u.iter().any(|(d, _, _)| *d == label))
+        {
+            continue; // nothing of this data set in this shard
+        }
+        progress.status(&format!("loading {label}"));
+        let t0 = Instant::now();
+        let dataset = match guarded("loading", || {
+            registry
+                .resolve(spec, &load_options)
+                .map_err(|e| anyhow!("{e}"))
+        }) {
+            Ok(d) => d,
+            Err(e) => {
+                let msg = format!("data set {spec:?} could not be loaded: {e:#}");
+                progress.log(&format!("ERROR: {msg}"));
+                writer.push_error(msg.clone())?;
+                outcome.errors.push(msg);
+                let units = match &shard_units {
+                    Some(u) => u.iter().filter(|(d, _, _)| *d == label).count(),
+                    None => variants_total,
+                };
+                progress.skip((units * config.viewpoints.len()) as u64);
+                continue;
+            }
+        };
+        let mesh = dataset.mesh;
+        progress.log(&format!(
+            "{label}: {} points, {} tets (loaded in {:.2} s)",
+            mesh.num_points(),
+            mesh.num_tets(),
+            t0.elapsed().as_secs_f64()
+        ));
+        let optics = Optics::for_mesh(config.tf.clone(), &mesh);
+        let mut ctx = DatasetContext::new(config, &gpu, &mesh, &optics, label.clone());
+        let mut renderers = vec![];
+        for (name, _) in &plan {
+            renderers.extend(factory(name)?.into_iter().filter(|r| {
+                config.settings_filter.accepts(&r.settings())
+                    && in_shard(&label, name, &settings_string(&r.settings()))
+            }));
+        }
+        if config.rounds <= 1 {
+            // One variant at a time: its GPU memory is freed before the next one prepares.
+            for renderer in renderers {
+                ctx.run_variants(vec![renderer], &mut writer, &mut progress, &mut outcome)?;
+            }
+        } else {
+            ctx.run_variants(renderers, &mut writer, &mut progress, &mut outcome)?;
+        }
+    }
+    progress.finish();
+    crate::suspect::mark_all(&mut writer.file.rows);
+    outcome.suspect_rows = writer
+        .file
+        .rows
+        .iter()
+        .filter(|r| !r.suspect.is_empty())
+        .map(|r| {
+            format!(
+                "{} {} on {} {}: {}",
+                r.algorithm, r.settings, r.dataset, r.viewpoint, r.suspect
+            )
+        })
+        .collect();
+    if let Some(cal) = writer.file.machine.calibration.clone() {
+        crate::calibrate::annotate(&mut writer.file.rows, &cal);
+    }
+    // Columns only known once every row is in (suspect flags, roofline): both files again.
+    writer.rewrite_all()?;
+    writer.finish()?;
+    outcome.rows = writer.file.rows.len();
+    if config.report {
+        crate::report::write(&config.out, &writer.file).context("writing the report")?;
+    }
+    outcome.seconds = started.elapsed().as_secs_f64();
+    Ok(outcome)
+}
+
+/// Every (data set, algorithm, settings) of the run, for `--shard`.
+fn matrix_units(
+    config: &RunConfig,
+    factory: VariantFactory,
+) -> anyhow::Result<Vec<crate::shard::Unit>> {
+    let mut units = vec![];
+    for spec in &config.datasets {
+        for name in &config.algorithms {
+            for r in factory(name)?
+                .iter()
+                .filter(|r| config.settings_filter.accepts(&r.settings()))
+            {
+                units.push((
+                    dataset_label(spec),
+                    name.clone(),
+                    settings_string(&r.settings()),
+                ));
+            }
+        }
+    }
+    Ok(units)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slugs_keep_viewpoints_distinct_and_paths_safe() {
+        assert_eq!(slug("box:20k"), "box_20k");
+        assert_eq!(viewpoint_slug("+x+y-z"), "pxpymz");
+        assert_ne!(viewpoint_slug("+x"), viewpoint_slug("-x"));
+        assert_eq!(slug("gator-pt"), "gator-pt");
+        assert_eq!(
+            slug("variant=linear;sort=radix"),
+            "variant_linear_sort_radix"
+        );
+        assert_eq!(slug("../etc"), ".._etc");
+        assert_eq!(slug(".."), "_..");
+    }
+
+    #[test]
+    fn labels() {
+        assert_eq!(dataset_label("spx"), "spx");
+        assert_eq!(dataset_label("/data/x/spx.vtk"), "spx.vtk");
+    }
+}
