@@ -316,13 +316,6 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
 // Roofline
 // ---------------------------------------------------------------------------------------------
 
-fn setting<'a>(row: &'a Row, key: &str) -> Option<&'a str> {
-    row.settings.split(';').find_map(|kv| {
-        let (k, v) = kv.split_once('=')?;
-        (k == key).then_some(v)
-    })
-}
-
 /// Triangles the row draws per frame: a `triangles` counter when the algorithm reports one,
 /// else the algorithm's fixed count — GATOR draws each tet as the 4 triangles of its basis
 /// graph (Wylie et al. 2002 §4), fragment PT 4 triangles per tet (Marroquim et al. 2006 §3.2,
@@ -338,7 +331,7 @@ fn triangles(row: &Row) -> Option<f64> {
 
 /// Keys the row sorts on the CPU per frame (none for the GPU-resident sorts).
 fn cpu_sort_keys(row: &Row) -> Option<f64> {
-    let sort = setting(row, "sort")?;
+    let sort = row.setting("sort")?;
     if sort.starts_with("gpu") {
         return None;
     }

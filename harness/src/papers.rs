@@ -168,11 +168,11 @@ pub fn paper_tets_per_sec(
     };
     match algorithm {
         "gator-pt" => {
-            let v = setting(settings, "variant")?;
+            let v = crate::results::value_of(settings, "variant")?;
             let col = format!("{v}_tets_per_sec");
             get("gator", "gator_table3", &col).map(|x| ("GATOR Table 3", x))
         }
-        "havs" if setting(settings, "k") == Some("2") => {
+        "havs" if crate::results::value_of(settings, "k") == Some("2") => {
             get("havs", "havs_table4", "tets_per_sec").map(|x| ("HAVS Table 4 (k=2)", x))
         }
         "fragment-pt" => get("fragment-pt", "fragment-pt_table1", "tets_per_sec")
@@ -248,15 +248,6 @@ pub fn uncertain_cells() -> anyhow::Result<Vec<[String; 4]>> {
         out.push(std::array::from_fn(|i| r.get(i).unwrap_or("").to_string()));
     }
     Ok(out)
-}
-
-/// Value of `key` in a settings string `k=v;k=v`.
-pub fn setting<'a>(settings: &'a str, key: &str) -> Option<&'a str> {
-    settings.split(';').find_map(|kv| {
-        kv.split_once('=')
-            .filter(|(k, _)| *k == key)
-            .map(|(_, v)| v)
-    })
 }
 
 #[cfg(test)]

@@ -115,13 +115,24 @@ pub struct Row {
     pub samples: FrameSamples,
 }
 
+/// The value of `key` in a `key=value;key=value` list: a row's `settings` or `counters`.
+pub fn value_of<'a>(list: &'a str, key: &str) -> Option<&'a str> {
+    list.split(';').find_map(|kv| {
+        kv.split_once('=')
+            .filter(|(k, _)| *k == key)
+            .map(|(_, v)| v)
+    })
+}
+
 impl Row {
+    /// A setting of the row's variant (`key=value;…` in `settings`).
+    pub fn setting(&self, key: &str) -> Option<&str> {
+        value_of(&self.settings, key)
+    }
+
     /// A counter of the row (`name=value;…` in `counters`), if present and numeric.
     pub fn counter(&self, name: &str) -> Option<f64> {
-        self.counters.split(';').find_map(|kv| {
-            let (k, v) = kv.split_once('=')?;
-            (k.trim() == name).then(|| v.trim().parse().ok()).flatten()
-        })
+        value_of(&self.counters, name)?.parse().ok()
     }
 
     pub fn ok(&self) -> bool {

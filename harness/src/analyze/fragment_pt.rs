@@ -60,14 +60,7 @@ fn model_bytes_per_tet(rows: &[Row], a: &Aggregate) -> Option<f64> {
         .filter(|r| {
             r.algorithm == a.algorithm && r.settings == a.settings && r.dataset == a.dataset
         })
-        .find_map(|r| {
-            r.counters.split(';').find_map(|kv| {
-                let (k, v) = kv.split_once('=')?;
-                (k.trim() == "model_bytes_per_tet")
-                    .then(|| v.trim().parse::<f64>().ok())
-                    .flatten()
-            })
-        })
+        .find_map(|r| r.counter("model_bytes_per_tet"))
 }
 
 /// Orders data sets as the paper's Table 1, then any others in order of appearance.

@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use render_core::{fixed_viewpoints, Camera, Optics, Projection, TransferFunction};
 
 use crate::report::{aggregate, Aggregate};
-use crate::results::{ResultsFile, Row};
+use crate::results::{value_of, ResultsFile, Row};
 
 /// What the paper reports that we could verify: its abstract's range of rates.
 pub const PAPER_RATE_RANGE_TETS_PER_SEC: (f64, f64) = (1.0e6, 6.0e6);
@@ -409,14 +409,6 @@ pub fn run_tables(args: TablesArgs, _ctx: &super::Context) -> anyhow::Result<()>
     Ok(())
 }
 
-fn setting<'a>(settings: &'a str, key: &str) -> Option<&'a str> {
-    settings.split(';').find_map(|kv| {
-        kv.split_once('=')
-            .filter(|(k, _)| *k == key)
-            .map(|(_, v)| v)
-    })
-}
-
 fn cell(v: Option<f64>, digits: usize) -> String {
     match v {
         Some(x) if x.is_finite() => format!("{x:.digits$}"),
@@ -446,9 +438,9 @@ pub fn tables_3_4(rows: &[Row]) -> String {
     let find = |ds: &str, k: &str, sort: &str| -> Option<&Aggregate> {
         aggs.iter().find(|a| {
             a.dataset == ds
-                && setting(&a.settings, "k") == Some(k)
-                && setting(&a.settings, "sort") == Some(sort)
-                && setting(&a.settings, "mode").is_none_or(|m| m == "fragment-race")
+                && value_of(&a.settings, "k") == Some(k)
+                && value_of(&a.settings, "sort") == Some(sort)
+                && value_of(&a.settings, "mode").is_none_or(|m| m == "fragment-race")
         })
     };
     let mut md = String::from(

@@ -92,18 +92,6 @@ impl PaperCsv {
     }
 }
 
-fn setting<'a>(settings: &'a str, key: &str) -> Option<&'a str> {
-    settings.split(';').find_map(|kv| {
-        kv.split_once('=')
-            .filter(|(k, _)| *k == key)
-            .map(|(_, v)| v)
-    })
-}
-
-fn counter(counters: &str, key: &str) -> Option<f64> {
-    setting(counters, key).and_then(|v| v.parse().ok())
-}
-
 /// Our data set name for a row (the label on the command line, or a path's file stem).
 fn dataset_name(r: &Row) -> String {
     let p = Path::new(&r.dataset);
@@ -123,14 +111,14 @@ fn faithful<'a>(rows: &'a [Row], table: &str) -> Vec<&'a Row> {
         .filter(|r| {
             r.algorithm == "raycast"
                 && r.ok()
-                && setting(&r.settings, "table") == Some(table)
-                && setting(&r.settings, "mode") == Some("passes")
+                && r.setting("table") == Some(table)
+                && r.setting("mode") == Some("passes")
         })
         .collect();
     let et_on: Vec<&Row> = base
         .iter()
         .copied()
-        .filter(|r| setting(&r.settings, "et") == Some("on"))
+        .filter(|r| r.setting("et") == Some("on"))
         .collect();
     if et_on.is_empty() {
         base
@@ -216,7 +204,7 @@ pub fn write_tables(rows: &[Row], out: &Path) -> anyhow::Result<String> {
         let mut v: Vec<&str> = rows2d
             .iter()
             .chain(&rows3d)
-            .filter_map(|r| setting(&r.settings, "et"))
+            .filter_map(|r| r.setting("et"))
             .collect();
         v.sort();
         v.dedup();
@@ -284,18 +272,9 @@ pub fn write_tables(rows: &[Row], out: &Path) -> anyhow::Result<String> {
             .copied()
             .filter(|r| Some(dataset_name(r)) == ours)
             .collect();
-        let passes = min_max(
-            mine.iter()
-                .filter_map(|r| counter(&r.counters, "passes_max")),
-        );
-        let layers = min_max(
-            mine.iter()
-                .filter_map(|r| counter(&r.counters, "peel_layers")),
-        );
-        let steps = min_max(
-            mine.iter()
-                .filter_map(|r| counter(&r.counters, "steps_max")),
-        );
+        let passes = min_max(mine.iter().filter_map(|r| r.counter("passes_max")));
+        let layers = min_max(mine.iter().filter_map(|r| r.counter("peel_layers")));
+        let steps = min_max(mine.iter().filter_map(|r| r.counter("steps_max")));
         let k = [("dataset", paper.as_str())];
         let (p0, p1) = (
             t4.value(&k, "min_ray_casting_passes"),
@@ -339,8 +318,7 @@ pub fn write_tables(rows: &[Row], out: &Path) -> anyhow::Result<String> {
                     .iter()
                     .copied()
                     .filter(|r| {
-                        Some(dataset_name(r)) == ours
-                            && setting(&r.settings, "tiles") == Some(tiles.as_str())
+                        Some(dataset_name(r)) == ours && r.setting("tiles") == Some(tiles.as_str())
                     })
                     .collect();
                 let ms = min_max(mine.iter().filter_map(|r| r.total_ms));
@@ -399,7 +377,7 @@ pub fn write_tables(rows: &[Row], out: &Path) -> anyhow::Result<String> {
             .filter(|r| dataset_name(r) == ds && r.settings == settings)
             .collect();
         let max_counter =
-            |name: &str| min_max(g.iter().filter_map(|r| counter(&r.counters, name))).map(|m| m.1);
+            |name: &str| min_max(g.iter().filter_map(|r| r.counter(name))).map(|m| m.1);
         let psnr = min_max(g.iter().filter_map(|r| r.psnr_db));
         let psnr_values: Vec<f64> = g.iter().filter_map(|r| r.psnr_db).collect();
         let mean = (!psnr_values.is_empty())

@@ -50,13 +50,6 @@ pub fn run(args: Args, _ctx: &super::Context) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn setting<'a>(r: &'a Row, key: &str) -> Option<&'a str> {
-    r.settings.split(';').find_map(|kv| {
-        let (k, v) = kv.split_once('=')?;
-        (k == key).then_some(v)
-    })
-}
-
 /// The settings of a row other than the bucket site and the sort: rows that differ only there
 /// are compared.
 fn common_settings(r: &Row) -> String {
@@ -129,8 +122,8 @@ pub fn lines(rows: &[Row]) -> Vec<Line> {
                 mean(
                     g.iter()
                         .filter(|r| {
-                            setting(r, "buckets") == Some(b)
-                                && s.is_none_or(|s| setting(r, "sort") == Some(s))
+                            r.setting("buckets") == Some(b)
+                                && s.is_none_or(|s| r.setting("sort") == Some(s))
                         })
                         .filter_map(|r| r.fps),
                 )

@@ -171,7 +171,7 @@ impl Measured {
     }
 }
 
-pub use crate::papers::setting;
+pub use crate::results::value_of;
 
 /// The aggregate of `algorithm` on `dataset` whose settings include every `want` pair.
 pub fn find<'a>(
@@ -185,7 +185,7 @@ pub fn find<'a>(
             && a.dataset == dataset
             && want
                 .iter()
-                .all(|(k, v)| setting(&a.settings, k) == Some(*v))
+                .all(|(k, v)| value_of(&a.settings, k) == Some(*v))
     })
 }
 

@@ -11,7 +11,7 @@
 
 use super::papers;
 use super::table::{Cell, CompRow, Comparison, Metric, Ordering};
-use super::{is_standin, setting, Extra, Measured, Paper, Report, RunSpec, Session};
+use super::{is_standin, Extra, Measured, Paper, Report, RunSpec, Session};
 
 pub const PAPER: Paper = Paper {
     id: "raycast",
@@ -58,8 +58,8 @@ fn rows_of<'a>(
     m.rows
         .iter()
         .filter(|r| r.algorithm == "raycast" && r.dataset == dataset && r.ok())
-        .filter(|r| tiles.is_none_or(|t| setting(&r.settings, "tiles") == Some(t)))
-        .filter(|r| table.is_none_or(|t| setting(&r.settings, "table") == Some(t)))
+        .filter(|r| tiles.is_none_or(|t| r.setting("tiles") == Some(t)))
+        .filter(|r| table.is_none_or(|t| r.setting("table") == Some(t)))
         .collect()
 }
 
@@ -131,12 +131,9 @@ pub fn tables(m: &Measured, _x: &Extra) -> Report {
     let rows = DATASETS
         .iter()
         .map(|(paper, d)| {
-            let passes = rows_of(m, d, None, Some("2d")).into_iter().filter_map(|r| {
-                r.counters.split(';').find_map(|kv| {
-                    let (k, v) = kv.split_once('=')?;
-                    (k == "passes_max").then(|| v.parse::<f64>().ok()).flatten()
-                })
-            });
+            let passes = rows_of(m, d, None, Some("2d"))
+                .into_iter()
+                .filter_map(|r| r.counter("passes_max"));
             let (lo, hi) = min_max(passes);
             let why = m.why("raycast", d);
             CompRow {
