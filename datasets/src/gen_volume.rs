@@ -228,13 +228,8 @@ pub fn volume_mesh(name: &str, grid: VoxelGrid) -> Result<TetMesh, ErrorKind> {
         .flat_map_iter(|k| {
             let grid = &grid;
             (0..cells[1]).flat_map(move |j| {
-                (0..cells[0]).filter_map(move |i| {
-                    let any = (0..8).any(|b| {
-                        grid.values[grid.index(i + (b & 1), j + (b >> 1 & 1), k + (b >> 2 & 1))]
-                            > 0.0
-                    });
-                    any.then_some([i, j, k])
-                })
+                (0..cells[0])
+                    .filter_map(move |i| grid.cube_has_nonzero_corner(i, j, k).then_some([i, j, k]))
             })
         })
         .collect();

@@ -24,6 +24,14 @@ impl VoxelGrid {
         self.dims.iter().product()
     }
 
+    /// Whether any of the 8 corners of cube (i, j, k) (grid points (i..=i+1, j..=j+1,
+    /// k..=k+1)) holds a non-zero value: the cubes a volume's support split keeps.
+    pub fn cube_has_nonzero_corner(&self, i: usize, j: usize, k: usize) -> bool {
+        (0..8).any(|b| {
+            self.values[self.index(i + (b & 1), j + (b >> 1 & 1), k + (b >> 2 & 1))] != 0.0
+        })
+    }
+
     /// Position of grid point (i, j, k).
     pub fn point(&self, i: usize, j: usize, k: usize) -> [f64; 3] {
         let ijk = [i, j, k];
