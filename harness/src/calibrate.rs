@@ -441,17 +441,21 @@ mod tests {
     /// the fill (borrowed from the HAVS row: 1 M fragments at 100 M/s = 10 ms) and the sort.
     #[test]
     fn roofline_picks_the_slowest_resource() {
-        let mut gator = crate::results::example_row();
-        gator.algorithm = "gator-pt".into();
-        gator.settings = "variant=linear;sort=radix".into();
-        gator.tets = 10_000;
-        gator.total_ms = Some(80.0);
-        gator.gpu_bytes_frame = Some(1_000_000);
-        let mut havs = crate::results::example_row();
-        havs.algorithm = "havs".into();
-        havs.settings = "k=2;sort=gpu-radix".into();
-        havs.counters = "fragments=1000000;faces=20000".into();
-        havs.total_ms = Some(50.0);
+        let gator = Row {
+            algorithm: "gator-pt".into(),
+            settings: "variant=linear;sort=radix".into(),
+            tets: 10_000,
+            total_ms: Some(80.0),
+            gpu_bytes_frame: Some(1_000_000),
+            ..Row::default()
+        };
+        let havs = Row {
+            algorithm: "havs".into(),
+            settings: "k=2;sort=gpu-radix".into(),
+            counters: "fragments=1000000;faces=20000".into(),
+            total_ms: Some(50.0),
+            ..Row::default()
+        };
         let mut rows = vec![gator, havs];
         annotate(&mut rows, &cal());
         let times = resource_times(&rows[0], &rows, &cal());

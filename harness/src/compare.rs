@@ -649,11 +649,13 @@ mod tests {
             .iter()
             .enumerate()
             .map(|(i, f)| {
-                let mut row = crate::results::example_row();
-                row.algorithm = format!("alg{i}");
-                row.settings = "k=2".into();
-                row.dataset = "box:1k".into();
-                row.viewpoint = "+x".into();
+                let mut row = crate::results::Row {
+                    algorithm: format!("alg{i}"),
+                    settings: "k=2".into(),
+                    dataset: "box:1k".into(),
+                    viewpoint: "+x".into(),
+                    ..Default::default()
+                };
                 // 3 % noise around 10 ms × factor.
                 row.samples.total_ms = (0..9)
                     .map(|_| 10.0 * f * (1.0 + 0.03 * rng.normal()))

@@ -317,16 +317,18 @@ mod tests {
     /// Writes a one-row results set whose f32 image is `img`, with 5 frames around `ms`.
     fn results_dir(dir: &Path, img: &render_core::Image, ms: f64) {
         std::fs::create_dir_all(dir.join("images")).unwrap();
-        let mut row = crate::results::example_row();
-        row.algorithm = "havs".into();
-        row.settings = "k=2".into();
-        row.dataset = "box:1k".into();
-        row.viewpoint = "+x".into();
-        row.total_ms = Some(ms);
-        row.psnr_db = Some(60.0);
-        row.gpu_bytes = Some(1000);
+        let mut row = crate::results::Row {
+            algorithm: "havs".into(),
+            settings: "k=2".into(),
+            dataset: "box:1k".into(),
+            viewpoint: "+x".into(),
+            total_ms: Some(ms),
+            psnr_db: Some(60.0),
+            gpu_bytes: Some(1000),
+            image_f32: "images/a.f32.zz".into(),
+            ..Default::default()
+        };
         row.samples.total_ms = (0..5).map(|i| ms + 0.01 * i as f64).collect();
-        row.image_f32 = "images/a.f32.zz".into();
         samples::write_f32_image(&dir.join(&row.image_f32), img).unwrap();
         row.image_hash = samples::image_hash(img);
         let file = ResultsFile {

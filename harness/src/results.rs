@@ -31,7 +31,7 @@ pub const JSON_FILE: &str = "results.json";
 /// One (algorithm, settings, data set, viewpoint) measurement. Times in ms, rates per second,
 /// error metrics as defined in [`crate::metrics`]. `None` is an empty CSV cell / JSON null: no
 /// timestamp queries (gpu_ms), no reference (error metrics), or a failed row (`error` set).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Row {
     pub algorithm: String,
     pub settings: String,
@@ -324,7 +324,7 @@ pub fn write_json(dir: &Path, file: &ResultsFile) -> anyhow::Result<()> {
 /// The CSV header: [`Row`]'s field names in order (taken from serde so they cannot drift).
 pub fn csv_header() -> Vec<String> {
     let mut w = csv::Writer::from_writer(vec![]);
-    w.serialize(example_row()).expect("row serialises");
+    w.serialize(Row::default()).expect("row serialises");
     let bytes = w.into_inner().expect("in-memory writer");
     let text = String::from_utf8(bytes).expect("utf-8");
     text.lines()
@@ -333,61 +333,6 @@ pub fn csv_header() -> Vec<String> {
         .split(',')
         .map(str::to_string)
         .collect()
-}
-
-pub(crate) fn example_row() -> Row {
-    Row {
-        algorithm: String::new(),
-        settings: String::new(),
-        dataset: String::new(),
-        tets: 0,
-        viewpoint: String::new(),
-        width: 0,
-        height: 0,
-        total_ms: None,
-        cpu_ms: None,
-        gpu_ms: None,
-        fps: None,
-        tets_per_sec: None,
-        gpu_bytes: None,
-        bytes_per_tet: None,
-        rmse: None,
-        psnr_db: None,
-        max_abs_error: None,
-        bad_pixel_share: None,
-        adapter: String::new(),
-        backend: String::new(),
-        total_ms_min: None,
-        total_ms_max: None,
-        cpu_ms_min: None,
-        cpu_ms_max: None,
-        gpu_ms_min: None,
-        gpu_ms_max: None,
-        frames: 0,
-        warmup: 0,
-        gpu_bytes_persistent: None,
-        gpu_bytes_frame: None,
-        stages: String::new(),
-        counters: String::new(),
-        covered_pixels: None,
-        transfer_function: String::new(),
-        projection: String::new(),
-        device_type: String::new(),
-        driver: String::new(),
-        image: String::new(),
-        reference_image: String::new(),
-        heatmap: String::new(),
-        suspect: String::new(),
-        image_f32: String::new(),
-        image_hash: String::new(),
-        roofline_ms: None,
-        limit_fraction: None,
-        bound_by: String::new(),
-        normalized_time: None,
-        host_peak_bytes: None,
-        error: String::new(),
-        samples: FrameSamples::default(),
-    }
 }
 
 /// The columns the measurement-core issue fixes, in order.
@@ -552,7 +497,7 @@ pub(crate) fn test_row(i: u32) -> Row {
         tets_per_sec: Some(500_000.0),
         adapter: "llvmpipe, \"quoted\"".into(),
         backend: "vulkan".into(),
-        ..example_row()
+        ..Row::default()
     }
 }
 

@@ -18,7 +18,7 @@ pub(super) struct DatasetContext<'a> {
     reference_mesh: Option<reference::Prepared<'a>>,
 }
 
-/// The row's fixed parts, before measuring.
+/// The row's fixed parts, before measuring (everything measured starts empty).
 fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Row {
     let c = ctx.config;
     let a = &ctx.gpu.adapter;
@@ -30,49 +30,15 @@ fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Ro
         viewpoint: vp.name.clone(),
         width: c.width,
         height: c.height,
-        total_ms: None,
-        cpu_ms: None,
-        gpu_ms: None,
-        fps: None,
-        tets_per_sec: None,
-        gpu_bytes: None,
-        bytes_per_tet: None,
-        rmse: None,
-        psnr_db: None,
-        max_abs_error: None,
-        bad_pixel_share: None,
         adapter: a.name.clone(),
         backend: a.backend.clone(),
-        total_ms_min: None,
-        total_ms_max: None,
-        cpu_ms_min: None,
-        cpu_ms_max: None,
-        gpu_ms_min: None,
-        gpu_ms_max: None,
         frames: c.frames * c.rounds.max(1),
         warmup: c.warmup,
-        gpu_bytes_persistent: None,
-        gpu_bytes_frame: None,
-        stages: String::new(),
-        counters: String::new(),
-        covered_pixels: None,
         transfer_function: c.tf_spec.clone(),
         projection: projection_name(&c.projection),
         device_type: a.device_type.clone(),
         driver: format!("{} {}", a.driver, a.driver_info).trim().to_string(),
-        image: String::new(),
-        reference_image: String::new(),
-        heatmap: String::new(),
-        suspect: String::new(),
-        image_f32: String::new(),
-        image_hash: String::new(),
-        roofline_ms: None,
-        limit_fraction: None,
-        bound_by: String::new(),
-        normalized_time: None,
-        host_peak_bytes: None,
-        error: String::new(),
-        samples: Default::default(),
+        ..Row::default()
     }
 }
 
