@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 . scripts/common.sh
 ensure_prerequisites
 cargo build --release -p harness --bin tetbench
-bin=target/release/tetbench
+bin=$(tetbench_release_bin)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$bin" run --rounds 5 --out "$tmp/run" --no-report "$@"

@@ -8,4 +8,4 @@ ensure_prerequisites
 # VTK's mappers (--peers vtk, or an algorithm vtk-*) need VTK's Python package.
 case " $* " in *vtk*) ensure_vtk_python ;; esac
 cargo build --release -p harness --bin tetbench
-exec target/release/tetbench run "$@"
+exec "$(tetbench_release_bin)" run "$@"

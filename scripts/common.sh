@@ -89,3 +89,9 @@ ensure_vtk_python() {
     fi
     export TETBENCH_VTK_PYTHON="$venv/bin/python"
 }
+
+# The release binary cargo built: under $CARGO_TARGET_DIR when set (cargo builds there), else
+# target/ at the repository root.
+tetbench_release_bin() {
+    printf '%s/release/tetbench' "${CARGO_TARGET_DIR:-$PWD/target}"
+}
