@@ -12,6 +12,7 @@ pub mod compare_report;
 pub mod compare_time;
 pub mod datasets_cmd;
 pub mod history;
+pub mod html;
 pub mod machine;
 pub mod metrics;
 pub mod names;

@@ -8,6 +8,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Context;
+use serde::Serialize;
 
 use crate::algorithms::is_peer;
 use crate::metrics::{HEATMAP_MAX_ERROR, ONE_STEP, PSNR_CAP_DB};
@@ -94,7 +95,11 @@ pub fn write(out: &Path, file: &ResultsFile) -> anyhow::Result<()> {
     inputs.add(file, crate::plot::raw_results(out).as_ref());
     let charts = crate::plot::write_charts(&out.join("charts"), &inputs, crate::plot::Kind::All)?;
     let aggs = aggregate(&file.rows);
-    let html = html(file, &aggs, &crate::plot::html_section(&charts, "charts"));
+    let html = html(
+        file,
+        &aggs,
+        &crate::plot::ChartsPage::new(&charts, "charts"),
+    )?;
     let path = out.join("index.html");
     std::fs::write(&path, html).with_context(|| format!("cannot write {}", path.display()))
 }
@@ -105,15 +110,8 @@ pub fn rewrite(out: &Path) -> anyhow::Result<()> {
     write(out, &file)
 }
 
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
-/// ` class="…"` for a table row: failed, suspect (issue 15's rule) and peer rows are marked.
-fn row_class(failed: bool, suspect: bool, algorithm: &str) -> String {
+/// CSS classes of a table row: failed, suspect (issue 15's rule) and peer rows are marked.
+fn row_classes(failed: bool, suspect: bool, algorithm: &str) -> Vec<&'static str> {
     let mut c = vec![];
     if failed {
         c.push("failed");
@@ -124,11 +122,7 @@ fn row_class(failed: bool, suspect: bool, algorithm: &str) -> String {
     if crate::plot::style::is_peer(algorithm) {
         c.push("peer");
     }
-    if c.is_empty() {
-        String::new()
-    } else {
-        format!(" class=\"{}\"", c.join(" "))
-    }
+    c
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {
@@ -141,40 +135,103 @@ fn mb(v: Option<u64>) -> String {
         .unwrap_or_else(|| "–".into())
 }
 
-fn html(file: &ResultsFile, aggs: &[Aggregate], charts: &str) -> String {
+/// A summary cell: mean with min–max, already formatted.
+#[derive(Serialize)]
+struct SpreadCell {
+    mean: String,
+    min: String,
+    max: String,
+}
+
+fn spread_cell(s: Option<Spread>, k: f64, digits: usize) -> Option<SpreadCell> {
+    s.map(|s| SpreadCell {
+        mean: format!("{:.digits$}", s.mean * k),
+        min: format!("{:.digits$}", s.min * k),
+        max: format!("{:.digits$}", s.max * k),
+    })
+}
+
+#[derive(Serialize)]
+struct SummaryLine {
+    classes: Vec<&'static str>,
+    algorithm: String,
+    peer: bool,
+    settings: String,
+    dataset: String,
+    tets: u64,
+    rows: usize,
+    failed: usize,
+    /// total, CPU, GPU ms, fps, M tets/s, PSNR, bad pixels %.
+    spreads: Vec<Option<SpreadCell>>,
+    bytes_per_tet: String,
+    gpu_mib: String,
+}
+
+#[derive(Serialize)]
+struct Picture {
+    path: String,
+    alt: &'static str,
+}
+
+#[derive(Serialize)]
+struct SuspectFigure {
+    images: Vec<Picture>,
+    algorithm: String,
+    settings: String,
+    dataset: String,
+    viewpoint: String,
+    why: String,
+}
+
+#[derive(Serialize)]
+struct ViewFigure {
+    image: String,
+    heatmap: String,
+    label: String,
+    psnr: String,
+    mtets: String,
+}
+
+#[derive(Serialize)]
+struct View {
+    dataset: String,
+    viewpoint: String,
+    reference: String,
+    figures: Vec<ViewFigure>,
+}
+
+#[derive(Serialize)]
+struct RowLine {
+    classes: Vec<&'static str>,
+    algorithm: String,
+    peer: bool,
+    settings: String,
+    dataset: String,
+    viewpoint: String,
+    cells: Vec<String>,
+    stages: String,
+    error: String,
+}
+
+/// Everything `templates/report.html` shows.
+#[derive(Serialize)]
+struct ReportPage<'a> {
+    machine: Vec<(&'static str, String)>,
+    errors: &'a [String],
+    charts: &'a crate::plot::ChartsPage,
+    suspects: Vec<SuspectFigure>,
+    any_peer: bool,
+    summary: Vec<SummaryLine>,
+    heatmap_max_error: f64,
+    psnr_cap_db: f64,
+    one_step: String,
+    views: Vec<View>,
+    rows: Vec<RowLine>,
+}
+
+fn machine_lines(file: &ResultsFile) -> Vec<(&'static str, String)> {
     let m = &file.machine;
     let r = &file.run;
-    let mut h = String::new();
-    let _ = write!(
-        h,
-        r#"<!doctype html>
-<html lang="en"><head><meta charset="utf-8"><title>tetbench report</title>
-<style>
-body {{ font-family: "DejaVu Sans", sans-serif; margin: 1.5em; color: #222; }}
-@font-face {{ font-family: "DejaVu Sans"; src: url("charts/DejaVuSans.ttf") format("truetype"); }}
-table {{ border-collapse: collapse; font-size: 13px; margin: 0.5em 0 1.5em; }}
-th, td {{ border: 1px solid #ccc; padding: 2px 6px; text-align: right; }}
-th {{ background: #eee; }} td.l, th.l {{ text-align: left; }}
-tr.failed td {{ background: #fdd; }}
-tr.suspect td {{ background: #ffe4b5; }} tr.suspect td:first-child::after {{ content: " ⚠ suspect"; color: #b00; }}
-.suspect figure {{ border: 2px solid #e69500; padding: 3px; }}
-tr.peer td:first-child::after {{ content: " (peer)"; color: #666; font-style: italic; }}
-figure.chart {{ margin: 0 0 14px; font-size: 13px; text-align: left; }}
-figure.chart img {{ width: auto; height: auto; max-width: 100%; background: #fff; object-fit: initial; image-rendering: auto; }}
-table.key td {{ text-align: left; }}
-.swatch {{ display: inline-block; width: 12px; height: 12px; border: 2px solid transparent; vertical-align: middle; }}
-dl {{ display: grid; grid-template-columns: max-content auto; gap: 2px 12px; font-size: 14px; }}
-dt {{ font-weight: bold; }} dd {{ margin: 0; }}
-.charts img {{ max-width: 100%; border: 1px solid #ddd; margin-bottom: 8px; }}
-.view {{ margin: 0 0 1.2em; }}
-.strip {{ display: flex; flex-wrap: wrap; gap: 10px; }}
-figure {{ margin: 0; font-size: 11px; text-align: center; }}
-figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000; display: block; image-rendering: pixelated; }}
-.pair {{ display: flex; gap: 2px; }}
-</style></head><body>
-<h1>tetbench report</h1>
-"#
-    );
     let mem = m
         .memory_bytes
         .map(|b| format!("{:.1} GiB", b as f64 / (1u64 << 30) as f64))
@@ -194,204 +251,200 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
         (Some(c), _) => c.clone(),
         _ => "unknown".into(),
     };
-    let _ = writeln!(
-        h,
-        "<h2>Machine and run</h2><dl>\
-         <dt>GPU adapter</dt><dd>{}</dd><dt>CPU</dt><dd>{} ({} logical cores)</dd><dt>memory</dt><dd>{}</dd>\
-         <dt>OS</dt><dd>{} {}</dd><dt>tetbench</dt><dd>{} at commit {}</dd><dt>started</dt><dd>{}</dd>\
-         <dt>finished</dt><dd>{}</dd><dt>command</dt><dd><code>{}</code></dd>\
-         <dt>viewpoints</dt><dd>{}</dd><dt>viewport</dt><dd>{}×{}, {}</dd><dt>frames</dt><dd>{} timed after {} warm-up</dd>\
-         <dt>transfer function</dt><dd>{}</dd></dl>",
-        esc(&adapter),
-        esc(&m.cpu_model),
-        m.cpu_cores,
-        mem,
-        esc(&m.os),
-        esc(m.kernel.as_deref().unwrap_or("")),
-        esc(&m.tetbench_version),
-        esc(&commit),
-        esc(&m.date_utc),
-        esc(file.finished_utc.as_deref().unwrap_or("not finished (interrupted?)")),
-        esc(&r.command_line.join(" ")),
-        esc(&r.viewpoints),
-        r.width,
-        r.height,
-        esc(&r.projection),
-        r.frames,
-        r.warmup,
-        esc(&r.transfer_function),
-    );
-    if !file.errors.is_empty() {
-        h.push_str("<h2>Errors</h2><ul>");
-        for e in &file.errors {
-            let _ = write!(h, "<li>{}</li>", esc(e));
-        }
-        h.push_str("</ul>\n");
-    }
+    vec![
+        ("GPU adapter", adapter),
+        (
+            "CPU",
+            format!("{} ({} logical cores)", m.cpu_model, m.cpu_cores),
+        ),
+        ("memory", mem),
+        (
+            "OS",
+            format!("{} {}", m.os, m.kernel.as_deref().unwrap_or("")),
+        ),
+        (
+            "tetbench",
+            format!("{} at commit {commit}", m.tetbench_version),
+        ),
+        ("started", m.date_utc.clone()),
+        (
+            "finished",
+            file.finished_utc
+                .clone()
+                .unwrap_or_else(|| "not finished (interrupted?)".into()),
+        ),
+        ("command", r.command_line.join(" ")),
+        ("viewpoints", r.viewpoints.clone()),
+        (
+            "viewport",
+            format!("{}×{}, {}", r.width, r.height, r.projection),
+        ),
+        (
+            "frames",
+            format!("{} timed after {} warm-up", r.frames, r.warmup),
+        ),
+        ("transfer function", r.transfer_function.clone()),
+    ]
+}
 
-    h.push_str(charts);
-    suspect_section(&mut h, file);
+fn summary_lines(file: &ResultsFile, aggs: &[Aggregate], suspect: &[bool]) -> Vec<SummaryLine> {
+    aggs.iter()
+        .map(|a| {
+            let any_suspect = file.rows.iter().zip(suspect).any(|(r, s)| {
+                *s && r.algorithm == a.algorithm
+                    && r.settings == a.settings
+                    && r.dataset == a.dataset
+            });
+            let peer = is_peer(&a.algorithm);
+            SummaryLine {
+                classes: row_classes(a.failed > 0, any_suspect, &a.algorithm),
+                algorithm: a.algorithm.clone(),
+                peer,
+                settings: a.settings.clone(),
+                dataset: a.dataset.clone(),
+                tets: a.tets,
+                rows: a.rows,
+                failed: a.failed,
+                spreads: vec![
+                    spread_cell(a.total_ms, 1.0, 2),
+                    spread_cell(a.cpu_ms, 1.0, 2),
+                    spread_cell(a.gpu_ms, 1.0, 2),
+                    spread_cell(a.fps, 1.0, 1),
+                    spread_cell(a.tets_per_sec, 1e-6, 3),
+                    spread_cell(a.psnr_db, 1.0, 2),
+                    spread_cell(a.bad_pixel_share, 100.0, 2),
+                ],
+                // Peers report no GPU memory of their own (VTK's mappers).
+                bytes_per_tet: opt(a.bytes_per_tet.filter(|_| !peer), 1),
+                gpu_mib: mb(a.gpu_bytes.filter(|_| !peer)),
+            }
+        })
+        .collect()
+}
 
-    h.push_str("<h2>Summary</h2><p>Mean over viewpoints (min–max in brackets).");
-    if file.rows.iter().any(|r| is_peer(&r.algorithm)) {
-        h.push_str(
-            " <em>peer</em>: another package's renderer (VTK, through its Python package) \
-             measured in the same run; VTK reports no GPU memory.",
-        );
-    }
-    h.push_str(
-        "</p><table><tr>\
-         <th class=l>algorithm</th><th class=l>settings</th><th class=l>data set</th><th>tets</th><th>rows</th>\
-         <th>total ms</th><th>CPU ms</th><th>GPU ms</th><th>fps</th><th>M tets/s</th><th>PSNR dB</th>\
-         <th>bad pixels %</th><th>bytes/tet</th><th>GPU MiB</th></tr>\n",
-    );
-    let suspect = crate::plot::data::suspect_flags(&file.rows);
-    for a in aggs {
-        let sp = |s: Option<Spread>, k: f64, d: usize| {
-            s.map(|s| {
-                format!(
-                    "{:.d$} <small>({:.d$}–{:.d$})</small>",
-                    s.mean * k,
-                    s.min * k,
-                    s.max * k
-                )
+/// Rows flagged by [`crate::suspect`], each with its heatmap first, then the rendering and the
+/// reference, so a broken renderer is the first picture a reader sees after the charts.
+fn suspect_figures(file: &ResultsFile) -> Vec<SuspectFigure> {
+    file.rows
+        .iter()
+        .filter(|r| !r.suspect.is_empty())
+        .map(|row| SuspectFigure {
+            images: [
+                (&row.heatmap, "error heatmap"),
+                (&row.image, "image"),
+                (&row.reference_image, "reference"),
+            ]
+            .into_iter()
+            .filter(|(path, _)| !path.is_empty())
+            .map(|(path, alt)| Picture {
+                path: path.clone(),
+                alt,
             })
-            .unwrap_or_else(|| "–".into())
-        };
-        let _ = writeln!(
-            h,
-            "<tr{}><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td>{}</td><td>{}{}</td><td>{}</td><td>{}</td>\
-             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            row_class(
-                a.failed > 0,
-                file.rows.iter().zip(&suspect).any(|(r, s)| {
-                    *s && r.algorithm == a.algorithm
-                        && r.settings == a.settings
-                        && r.dataset == a.dataset
-                }),
-                &a.algorithm
-            ),
-            algorithm_cell(&a.algorithm),
-            esc(&a.settings),
-            esc(&a.dataset),
-            a.tets,
-            a.rows,
-            if a.failed > 0 { format!(" ({} failed)", a.failed) } else { String::new() },
-            sp(a.total_ms, 1.0, 2),
-            sp(a.cpu_ms, 1.0, 2),
-            sp(a.gpu_ms, 1.0, 2),
-            sp(a.fps, 1.0, 1),
-            sp(a.tets_per_sec, 1e-6, 3),
-            sp(a.psnr_db, 1.0, 2),
-            sp(a.bad_pixel_share, 100.0, 2),
-            opt(a.bytes_per_tet.filter(|_| !is_peer(&a.algorithm)), 1),
-            mb(a.gpu_bytes.filter(|_| !is_peer(&a.algorithm))),
-        );
-    }
-    h.push_str("</table>\n");
+            .collect(),
+            algorithm: row.algorithm.clone(),
+            settings: row.settings.clone(),
+            dataset: row.dataset.clone(),
+            viewpoint: row.viewpoint.clone(),
+            why: row.suspect.clone(),
+        })
+        .collect()
+}
 
-    let _ = writeln!(
-        h,
-        "<h2>Images</h2><p>Each rendering beside its error heatmap (largest channel error per pixel: black ≤ 1/255, \
-         then a log scale up to ≥ {HEATMAP_MAX_ERROR} in pale yellow); the exact reference first. PSNR over \
-         premultiplied linear RGB, capped at {PSNR_CAP_DB} dB; “bad” pixels are covered pixels off by more than \
-         1/255 ({ONE_STEP:.4}) in any channel.</p>"
-    );
-    let mut views: Vec<(String, String)> = vec![];
+fn views(file: &ResultsFile) -> Vec<View> {
+    let mut keys: Vec<(&str, &str)> = vec![];
     for row in &file.rows {
-        let k = (row.dataset.clone(), row.viewpoint.clone());
-        if !views.contains(&k) {
-            views.push(k);
+        let k = (row.dataset.as_str(), row.viewpoint.as_str());
+        if !keys.contains(&k) {
+            keys.push(k);
         }
     }
-    for (dataset, viewpoint) in &views {
-        let rows: Vec<&Row> = file
-            .rows
-            .iter()
-            .filter(|r| &r.dataset == dataset && &r.viewpoint == viewpoint)
-            .collect();
-        let _ = write!(
-            h,
-            "<div class=view><h3>{} — {}</h3><div class=strip>",
-            esc(dataset),
-            esc(viewpoint)
-        );
-        if let Some(reference) = rows
-            .iter()
-            .find(|r| !r.reference_image.is_empty())
-            .map(|r| &r.reference_image)
-        {
-            let _ = write!(
-                h,
-                "<figure><a href=\"{0}\"><img src=\"{0}\" alt=\"reference\" loading=lazy></a><figcaption>exact reference</figcaption></figure>",
-                esc(reference)
-            );
-        }
-        for row in rows {
-            if row.image.is_empty() {
-                continue;
+    keys.into_iter()
+        .map(|(dataset, viewpoint)| {
+            let rows: Vec<&Row> = file
+                .rows
+                .iter()
+                .filter(|r| r.dataset == dataset && r.viewpoint == viewpoint)
+                .collect();
+            View {
+                dataset: dataset.to_string(),
+                viewpoint: viewpoint.to_string(),
+                reference: rows
+                    .iter()
+                    .find(|r| !r.reference_image.is_empty())
+                    .map(|r| r.reference_image.clone())
+                    .unwrap_or_default(),
+                figures: rows
+                    .iter()
+                    .filter(|r| !r.image.is_empty())
+                    .map(|row| ViewFigure {
+                        image: row.image.clone(),
+                        heatmap: row.heatmap.clone(),
+                        label: series_label(&row.algorithm, &row.settings),
+                        psnr: opt(row.psnr_db, 2),
+                        mtets: opt(row.tets_per_sec.map(|v| v * 1e-6), 3),
+                    })
+                    .collect(),
             }
-            let _ = write!(
-                h,
-                "<figure><div class=pair><a href=\"{0}\"><img src=\"{0}\" alt=\"image\" loading=lazy></a>",
-                esc(&row.image)
-            );
-            if !row.heatmap.is_empty() {
-                let _ = write!(
-                    h,
-                    "<a href=\"{0}\"><img src=\"{0}\" alt=\"error heatmap\" loading=lazy></a>",
-                    esc(&row.heatmap)
-                );
-            }
-            let _ = write!(
-                h,
-                "</div><figcaption>{}<br>PSNR {} dB · {} M tets/s</figcaption></figure>",
-                esc(&series_label(&row.algorithm, &row.settings)),
-                opt(row.psnr_db, 2),
-                opt(row.tets_per_sec.map(|v| v * 1e-6), 3)
-            );
-        }
-        h.push_str("</div></div>\n");
-    }
+        })
+        .collect()
+}
 
-    h.push_str(
-        "<h2>All rows</h2><table><tr><th class=l>algorithm</th><th class=l>settings</th><th class=l>data set</th>\
-         <th class=l>viewpoint</th><th>total ms</th><th>CPU ms</th><th>GPU ms</th><th>fps</th><th>M tets/s</th>\
-         <th>GPU MiB</th><th>bytes/tet</th><th>RMSE</th><th>PSNR dB</th><th>max err</th><th>bad %</th>\
-         <th class=l>stages (ms)</th><th class=l>error</th></tr>\n",
-    );
-    for (row, suspect) in file.rows.iter().zip(&suspect) {
-        let _ = writeln!(
-            h,
-            "<tr{}><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td>{}</td><td>{}</td>\
-             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
-             <td class=l>{}</td><td class=l>{}</td></tr>",
-            row_class(!row.ok(), *suspect, &row.algorithm),
-            algorithm_cell(&row.algorithm),
-            esc(&row.settings),
-            esc(&row.dataset),
-            esc(&row.viewpoint),
-            opt(row.total_ms, 2),
-            opt(row.cpu_ms, 2),
-            opt(row.gpu_ms, 2),
-            opt(row.fps, 1),
-            opt(row.tets_per_sec.map(|v| v * 1e-6), 3),
-            mb(row.gpu_bytes),
-            opt(row.bytes_per_tet, 1),
-            opt(row.rmse, 5),
-            opt(row.psnr_db, 2),
-            opt(row.max_abs_error, 4),
-            opt(row.bad_pixel_share.map(|v| v * 100.0), 2),
-            esc(&row.stages),
-            if row.suspect.is_empty() {
-                esc(&row.error)
+fn row_lines(file: &ResultsFile, suspect: &[bool]) -> Vec<RowLine> {
+    file.rows
+        .iter()
+        .zip(suspect)
+        .map(|(row, suspect)| RowLine {
+            classes: row_classes(!row.ok(), *suspect, &row.algorithm),
+            algorithm: row.algorithm.clone(),
+            peer: is_peer(&row.algorithm),
+            settings: row.settings.clone(),
+            dataset: row.dataset.clone(),
+            viewpoint: row.viewpoint.clone(),
+            cells: vec![
+                opt(row.total_ms, 2),
+                opt(row.cpu_ms, 2),
+                opt(row.gpu_ms, 2),
+                opt(row.fps, 1),
+                opt(row.tets_per_sec.map(|v| v * 1e-6), 3),
+                mb(row.gpu_bytes),
+                opt(row.bytes_per_tet, 1),
+                opt(row.rmse, 5),
+                opt(row.psnr_db, 2),
+                opt(row.max_abs_error, 4),
+                opt(row.bad_pixel_share.map(|v| v * 100.0), 2),
+            ],
+            stages: row.stages.clone(),
+            error: if row.suspect.is_empty() {
+                row.error.clone()
             } else {
-                esc(&format!("SUSPECT: {}", row.suspect))
+                format!("SUSPECT: {}", row.suspect)
             },
-        );
-    }
-    h.push_str("</table>\n<p>Raw data: <a href=\"results.csv\">results.csv</a>, <a href=\"results.json\">results.json</a>.</p>\n</body></html>\n");
-    h
+        })
+        .collect()
+}
+
+fn html(
+    file: &ResultsFile,
+    aggs: &[Aggregate],
+    charts: &crate::plot::ChartsPage,
+) -> anyhow::Result<String> {
+    let suspect = crate::plot::data::suspect_flags(&file.rows);
+    crate::html::render(
+        "report.html",
+        ReportPage {
+            machine: machine_lines(file),
+            errors: &file.errors,
+            charts,
+            suspects: suspect_figures(file),
+            any_peer: file.rows.iter().any(|r| is_peer(&r.algorithm)),
+            summary: summary_lines(file, aggs, &suspect),
+            heatmap_max_error: HEATMAP_MAX_ERROR,
+            psnr_cap_db: PSNR_CAP_DB,
+            one_step: format!("{ONE_STEP:.4}"),
+            views: views(file),
+            rows: row_lines(file, &suspect),
+        },
+    )
 }
 
 /// The summary as a Markdown table (for `tetbench analyze summary` and notes).
@@ -438,57 +491,6 @@ pub fn markdown_summary(aggs: &[Aggregate]) -> String {
     s
 }
 
-/// The algorithm's name for the HTML tables, with peers (other packages' renderers) marked.
-fn algorithm_cell(name: &str) -> String {
-    if is_peer(name) {
-        format!("{} <small class=peer>(peer)</small>", esc(name))
-    } else {
-        esc(name)
-    }
-}
-
-/// Rows flagged by [`crate::suspect`], each with its heatmap first, then the rendering and the
-/// reference, so a broken renderer is the first picture a reader sees after the charts.
-fn suspect_section(h: &mut String, file: &ResultsFile) {
-    let suspects: Vec<&Row> = file.rows.iter().filter(|r| !r.suspect.is_empty()).collect();
-    if suspects.is_empty() {
-        return;
-    }
-    let _ = write!(
-        h,
-        "<h2>Suspect rows ({})</h2><p>Image error far out of line with the other algorithms on \
-         the same image: a renderer defect, or a mesh or setting the method cannot handle. \
-         Heatmap first, then the rendering and the reference.</p><div class=\"strip suspect\">",
-        suspects.len()
-    );
-    for row in suspects {
-        h.push_str("<figure><div class=pair>");
-        for (path, alt) in [
-            (&row.heatmap, "error heatmap"),
-            (&row.image, "image"),
-            (&row.reference_image, "reference"),
-        ] {
-            if !path.is_empty() {
-                let _ = write!(
-                    h,
-                    "<a href=\"{0}\"><img src=\"{0}\" alt=\"{alt}\" loading=lazy></a>",
-                    esc(path)
-                );
-            }
-        }
-        let _ = write!(
-            h,
-            "</div><figcaption>{} {} on {} {}<br>{}</figcaption></figure>",
-            esc(&row.algorithm),
-            esc(&row.settings),
-            esc(&row.dataset),
-            esc(&row.viewpoint),
-            esc(&row.suspect)
-        );
-    }
-    h.push_str("</div>\n");
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -531,11 +533,34 @@ mod tests {
         assert!(markdown_summary(&a).contains("| test | variant=a;sort=radix | box:1k | 1000 |"));
     }
 
+    /// Issue 23: markup in a data set's name, a setting, an error or the command line lands in
+    /// the page as text.
+    #[test]
+    fn markup_in_names_is_escaped() {
+        use crate::html::{assert_no_live_markup, HOSTILE_NAME};
+        let mut f = file();
+        for r in &mut f.rows {
+            r.dataset = HOSTILE_NAME.into();
+            r.settings = format!("k={HOSTILE_NAME}");
+            r.image = format!("images/{HOSTILE_NAME}.png");
+        }
+        f.rows[3].error = HOSTILE_NAME.into();
+        f.errors.push(HOSTILE_NAME.into());
+        f.run.command_line = vec!["tetbench".into(), HOSTILE_NAME.into()];
+        let dir = tempfile::tempdir().unwrap();
+        write(dir.path(), &f).unwrap();
+        let page = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+        assert_no_live_markup(&page);
+    }
+
     #[test]
     fn report_has_charts_table_and_images() {
         let dir = tempfile::tempdir().unwrap();
         write(dir.path(), &file()).unwrap();
-        let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+        // minijinja's HTML escaping also writes '/' as "&#x2f;", which browsers read back as '/'.
+        let html = std::fs::read_to_string(dir.path().join("index.html"))
+            .unwrap()
+            .replace("&#x2f;", "/");
         for needle in [
             "charts/tets_per_sec.png",
             "charts/psnr.png",

@@ -7,10 +7,10 @@
 //! `tetbench plot KIND RESULTS… --out DIR` draws them from any results (one run, shards,
 //! several runs, a sweep); the HTML report of a run embeds them, speed vs error first.
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use serde::Serialize;
 
 pub mod bars;
 
@@ -73,13 +73,6 @@ pub struct Charts {
     pub fits: Vec<scaling::Fit>,
     /// Why a kind that was asked for drew nothing.
     pub skipped: Vec<(Kind, String)>,
-}
-
-pub fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }
 
 /// The style book of every variant in `rows`.
@@ -150,52 +143,65 @@ pub fn write_charts(dir: &Path, inputs: &Inputs, kind: Kind) -> anyhow::Result<C
     Ok(charts)
 }
 
-/// The charts part of `index.html`: speed vs error first, then scaling, resolution and bars,
-/// each image linking its SVG and CSV, then the key table. `prefix` is the chart directory
-/// relative to the HTML file.
-pub fn html_section(charts: &Charts, prefix: &str) -> String {
-    let mut h = String::from("<h2>Charts</h2>\n");
-    let _ = writeln!(
-        h,
-        "<p>Each variant keeps one colour and marker in every chart (colour family per \
-         algorithm; hollow grey markers are outside peers; a red ring marks suspect rows). \
-         The <a href=\"#key\">key</a> maps the short labels to full settings. Every chart has \
-         its data as CSV beside it.</p>"
-    );
-    for kind in [
-        Kind::SpeedError,
-        Kind::Scaling,
-        Kind::Resolution,
-        Kind::Bars,
-    ] {
-        let files: Vec<&ChartFile> = charts.files.iter().filter(|f| f.kind == kind).collect();
-        let skipped = charts.skipped.iter().find(|(k, _)| *k == kind);
-        if files.is_empty() && skipped.is_none() {
-            continue;
+/// The charts and their key as the data of `templates/charts.html` (the run report and the
+/// reproduced papers' pages include it); image paths are relative to `prefix`.
+#[derive(Debug, Serialize)]
+pub struct ChartsPage {
+    pub prefix: String,
+    pub kinds: Vec<ChartsOfKind>,
+    pub key: Vec<style::KeyEntry>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ChartsOfKind {
+    pub heading: &'static str,
+    pub files: Vec<ChartLink>,
+    /// Why a kind that was asked for drew nothing (empty when it drew).
+    pub skipped: String,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ChartLink {
+    pub stem: String,
+    pub title: String,
+}
+
+impl ChartsPage {
+    pub fn new(charts: &Charts, prefix: &str) -> ChartsPage {
+        let kinds = [
+            Kind::SpeedError,
+            Kind::Scaling,
+            Kind::Resolution,
+            Kind::Bars,
+        ]
+        .into_iter()
+        .filter_map(|kind| {
+            let files: Vec<ChartLink> = charts
+                .files
+                .iter()
+                .filter(|f| f.kind == kind)
+                .map(|f| ChartLink {
+                    stem: f.stem.clone(),
+                    title: f.title.clone(),
+                })
+                .collect();
+            let skipped = charts.skipped.iter().find(|(k, _)| *k == kind);
+            if files.is_empty() && skipped.is_none() {
+                return None;
+            }
+            Some(ChartsOfKind {
+                heading: kind.heading(),
+                files,
+                skipped: skipped.map(|(_, why)| why.clone()).unwrap_or_default(),
+            })
+        })
+        .collect();
+        ChartsPage {
+            prefix: prefix.to_string(),
+            kinds,
+            key: charts.book.key_entries(),
         }
-        let _ = writeln!(h, "<h3>{}</h3><div class=\"charts\">", kind.heading());
-        for f in files {
-            let _ = writeln!(
-                h,
-                "<figure class=chart><img src=\"{p}/{s}.png\" alt=\"{t}\">\
-                 <figcaption>{t} — <a href=\"{p}/{s}.svg\">SVG</a> · <a href=\"{p}/{s}.csv\">CSV</a></figcaption></figure>",
-                p = esc(prefix),
-                s = esc(&f.stem),
-                t = esc(&f.title)
-            );
-        }
-        if let Some((_, why)) = skipped {
-            let _ = writeln!(h, "<p class=note>Not drawn: {}</p>", esc(why));
-        }
-        h.push_str("</div>\n");
     }
-    let _ = writeln!(
-        h,
-        "<h3 id=key>Key</h3>{}<p><a href=\"{}/key.csv\">key.csv</a></p>",
-        charts.book.key_html(),
-        esc(prefix)
-    );
-    h
 }
 
 /// Reads `dir/results.json` as raw JSON, for fields this version does not model (a

@@ -9,7 +9,6 @@
 //! the next free slot, so no two variants of one chart set share a style.
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 
 use plotters::style::RGBColor;
 
@@ -375,34 +374,19 @@ impl StyleBook {
         String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()
     }
 
-    /// The key table as HTML rows (label with its colour swatch → full settings).
-    pub fn key_html(&self) -> String {
-        let mut h = String::from(
-            "<table class=key><tr><th class=l>label</th><th class=l>algorithm</th>\
-             <th class=l>settings</th><th class=l>marker</th></tr>\n",
-        );
-        for ((a, s), st) in &self.styles {
-            let _ = writeln!(
-                h,
-                "<tr{}><td class=l><span class=swatch style=\"{}:{}\"></span> {}</td>\
-                 <td class=l>{}{}</td><td class=l><code>{}</code></td><td class=l>{}{}</td></tr>",
-                if st.hollow { " class=peer" } else { "" },
-                if st.hollow {
-                    "border-color"
-                } else {
-                    "background"
-                },
-                st.hex(),
-                crate::plot::esc(&st.label),
-                crate::plot::esc(a),
-                if st.hollow { " <em>(peer)</em>" } else { "" },
-                crate::plot::esc(s),
-                st.marker.name(),
-                if st.hollow { ", hollow" } else { "" },
-            );
-        }
-        h.push_str("</table>\n");
-        h
+    /// The key table (label with its colour → full settings) for the HTML pages.
+    pub fn key_entries(&self) -> Vec<KeyEntry> {
+        self.styles
+            .iter()
+            .map(|((a, s), st)| KeyEntry {
+                label: st.label.clone(),
+                algorithm: a.clone(),
+                settings: s.clone(),
+                color: st.hex(),
+                marker: st.marker.name(),
+                hollow: st.hollow,
+            })
+            .collect()
     }
 }
 
@@ -449,6 +433,18 @@ fn short_labels<'a>(algorithm: &str, settings: impl Iterator<Item = &'a str>) ->
         }
     }
     labels
+}
+
+/// One line of the charts' key, as the HTML pages show it.
+#[derive(Debug, serde::Serialize)]
+pub struct KeyEntry {
+    pub label: String,
+    pub algorithm: String,
+    pub settings: String,
+    pub color: String,
+    pub marker: &'static str,
+    /// Hollow grey markers: an outside peer.
+    pub hollow: bool,
 }
 
 #[cfg(test)]
