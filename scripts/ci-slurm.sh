@@ -27,7 +27,7 @@ command -v python3 >/dev/null 2>&1 || apt_install python3
 ensure_prerequisites
 
 # The debug binary the test suite has already built (cheap to bring up to date here).
-cargo build -q -p tetbench
+cargo build -q -p harness --bin tetbench
 bin="${CARGO_TARGET_DIR:-$repo/target}/debug/tetbench"
 case "$bin" in /*) ;; *) bin="$repo/$bin" ;; esac
 
@@ -45,7 +45,10 @@ cleanup() {
     local status=$?
     local p
     # Jobs still queued or running (after a failure) go first: their processes outlive slurmd.
-    [ "${#jobs_seen[@]}" -eq 0 ] || scancel "${jobs_seen[@]}" 2>/dev/null && sleep 1 || true
+    if [ "$status" -ne 0 ] && [ "${#jobs_seen[@]}" -gt 0 ]; then
+        scancel "${jobs_seen[@]}" 2>/dev/null || true
+        sleep 2
+    fi
     # slurmd and slurmctld first, munged (which they authenticate through) last.
     for ((k = ${#pids[@]} - 1; k >= 0; k--)); do "${root[@]}" kill "${pids[k]}" 2>/dev/null || true; done
     for p in "${pids[@]}"; do

@@ -67,7 +67,7 @@ command -v sbatch >/dev/null 2>&1 ||
 
 if [ -z "$bin" ]; then
     bin="${CARGO_TARGET_DIR:-target}/release/tetbench"
-    [ -x "$bin" ] || die "no tetbench binary at $bin: build it (cargo build --release -p tetbench) or pass --tetbench BIN"
+    [ -x "$bin" ] || die "no tetbench binary at $bin: build it (cargo build --release -p harness --bin tetbench) or pass --tetbench BIN"
 fi
 [ -x "$bin" ] && [ -f "$bin" ] || die "--tetbench $bin: not an executable file"
 bin="$(cd "$(dirname "$bin")" && pwd)/$(basename "$bin")"
