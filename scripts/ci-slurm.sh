@@ -4,7 +4,7 @@
 #     (state, spool, sockets and logs in one temporary directory; ports chosen free).
 #  2. A 3-shard array of a small matrix plus its merge job: the merged rows must equal one
 #     plain run of the same matrix in every key and image hash, in the same order.
-#  3. The same array with shard 2 made to fail: the merge job must fail and name shard 2/3,
+#  3. The same array with --gpu (one stand-in GPU) and shard 2 made to fail: the merge job must fail and name shard 2/3,
 #     and `report --merge` of the two shards that arrived must refuse (naming 2/3) unless
 #     --allow-missing, which lists the missing units.
 # Every wait is bounded; on failure it prints squeue, the jobs' state and the logs' tails. The
@@ -118,9 +118,15 @@ SelectTypeParameters=CR_Core
 ReturnToService=2
 SlurmdParameters=config_overrides
 MinJobAge=600
-NodeName=$node NodeAddr=127.0.0.1 CPUs=2 State=UNKNOWN
+# One stand-in GPU (gres.conf below), so that slurm-run.sh --gpu's --gres=gpu:1 is scheduled
+# for real.
+GresTypes=gpu
+NodeName=$node NodeAddr=127.0.0.1 CPUs=2 Gres=gpu:1 State=UNKNOWN
 PartitionName=ci Nodes=$node Default=YES MaxTime=INFINITE State=UP
 EOF
+# The stand-in GPU's device is /dev/null: slurmd counts a GPU only with a device file, and
+# nothing here opens it (the tasks render on lavapipe).
+printf 'AutoDetect=off\nNodeName=%s Name=gpu File=/dev/null Count=1\n' "$node" >"$tmp/gres.conf"
 for _ in $(seq 1 40); do [ -S "$sock" ] && break; sleep 0.25; done
 [ -S "$sock" ] || { cat "$tmp/munged.out" >&2; diagnose "munged did not start"; }
 "${root[@]}" env SLURM_CONF="$SLURM_CONF" slurmctld -D -i -f "$SLURM_CONF" >"$tmp/slurmctld.out" 2>&1 &
@@ -186,7 +192,8 @@ print(f"ci-slurm: merged rows equal one run: {len(a)} rows, {len(set(r[7] for r 
 EOF
 
 # 3. Shard 2 fails: the merge job fails and names it; report --merge refuses the rest.
-scripts/slurm-run.sh --shards 3 --out "$out/fail" --tetbench "$bin" --fail-shard 2 -- "${matrix[@]}" >&2 ||
+# With --gpu: each task asks for the node's one (stand-in) GPU, so the tasks run one by one.
+scripts/slurm-run.sh --shards 3 --out "$out/fail" --tetbench "$bin" --gpu --fail-shard 2 -- "${matrix[@]}" >&2 ||
     diagnose "slurm-run.sh refused"
 . "$out/fail/slurm/jobs.env"
 jobs_seen+=("$ARRAY_JOB" "$MERGE_JOB")
@@ -195,6 +202,8 @@ s="$(wait_job "$MERGE_JOB" 300)"
 grep -q 'shard 2/3 failed: it exited with status 42' "$out/fail/logs/merge.out" ||
     diagnose "the merge job's log does not name shard 2/3"
 [ ! -e "$out/fail/merged/results.json" ] || diagnose "the failed merge wrote merged results"
+scontrol -o show job "${ARRAY_JOB}_1" | grep -q -E 'gres[:/]gpu[:=]1' ||
+    diagnose "shard 1 was not given a GPU (--gpu)"
 log "merge job failed as it should: $(grep 'shard 2/3' "$out/fail/logs/merge.out" | head -n 1)"
 if "$bin" report --merge "$out/fail/shard-1" "$out/fail/shard-3" --out "$out/fail/partial" 2>"$out/fail/partial.err"; then
     diagnose "report --merge of shards 1 and 3 of 3 succeeded"
