@@ -4,9 +4,9 @@
 #     (state, spool, sockets and logs in one temporary directory; ports chosen free).
 #  2. A 3-shard array of a small matrix plus its merge job: the merged rows must equal one
 #     plain run of the same matrix in every key and image hash, in the same order.
-#  3. The same array with --gpu (one stand-in GPU) and shard 2 made to fail: the merge job must fail and name shard 2/3,
-#     and `report --merge` of the two shards that arrived must refuse (naming 2/3) unless
-#     --allow-missing, which lists the missing units.
+#  3. The same array with --gpu (one stand-in GPU) and shard 2 made to fail: the merge job
+#     must fail and name shard 2/3, and `report --merge` of the two shards that arrived must
+#     refuse (naming 2/3) unless --allow-missing, which lists the missing units.
 # Every wait is bounded; on failure it prints squeue, the jobs' state and the logs' tails. The
 # daemons it started are stopped by their pids on exit.
 set -euo pipefail
