@@ -11,6 +11,7 @@ use crate::datasets_cmd::{self, DatasetsCommand};
 pub use crate::plan::default_cache_dir;
 use crate::plan::RunPlan;
 use crate::run::{self, RunConfig};
+use crate::shard::INCOMPLETE;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -54,6 +55,10 @@ pub enum Command {
         /// Where the merged results and report go.
         #[arg(long, value_name = "OUT")]
         out: Option<PathBuf>,
+        /// Merge even when a shard is missing or a run did not finish; the missing units are
+        /// listed in the merged results' errors (without it such a merge is refused).
+        #[arg(long, requires = "merge")]
+        allow_missing: bool,
     },
     /// Compare two runs: faster / slower / no change per row and group (Mann–Whitney U and a
     /// factor threshold), image and memory changes; writes compare.{md,json,html}.
@@ -294,10 +299,18 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             },
         ),
         Command::Reproduce(args) => crate::reproduce::run(args, cli.data_dir),
-        Command::Report { dir, merge, out } => {
+        Command::Report {
+            dir,
+            merge,
+            out,
+            allow_missing,
+        } => {
             if !merge.is_empty() {
                 let out = out.context("report --merge needs --out OUT")?;
-                let merged = crate::shard::merge(&merge, &out)?;
+                let merged = crate::shard::merge(&merge, &out, allow_missing)?;
+                for gap in merged.errors.iter().filter(|e| e.starts_with(INCOMPLETE)) {
+                    eprintln!("tetbench: {gap}");
+                }
                 crate::report::write(&out, &merged)
                     .with_context(|| format!("writing the report in {}", out.display()))?;
                 println!(

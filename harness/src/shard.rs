@@ -127,9 +127,141 @@ fn row_key(r: &Row) -> (String, String, String, String, u32, u32, String) {
     )
 }
 
+/// How a merged results set's `errors` begin for each [`Gap`] merged with `--allow-missing`.
+pub const INCOMPLETE: &str = "incomplete merge: ";
+
+/// A part of the matrix that did not arrive: a shard no directory holds, or a run that did
+/// not finish (its task was killed or crashed) and so lacks some of its units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gap {
+    /// What is missing and why, naming the shard (`i/N`) or the directory.
+    pub what: String,
+    /// The (data set, algorithm, settings) units it should have measured and did not.
+    pub units: Vec<Unit>,
+}
+
+impl fmt::Display for Gap {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.what)?;
+        if !self.units.is_empty() {
+            let units: Vec<String> = self
+                .units
+                .iter()
+                .map(|(d, a, s)| format!("{d} {a} {s}").trim_end().to_string())
+                .collect();
+            write!(f, "; missing units: {}", units.join(", "))?;
+        }
+        Ok(())
+    }
+}
+
+/// Every (data set, algorithm, settings) unit `run` asks for, in the order it runs them (the
+/// units `--shard` deals out).
+pub fn units_of(run: &RunDescription) -> Vec<Unit> {
+    let filter = crate::algorithms::SettingsFilter::parse(&run.settings_filter).unwrap_or_default();
+    let mut units = vec![];
+    for spec in &run.datasets {
+        let label = crate::names::dataset_label(spec);
+        for a in &run.algorithms {
+            for r in crate::algorithms::selected_variants(a, &filter).unwrap_or_default() {
+                let settings = render_core::settings_string(&r.settings());
+                units.push((label.clone(), a.clone(), settings));
+            }
+        }
+    }
+    units
+}
+
+/// The shard a results file records, if it is one.
+fn shard_of(f: &ResultsFile, dir: &Path) -> anyhow::Result<Option<Shard>> {
+    f.run
+        .shard
+        .as_deref()
+        .map(|s| {
+            s.parse::<Shard>()
+                .with_context(|| format!("{}: run.shard in results.json", dir.display()))
+        })
+        .transpose()
+}
+
+/// What `files` (read from `dirs`) lack of the matrices they are parts of: every run that did
+/// not finish (no `finished_utc`: it was killed or crashed), with the units it has no row
+/// for, and every shard `i/N` of a split (same algorithms and N) that fewer files hold than
+/// another shard of that split — none, or once where the others came from two machines.
+/// Empty when the parts are complete.
+pub fn gaps(files: &[ResultsFile], dirs: &[PathBuf]) -> anyhow::Result<Vec<Gap>> {
+    let mut gaps = vec![];
+    // Split (algorithms, N) → how many files hold each shard, and one of its files. Not keyed
+    // by adapter: the shards of one split may run on different GPUs of a cluster.
+    let mut splits: Vec<((Vec<String>, usize), HashMap<usize, usize>, &ResultsFile)> = vec![];
+    for (f, d) in files.iter().zip(dirs) {
+        let shard = shard_of(f, d)?;
+        if f.finished_utc.is_none() {
+            let own: Vec<Unit> = match shard {
+                Some(s) => {
+                    let all = units_of(&f.run);
+                    let mine = select(s, &all);
+                    all.into_iter().filter(|u| mine.contains(u)).collect()
+                }
+                None => units_of(&f.run),
+            };
+            let measured: HashSet<Unit> = f
+                .rows
+                .iter()
+                .map(|r| (r.dataset.clone(), r.algorithm.clone(), r.settings.clone()))
+                .collect();
+            let name = shard.map(|s| format!("shard {s} in ")).unwrap_or_default();
+            gaps.push(Gap {
+                what: format!(
+                    "{name}{} did not finish (results.json has no finished_utc: the run was \
+                     killed or crashed)",
+                    d.display()
+                ),
+                units: own.into_iter().filter(|u| !measured.contains(u)).collect(),
+            });
+        }
+        let Some(shard) = shard else { continue };
+        let key = (f.run.algorithms.clone(), shard.count);
+        match splits.iter_mut().find(|(k, _, _)| *k == key) {
+            Some((_, held, _)) => *held.entry(shard.index).or_default() += 1,
+            None => splits.push((key, HashMap::from([(shard.index, 1)]), f)),
+        }
+    }
+    for ((_, count), held, f) in &splits {
+        let most = held.values().copied().max().unwrap_or(0);
+        let all = units_of(&f.run);
+        for index in 1..=*count {
+            let times = held.get(&index).copied().unwrap_or(0);
+            if times == most {
+                continue;
+            }
+            let shard = Shard {
+                index,
+                count: *count,
+            };
+            let what = if times == 0 {
+                format!("shard {shard} is missing: none of the directories given holds it")
+            } else {
+                format!(
+                    "shard {shard} is missing from a machine: {times} of the directories hold \
+                     it, {most} hold another shard of the split"
+                )
+            };
+            let mine = select(shard, &all);
+            gaps.push(Gap {
+                what,
+                units: all.iter().filter(|u| mine.contains(*u)).cloned().collect(),
+            });
+        }
+    }
+    Ok(gaps)
+}
+
 /// Merges the results in `dirs` into one set written to `out` (results, samples, copied
-/// images), ordered as one unsharded run would order them, machines side by side.
-pub fn merge(dirs: &[PathBuf], out: &Path) -> anyhow::Result<ResultsFile> {
+/// images), ordered as one unsharded run would order them, machines side by side. A missing
+/// shard or an unfinished run (see [`gaps`]) is an error naming it, unless `allow_missing`:
+/// then the merge goes on and records each gap, with its missing units, in `errors`.
+pub fn merge(dirs: &[PathBuf], out: &Path, allow_missing: bool) -> anyhow::Result<ResultsFile> {
     anyhow::ensure!(
         !dirs.is_empty(),
         "report --merge needs at least one directory"
@@ -138,6 +270,15 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> anyhow::Result<ResultsFile> {
         .iter()
         .map(|d| ResultsFile::read(d))
         .collect::<anyhow::Result<_>>()?;
+    let gaps = gaps(&files, dirs)?;
+    if !gaps.is_empty() && !allow_missing {
+        let list: Vec<String> = gaps.iter().map(|g| format!("  {g}")).collect();
+        anyhow::bail!(
+            "the results to merge are incomplete:\n{}\nrerun what is missing, or merge anyway \
+             with --allow-missing (the missing units are then listed in the merged errors)",
+            list.join("\n")
+        );
+    }
     let first = &files[0];
     let mut matrix = matrix_of(&first.run);
     for (f, d) in files.iter().zip(dirs).skip(1) {
@@ -215,7 +356,11 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> anyhow::Result<ResultsFile> {
         run,
         finished_utc: finished.and_then(|f| f.into_iter().max()),
         rows,
-        errors: files.iter().flat_map(|f| f.errors.clone()).collect(),
+        errors: files
+            .iter()
+            .flat_map(|f| f.errors.clone())
+            .chain(gaps.iter().map(|g| format!("{INCOMPLETE}{g}")))
+            .collect(),
     };
     results::write_csv(out, &merged.rows)?;
     results::write_json(out, &merged)?;
@@ -324,6 +469,144 @@ mod tests {
         r.reverse();
         let s = Shard { index: 2, count: 3 };
         assert_eq!(select(s, &u), select(s, &r));
+    }
+
+    /// A finished shard `i/n` of a one-algorithm matrix over two meshes: one row per unit.
+    fn shard_file(i: usize, n: usize) -> ResultsFile {
+        let run = RunDescription {
+            algorithms: vec!["gator-pt".into()],
+            datasets: vec!["box:1k".into(), "shell:1k".into()],
+            viewpoints: "+x".into(),
+            width: 8,
+            height: 8,
+            frames: 1,
+            rounds: 1,
+            shard: Some(format!("{i}/{n}")),
+            ..RunDescription::default()
+        };
+        let mine = select(Shard { index: i, count: n }, &units_of(&run));
+        let rows = units_of(&run)
+            .into_iter()
+            .filter(|u| mine.contains(u))
+            .map(|(dataset, algorithm, settings)| Row {
+                algorithm,
+                settings,
+                dataset,
+                viewpoint: "+x".into(),
+                width: 8,
+                height: 8,
+                ..Row::default()
+            })
+            .collect();
+        ResultsFile {
+            schema_version: results::SCHEMA_VERSION,
+            machine: crate::machine::MachineInfo::collect(),
+            run,
+            finished_utc: Some("2026-01-01T00:00:00Z".into()),
+            rows,
+            errors: vec![],
+        }
+    }
+
+    fn dirs(names: &[usize]) -> Vec<PathBuf> {
+        names
+            .iter()
+            .map(|i| PathBuf::from(format!("out/shard-{i}")))
+            .collect()
+    }
+
+    /// All shards: complete. One left out: a gap naming it and exactly its units.
+    #[test]
+    fn a_missing_shard_is_named_with_its_units() {
+        let all: Vec<ResultsFile> = (1..=3).map(|i| shard_file(i, 3)).collect();
+        assert!(units_of(&all[0].run).len() >= 3, "every shard has a unit");
+        assert_eq!(gaps(&all, &dirs(&[1, 2, 3])).unwrap(), vec![]);
+
+        let some = vec![all[0].clone(), all[2].clone()];
+        let found = gaps(&some, &dirs(&[1, 3])).unwrap();
+        assert_eq!(found.len(), 1, "{found:?}");
+        assert!(found[0].what.contains("shard 2/3"), "{}", found[0]);
+        let expected = select(Shard { index: 2, count: 3 }, &units_of(&all[0].run));
+        assert_eq!(found[0].units.len(), expected.len());
+        assert!(found[0].units.iter().all(|u| expected.contains(u)));
+        assert!(found[0].to_string().contains("missing units: "));
+    }
+
+    /// A shard whose task was killed (no finished_utc) is a gap listing the units it has no
+    /// row for; the same file finished is not.
+    #[test]
+    fn an_unfinished_shard_is_a_gap() {
+        let mut files: Vec<ResultsFile> = (1..=2).map(|i| shard_file(i, 2)).collect();
+        let lost = files[1].rows.pop().unwrap();
+        assert_eq!(gaps(&files, &dirs(&[1, 2])).unwrap(), vec![]);
+        files[1].finished_utc = None;
+        let found = gaps(&files, &dirs(&[1, 2])).unwrap();
+        assert_eq!(found.len(), 1, "{found:?}");
+        assert!(found[0]
+            .what
+            .contains("shard 2/2 in out/shard-2 did not finish"));
+        assert_eq!(
+            found[0].units,
+            vec![(lost.dataset, lost.algorithm, lost.settings)]
+        );
+    }
+
+    /// The same split on two machines: shard 2 from only one of them is a gap.
+    #[test]
+    fn a_shard_missing_from_one_machine_is_a_gap() {
+        let mut other: Vec<ResultsFile> = (1..=2).map(|i| shard_file(i, 2)).collect();
+        for f in &mut other {
+            f.machine.cpu_model = "another CPU".into();
+        }
+        let mut files: Vec<ResultsFile> = (1..=2).map(|i| shard_file(i, 2)).collect();
+        files.extend(other.clone());
+        assert_eq!(gaps(&files, &dirs(&[1, 2, 3, 4])).unwrap(), vec![]);
+        files.pop();
+        let found = gaps(&files, &dirs(&[1, 2, 3])).unwrap();
+        assert_eq!(found.len(), 1, "{found:?}");
+        assert!(found[0]
+            .what
+            .starts_with("shard 2/2 is missing from a machine"));
+    }
+
+    /// Splits are told apart by N: shards 1/2 and 2/2 are complete beside a whole 1/1.
+    #[test]
+    fn splits_of_different_sizes_are_checked_apart() {
+        let files = vec![shard_file(1, 2), shard_file(2, 2), shard_file(1, 1)];
+        assert_eq!(gaps(&files, &dirs(&[1, 2, 3])).unwrap(), vec![]);
+        let files = vec![shard_file(1, 2), shard_file(1, 1)];
+        let found = gaps(&files, &dirs(&[1, 3])).unwrap();
+        assert_eq!(found.len(), 1);
+        assert!(found[0].what.starts_with("shard 2/2 is missing"));
+    }
+
+    /// `merge` refuses a missing shard, naming it, and with `allow_missing` merges what
+    /// arrived and lists the gap in the merged errors.
+    #[test]
+    fn merge_refuses_a_missing_shard_unless_allowed() {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut dirs = vec![];
+        for i in [1, 3] {
+            let d = tmp.path().join(format!("shard-{i}"));
+            std::fs::create_dir_all(&d).unwrap();
+            results::write_json(&d, &shard_file(i, 3)).unwrap();
+            dirs.push(d);
+        }
+        let out = tmp.path().join("merged");
+        let err = merge(&dirs, &out, false).unwrap_err().to_string();
+        assert!(err.contains("shard 2/3 is missing"), "{err}");
+        assert!(err.contains("--allow-missing"), "{err}");
+        assert!(!out.join("results.json").exists());
+
+        let merged = merge(&dirs, &out, true).unwrap();
+        let gaps: Vec<&String> = merged
+            .errors
+            .iter()
+            .filter(|e| e.starts_with(INCOMPLETE))
+            .collect();
+        assert_eq!(gaps.len(), 1, "{:?}", merged.errors);
+        assert!(gaps[0].contains("shard 2/3"));
+        assert_eq!(ResultsFile::read(&out).unwrap().errors, merged.errors);
     }
 
     #[test]
