@@ -139,9 +139,11 @@ impl Gpu {
         let info = adapter.get_info();
         let mut features = adapter.features() & wanted_features();
         if request.no_timestamps {
-            features -= wgpu::Features::TIMESTAMP_QUERY
-                | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
-                | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
+            features.remove(
+                wgpu::Features::TIMESTAMP_QUERY
+                    | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+                    | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES,
+            );
         }
         let mut limits = adapter.limits();
         if let Some(bytes) = request.max_storage_binding {
