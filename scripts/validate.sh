@@ -87,7 +87,7 @@ SETTINGS
     env VK_LAYER_SETTINGS_PATH="$out/$name.vk_layer_settings.txt" "${vars[@]}" "$bin" run "${common[@]}" --out "$out/$name" "$@" >"$out/$name.log" 2>&1 || {
         status=1
         echo "tetbench validate: pass $name failed; tetbench run said ($out/$name.log):" >&2
-        grep -E -A4 '^error|FAILED|^Caused by' "$out/$name.log" | head -n 30 >&2
+        grep -E -A4 '^error|FAILED|^Caused by' "$out/$name.log" | awk 'NR <= 30' >&2 || true
     }
     local n=0
     [ -f "$out/$name/results.csv" ] && n=$(($(wc -l <"$out/$name/results.csv") - 1))
@@ -116,8 +116,11 @@ warnings=$(grep -c -E 'Validation (Warning|Performance Warning)' "$log" || true)
 echo "tetbench validate: $rows rows under VK_LAYER_KHRONOS_validation with synchronization" \
     "validation ($instances instances): $errors errors, $warnings warnings; $((SECONDS - start)) s"
 if [ "$errors" -gt 0 ] || [ "$warnings" -gt 0 ]; then
-    echo "tetbench validate: the layer reported problems; the first ($log):" >&2
-    grep -E 'Validation (Error|Warning|Performance Warning)' "$log" | head -n 5 | cut -c1-600 >&2
+    echo "tetbench validate: the layer reported problems; the first distinct ones ($log):" >&2
+    # Object handles differ between repeats of one message: fold them before keeping 5.
+    grep -E 'Validation (Error|Warning|Performance Warning)' "$log" |
+        sed 's/handle = 0x[0-9a-f]*/handle = …/g' | awk '!seen[$0]++ && n++ < 5' |
+        cut -c1-600 >&2 || true
     status=1
 fi
 exit $status
