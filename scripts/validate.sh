@@ -86,15 +86,21 @@ SETTINGS
     local t0=$SECONDS
     env VK_LAYER_SETTINGS_PATH="$out/$name.vk_layer_settings.txt" "${vars[@]}" "$bin" run "${common[@]}" --out "$out/$name" "$@" >"$out/$name.log" 2>&1 || {
         status=1
-        echo "tetbench validate: pass $name failed; tetbench run said ($out/$name.log):" >&2
-        grep -E -A4 '^error|FAILED|^Caused by' "$out/$name.log" | awk 'NR <= 30' >&2 || true
+        echo "tetbench validate: pass $name failed ($out/$name.log): $(grep -c FAILED "$out/$name.log" || true) failed rows; the first:" >&2
+        # The first failed row and its cause, then tetbench's closing error line.
+        awk '/FAILED/ && !f { f = 1; n = 0 } f && n++ < 8' "$out/$name.log" >&2 || true
+        grep -E '^error' "$out/$name.log" | cut -c1-300 >&2 || true
     }
-    local n=0
-    [ -f "$out/$name/results.csv" ] && n=$(($(wc -l <"$out/$name/results.csv") - 1))
-    rows=$((rows + n))
-    local variants=0
-    [ -f "$out/$name/results.csv" ] && variants=$(tail -n +2 "$out/$name/results.csv" | cut -d, -f1-2 | sort -u | wc -l)
-    echo "tetbench validate: pass $name: $n rows, $variants variants, $((SECONDS - t0)) s" >&2
+    # Rows and distinct variants (algorithm + settings) of the pass's results.
+    local counts
+    counts=$(python3 - "$out/$name/results.csv" <<'PY' 2>/dev/null || echo "0 0"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1], newline="")))
+print(len(rows), len({(r["algorithm"], r["settings"]) for r in rows}))
+PY
+)
+    rows=$((rows + ${counts% *}))
+    echo "tetbench validate: pass $name: ${counts% *} rows, ${counts#* } variants, $((SECONDS - t0)) s" >&2
 }
 run_pass variants -- --all-variants --datasets box:1k,shell:1k \
     --settings 'k=2|16;tiles=1x1|2x2;layers=4|32;radius=2;slab=1;grid=32'
