@@ -163,6 +163,11 @@ pub struct RunArgs {
     /// (keys an algorithm lacks are ignored for it).
     #[arg(long, value_name = "FILTER")]
     pub settings: Option<String>,
+    /// Run every variant each algorithm offers (what `--settings` selects from) instead of
+    /// the defaults; with `--settings`, every variant that matches it (settings the filter does
+    /// not name are not held to their defaults).
+    #[arg(long)]
+    pub all_variants: bool,
     /// Skip the reference and the error metrics (timing only).
     #[arg(long)]
     pub no_reference: bool,
@@ -232,6 +237,20 @@ impl RunArgs {
     }
 }
 
+/// The variants `tetbench run` starts from for algorithm `name`: every one it offers with
+/// `--all-variants` (the run then keeps those `filter` accepts), else `--settings`' selection.
+fn run_variants(
+    name: &str,
+    all_variants: bool,
+    filter: &algorithms::SettingsFilter,
+) -> anyhow::Result<Vec<Box<dyn render_core::Renderer>>> {
+    if all_variants {
+        algorithms::all_variants(name)
+    } else {
+        algorithms::selected_variants(name, filter)
+    }
+}
+
 /// Parses `args` (program name first) and runs the command.
 pub fn main_with_args<I, T>(args: I) -> anyhow::Result<()>
 where
@@ -253,7 +272,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             let config = args.to_config(cli.data_dir, command_line)?;
             let filter = config.settings_filter.clone();
             let outcome = run::run(&config, &|name: &str| {
-                algorithms::selected_variants(name, &filter)
+                run_variants(name, args.all_variants, &filter)
             })?;
             println!(
                 "{} rows in {:.1} s; results in {} (open {})",
@@ -379,6 +398,33 @@ mod tests {
             unreachable!()
         };
         Ok(run.to_config(None, vec![])?.algorithms)
+    }
+
+    /// `--all-variants` starts from every variant, `--settings` alone from the defaults'
+    /// neighbourhood: HAVS offers more variants than it runs by default.
+    #[test]
+    fn all_variants_starts_from_every_variant() {
+        let Command::Run(run) =
+            Cli::try_parse_from(["tetbench", "run", "--all-variants", "--datasets", "box:1k"])
+                .unwrap()
+                .command
+        else {
+            unreachable!()
+        };
+        assert!(run.all_variants);
+        let none = algorithms::SettingsFilter::default();
+        for name in algorithms::names() {
+            let every = run_variants(name, true, &none).unwrap().len();
+            assert_eq!(every, algorithms::all_variants(name).unwrap().len());
+            assert_eq!(
+                run_variants(name, false, &none).unwrap().len(),
+                algorithms::variants(name).unwrap().len()
+            );
+        }
+        assert!(
+            run_variants("havs", true, &none).unwrap().len()
+                > run_variants("havs", false, &none).unwrap().len()
+        );
     }
 
     #[test]

@@ -43,11 +43,87 @@ fn wanted_features() -> wgpu::Features {
         | wgpu::Features::INDIRECT_FIRST_INSTANCE
 }
 
+/// What to ask of the adapter beyond "everything it offers": the paths a given machine would
+/// not take on its own. Tests ask for small storage bindings (the chunked paths engage on a
+/// mesh of modest size, and wgpu then refuses any binding past the limit, as a GPU with that
+/// limit would) and for no timestamp queries (frames without `gpu_ms`, as on adapters that
+/// lack them); `scripts/validate.sh` sets the same through the environment
+/// ([`DeviceRequest::from_env`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct DeviceRequest {
+    /// Request at most this `max_storage_buffer_binding_size` (bytes, rounded down to a
+    /// multiple of 256, at least 256); `None`: the adapter's own.
+    pub max_storage_binding: Option<u64>,
+    /// Leave the timestamp-query features off even where the adapter has them.
+    pub no_timestamps: bool,
+}
+
+/// Environment variable of [`DeviceRequest::max_storage_binding`] (bytes).
+pub const ENV_MAX_STORAGE_BINDING: &str = "TETBENCH_MAX_STORAGE_BINDING";
+/// Environment variable of [`DeviceRequest::no_timestamps`] (`off` turns them off).
+pub const ENV_TIMESTAMPS: &str = "TETBENCH_TIMESTAMPS";
+
+impl DeviceRequest {
+    /// The request `TETBENCH_MAX_STORAGE_BINDING=BYTES` and `TETBENCH_TIMESTAMPS=off` describe
+    /// (neither set: the adapter as it is).
+    pub fn from_env() -> anyhow::Result<DeviceRequest> {
+        let var = |k: &str| std::env::var(k).ok().filter(|v| !v.trim().is_empty());
+        let max_storage_binding = match var(ENV_MAX_STORAGE_BINDING) {
+            None => None,
+            Some(v) => Some(v.trim().parse::<u64>().map_err(|_| {
+                anyhow!("{ENV_MAX_STORAGE_BINDING}={v:?}: expected a number of bytes")
+            })?),
+        };
+        let no_timestamps = match var(ENV_TIMESTAMPS).as_deref().map(str::trim) {
+            None | Some("on") => false,
+            Some("off") => true,
+            Some(v) => anyhow::bail!("{ENV_TIMESTAMPS}={v:?}: expected on or off"),
+        };
+        Ok(DeviceRequest {
+            max_storage_binding,
+            no_timestamps,
+        })
+    }
+
+    /// What the request changed, for the adapter's description (so that rows measured on a
+    /// restricted device say so); empty when nothing.
+    fn note(&self, limits: &wgpu::Limits) -> String {
+        let mut parts = vec![];
+        if self.max_storage_binding.is_some() {
+            parts.push(format!(
+                "max_storage_buffer_binding_size requested as {}",
+                limits.max_storage_buffer_binding_size
+            ));
+        }
+        if self.no_timestamps {
+            parts.push("timestamp queries off".to_string());
+        }
+        parts.join(", ")
+    }
+}
+
+/// Instance flags: wgpu's defaults for the build without backend validation, then the
+/// `WGPU_*` environment variables (`WGPU_VALIDATION=1`, `WGPU_DEBUG=1`, …) as wgpu documents
+/// them. wgpu's default turns the Khronos validation layer on in every debug build where the
+/// layer is installed, which would slow every test on a machine that once ran
+/// `scripts/validate.sh`; here validation is asked for, never implied by the build profile.
+/// (wgpu's own API validation is always on: a violation is an error whatever the flags.)
+pub fn instance_flags() -> wgpu::InstanceFlags {
+    (wgpu::InstanceFlags::from_build_config() - wgpu::InstanceFlags::VALIDATION).with_env()
+}
+
 impl Gpu {
-    /// Opens the first adapter (high-performance preferred; software adapters allowed).
+    /// Opens the first adapter (high-performance preferred; software adapters allowed), as
+    /// the environment asks ([`DeviceRequest::from_env`]; normally: all it offers).
     pub fn new() -> anyhow::Result<Gpu> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Self::with_request(&DeviceRequest::from_env()?)
+    }
+
+    /// Opens the first adapter with the features and limits `request` allows.
+    pub fn with_request(request: &DeviceRequest) -> anyhow::Result<Gpu> {
+        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        descriptor.flags = instance_flags();
+        let instance = wgpu::Instance::new(descriptor);
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,
@@ -61,8 +137,20 @@ impl Gpu {
             )
         })?;
         let info = adapter.get_info();
-        let features = adapter.features() & wanted_features();
-        let limits = adapter.limits();
+        let mut features = adapter.features() & wanted_features();
+        if request.no_timestamps {
+            features.remove(
+                wgpu::Features::TIMESTAMP_QUERY
+                    | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+                    | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES,
+            );
+        }
+        let mut limits = adapter.limits();
+        if let Some(bytes) = request.max_storage_binding {
+            limits.max_storage_buffer_binding_size = (bytes & !255)
+                .max(256)
+                .min(limits.max_storage_buffer_binding_size);
+        }
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("tetbench"),
             required_features: features,
@@ -72,6 +160,14 @@ impl Gpu {
             trace: wgpu::Trace::Off,
         }))
         .context("requesting the GPU device")?;
+        // What the device enforces, which is what the algorithms must plan for.
+        let limits = device.limits();
+        let note = request.note(&limits);
+        let driver_info = if note.is_empty() {
+            info.driver_info.clone()
+        } else {
+            format!("{} (tetbench: {note})", info.driver_info)
+        };
         Ok(Gpu {
             device,
             queue,
@@ -80,7 +176,7 @@ impl Gpu {
                 backend: format!("{:?}", info.backend).to_lowercase(),
                 device_type: format!("{:?}", info.device_type),
                 driver: info.driver.clone(),
-                driver_info: info.driver_info.clone(),
+                driver_info,
             },
             features,
             limits,

@@ -1,0 +1,175 @@
+#!/usr/bin/env bash
+# One command for the minutes a machine with a GPU is lent (docs/gpu.md): builds tetbench in
+# release (or takes --bin), refuses a software adapter (lavapipe, llvmpipe, SwiftShader, WARP)
+# unless --allow-software, then runs, timing each step:
+#
+#   calibrate   tetbench calibrate --force                     → calibration.json
+#   suite       the default suite with --rounds 5               → results.json, results.csv, samples.csv
+#   reproduce   tetbench reproduce PAPER --quick for each paper → reproduce/
+#   peers       the default suite of VTK's mappers, when VTK is installed → peers/
+#
+# into ONE directory, reports/baselines/ADAPTER-DATE/ (the shape of scripts/baseline.sh's:
+# ready to commit, `tetbench compare` and `history` read it as a baseline), with gpu.md: the
+# adapter, the command, and the wall time of every step. Needs no network once built (VTK is
+# used only when already installed). Options shrink it:
+#
+#   --allow-software   run on a software adapter too (a smoke test of this script)
+#   --rounds N         rounds of the suite (default 5)
+#   --quick            skip the papers' reproduction
+#   --papers LIST      reproduce only these papers (comma-separated: havs, gator, fragment-pt,
+#                      raycast, splat; default all)
+#   --skip-peers       skip the VTK peers
+#   --out DIR          output directory (default reports/baselines/ADAPTER-DATE)
+#   --bin PATH         use this tetbench binary instead of building one
+#   -- ARGS            passed to the suite's `tetbench run` (e.g. -- --datasets box:1k)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+. scripts/common.sh
+
+orig_args=("$@")
+allow_software=0
+rounds=5
+papers=all
+skip_peers=0
+out=""
+bin=""
+suite_args=()
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --allow-software) allow_software=1 ;;
+        --rounds) rounds=${2:?--rounds needs a number}; shift ;;
+        --quick) papers="" ;;
+        --papers) papers=${2:?--papers needs a list}; shift ;;
+        --skip-peers) skip_peers=1 ;;
+        --out) out=${2:?--out needs a directory}; shift ;;
+        --bin) bin=${2:?--bin needs a path}; shift ;;
+        --) shift; suite_args=("$@"); break ;;
+        -h|--help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        *) echo "scripts/gpu.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
+    esac
+    shift
+done
+case "$rounds" in ''|*[!0-9]*|0) echo "scripts/gpu.sh: --rounds $rounds: need a whole number ≥ 1" >&2; exit 2 ;; esac
+
+ensure_prerequisites
+script_start=$(date +%s)
+timings=()
+# `step NAME CMD…`: runs CMD, records and prints its wall time; a failing step is recorded and
+# the script goes on (a lent GPU's minutes are better spent on the other steps), then fails.
+failed=()
+step() {
+    local name=$1
+    shift
+    local t0
+    t0=$(date +%s%N)
+    echo "=== gpu.sh: $name" >&2
+    local rc=0
+    "$@" || rc=$?
+    local ms=$((($(date +%s%N) - t0) / 1000000))
+    local s
+    s=$(printf '%d.%d' $((ms / 1000)) $((ms % 1000 / 100)))
+    if [ "$rc" -ne 0 ]; then
+        failed+=("$name (exit $rc)")
+        timings+=("| $name | $s | failed (exit $rc) |")
+    else
+        timings+=("| $name | $s | ok |")
+    fi
+    echo "=== gpu.sh: $name: $s s$([ "$rc" -ne 0 ] && echo ", FAILED (exit $rc)")" >&2
+}
+
+if [ -z "$bin" ]; then
+    build() { cargo build --release -p harness --bin tetbench; }
+    step build build
+    bin="${CARGO_TARGET_DIR:-$PWD/target}/release/tetbench"
+fi
+[ -x "$bin" ] || { echo "scripts/gpu.sh: no tetbench binary at $bin" >&2; exit 1; }
+
+# The adapter, from a calibration measured now (also the first step of the work).
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cache="${TETBENCH_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/tetbench}"
+calibrate() { "$bin" calibrate --force --json --cache-dir "$cache" >"$tmp/calibration.json"; }
+step calibrate calibrate
+[ -s "$tmp/calibration.json" ] || { echo "scripts/gpu.sh: calibration failed; no adapter" >&2; exit 1; }
+adapter=$(grep -m1 '"adapter"' "$tmp/calibration.json" | sed 's/.*"adapter": *"\(.*\)",*$/\1/')
+software=$(printf '%s' "$adapter" | grep -o -i -E 'llvmpipe|lavapipe|softpipe|swiftshader|microsoft basic render' | head -n1 || true)
+if [ -n "$software" ]; then
+    if [ "$allow_software" -eq 0 ]; then
+        echo "scripts/gpu.sh: the adapter is \"$adapter\", a software renderer ($software):" \
+            "its times say nothing about a GPU. Is the GPU's Vulkan driver installed" \
+            "(e.g. NVIDIA's libnvidia-gl / nvidia-vulkan-icd; ls /usr/share/vulkan/icd.d)?" \
+            "Pass --allow-software to run anyway." >&2
+        exit 1
+    fi
+    echo "=== gpu.sh: adapter \"$adapter\" is a software renderer ($software); going on (--allow-software)" >&2
+else
+    echo "=== gpu.sh: adapter \"$adapter\"" >&2
+fi
+
+slug=$(printf '%s' "$adapter" | tr 'A-Z' 'a-z' | sed 's/[^a-z0-9]\{1,\}/-/g; s/^-//; s/-$//')
+dest="${out:-reports/baselines/$slug-$(date -u +%Y-%m-%d)}"
+rm -rf "$dest"
+mkdir -p "$dest"
+cp "$tmp/calibration.json" "$dest/calibration.json"
+
+# The baseline: the default suite, no report (the files scripts/baseline.sh stores).
+suite() {
+    "$bin" run --rounds "$rounds" --out "$tmp/suite" --no-report --cache-dir "$cache" \
+        "${suite_args[@]}" &&
+        cp "$tmp/suite/results.json" "$tmp/suite/results.csv" "$tmp/suite/samples.csv" "$dest/"
+}
+step suite suite
+
+if [ -n "$papers" ]; then
+    if [ "$papers" = all ]; then
+        reproduce() { "$bin" reproduce all --quick --out "$dest/reproduce" --cache-dir "$cache"; }
+        step "reproduce all --quick" reproduce
+    else
+        IFS=, read -r -a paper_list <<<"$papers"
+        for p in "${paper_list[@]}"; do
+            reproduce_one() { "$bin" reproduce "$1" --quick --out "$dest/reproduce" --cache-dir "$cache"; }
+            step "reproduce $p --quick" reproduce_one "$p"
+        done
+    fi
+    # Images are regenerated by the command; only the reports and tables are kept.
+    find "$dest/reproduce" -type d -name images -prune -exec rm -rf {} + 2>/dev/null || true
+fi
+
+vtk_python="${TETBENCH_VTK_PYTHON:-$PWD/.venv-vtk/bin/python}"
+if [ "$skip_peers" -eq 1 ]; then
+    echo "=== gpu.sh: peers skipped (--skip-peers)" >&2
+elif "$vtk_python" -c 'import vtkmodules.vtkRenderingVolume' >/dev/null 2>&1; then
+    peers() {
+        TETBENCH_VTK_PYTHON="$vtk_python" "$bin" run --algorithms vtk-pt,vtk-raycast,vtk-zsweep \
+            --rounds "$rounds" --out "$tmp/peers" --no-report --no-calibrate \
+            --cache-dir "$cache" "${suite_args[@]}" &&
+            mkdir -p "$dest/peers" &&
+            cp "$tmp/peers/results.json" "$tmp/peers/results.csv" "$tmp/peers/samples.csv" "$dest/peers/"
+    }
+    step peers peers
+else
+    echo "=== gpu.sh: peers skipped: no Python with VTK at $vtk_python (scripts/setup-vtk.sh installs it; needs the network)" >&2
+fi
+
+total=$(($(date +%s) - script_start))
+{
+    echo "# scripts/gpu.sh on $adapter"
+    echo
+    echo "- adapter: $adapter${software:+ (software: $software)}"
+    echo "- date (UTC): $(date -u +%Y-%m-%dT%H:%M:%SZ)"
+    echo "- commit: $(git rev-parse HEAD 2>/dev/null || echo unknown)$(git diff --quiet 2>/dev/null || echo ' (uncommitted changes)')"
+    echo "- command: scripts/gpu.sh ${orig_args[*]:-}"
+    echo "- options: rounds $rounds; papers ${papers:-none}; peers $([ "$skip_peers" -eq 1 ] && echo skipped || echo 'when VTK is installed')"
+    echo
+    echo "| step | seconds | |"
+    echo "|---|---:|---|"
+    printf '%s\n' "${timings[@]}"
+    echo "| total | $total | |"
+} >"$dest/gpu.md"
+echo >&2
+cat "$dest/gpu.md" >&2
+echo "=== gpu.sh: everything in $dest ($total s)" >&2
+if [ "${#failed[@]}" -gt 0 ]; then
+    echo "=== gpu.sh: failed steps: ${failed[*]}" >&2
+    exit 1
+fi
