@@ -649,4 +649,100 @@ mod tests {
             "{html}"
         );
     }
+
+    /// Six runs of two groups; the code changes at run 3 (a new commit) and makes alg0 ×1.5
+    /// slower: compare's test marks the pair, the fit puts one step at run 3 for alg0 and
+    /// none for alg1; the same six runs all of one commit have no step at all. The runs are
+    /// given out of order and put in order by date.
+    #[test]
+    fn history_marks_the_step_where_the_code_changed() {
+        let tmp = tempfile::tempdir().unwrap();
+        let write = |name: &str, k: usize, commit: &str, slow: f64| {
+            let dir = tmp.path().join(name);
+            std::fs::create_dir_all(&dir).unwrap();
+            let mut rows = vec![];
+            for (g, f) in [(0, slow), (1, 1.0)] {
+                for (v, vp) in ["+x", "-x", "+y"].iter().enumerate() {
+                    let mut row = Row {
+                        algorithm: format!("alg{g}"),
+                        settings: "k=2".into(),
+                        dataset: "box:1k".into(),
+                        viewpoint: vp.to_string(),
+                        ..Default::default()
+                    };
+                    row.samples.total_ms = (0..5)
+                        .map(|r| 10.0 * f * (1.0 + 0.01 * (((k + v + r) * 7) % 5) as f64))
+                        .collect();
+                    row.total_ms = Some(median(&row.samples.total_ms));
+                    rows.push(row);
+                }
+            }
+            let mut machine = crate::machine::MachineInfo::collect();
+            machine.git_commit = Some(commit.into());
+            machine.date_utc = format!("2026-01-0{}T00:00:00Z", k + 1);
+            let file = ResultsFile {
+                schema_version: crate::results::SCHEMA_VERSION,
+                machine,
+                run: crate::results::RunDescription {
+                    rounds: 5,
+                    frames: 1,
+                    ..Default::default()
+                },
+                finished_utc: None,
+                rows,
+                errors: vec![],
+            };
+            crate::results::write_json(&dir, &file).unwrap();
+            dir
+        };
+        let mut changed = vec![];
+        let mut same = vec![];
+        for k in (0..6).rev() {
+            let (commit, slow) = if k < 3 { ("aaa", 1.0) } else { ("bbb", 1.5) };
+            changed.push(write(&format!("c{k}"), k, commit, slow));
+            same.push(write(&format!("s{k}"), k, "aaa", 1.0));
+        }
+        let out = tmp.path().join("out");
+        let h = history(&changed, &out, 1.10, 0.05).unwrap();
+        assert_eq!(h.runs[0].date_utc, "2026-01-01T00:00:00Z");
+        assert_eq!(h.runs[3].label, "bbb 2026-01-04");
+        let alg0 = &h.series[0];
+        assert_eq!(alg0.algorithm, "alg0");
+        let steps: Vec<usize> = alg0
+            .points
+            .iter()
+            .filter(|p| p.step.is_some())
+            .map(|p| p.run)
+            .collect();
+        assert_eq!(steps, [3]);
+        assert!((alg0.points[3].step.unwrap() - 1.5).abs() < 0.05);
+        assert!(
+            alg0.points[3]
+                .changes
+                .iter()
+                .any(|c| c.starts_with("slower")),
+            "{:?}",
+            alg0.points[3]
+        );
+        assert!(h.series[1].points.iter().all(|p| p.step.is_none()));
+        let flat = history(&same, &out, 1.10, 0.05).unwrap();
+        assert!(flat.series.iter().all(|s| s
+            .points
+            .iter()
+            .all(|p| p.step.is_none() && p.changes.is_empty())));
+
+        // Another adapter in the series is refused.
+        let mut other = ResultsFile::read(&changed[0]).unwrap();
+        other.machine.cpu_model = "another CPU".into();
+        other.machine.adapter = Some(render_core::AdapterDescription {
+            name: "Other GPU".into(),
+            backend: "vulkan".into(),
+            device_type: "DiscreteGpu".into(),
+            driver: String::new(),
+            driver_info: String::new(),
+        });
+        crate::results::write_json(&changed[0], &other).unwrap();
+        let e = history(&changed, &out, 1.10, 0.05).unwrap_err().to_string();
+        assert!(e.contains("another adapter"), "{e}");
+    }
 }
