@@ -7,6 +7,13 @@
 # `tetbench run` (e.g. --cache-dir DIR). Replaces a baseline of the same adapter and day.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# A baseline says which commit it measured; with uncommitted changes to tracked files it would
+# not be that commit (the binary records the dirty flag at build time; compare warns on it).
+if [ -n "$(git status --porcelain --untracked-files=no)" ]; then
+    echo "baseline.sh: the working tree has uncommitted changes; commit or stash them first:" >&2
+    git status --short --untracked-files=no >&2
+    exit 1
+fi
 . scripts/common.sh
 ensure_prerequisites
 cargo build --release -p harness --bin tetbench

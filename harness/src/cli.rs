@@ -76,10 +76,11 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Metrics over a series of runs (in commit order, e.g. the baselines) per algorithm × data
-    /// set, with the noise band and the changes `compare` finds.
+    /// Metrics over a series of runs of one adapter (ordered by date, e.g. the baselines) per
+    /// algorithm × data set: compare's test for each adjacent pair and the steps of the whole
+    /// series.
     History {
-        /// Result directories, oldest first.
+        /// Result directories (put in order by the date each run started).
         #[arg(required = true, value_name = "DIR")]
         dirs: Vec<PathBuf>,
         /// Output directory for history.{md,html,json} and the charts.
@@ -88,6 +89,14 @@ pub enum Command {
         /// Factor a median must move by to count as a change.
         #[arg(long, default_value_t = 1.10)]
         threshold: f64,
+    },
+    /// Print a results set for a continuous-benchmarking service: Bencher's BMF or
+    /// github-action-benchmark's customSmallerIsBetter (docs/regression.md, "Exports").
+    Export {
+        #[arg(long, value_enum)]
+        format: crate::export::ExportFormat,
+        /// The run's output directory (holding results.json).
+        results: PathBuf,
     },
     /// Draw comparison charts (speed-error, scaling, resolution, bars, all) from any results,
     /// or run a sweep first (--sweep).
@@ -106,7 +115,8 @@ pub struct CompareArgs {
     /// Significance level of the Mann–Whitney U test.
     #[arg(long, default_value_t = 0.05)]
     pub alpha: f64,
-    /// Exit with status 1 on a regression (or on any change).
+    /// Exit with status 3 on a regression (or on any change); 1 means an error or a refused
+    /// comparison, 0 neither (docs/regression.md, "Exit codes").
     #[arg(long, value_enum, default_value = "never")]
     pub fail_on: crate::compare::FailOn,
     /// Compare runs from different adapters on calibration-normalised times.
@@ -124,6 +134,10 @@ pub struct CompareArgs {
     /// Output directory (default: NEW/compare).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// What goes to stdout: the terminal table, compare.json, or compare.md (for a pull
+    /// request comment). The files are written to --out in every case.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: crate::compare_report::CompareFormat,
 }
 
 #[derive(Debug, Clone, clap::Args)]
@@ -156,9 +170,14 @@ pub struct RunArgs {
     /// data set stay prepared at once.
     #[arg(long, value_name = "N")]
     pub rounds: Option<u32>,
-    /// Output directory (results, images, report). Earlier results there are replaced.
+    /// Output directory (results, images, report). Earlier results there are replaced
+    /// (unless --resume). One run at a time: a second run into a busy directory refuses.
     #[arg(long, value_name = "DIR", default_value = "out")]
     pub out: PathBuf,
+    /// Continue an interrupted run: keep the finished (data set, algorithm, settings) units of
+    /// the results already in --out and measure the rest; refused if the plan differs.
+    #[arg(long)]
+    pub resume: bool,
     /// Keep only variants whose settings match, e.g. `variant=linear` or `k=2|6;sort=radix`
     /// (keys an algorithm lacks are ignored for it).
     #[arg(long, value_name = "FILTER")]
@@ -233,7 +252,9 @@ impl RunArgs {
         data_dir: Option<PathBuf>,
         command_line: Vec<String>,
     ) -> anyhow::Result<RunConfig> {
-        self.to_plan().to_config(data_dir, command_line)
+        let mut config = self.to_plan().to_config(data_dir, command_line)?;
+        config.resume = self.resume;
+        Ok(config)
     }
 }
 
@@ -358,9 +379,9 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             };
             anyhow::ensure!(args.threshold >= 1.0, "--threshold must be at least 1");
             anyhow::ensure!(args.drift_limit >= 1.0, "--drift-limit must be at least 1");
-            if crate::compare_report::run_command(&args.base, &args.new, &opt)? {
-                // The documented CI gate: status 1 without an error message.
-                std::process::exit(1);
+            if crate::compare_report::run_command(&args.base, &args.new, &opt, args.format)? {
+                // The documented CI gate: status 3 (1 is an error or a refusal).
+                std::process::exit(crate::compare::EXIT_REGRESSION);
             }
             Ok(())
         }
@@ -377,6 +398,10 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             out,
             threshold,
         } => crate::history::run_command(&dirs, &out, threshold, 0.05),
+        Command::Export { format, results } => {
+            print!("{}", crate::export::run_command(&results, format)?);
+            Ok(())
+        }
         Command::Plot(args) => crate::plot_cli::run(args, cli.data_dir, command_line),
     }
 }

@@ -1,13 +1,19 @@
 //! `tetbench compare BASE NEW`: did NEW get slower, less exact or bigger than BASE, beyond noise?
 //!
 //! Rows are matched by (algorithm, settings, data set, viewpoint, size). Per row:
-//! - **time** (`total_ms`, `cpu_ms`, `gpu_ms`): the Mann–Whitney U test on the per-frame
-//!   samples plus asv's factor threshold ([`crate::stats`] says why): "slower" needs the ratio
-//!   of medians ≥ threshold *and* p < α; never a decision on one number (rows without samples,
-//!   e.g. from schema 1, say "too few samples"). With the default suite's 3 frames a single
-//!   row cannot reach p < 0.05 (the smallest exact p of 3 vs 3 is 0.1), so the decision that
-//!   gates is the **group** test: per algorithm × settings × data set, every viewpoint's samples
-//!   divided by BASE's median of that viewpoint, pooled (9 vs 9 in the default suite).
+//! - **time** (`total_ms`, `cpu_ms`, `gpu_ms`): the Mann–Whitney U test plus asv's factor
+//!   threshold ([`crate::stats`] says why): "slower" needs the ratio of medians ≥ threshold
+//!   *and* p < α. The unit of replication is the **round** (`run --rounds`), not the frame:
+//!   frames rendered back to back share the machine's state of that moment, so they are one
+//!   sample, and testing them as many is pseudo-replication (any drift during one round
+//!   becomes "significant"). Each row contributes one value per round (the median of that
+//!   round's frames, [`round_values`]); with fewer than [`MIN_ROUNDS`] rounds on either side
+//!   every time verdict is "too few independent samples (N rounds)" and time never gates
+//!   (image and memory still do: they are exact). A single row (3 vs 3 rounds in the default
+//!   suite) cannot reach p < 0.05 (the smallest exact p of 3 vs 3 is 0.1), so the decision
+//!   that gates is the **group** test: per algorithm × settings × data set, every viewpoint's
+//!   round values divided by BASE's median of that viewpoint, pooled (9 vs 9 in the default
+//!   suite).
 //!   Only `total_ms` gates; CPU and GPU ms are reported (a GPU-resident variant's 0.05 ms of CPU
 //!   time moves by 10 % with nothing changed).
 //! - **image**: rendering is deterministic on one adapter, so any changed f32 pixel is reported
@@ -35,14 +41,64 @@ use crate::stats::{holm_adjust, mann_whitney_p, median};
 /// A PSNR change larger than this is reported (and a drop this large is a regression).
 pub const PSNR_TOLERANCE_DB: f64 = 0.1;
 
+/// Fewer rounds than this on either side and time is not judged: 2 vs 2 values cannot reach
+/// p < 0.05 even pooled over a few viewpoints, and one round is one moment of the machine.
+pub const MIN_ROUNDS: u32 = 3;
+
+/// How many independent samples (rounds) each side's rows hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Rounds {
+    pub base: u32,
+    pub new: u32,
+}
+
+impl Rounds {
+    pub fn of(base: &ResultsFile, new: &ResultsFile) -> Rounds {
+        Rounds {
+            base: base.run.rounds.max(1),
+            new: new.run.rounds.max(1),
+        }
+    }
+
+    /// Whether time may be judged at all.
+    pub fn enough(self) -> bool {
+        self.base.min(self.new) >= MIN_ROUNDS
+    }
+
+    /// Why time is not judged (`None`: it is).
+    pub fn refusal(self) -> Option<String> {
+        (!self.enough()).then(|| {
+            format!(
+                "time: too few independent samples ({} rounds; BASE {}, NEW {}): frames of one \
+                 round are one sample, so no time verdict and no time gate; run both sides with \
+                 --rounds {MIN_ROUNDS} or more",
+                self.base.min(self.new),
+                self.base,
+                self.new
+            )
+        })
+    }
+}
+
+impl Default for Rounds {
+    fn default() -> Self {
+        Rounds { base: 1, new: 1 }
+    }
+}
+
+/// `compare --fail-on` met: the exit status, distinct from 1 (an error, or a comparison
+/// refused: other adapters, unreadable results) so that CI can tell a regression from a
+/// broken job.
+pub const EXIT_REGRESSION: i32 = 3;
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum FailOn {
     /// Always exit 0 (the report is the product).
     Never,
-    /// Exit 1 when anything got slower, less exact, bigger, or failed.
+    /// Exit 3 when anything got slower, less exact, bigger, or failed.
     Regression,
-    /// Exit 1 on any change at all, including improvements and changed pixels.
+    /// Exit 3 on any change at all, including improvements and changed pixels.
     Change,
 }
 
@@ -119,6 +175,16 @@ pub struct Comparison {
     pub normalised: bool,
     pub threshold: f64,
     pub alpha: f64,
+    /// Rounds per row on each side; time is judged only with [`MIN_ROUNDS`] or more on both.
+    #[serde(default)]
+    pub rounds: Rounds,
+    /// What makes the comparison less trustworthy: a side built from a dirty tree or as a
+    /// debug build ([`provenance_warnings`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+    /// Why time was not judged, when it was not ([`Rounds::refusal`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_refused: Option<String>,
     /// NEW / BASE over the whole run: the median of the groups' pooled `total_ms` ratios
     /// (`None`: too few groups). When `drift_corrected`, every NEW time was divided by it
     /// before the tests, so a group is judged against the rest of its own run.
@@ -147,7 +213,8 @@ impl Comparison {
     }
 }
 
-fn adapter_of(f: &ResultsFile) -> String {
+/// The adapter a results set ran on, as compare matches them (a software rasteriser with its CPU).
+pub fn adapter_of(f: &ResultsFile) -> String {
     let Some(a) = f.machine.adapter.as_ref() else {
         return "unknown adapter".into();
     };
@@ -194,6 +261,42 @@ fn metric_samples(r: &Row, metric: &str, normalised: bool) -> anyhow::Result<Vec
     Ok(s.iter().map(|x| x / roof).collect())
 }
 
+/// One value per round of `metric` (the median of that round's frames), divided by the row's
+/// roofline time when normalising. A row's samples hold its rounds one after the other
+/// (`run::DatasetContext::run_variants`); samples that do not split evenly into `rounds`
+/// (a round failed) give one value, which decides nothing.
+pub fn round_values(
+    r: &Row,
+    metric: &str,
+    rounds: u32,
+    normalised: bool,
+) -> anyhow::Result<Vec<f64>> {
+    let s = metric_samples(r, metric, normalised)?;
+    let rounds = rounds.max(1) as usize;
+    if s.is_empty() {
+        return Ok(s);
+    }
+    if s.len() % rounds != 0 {
+        return Ok(vec![median(&s)]);
+    }
+    Ok(s.chunks(s.len() / rounds).map(median).collect())
+}
+
+/// [`time_test`], with the verdict withheld when the runs have too few rounds.
+fn round_test(
+    metric: &str,
+    base: &[f64],
+    new: &[f64],
+    opt: &CompareOptions,
+    rounds: Rounds,
+) -> TimeTest {
+    let mut t = time_test(metric, base, new, opt.threshold, opt.alpha);
+    if !rounds.enough() {
+        t.verdict = Verdict::TooFewSamples;
+    }
+    t
+}
+
 /// Compares two result directories; writes nothing (see [`write_outputs`]).
 pub fn compare(
     base_dir: &Path,
@@ -222,7 +325,8 @@ pub fn compare(
         }
     }
     let heat_dir = opt.out.join("heatmaps");
-    let unscaled = group_tests(&base.rows, &new.rows, opt, 1.0)?;
+    let rounds = Rounds::of(&base, &new);
+    let unscaled = group_tests(&base.rows, &new.rows, opt, 1.0, rounds)?;
     let run_factor = run_wide_factor(unscaled.iter().map(|g| &g.total));
     let scale = match run_factor {
         Some(f) if opt.drift_correction => f,
@@ -238,9 +342,12 @@ pub fn compare(
     for (b, n) in &pairs {
         raw_total_p.push(match n {
             Some(n) => {
-                let bs = metric_samples(b, "total_ms", opt.normalised)?;
-                let ns = scaled(metric_samples(n, "total_ms", opt.normalised)?, scale);
-                (bs.len() >= 2 && ns.len() >= 2)
+                let bs = round_values(b, "total_ms", rounds.base, opt.normalised)?;
+                let ns = scaled(
+                    round_values(n, "total_ms", rounds.new, opt.normalised)?,
+                    scale,
+                );
+                (rounds.enough() && bs.len() >= 2 && ns.len() >= 2)
                     .then(|| mann_whitney_p(&bs, &ns))
                     .flatten()
             }
@@ -250,7 +357,13 @@ pub fn compare(
     let mut rows = vec![];
     for ((b, n), p_total) in pairs.into_iter().zip(holm_adjust(&raw_total_p)) {
         rows.push(match n {
-            Some(n) => compare_rows(b, n, p_total, scale, base_dir, new_dir, &heat_dir, opt)?,
+            Some(n) => compare_rows(
+                b,
+                n,
+                (p_total, scale, rounds),
+                (base_dir, new_dir, &heat_dir),
+                opt,
+            )?,
             None => only(b, "only in base"),
         });
     }
@@ -259,7 +372,7 @@ pub fn compare(
             rows.push(only(n, "only in new"));
         }
     }
-    let mut groups = group_tests(&base.rows, &new.rows, opt, scale)?;
+    let mut groups = group_tests(&base.rows, &new.rows, opt, scale, rounds)?;
     adjust_family(
         groups.iter_mut().map(|g| &mut g.total),
         opt.threshold,
@@ -275,6 +388,12 @@ pub fn compare(
         normalised: opt.normalised,
         threshold: opt.threshold,
         alpha: opt.alpha,
+        rounds,
+        warnings: [("BASE", &base), ("NEW", &new)]
+            .iter()
+            .flat_map(|(side, f)| provenance_warnings(side, f))
+            .collect(),
+        time_refused: rounds.refusal(),
         run_factor,
         drift_corrected: scale != 1.0,
         test: format!(
@@ -335,6 +454,25 @@ pub fn compare(
     Ok(cmp)
 }
 
+/// Why one side's numbers may not be what its commit does: built from a dirty tree (the commit
+/// is not the code), or a debug build (times of another program).
+pub fn provenance_warnings(side: &str, f: &ResultsFile) -> Vec<String> {
+    let m = &f.machine;
+    let mut out = vec![];
+    if m.git_dirty == Some(true) {
+        out.push(format!(
+            "{side} was built from a dirty tree (commit {} plus uncommitted changes)",
+            m.git_commit.as_deref().unwrap_or("?")
+        ));
+    }
+    if m.build_profile.as_deref() == Some("debug") {
+        out.push(format!(
+            "{side} is a debug build: its times are not those of a release build"
+        ));
+    }
+    out
+}
+
 fn only(r: &Row, status: &str) -> RowComparison {
     RowComparison {
         algorithm: r.algorithm.clone(),
@@ -351,17 +489,17 @@ fn only(r: &Row, status: &str) -> RowComparison {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
+/// One matched row. `time`: the Holm-adjusted p of its `total_ms`, the run-wide factor NEW is
+/// divided by, and the rounds; `dirs`: BASE, NEW and where heatmaps go.
 fn compare_rows(
     b: &Row,
     n: &Row,
-    total_p_adjusted: Option<f64>,
-    scale: f64,
-    base_dir: &Path,
-    new_dir: &Path,
-    heat_dir: &Path,
+    time: (Option<f64>, f64, Rounds),
+    dirs: (&Path, &Path, &Path),
     opt: &CompareOptions,
 ) -> anyhow::Result<RowComparison> {
+    let (total_p_adjusted, scale, rounds) = time;
+    let (base_dir, new_dir, heat_dir) = dirs;
     let mut out = only(b, "no change");
     out.notes.clear();
     let (mut worse, mut better, mut changed) = (false, false, false);
@@ -379,8 +517,8 @@ fn compare_rows(
     }
     for metric in ["total_ms", "cpu_ms", "gpu_ms"] {
         let (bs, mut ns) = (
-            metric_samples(b, metric, opt.normalised)?,
-            metric_samples(n, metric, opt.normalised)?,
+            round_values(b, metric, rounds.base, opt.normalised)?,
+            round_values(n, metric, rounds.new, opt.normalised)?,
         );
         if bs.is_empty() && ns.is_empty() {
             continue;
@@ -388,7 +526,7 @@ fn compare_rows(
         if metric == "total_ms" {
             ns = scaled(ns, scale);
         }
-        let mut t = time_test(metric, &bs, &ns, opt.threshold, opt.alpha);
+        let mut t = round_test(metric, &bs, &ns, opt, rounds);
         if metric == "total_ms" {
             t = t.with_family_p(total_p_adjusted, opt.threshold, opt.alpha);
             match t.verdict {
@@ -536,6 +674,7 @@ fn group_tests(
     new: &[Row],
     opt: &CompareOptions,
     scale: f64,
+    rounds: Rounds,
 ) -> anyhow::Result<Vec<GroupComparison>> {
     let mut groups: Vec<(String, String, String)> = vec![];
     for r in base {
@@ -554,8 +693,11 @@ fn group_tests(
                 continue;
             };
             let (bv, nv) = (
-                metric_samples(b, "total_ms", opt.normalised)?,
-                scaled(metric_samples(n, "total_ms", opt.normalised)?, scale),
+                round_values(b, "total_ms", rounds.base, opt.normalised)?,
+                scaled(
+                    round_values(n, "total_ms", rounds.new, opt.normalised)?,
+                    scale,
+                ),
             );
             let m = median(&bv);
             if bv.is_empty() || nv.is_empty() || m.is_nan() || m <= 0.0 {
@@ -569,7 +711,7 @@ fn group_tests(
             continue;
         }
         out.push(GroupComparison {
-            total: time_test("total_ms", &bs, &ns, opt.threshold, opt.alpha),
+            total: round_test("total_ms", &bs, &ns, opt, rounds),
             algorithm,
             settings,
             dataset,
@@ -638,107 +780,5 @@ pub fn image_difference(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Eight groups of 9 noisy samples each; group i's times are scaled by `factors[i]`.
-    fn groups_dir(dir: &Path, factors: &[f64], seed: u64) {
-        std::fs::create_dir_all(dir).unwrap();
-        let mut rng = crate::stats::TestRng::new(seed);
-        let rows = factors
-            .iter()
-            .enumerate()
-            .map(|(i, f)| {
-                let mut row = crate::results::Row {
-                    algorithm: format!("alg{i}"),
-                    settings: "k=2".into(),
-                    dataset: "box:1k".into(),
-                    viewpoint: "+x".into(),
-                    ..Default::default()
-                };
-                // 3 % noise around 10 ms × factor.
-                row.samples.total_ms = (0..9)
-                    .map(|_| 10.0 * f * (1.0 + 0.03 * rng.normal()))
-                    .collect();
-                row.total_ms = Some(median(&row.samples.total_ms));
-                row
-            })
-            .collect();
-        let file = ResultsFile {
-            schema_version: crate::results::SCHEMA_VERSION,
-            machine: crate::machine::MachineInfo::collect(),
-            run: Default::default(),
-            finished_utc: None,
-            rows,
-            errors: vec![],
-        };
-        crate::results::write_json(dir, &file).unwrap();
-    }
-
-    /// The whole NEW run ×1.3 slower (the machine drifting) and one group ×2 on top: with the
-    /// run-wide factor divided out only that group is slower; without, all of them; a factor
-    /// beyond --drift-limit is a regression of its own; and 2 groups give no factor at all.
-    #[test]
-    fn drift_is_divided_out_and_one_slower_group_still_stands_out() {
-        let tmp = tempfile::tempdir().unwrap();
-        let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
-        groups_dir(&a, &[1.0; 8], 1);
-        let mut slow = [1.3; 8];
-        slow[3] = 2.6;
-        groups_dir(&b, &slow, 2);
-        let opt = |drift_correction: bool, drift_limit: f64| CompareOptions {
-            threshold: 1.10,
-            alpha: 0.05,
-            normalised: false,
-            drift_correction,
-            drift_limit,
-            fail_on: FailOn::Regression,
-            out: tmp.path().join("out"),
-        };
-        let c = compare(&a, &b, &opt(true, 1.5)).unwrap();
-        let f = c.run_factor.unwrap();
-        assert!((f - 1.3).abs() < 0.03, "{f}");
-        assert!(c.drift_corrected);
-        let slower: Vec<&str> = c
-            .groups
-            .iter()
-            .filter(|g| g.total.verdict == Verdict::Slower)
-            .map(|g| g.algorithm.as_str())
-            .collect();
-        assert_eq!(slower, ["alg3"], "{:#?}", c.groups);
-        assert!(c.groups.iter().all(|g| g.total.p_adjusted.is_some()));
-        assert_eq!(
-            c.regressions.len(),
-            2,
-            "the group and its row: {:?}",
-            c.regressions
-        );
-
-        let absolute = compare(&a, &b, &opt(false, 1.5)).unwrap();
-        assert!(!absolute.drift_corrected);
-        assert!(absolute
-            .groups
-            .iter()
-            .all(|g| g.total.verdict == Verdict::Slower));
-
-        let limited = compare(&a, &b, &opt(true, 1.2)).unwrap();
-        assert!(
-            limited
-                .regressions
-                .iter()
-                .any(|r| r.starts_with("run-wide")),
-            "{:?}",
-            limited.regressions
-        );
-
-        let (c2, d2) = (tmp.path().join("c2"), tmp.path().join("d2"));
-        groups_dir(&c2, &[1.0; 2], 3);
-        groups_dir(&d2, &[1.3; 2], 4);
-        let few = compare(&c2, &d2, &opt(true, 1.5)).unwrap();
-        assert_eq!(few.run_factor, None);
-        assert!(few
-            .groups
-            .iter()
-            .all(|g| g.total.verdict == Verdict::Slower));
-    }
-}
+#[path = "compare_tests.rs"]
+mod tests;

@@ -16,7 +16,7 @@ fn header(c: &Comparison) -> Vec<String> {
             .unwrap_or("?")
             .to_string()
     };
-    vec![
+    let mut lines = vec![
         format!("BASE {} — {} (commit {})", c.base, c.base_adapter, commit(&c.base_commit)),
         format!("NEW  {} — {} (commit {})", c.new, c.new_adapter, commit(&c.new_commit)),
         format!(
@@ -28,6 +28,13 @@ fn header(c: &Comparison) -> Vec<String> {
                 ""
             }
         ),
+        match &c.time_refused {
+            Some(why) => why.clone(),
+            None => format!(
+                "samples: one per round ({} rounds in BASE, {} in NEW)",
+                c.rounds.base, c.rounds.new
+            ),
+        },
         match (c.run_factor, c.drift_corrected) {
             (Some(f), true) => format!(
                 "run-wide factor: NEW/BASE ×{f:.3} (median over the groups); NEW's total_ms was \
@@ -48,7 +55,9 @@ fn header(c: &Comparison) -> Vec<String> {
             c.rows.len(),
             c.groups.len()
         ),
-    ]
+    ];
+    lines.extend(c.warnings.iter().map(|w| format!("WARNING: {w}")));
+    lines
 }
 
 fn time_cell(t: Option<&TimeTest>) -> String {
@@ -133,9 +142,19 @@ fn markdown(c: &Comparison) -> String {
             g.total.verdict.label()
         );
     }
-    s.push_str("\n## Rows\n\n");
+    // Only the rows with something to say: the page is meant for a pull-request comment.
+    let notable: Vec<&RowComparison> = c.rows.iter().filter(|r| r.status != "no change").collect();
+    let _ = write!(
+        s,
+        "\n## Rows with a change ({} of {})\n\n",
+        notable.len(),
+        c.rows.len()
+    );
+    if notable.is_empty() {
+        return s;
+    }
     s.push_str("| status | algorithm | settings | data set | view | total_ms | cpu_ms | gpu_ms | PSNR Δ dB | changed px | memory | notes |\n|---|---|---|---|---|---|---|---|---:|---:|---|---|\n");
-    for r in &c.rows {
+    for r in notable {
         let img = r.image.as_ref();
         let _ = writeln!(
             s,
@@ -291,15 +310,37 @@ pub fn write_outputs(c: &Comparison, out: &Path) -> anyhow::Result<()> {
     write("compare.html", html(c))
 }
 
-/// `tetbench compare`: prints the table, writes compare.{md,json,html}, returns whether the
-/// `--fail-on` condition was met.
-pub fn run_command(base: &Path, new: &Path, opt: &CompareOptions) -> anyhow::Result<bool> {
+/// What `compare` prints on stdout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CompareFormat {
+    /// The terminal table.
+    Text,
+    /// compare.json.
+    Json,
+    /// compare.md: fit for a pull-request comment.
+    Md,
+}
+
+/// `tetbench compare`: prints the table (or the JSON or Markdown), writes
+/// compare.{md,json,html}, returns whether the `--fail-on` condition was met.
+pub fn run_command(
+    base: &Path,
+    new: &Path,
+    opt: &CompareOptions,
+    format: CompareFormat,
+) -> anyhow::Result<bool> {
     let cmp = crate::compare::compare(base, new, opt)?;
     std::fs::create_dir_all(&opt.out)
         .with_context(|| format!("cannot create {}", opt.out.display()))?;
-    print!("{}", terminal(&cmp));
     write_outputs(&cmp, &opt.out)?;
-    println!("wrote {}/compare.{{md,json,html}}", opt.out.display());
+    match format {
+        CompareFormat::Text => {
+            print!("{}", terminal(&cmp));
+            println!("wrote {}/compare.{{md,json,html}}", opt.out.display());
+        }
+        CompareFormat::Json => print!("{}", serde_json::to_string_pretty(&cmp)? + "\n"),
+        CompareFormat::Md => print!("{}", markdown(&cmp)),
+    }
     Ok(match opt.fail_on {
         FailOn::Never => false,
         FailOn::Regression => !cmp.regressions.is_empty(),
@@ -372,7 +413,7 @@ mod tests {
         };
         let same = compare(&a, &b, &opt("ab")).unwrap();
         assert_eq!(same.outcome(), "no change", "{same:#?}");
-        assert!(!run_command(&a, &b, &opt("ab")).unwrap());
+        assert!(!run_command(&a, &b, &opt("ab"), CompareFormat::Text).unwrap());
         let diff = compare(&a, &c, &opt("ac")).unwrap();
         let row = &diff.rows[0];
         let image = row.image.as_ref().unwrap();
@@ -382,7 +423,7 @@ mod tests {
         assert_eq!(row.status, "changed");
         assert_eq!(diff.outcome(), "changed");
         // fail-on change gates it; the outputs name the heatmap.
-        assert!(run_command(&a, &c, &opt("ac")).unwrap());
+        assert!(run_command(&a, &c, &opt("ac"), CompareFormat::Text).unwrap());
         assert!(tmp.path().join("ac").join(&image.heatmap).is_file());
         for f in [
             "compare.md",

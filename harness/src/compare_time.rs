@@ -25,7 +25,7 @@ impl Verdict {
             Verdict::Faster => "faster",
             Verdict::Slower => "slower",
             Verdict::NoChange => "no change",
-            Verdict::TooFewSamples => "too few samples",
+            Verdict::TooFewSamples => "too few independent samples",
         }
     }
 }

@@ -1,11 +1,18 @@
-//! `tetbench history DIR…`: each algorithm × settings × data set over a series of runs (given
-//! in commit order, e.g. the committed baselines), with the noise band and the points where
-//! `compare`'s pooled test finds a change against the run before.
+//! `tetbench history DIR…`: each algorithm × settings × data set over a series of runs (e.g.
+//! the committed baselines), ordered by the date each run started, labelled by commit and date.
 //!
-//! Per run and group the time is the median over viewpoints of the rows' median `total_ms`;
-//! the band is the 10–90 % range of all of the group's frames, each divided by its row's median
-//! and multiplied by that time (the frame-to-frame noise, comparable across groups). PSNR is
-//! the mean over viewpoints; a change > 0.1 dB is marked as well.
+//! - Per run and group the time is the median over viewpoints of the rows' median `total_ms`;
+//!   the band is the 10–90 % range of all the group's frames, each divided by its row's median
+//!   and multiplied by that time (the frame-to-frame noise, comparable across groups).
+//! - Each adjacent pair of runs is judged by **compare's own test** ([`crate::compare`]: one
+//!   value per round, the run-wide factor divided out, Holm over the groups, PSNR and memory
+//!   exact), so history and compare never disagree about a pair.
+//! - Over the whole series, **steps** are found by a piecewise-constant fit with a penalty per
+//!   step, as asv's step detection does (its `step_detect`: an L1 fit of log times, segments
+//!   found by dynamic programming); [`detect_steps`] is our own, smaller version. No step is
+//!   placed between runs of the same commit (they measured the same code), and a step smaller
+//!   than the threshold factor is not one.
+//! - Runs of different adapters are refused: a step between two machines is not a change.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -14,7 +21,7 @@ use anyhow::{anyhow, Context};
 use plotters::prelude::*;
 use serde::Serialize;
 
-use crate::compare::{time_test, Verdict, PSNR_TOLERANCE_DB};
+use crate::compare::{adapter_of, CompareOptions, FailOn, Verdict};
 use crate::plot::draw::{register_font, FONT};
 use crate::results::{ResultsFile, Row};
 use crate::stats::{median, quantile};
@@ -27,8 +34,11 @@ pub struct Point {
     pub band_hi: f64,
     pub psnr_db: Option<f64>,
     pub gpu_bytes: Option<u64>,
-    /// Against the previous run of this group: `slower`, `faster`, `psnr ±x dB`, `memory`.
+    /// Against the previous run, by compare's test: `slower ×r`, `faster ×r`, `psnr ±x dB`,
+    /// `memory`, `too few rounds`.
     pub changes: Vec<String>,
+    /// A step of the piecewise-constant fit starts at this run (`×r` against the level before).
+    pub step: Option<f64>,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -40,9 +50,18 @@ pub struct Series {
 }
 
 #[derive(Debug, Clone, Serialize)]
+pub struct Run {
+    pub dir: String,
+    pub commit: String,
+    pub date_utc: String,
+    /// `commit date` as the x-axis shows it.
+    pub label: String,
+}
+
+#[derive(Debug, Clone, Serialize)]
 pub struct History {
-    /// Label per run: short commit and date.
-    pub runs: Vec<String>,
+    pub adapter: String,
+    pub runs: Vec<Run>,
     pub series: Vec<Series>,
 }
 
@@ -61,27 +80,138 @@ fn pooled(rows: &[&Row], scale: impl Fn(&Row) -> Option<f64>) -> Vec<f64> {
         .collect()
 }
 
-pub fn history(dirs: &[PathBuf], threshold: f64, alpha: f64) -> anyhow::Result<History> {
-    let files: Vec<ResultsFile> = dirs
+/// The change points of `values` (indices where a new level starts) by an L1 piecewise-constant
+/// fit of their logarithms: minimise Σ over segments of Σ|ln v − median| plus `penalty` per
+/// segment, by dynamic programming over every segmentation (O(n³), n is a few hundred runs at
+/// most). `same_as_previous[i]`: run i measured the same code as run i−1, so no step may start
+/// there. Steps whose levels differ by less than `threshold` (a factor) are merged away.
+pub fn detect_steps(
+    values: &[f64],
+    same_as_previous: &[bool],
+    penalty: f64,
+    threshold: f64,
+) -> Vec<usize> {
+    let y: Vec<f64> = values.iter().map(|v| v.max(1e-12).ln()).collect();
+    let n = y.len();
+    if n < 2 {
+        return vec![];
+    }
+    let cost = |a: usize, b: usize| {
+        let m = median(&y[a..b]);
+        y[a..b].iter().map(|v| (v - m).abs()).sum::<f64>()
+    };
+    // best[j]: the least cost of y[..j]; from[j]: where its last segment starts.
+    let mut best = vec![0.0f64; n + 1];
+    let mut from = vec![0usize; n + 1];
+    for j in 1..=n {
+        best[j] = f64::INFINITY;
+        for i in 0..j {
+            if i > 0 && same_as_previous.get(i).copied().unwrap_or(false) {
+                continue; // no step between two runs of one commit
+            }
+            let c = best[i] + cost(i, j) + penalty;
+            if c < best[j] {
+                best[j] = c;
+                from[j] = i;
+            }
+        }
+    }
+    let mut starts = vec![];
+    let mut j = n;
+    while j > 0 {
+        starts.push(from[j]);
+        j = from[j];
+    }
+    starts.reverse();
+    // Keep a step only if the levels either side differ by the threshold factor.
+    let mut steps: Vec<usize> = vec![];
+    let mut seg_start = 0;
+    for (k, &s) in starts.iter().enumerate().skip(1) {
+        let end = starts.get(k + 1).copied().unwrap_or(n);
+        let before = median(&y[seg_start..s]);
+        let after = median(&y[s..end]);
+        if (after - before).abs() >= threshold.ln() {
+            steps.push(s);
+            seg_start = s;
+        }
+    }
+    steps
+}
+
+/// The step penalty: a step must pay for itself against the series' own run-to-run noise
+/// (a robust estimate from adjacent differences), and never costs less than a threshold-sized
+/// step over two runs.
+fn step_penalty(values: &[f64], threshold: f64) -> f64 {
+    let y: Vec<f64> = values.iter().map(|v| v.max(1e-12).ln()).collect();
+    let diffs: Vec<f64> = y.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
+    let sigma = if diffs.is_empty() {
+        0.0
+    } else {
+        median(&diffs) / 0.6745 / std::f64::consts::SQRT_2
+    };
+    (3.0 * sigma).max(2.0 * threshold.ln()) * ((values.len() as f64).ln().max(1.0))
+}
+
+pub fn history(
+    dirs: &[PathBuf],
+    out: &Path,
+    threshold: f64,
+    alpha: f64,
+) -> anyhow::Result<History> {
+    let mut files: Vec<(PathBuf, ResultsFile)> = dirs
         .iter()
-        .map(|d| ResultsFile::read(d))
+        .map(|d| ResultsFile::read(d).map(|f| (d.clone(), f)))
         .collect::<anyhow::Result<_>>()?;
-    let runs = files
+    anyhow::ensure!(
+        !files.is_empty(),
+        "history needs at least one results directory"
+    );
+    let adapter = adapter_of(&files[0].1);
+    let others: Vec<String> = files
         .iter()
-        .zip(dirs)
-        .map(|(f, d)| {
-            let c = f.machine.git_commit.as_deref().unwrap_or("?");
-            format!(
-                "{} {}",
-                &c[..c.len().min(7)],
-                d.file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default()
-            )
+        .filter(|(_, f)| adapter_of(f) != adapter)
+        .map(|(d, f)| format!("{} ({})", d.display(), adapter_of(f)))
+        .collect();
+    if !others.is_empty() {
+        anyhow::bail!(
+            "history: {} ran on {adapter}, but {} on another adapter; a change between two \
+             machines is not a change of the code. Give the runs of one adapter only (e.g. \
+             reports/baselines/llvmpipe-*)",
+            files[0].0.display(),
+            others.join(", ")
+        );
+    }
+    // The x-axis is time: the date each run started (then the order given, for equal dates).
+    files.sort_by(|a, b| a.1.machine.date_utc.cmp(&b.1.machine.date_utc));
+    let runs: Vec<Run> = files
+        .iter()
+        .map(|(d, f)| {
+            let commit = f.machine.git_commit.clone().unwrap_or_else(|| "?".into());
+            let date = f.machine.date_utc.get(..10).unwrap_or("?").to_string();
+            Run {
+                dir: d.display().to_string(),
+                label: format!("{} {date}", &commit[..commit.len().min(7)]),
+                commit,
+                date_utc: f.machine.date_utc.clone(),
+            }
         })
         .collect();
+    // compare's verdicts for each adjacent pair.
+    let mut pairs = vec![None];
+    for (k, w) in files.windows(2).enumerate() {
+        let opt = CompareOptions {
+            threshold,
+            alpha,
+            normalised: false,
+            drift_correction: true,
+            drift_limit: 1.5,
+            fail_on: FailOn::Never,
+            out: out.join("pairs").join(format!("{}-{}", k, k + 1)),
+        };
+        pairs.push(Some(crate::compare::compare(&w[0].0, &w[1].0, &opt)?));
+    }
     let mut groups: Vec<(String, String, String)> = vec![];
-    for f in &files {
+    for (_, f) in &files {
         for r in &f.rows {
             let g = (r.algorithm.clone(), r.settings.clone(), r.dataset.clone());
             if !groups.contains(&g) {
@@ -92,8 +222,7 @@ pub fn history(dirs: &[PathBuf], threshold: f64, alpha: f64) -> anyhow::Result<H
     let mut series = vec![];
     for g in groups {
         let mut points: Vec<Point> = vec![];
-        let mut prev: Option<usize> = None;
-        for (i, f) in files.iter().enumerate() {
+        for (i, (_, f)) in files.iter().enumerate() {
             let rows = group_rows(f, &g);
             let medians: Vec<f64> = rows.iter().filter_map(|r| r.total_ms).collect();
             if medians.is_empty() {
@@ -107,43 +236,74 @@ pub fn history(dirs: &[PathBuf], threshold: f64, alpha: f64) -> anyhow::Result<H
                 (t * quantile(&noise, 0.1), t * quantile(&noise, 0.9))
             };
             let psnr: Vec<f64> = rows.iter().filter_map(|r| r.psnr_db).collect();
-            let mut p = Point {
+            let mut changes = vec![];
+            // Only a pair of adjacent runs is judged: a group missing from a run starts afresh.
+            if let Some(cmp) = pairs[i]
+                .as_ref()
+                .filter(|_| points.last().is_some_and(|p| p.run + 1 == i))
+            {
+                if let Some(gc) = cmp
+                    .groups
+                    .iter()
+                    .find(|c| (&c.algorithm, &c.settings, &c.dataset) == (&g.0, &g.1, &g.2))
+                {
+                    match gc.total.verdict {
+                        Verdict::Slower => changes.push(format!("slower ×{:.3}", gc.total.ratio)),
+                        Verdict::Faster => changes.push(format!("faster ×{:.3}", gc.total.ratio)),
+                        Verdict::TooFewSamples => changes.push("too few rounds".into()),
+                        Verdict::NoChange => {}
+                    }
+                }
+                let rows_here = cmp
+                    .rows
+                    .iter()
+                    .filter(|r| (&r.algorithm, &r.settings, &r.dataset) == (&g.0, &g.1, &g.2));
+                let mut psnr_moved = false;
+                let mut memory = false;
+                for r in rows_here {
+                    psnr_moved |= r
+                        .image
+                        .as_ref()
+                        .is_some_and(|i| i.verdict == "worse" || i.verdict == "better");
+                    memory |= r.memory.iter().any(|m| m.what == "gpu_bytes");
+                }
+                let last = points.last().expect("checked above");
+                if psnr_moved {
+                    if let (Some(a), Some(b)) = (last.psnr_db, psnr_mean(&psnr)) {
+                        changes.push(format!("psnr {:+.2} dB", b - a));
+                    }
+                }
+                if memory {
+                    changes.push("memory".into());
+                }
+            }
+            points.push(Point {
                 run: i,
                 total_ms: t,
                 band_lo: lo,
                 band_hi: hi,
-                psnr_db: (!psnr.is_empty()).then(|| psnr.iter().sum::<f64>() / psnr.len() as f64),
+                psnr_db: psnr_mean(&psnr),
                 gpu_bytes: rows.iter().filter_map(|r| r.gpu_bytes).max(),
-                changes: vec![],
-            };
-            if let Some(j) = prev {
-                let before = group_rows(&files[j], &g);
-                // Each viewpoint normalised by the earlier run's median, as compare's group test.
-                let base_median = |r: &Row| {
-                    before
-                        .iter()
-                        .find(|b| (&b.viewpoint, b.width) == (&r.viewpoint, r.width))
-                        .and_then(|b| b.total_ms)
-                };
-                let b = pooled(&before, |r| base_median(r));
-                let n = pooled(&rows, |r| base_median(r));
-                match time_test("total_ms", &b, &n, threshold, alpha).verdict {
-                    Verdict::Slower => p.changes.push("slower".into()),
-                    Verdict::Faster => p.changes.push("faster".into()),
-                    _ => {}
-                }
-                let last = &points[points.len() - 1];
-                if let (Some(a), Some(b)) = (last.psnr_db, p.psnr_db) {
-                    if (b - a).abs() > PSNR_TOLERANCE_DB {
-                        p.changes.push(format!("psnr {:+.2} dB", b - a));
-                    }
-                }
-                if last.gpu_bytes != p.gpu_bytes {
-                    p.changes.push("memory".into());
-                }
-            }
-            prev = Some(i);
-            points.push(p);
+                changes,
+                step: None,
+            });
+        }
+        let values: Vec<f64> = points.iter().map(|p| p.total_ms).collect();
+        let same: Vec<bool> = points
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                k > 0
+                    && runs[points[k - 1].run].commit == runs[p.run].commit
+                    && runs[p.run].commit != "?"
+            })
+            .collect();
+        let penalty = step_penalty(&values, threshold);
+        let steps = detect_steps(&values, &same, penalty, threshold);
+        for (k, &s) in steps.iter().enumerate() {
+            let prev_start = if k == 0 { 0 } else { steps[k - 1] };
+            let end = steps.get(k + 1).copied().unwrap_or(values.len());
+            points[s].step = Some(median(&values[s..end]) / median(&values[prev_start..s]));
         }
         series.push(Series {
             algorithm: g.0,
@@ -152,7 +312,15 @@ pub fn history(dirs: &[PathBuf], threshold: f64, alpha: f64) -> anyhow::Result<H
             points,
         });
     }
-    Ok(History { runs, series })
+    Ok(History {
+        adapter,
+        runs,
+        series,
+    })
+}
+
+fn psnr_mean(v: &[f64]) -> Option<f64> {
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
 /// One chart per algorithm × data set: a line per settings variant, its noise band, and a
@@ -183,7 +351,7 @@ fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<(
         .y_label_area_size(60)
         .build_cartesian_2d(-0.3f64..(n - 1) as f64 + 0.3, 0f64..ymax.max(1e-3))
         .map_err(err)?;
-    let labels = h.runs.clone();
+    let labels: Vec<String> = h.runs.iter().map(|r| r.label.clone()).collect();
     c.configure_mesh()
         .x_labels(n)
         .x_label_formatter(&|x| {
@@ -213,12 +381,21 @@ fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<(
         .map_err(err)?
         .label(s.settings.clone())
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2)));
+        // A step of the fit: a vertical bar at the run where the new level starts.
+        for p in s.points.iter().filter(|p| p.step.is_some()) {
+            let x = p.run as f64 - 0.5;
+            c.draw_series(std::iter::once(PathElement::new(
+                vec![(x, 0.0), (x, ymax)],
+                col.mix(0.6).stroke_width(2),
+            )))
+            .map_err(err)?;
+        }
         for p in s.points.iter().filter(|p| !p.changes.is_empty()) {
             let at = (p.run as f64, p.total_ms);
-            if p.changes.iter().any(|c| c == "slower") {
+            if p.changes.iter().any(|c| c.starts_with("slower")) {
                 c.draw_series(std::iter::once(TriangleMarker::new(at, 8, RED.filled())))
                     .map_err(err)?;
-            } else if p.changes.iter().any(|c| c == "faster") {
+            } else if p.changes.iter().any(|c| c.starts_with("faster")) {
                 c.draw_series(std::iter::once(Cross::new(at, 7, GREEN.stroke_width(3))))
                     .map_err(err)?;
             } else {
@@ -237,20 +414,113 @@ fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<(
     Ok(())
 }
 
+/// The page: every value goes through minijinja's HTML auto-escaping (on for a template named
+/// `*.html`), so a data set or settings string with markup in it lands as text.
+const PAGE: &str = r#"<!doctype html>
+<html><head><meta charset="utf-8"><title>tetbench history</title>
+<style>body{font-family:sans-serif;margin:1.5em}table{border-collapse:collapse;font-size:13px}
+td,th{border:1px solid #ccc;padding:2px 6px}.step{background:#fdd}</style></head><body>
+<h1>tetbench history</h1>
+<p>Adapter: {{ adapter }}</p>
+<p>Runs (by start date): {% for r in runs %}{{ r.label }}{% if not loop.last %} → {% endif %}{% endfor %}</p>
+<p>Changes against the run before are compare's test (rounds as samples, run-wide factor
+divided out, Holm); a step is where the piecewise-constant fit of the whole series changes level.</p>
+<table><tr><th>algorithm</th><th>settings</th><th>data set</th><th>ms per run</th><th>steps</th></tr>
+{% for s in series %}<tr><td>{{ s.algorithm }}</td><td>{{ s.settings }}</td><td>{{ s.dataset }}</td>
+<td>{% for p in s.points %}{{ "%.2f"|format(p.total_ms) }}{% if p.changes %} ({{ p.changes|join(", ") }}){% endif %}{% if not loop.last %} → {% endif %}{% endfor %}</td>
+<td{% if s.steps %} class="step"{% endif %}>{{ s.steps|join(", ") }}</td></tr>
+{% endfor %}</table>
+{% for c in charts %}<h2>{{ c.title }}</h2><img src="charts/{{ c.file }}">
+{% endfor %}</body></html>
+"#;
+
+#[derive(Serialize)]
+struct PageSeries<'a> {
+    algorithm: &'a str,
+    settings: &'a str,
+    dataset: &'a str,
+    points: &'a [Point],
+    steps: Vec<String>,
+}
+
+#[derive(Serialize)]
+struct PageChart {
+    title: String,
+    file: String,
+}
+
+fn step_labels(h: &History, s: &Series) -> Vec<String> {
+    s.points
+        .iter()
+        .filter_map(|p| {
+            p.step
+                .map(|r| format!("×{r:.3} at {}", h.runs[p.run].label))
+        })
+        .collect()
+}
+
+/// history.html: the runs, each series with its changes and steps, and the charts.
+pub fn page(h: &History, charts: &[(String, String)]) -> anyhow::Result<String> {
+    let mut env = minijinja::Environment::new();
+    env.add_template("history.html", PAGE)?;
+    let series: Vec<PageSeries> = h
+        .series
+        .iter()
+        .map(|s| PageSeries {
+            algorithm: &s.algorithm,
+            settings: &s.settings,
+            dataset: &s.dataset,
+            points: &s.points,
+            steps: step_labels(h, s),
+        })
+        .collect();
+    let charts: Vec<PageChart> = charts
+        .iter()
+        .map(|(title, file)| PageChart {
+            title: title.clone(),
+            file: file.clone(),
+        })
+        .collect();
+    #[derive(Serialize)]
+    struct Page<'a> {
+        adapter: &'a str,
+        runs: &'a [Run],
+        series: Vec<PageSeries<'a>>,
+        charts: Vec<PageChart>,
+    }
+    let page = Page {
+        adapter: &h.adapter,
+        runs: &h.runs,
+        series,
+        charts,
+    };
+    let html = env
+        .get_template("history.html")?
+        .render(minijinja::Value::from(minijinja::value::Serde(&page)))?;
+    Ok(html)
+}
+
 /// `tetbench history`: history.json, history.md, history.html and one chart per algorithm ×
 /// data set in `out`.
 pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> anyhow::Result<()> {
-    let h = history(dirs, threshold, alpha)?;
-    let charts = out.join("charts");
-    std::fs::create_dir_all(&charts)
-        .with_context(|| format!("cannot create {}", charts.display()))?;
-    let mut md = String::from("# tetbench history\n\nRuns: ");
-    md.push_str(&h.runs.join(" → "));
-    md.push_str(
-        "\n\n| algorithm | settings | data set | ms per run (changes) |\n|---|---|---|---|\n",
+    let h = history(dirs, out, threshold, alpha)?;
+    let charts_dir = out.join("charts");
+    std::fs::create_dir_all(&charts_dir)
+        .with_context(|| format!("cannot create {}", charts_dir.display()))?;
+    let mut md = format!(
+        "# tetbench history\n\nAdapter: {}\n\nRuns (by start date): ",
+        h.adapter
     );
-    let mut html = String::from("<!doctype html><html><head><meta charset=\"utf-8\"><title>tetbench history</title></head><body style=\"font-family:sans-serif\"><h1>tetbench history</h1>");
-    let _ = write!(html, "<p>Runs: {}</p>", h.runs.join(" → "));
+    md.push_str(
+        &h.runs
+            .iter()
+            .map(|r| r.label.as_str())
+            .collect::<Vec<_>>()
+            .join(" → "),
+    );
+    md.push_str(
+        "\n\n| algorithm | settings | data set | ms per run (changes against the run before) | steps |\n|---|---|---|---|---|\n",
+    );
     let mut pairs: Vec<(String, String)> = vec![];
     for s in &h.series {
         let cells: Vec<String> = s
@@ -266,29 +536,30 @@ pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> 
             .collect();
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} |",
             s.algorithm,
             s.settings,
             s.dataset,
-            cells.join(" → ")
+            cells.join(" → "),
+            step_labels(&h, s).join(", ")
         );
         let k = (s.algorithm.clone(), s.dataset.clone());
         if !pairs.contains(&k) {
             pairs.push(k);
         }
     }
+    let mut charts = vec![];
     for (alg, ds) in &pairs {
         let name = format!(
             "history_{}_{}.png",
             crate::names::slug(alg),
             crate::names::slug(ds)
         );
-        chart(&charts.join(&name), &h, alg, ds)?;
-        let _ = write!(html, "<h2>{alg} on {ds}</h2><img src=\"charts/{name}\">");
+        chart(&charts_dir.join(&name), &h, alg, ds)?;
+        charts.push((format!("{alg} on {ds}"), name));
     }
-    html.push_str("</body></html>\n");
     std::fs::write(out.join("history.md"), &md).context("writing history.md")?;
-    std::fs::write(out.join("history.html"), html).context("writing history.html")?;
+    std::fs::write(out.join("history.html"), page(&h, &charts)?).context("writing history.html")?;
     std::fs::write(out.join("history.json"), serde_json::to_string_pretty(&h)?)
         .context("writing history.json")?;
     print!("{md}");
@@ -312,4 +583,166 @@ fn palette(i: usize) -> RGBColor {
         RGBColor(23, 190, 207),
     ];
     PALETTE[i % PALETTE.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A ×1.3 level change in a noisy series is one step at the right place; the same series
+    /// without it has none; a step between two runs of one commit is not allowed.
+    #[test]
+    fn steps_are_found_where_the_level_changes() {
+        let wobble = [1.0, 1.03, 0.98, 1.01, 0.97, 1.02, 1.0, 0.99];
+        let flat: Vec<f64> = wobble.iter().chain(&wobble).map(|w| 10.0 * w).collect();
+        let none = vec![false; flat.len()];
+        let p = step_penalty(&flat, 1.10);
+        assert!(detect_steps(&flat, &none, p, 1.10).is_empty());
+        let stepped: Vec<f64> = flat
+            .iter()
+            .enumerate()
+            .map(|(i, v)| if i >= 8 { v * 1.3 } else { *v })
+            .collect();
+        let p = step_penalty(&stepped, 1.10);
+        assert_eq!(detect_steps(&stepped, &none, p, 1.10), [8]);
+        // Run 8 measured the same commit as run 7: the step moves to where the code changed.
+        let mut same = none.clone();
+        same[8] = true;
+        let at = detect_steps(&stepped, &same, p, 1.10);
+        assert!(!at.contains(&8), "{at:?}");
+        // All one commit: no step at all.
+        assert!(detect_steps(&stepped, &vec![true; stepped.len()], p, 1.10).is_empty());
+    }
+
+    /// history.html escapes everything: a data set named with markup lands as text.
+    #[test]
+    fn the_page_escapes_names() {
+        let hostile = "<img src=x onerror=alert(1)>";
+        let h = History {
+            adapter: hostile.into(),
+            runs: vec![Run {
+                dir: hostile.into(),
+                commit: "abc".into(),
+                date_utc: "2026-01-01T00:00:00Z".into(),
+                label: hostile.into(),
+            }],
+            series: vec![Series {
+                algorithm: hostile.into(),
+                settings: hostile.into(),
+                dataset: hostile.into(),
+                points: vec![Point {
+                    run: 0,
+                    total_ms: 1.0,
+                    band_lo: 1.0,
+                    band_hi: 1.0,
+                    psnr_db: None,
+                    gpu_bytes: None,
+                    changes: vec![hostile.into()],
+                    step: Some(1.5),
+                }],
+            }],
+        };
+        let html = page(&h, &[(hostile.into(), hostile.into())]).unwrap();
+        assert!(!html.contains("<img src=x"), "{html}");
+        assert!(
+            html.contains("&lt;img src=x onerror=alert(1)&gt;"),
+            "{html}"
+        );
+    }
+
+    /// Six runs of two groups; the code changes at run 3 (a new commit) and makes alg0 ×1.5
+    /// slower: compare's test marks the pair, the fit puts one step at run 3 for alg0 and
+    /// none for alg1; the same six runs all of one commit have no step at all. The runs are
+    /// given out of order and put in order by date.
+    #[test]
+    fn history_marks_the_step_where_the_code_changed() {
+        let tmp = tempfile::tempdir().unwrap();
+        let write = |name: &str, k: usize, commit: &str, slow: f64| {
+            let dir = tmp.path().join(name);
+            std::fs::create_dir_all(&dir).unwrap();
+            let mut rows = vec![];
+            for (g, f) in [(0, slow), (1, 1.0)] {
+                for (v, vp) in ["+x", "-x", "+y"].iter().enumerate() {
+                    let mut row = Row {
+                        algorithm: format!("alg{g}"),
+                        settings: "k=2".into(),
+                        dataset: "box:1k".into(),
+                        viewpoint: vp.to_string(),
+                        ..Default::default()
+                    };
+                    row.samples.total_ms = (0..5)
+                        .map(|r| 10.0 * f * (1.0 + 0.01 * (((k + v + r) * 7) % 5) as f64))
+                        .collect();
+                    row.total_ms = Some(median(&row.samples.total_ms));
+                    rows.push(row);
+                }
+            }
+            let mut machine = crate::machine::MachineInfo::collect();
+            machine.git_commit = Some(commit.into());
+            machine.date_utc = format!("2026-01-0{}T00:00:00Z", k + 1);
+            let file = ResultsFile {
+                schema_version: crate::results::SCHEMA_VERSION,
+                machine,
+                run: crate::results::RunDescription {
+                    rounds: 5,
+                    frames: 1,
+                    ..Default::default()
+                },
+                finished_utc: None,
+                rows,
+                errors: vec![],
+            };
+            crate::results::write_json(&dir, &file).unwrap();
+            dir
+        };
+        let mut changed = vec![];
+        let mut same = vec![];
+        for k in (0..6).rev() {
+            let (commit, slow) = if k < 3 { ("aaa", 1.0) } else { ("bbb", 1.5) };
+            changed.push(write(&format!("c{k}"), k, commit, slow));
+            same.push(write(&format!("s{k}"), k, "aaa", 1.0));
+        }
+        let out = tmp.path().join("out");
+        let h = history(&changed, &out, 1.10, 0.05).unwrap();
+        assert_eq!(h.runs[0].date_utc, "2026-01-01T00:00:00Z");
+        assert_eq!(h.runs[3].label, "bbb 2026-01-04");
+        let alg0 = &h.series[0];
+        assert_eq!(alg0.algorithm, "alg0");
+        let steps: Vec<usize> = alg0
+            .points
+            .iter()
+            .filter(|p| p.step.is_some())
+            .map(|p| p.run)
+            .collect();
+        assert_eq!(steps, [3]);
+        assert!((alg0.points[3].step.unwrap() - 1.5).abs() < 0.05);
+        assert!(
+            alg0.points[3]
+                .changes
+                .iter()
+                .any(|c| c.starts_with("slower")),
+            "{:?}",
+            alg0.points[3]
+        );
+        assert!(h.series[1].points.iter().all(|p| p.step.is_none()));
+        let flat = history(&same, &out, 1.10, 0.05).unwrap();
+        assert!(flat.series.iter().all(|s| s
+            .points
+            .iter()
+            .all(|p| p.step.is_none() && p.changes.is_empty())));
+
+        // Another adapter in the series is refused.
+        let mut other = ResultsFile::read(&changed[0]).unwrap();
+        other.machine.cpu_model = "another CPU".into();
+        other.machine.adapter = Some(render_core::AdapterDescription {
+            name: "Other GPU".into(),
+            backend: "vulkan".into(),
+            device_type: "DiscreteGpu".into(),
+            driver: String::new(),
+            driver_info: String::new(),
+        });
+        crate::results::write_json(&changed[0], &other).unwrap();
+        let e = history(&changed, &out, 1.10, 0.05).unwrap_err().to_string();
+        assert!(e.contains("another adapter"), "{e}");
+    }
 }

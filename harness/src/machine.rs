@@ -1,14 +1,16 @@
-//! What a result was measured on: CPU, memory, OS, GPU adapter, tetbench version and commit,
-//! date. Recorded once per results file (and adapter/backend again in every row).
+//! What a result was measured on: CPU, memory, OS, host, load, GPU adapter, and what measured
+//! it: tetbench's version, commit, dirty flag, build profile and compiler, all embedded when
+//! the binary was built (`harness/build.rs`), so a copied or stale binary still says what it
+//! is. Recorded once per results file (and adapter/backend again in every row).
 
-use std::path::Path;
 use std::process::Command;
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use render_core::AdapterDescription;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct MachineInfo {
     pub cpu_model: String,
     /// Logical cores available to this process.
@@ -17,10 +19,26 @@ pub struct MachineInfo {
     pub os: String,
     pub kernel: Option<String>,
     pub arch: String,
+    #[schemars(with = "Option<AdapterSchema>")]
     pub adapter: Option<AdapterDescription>,
+    /// The commit the binary was built from (`None`: built outside a git checkout).
     pub git_commit: Option<String>,
-    /// Whether the working tree had uncommitted changes (`None` when git is unavailable).
+    /// Whether tracked files differed from that commit when the binary was built.
     pub git_dirty: Option<bool>,
+    /// `release` or `debug` (`None` in files written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub build_profile: Option<String>,
+    /// `rustc --version` of the build.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rustc_version: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub host_name: Option<String>,
+    /// The 1-minute load average when the run started and when it finished (Linux; a loaded
+    /// machine explains a slow run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load_average_start: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load_average_end: Option<f64>,
     /// When the run started, ISO 8601 UTC.
     pub date_utc: String,
     pub tetbench_version: String,
@@ -30,13 +48,22 @@ pub struct MachineInfo {
     pub calibration: Option<Calibration>,
 }
 
+/// [`AdapterDescription`]'s fields for the JSON Schema (render-core does not depend on
+/// schemars); `adapter_schema_mirrors_render_core` keeps the two in step.
+#[derive(JsonSchema)]
+#[allow(dead_code)]
+struct AdapterSchema {
+    name: String,
+    backend: String,
+    device_type: String,
+    driver: String,
+    driver_info: String,
+}
+
 impl MachineInfo {
     /// Gathers everything but the adapter (set by the caller once the GPU is opened).
     pub fn collect() -> MachineInfo {
-        let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let git_commit = git(&repo, &["rev-parse", "HEAD"]);
-        let git_dirty =
-            git(&repo, &["status", "--porcelain", "--untracked-files=no"]).map(|s| !s.is_empty());
+        let built = |s: &'static str| (!s.is_empty()).then(|| s.to_string());
         MachineInfo {
             cpu_model: cpu_model().unwrap_or_else(|| "unknown".into()),
             cpu_cores: std::thread::available_parallelism()
@@ -49,8 +76,13 @@ impl MachineInfo {
                 .map(|s| s.trim().to_string()),
             arch: std::env::consts::ARCH.to_string(),
             adapter: None,
-            git_commit,
-            git_dirty,
+            git_commit: built(env!("TETBENCH_GIT_COMMIT")),
+            git_dirty: built(env!("TETBENCH_GIT_DIRTY")).map(|d| d == "true"),
+            build_profile: built(env!("TETBENCH_BUILD_PROFILE")),
+            rustc_version: built(env!("TETBENCH_RUSTC_VERSION")),
+            host_name: Some(host_name()),
+            load_average_start: load_average(),
+            load_average_end: None,
             date_utc: iso8601_utc(SystemTime::now()),
             tetbench_version: env!("CARGO_PKG_VERSION").to_string(),
             calibration: None,
@@ -58,16 +90,29 @@ impl MachineInfo {
     }
 }
 
-fn git(dir: &Path, args: &[&str]) -> Option<String> {
-    let out = Command::new("git")
-        .arg("-C")
-        .arg(dir)
-        .args(args)
-        .output()
-        .ok()?;
-    out.status
-        .success()
-        .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
+/// This machine's name (`/proc/sys/kernel/hostname`, `$HOSTNAME`, `uname -n`), or `unknown`.
+pub fn host_name() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .or_else(|| std::env::var("HOSTNAME").ok().filter(|s| !s.is_empty()))
+        .or_else(|| {
+            let out = Command::new("uname").arg("-n").output().ok()?;
+            let s = String::from_utf8_lossy(&out.stdout).trim().to_string();
+            (!s.is_empty()).then_some(s)
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// The 1-minute load average (`/proc/loadavg`); `None` elsewhere.
+pub fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
 }
 
 fn cpu_model() -> Option<String> {
@@ -142,7 +187,7 @@ pub fn iso8601_utc(t: SystemTime) -> String {
 }
 
 /// The backend's figures, stored in every run's machine record.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Calibration {
     pub version: u32,
     pub adapter: String,
@@ -217,5 +262,47 @@ mod tests {
         assert!(m.cpu_cores >= 1);
         assert!(!m.os.is_empty());
         assert_eq!(m.date_utc.len(), 20);
+        assert!(!m.host_name.unwrap().is_empty());
+    }
+
+    #[test]
+    fn adapter_schema_mirrors_render_core() {
+        let a = AdapterDescription {
+            name: String::new(),
+            backend: String::new(),
+            device_type: String::new(),
+            driver: String::new(),
+            driver_info: String::new(),
+        };
+        let fields: Vec<String> = serde_json::to_value(a)
+            .unwrap()
+            .as_object()
+            .unwrap()
+            .keys()
+            .cloned()
+            .collect();
+        let schema = serde_json::to_value(schemars::schema_for!(AdapterSchema)).unwrap();
+        let mut mirrored: Vec<String> = schema["properties"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .cloned()
+            .collect();
+        let mut fields = fields;
+        fields.sort();
+        mirrored.sort();
+        assert_eq!(fields, mirrored);
+    }
+
+    /// The provenance comes from the build, not from the directory the binary runs in: the
+    /// test binary is built from this checkout, so it knows its commit, profile and compiler.
+    #[test]
+    fn provenance_is_embedded_at_build_time() {
+        let m = MachineInfo::collect();
+        let commit = m.git_commit.expect("built from a git checkout");
+        assert_eq!(commit.len(), 40, "{commit}");
+        assert!(m.git_dirty.is_some());
+        assert!(["debug", "release"].contains(&m.build_profile.as_deref().unwrap()));
+        assert!(m.rustc_version.unwrap().starts_with("rustc "));
     }
 }

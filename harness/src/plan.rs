@@ -203,6 +203,7 @@ impl RunPlan {
             strict: self.strict,
             shard: self.shard.as_deref().map(str::parse).transpose()?,
             calibrate: !self.no_calibrate,
+            resume: false,
         })
     }
 }

@@ -12,6 +12,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::machine::MachineInfo;
@@ -31,7 +32,7 @@ pub const JSON_FILE: &str = "results.json";
 /// One (algorithm, settings, data set, viewpoint) measurement. Times in ms, rates per second,
 /// error metrics as defined in [`crate::metrics`]. `None` is an empty CSV cell / JSON null: no
 /// timestamp queries (gpu_ms), no reference (error metrics), or a failed row (`error` set).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Row {
     pub algorithm: String,
     pub settings: String,
@@ -141,7 +142,7 @@ impl Row {
 }
 
 /// How the run was asked for, stored with the results so a report says what it shows.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, JsonSchema)]
 pub struct RunDescription {
     pub command_line: Vec<String>,
     pub algorithms: Vec<String>,
@@ -168,7 +169,7 @@ pub struct RunDescription {
 }
 
 /// Where the rows of a merged results set came from.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct MergedRun {
     pub dir: String,
     pub shard: Option<String>,
@@ -183,7 +184,7 @@ fn one_round() -> u32 {
 }
 
 /// The whole of `results.json`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct ResultsFile {
     pub schema_version: u32,
     pub machine: MachineInfo,
@@ -217,6 +218,12 @@ impl ResultsFile {
         serde_json::from_value(value)
             .with_context(|| format!("{}: unexpected layout", path.display()))
     }
+}
+
+/// The JSON Schema of `results.json`, generated from these types (`docs/results.schema.json`
+/// is this, checked by a test).
+pub fn json_schema() -> serde_json::Value {
+    serde_json::to_value(schemars::schema_for!(ResultsFile)).expect("a schema is JSON")
 }
 
 /// Writes rows to `results.csv` and `results.json` as they finish.
@@ -269,6 +276,23 @@ impl ResultsWriter {
         self.csv.flush().context("writing results.csv")?;
         self.samples.push(&row)?;
         self.file.rows.push(row);
+        self.write_json()
+    }
+
+    /// Appends rows of an earlier run (`run --resume`) to both files, with one JSON write.
+    pub fn push_restored(&mut self, rows: Vec<Row>) -> anyhow::Result<()> {
+        if rows.is_empty() {
+            return Ok(());
+        }
+        for row in rows {
+            self.csv.serialize(Row {
+                samples: FrameSamples::default(),
+                ..row.clone()
+            })?;
+            self.samples.push(&row)?;
+            self.file.rows.push(row);
+        }
+        self.csv.flush().context("writing results.csv")?;
         self.write_json()
     }
 
@@ -368,7 +392,7 @@ pub const SAMPLES_CSV: &str = "samples.csv";
 
 /// Per-frame measurements of one row, in frame order. `gpu_ms` is empty when the adapter has no
 /// timestamp queries.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct FrameSamples {
     pub total_ms: Vec<f64>,
     pub cpu_ms: Vec<f64>,
@@ -566,5 +590,59 @@ mod tests {
         std::fs::write(dir.path().join(JSON_FILE), r#"{"schema_version": 999}"#).unwrap();
         let e = ResultsFile::read(dir.path()).unwrap_err().to_string();
         assert!(e.contains("schema_version"), "{e}");
+    }
+
+    /// docs/results.schema.json is what the types generate (regenerate with
+    /// `TETBENCH_BLESS=1 cargo test -p harness --lib results::`), and a results.json written
+    /// by a real run (the committed baseline) fits it: every field known, every required one
+    /// present.
+    #[test]
+    fn checked_in_schema_matches_the_types() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/results.schema.json");
+        let text = serde_json::to_string_pretty(&json_schema()).unwrap() + "\n";
+        if std::env::var_os("TETBENCH_BLESS").is_some() {
+            std::fs::write(&path, &text).unwrap();
+        }
+        let stored = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            stored == text,
+            "{} is out of date: regenerate it with TETBENCH_BLESS=1 cargo test -p harness --lib \
+             results::",
+            path.display()
+        );
+        // The committed baseline against the schema: it loads, and every object in it has
+        // the schema's required fields and no field the schema lacks (a structural check of
+        // the parts a results file is made of, without a validator crate).
+        let schema = json_schema();
+        let baselines = Path::new(env!("CARGO_MANIFEST_DIR")).join("../reports/baselines");
+        let dir = std::fs::read_dir(&baselines)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.join(JSON_FILE).is_file())
+            .expect("a committed baseline");
+        ResultsFile::read(&dir).unwrap();
+        let real: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(JSON_FILE)).unwrap()).unwrap();
+        let defs = &schema["$defs"];
+        let check = |value: &serde_json::Value, def: &serde_json::Value, what: &str| {
+            let props = def["properties"].as_object().unwrap();
+            let obj = value.as_object().unwrap();
+            for k in obj.keys() {
+                assert!(
+                    props.contains_key(k),
+                    "{what}: field {k} is not in the schema"
+                );
+            }
+            for r in def["required"].as_array().into_iter().flatten() {
+                let r = r.as_str().unwrap();
+                assert!(obj.contains_key(r), "{what}: required field {r} missing");
+            }
+        };
+        check(&real, &schema, "results.json");
+        check(&real["machine"], &defs["MachineInfo"], "machine");
+        check(&real["run"], &defs["RunDescription"], "run");
+        for row in real["rows"].as_array().unwrap() {
+            check(row, &defs["Row"], "row");
+        }
     }
 }

@@ -28,7 +28,9 @@ use crate::machine::MachineInfo;
 use crate::metrics::{self, summarize};
 use crate::results::{ResultsWriter, Row, RunDescription};
 
+pub mod lock;
 mod measure;
+pub mod resume;
 use measure::DatasetContext;
 
 /// Everything a run needs, already parsed and checked.
@@ -66,6 +68,9 @@ pub struct RunConfig {
     pub shard: Option<crate::shard::Shard>,
     /// Calibrate the backend (or reuse the cached figures) and add the roofline columns.
     pub calibrate: bool,
+    /// Keep the finished units of an earlier run of the same plan in `out` and measure only
+    /// the rest (`run --resume`, [`resume`]).
+    pub resume: bool,
 }
 
 /// Makes the variants of an algorithm by name (normally
@@ -304,6 +309,8 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     let plan = plan_variants(config, factory)?;
     check_datasets(config)?;
     let variants_total: usize = plan.iter().map(|(_, n)| n).sum();
+    // Held until the run returns: a second run into this directory refuses (lock.rs).
+    let _lock = lock::acquire(&config.out, &config.command_line)?;
 
     let gpu = Gpu::new()?;
     let mut machine = MachineInfo::collect();
@@ -348,12 +355,31 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         shard: config.shard.map(|s| s.to_string()),
         merged_from: vec![],
     };
+    let kept = if config.resume {
+        resume::finished_rows(&config.out, &description, &machine, config.viewpoints.len())?
+    } else {
+        vec![]
+    };
+    let done: std::collections::HashSet<resume::Unit> = kept
+        .iter()
+        .map(|r| (r.dataset.clone(), r.algorithm.clone(), r.settings.clone()))
+        .collect();
     let mut writer = ResultsWriter::create(&config.out, machine, description)?;
+    writer.push_restored(kept)?;
     let units_total = match &shard_units {
         Some(u) => u.len(),
         None => config.datasets.len() * variants_total,
     };
     let mut progress = Progress::new((units_total * config.viewpoints.len()) as u64);
+    if !done.is_empty() {
+        progress.log(&format!(
+            "tetbench: --resume keeps {} finished unit(s) ({} rows) of {}",
+            done.len(),
+            writer.file.rows.len(),
+            config.out.display()
+        ));
+        progress.skip((done.len() * config.viewpoints.len()) as u64);
+    }
     progress.log(&format!(
         "tetbench: {} on {} ({}, {}); writing {}",
         config.algorithms.join(","),
@@ -377,6 +403,13 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
             .is_some_and(|u| !u.iter().any(|(d, _, _)| *d == label))
         {
             continue; // nothing of this data set in this shard
+        }
+        let units_here = match &shard_units {
+            Some(u) => u.iter().filter(|(d, _, _)| *d == label).count(),
+            None => variants_total,
+        };
+        if units_here > 0 && done.iter().filter(|(d, _, _)| *d == label).count() == units_here {
+            continue; // every unit of this data set finished in the resumed run
         }
         progress.status(&format!("loading {label}"));
         let t0 = Instant::now();
@@ -411,8 +444,10 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         let mut renderers = vec![];
         for (name, _) in &plan {
             renderers.extend(factory(name)?.into_iter().filter(|r| {
+                let settings = settings_string(&r.settings());
                 config.settings_filter.accepts(&r.settings())
-                    && in_shard(&label, name, &settings_string(&r.settings()))
+                    && in_shard(&label, name, &settings)
+                    && !done.contains(&(label.clone(), name.clone(), settings))
             }));
         }
         if config.rounds <= 1 {
@@ -443,6 +478,7 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     }
     // Columns only known once every row is in (suspect flags, roofline): both files again.
     writer.rewrite_all()?;
+    writer.file.machine.load_average_end = crate::machine::load_average();
     writer.finish()?;
     outcome.rows = writer.file.rows.len();
     if config.report {

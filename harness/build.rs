@@ -1,0 +1,86 @@
+//! Embeds the build's provenance in the binary (issue 25): the commit, whether the tracked
+//! files differed from it, the build profile and the compiler. Read at run time these were
+//! wrong for a copied binary (no commit) and for a stale one (whatever is checked out now).
+//!
+//! Hand-written rather than `vergen-gitcl`/`built`: it is the git command line and four
+//! `rustc-env` lines, and it must also rerun when a tracked source changes (for the dirty
+//! flag), which those crates leave to the caller anyway.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn git(root: &Path, args: &[&str]) -> Option<String> {
+    let out = Command::new("git")
+        .arg("-C")
+        .arg(root)
+        .args(args)
+        .output()
+        .ok()?;
+    out.status
+        .success()
+        .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
+}
+
+fn main() {
+    let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo"));
+    let root = manifest
+        .parent()
+        .expect("harness lives in the workspace")
+        .to_path_buf();
+
+    let commit = git(&root, &["rev-parse", "HEAD"]);
+    let dirty = commit.as_ref().and_then(|_| {
+        git(&root, &["status", "--porcelain", "--untracked-files=no"]).map(|s| !s.is_empty())
+    });
+    println!(
+        "cargo:rustc-env=TETBENCH_GIT_COMMIT={}",
+        commit.clone().unwrap_or_default()
+    );
+    println!(
+        "cargo:rustc-env=TETBENCH_GIT_DIRTY={}",
+        dirty.map(|d| d.to_string()).unwrap_or_default()
+    );
+    println!(
+        "cargo:rustc-env=TETBENCH_BUILD_PROFILE={}",
+        std::env::var("PROFILE").unwrap_or_default()
+    );
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let version = Command::new(rustc)
+        .arg("--version")
+        .output()
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_default();
+    println!("cargo:rustc-env=TETBENCH_RUSTC_VERSION={version}");
+
+    // Rerun when HEAD moves (a checkout: HEAD; a commit: the branch's ref, or packed-refs
+    // after a gc), when the index changes, and when a tracked source changes (the dirty flag).
+    // `--git-path` resolves all of them inside a worktree's own and the common git directory.
+    if commit.is_some() {
+        for name in ["HEAD", "index", "packed-refs"] {
+            if let Some(p) = git(&root, &["rev-parse", "--git-path", name]) {
+                println!("cargo:rerun-if-changed={}", root.join(p).display());
+            }
+        }
+        if let Some(head_ref) = git(&root, &["symbolic-ref", "-q", "HEAD"]) {
+            if let Some(p) = git(&root, &["rev-parse", "--git-path", &head_ref]) {
+                println!("cargo:rerun-if-changed={}", root.join(p).display());
+            }
+        }
+        for dir in [
+            "harness",
+            "datasets",
+            "renderers",
+            "peers",
+            "tests",
+            "scripts",
+        ] {
+            println!("cargo:rerun-if-changed={}", root.join(dir).display());
+        }
+        for file in ["Cargo.toml", "Cargo.lock"] {
+            println!("cargo:rerun-if-changed={}", root.join(file).display());
+        }
+    } else {
+        println!("cargo:rerun-if-changed=build.rs");
+    }
+}

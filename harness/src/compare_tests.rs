@@ -1,0 +1,202 @@
+//! Tests of [`crate::compare`]: drift correction, rounds as the unit of replication,
+//! provenance warnings (kept apart so compare.rs stays readable).
+use super::*;
+
+/// A results set of one group per entry of `factors` (algorithm `alg{i}`), 3 viewpoints
+/// each, `rounds` rounds of `frames` frames around 10 ms × factor with 3 % noise; frame j
+/// of a round is further multiplied by `1 + drift·j` (the machine drifting during a round).
+fn run_dir(dir: &Path, factors: &[f64], rounds: u32, frames: u32, drift: f64, seed: u64) {
+    std::fs::create_dir_all(dir).unwrap();
+    let mut rng = crate::stats::TestRng::new(seed);
+    let mut rows = vec![];
+    for (i, f) in factors.iter().enumerate() {
+        for vp in ["+x", "+x+y+z", "-x+y-z"] {
+            let mut row = crate::results::Row {
+                algorithm: format!("alg{i}"),
+                settings: "k=2".into(),
+                dataset: "box:1k".into(),
+                viewpoint: vp.into(),
+                frames: rounds * frames,
+                ..Default::default()
+            };
+            for _ in 0..rounds {
+                for j in 0..frames {
+                    let t = 10.0 * f * (1.0 + drift * j as f64) * (1.0 + 0.03 * rng.normal());
+                    row.samples.total_ms.push(t);
+                }
+            }
+            row.total_ms = Some(median(&row.samples.total_ms));
+            rows.push(row);
+        }
+    }
+    let file = ResultsFile {
+        schema_version: crate::results::SCHEMA_VERSION,
+        machine: crate::machine::MachineInfo::collect(),
+        run: crate::results::RunDescription {
+            rounds,
+            frames,
+            ..Default::default()
+        },
+        finished_utc: None,
+        rows,
+        errors: vec![],
+    };
+    crate::results::write_json(dir, &file).unwrap();
+}
+
+fn options(out: &Path, drift_correction: bool, drift_limit: f64) -> CompareOptions {
+    CompareOptions {
+        threshold: 1.10,
+        alpha: 0.05,
+        normalised: false,
+        drift_correction,
+        drift_limit,
+        fail_on: FailOn::Regression,
+        out: out.to_path_buf(),
+    }
+}
+
+/// Eight groups; NEW ×1.3 as a whole (the machine drifting) and group 3 ×2 on top: with
+/// the run-wide factor divided out only that group is slower; without, all of them; a
+/// factor beyond --drift-limit is a regression of its own; and 2 groups give no factor.
+#[test]
+fn drift_is_divided_out_and_one_slower_group_still_stands_out() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    run_dir(&a, &[1.0; 8], 5, 1, 0.0, 1);
+    let mut slow = [1.3; 8];
+    slow[3] = 2.6;
+    run_dir(&b, &slow, 5, 1, 0.0, 2);
+    let out = tmp.path().join("out");
+    let c = compare(&a, &b, &options(&out, true, 1.5)).unwrap();
+    let f = c.run_factor.unwrap();
+    assert!((f - 1.3).abs() < 0.03, "{f}");
+    assert!(c.drift_corrected);
+    let slower: Vec<&str> = c
+        .groups
+        .iter()
+        .filter(|g| g.total.verdict == Verdict::Slower)
+        .map(|g| g.algorithm.as_str())
+        .collect();
+    assert_eq!(slower, ["alg3"], "{:#?}", c.groups);
+    assert!(c.groups.iter().all(|g| g.total.p_adjusted.is_some()));
+
+    let absolute = compare(&a, &b, &options(&out, false, 1.5)).unwrap();
+    assert!(!absolute.drift_corrected);
+    assert!(absolute
+        .groups
+        .iter()
+        .all(|g| g.total.verdict == Verdict::Slower));
+
+    let limited = compare(&a, &b, &options(&out, true, 1.2)).unwrap();
+    assert!(
+        limited
+            .regressions
+            .iter()
+            .any(|r| r.starts_with("run-wide")),
+        "{:?}",
+        limited.regressions
+    );
+
+    let (c2, d2) = (tmp.path().join("c2"), tmp.path().join("d2"));
+    run_dir(&c2, &[1.0; 2], 5, 1, 0.0, 3);
+    run_dir(&d2, &[1.3; 2], 5, 1, 0.0, 4);
+    let few = compare(&c2, &d2, &options(&out, true, 1.5)).unwrap();
+    assert_eq!(few.run_factor, None);
+    assert!(few
+        .groups
+        .iter()
+        .all(|g| g.total.verdict == Verdict::Slower));
+}
+
+/// A row's samples split into one median per round.
+#[test]
+fn rounds_are_the_samples() {
+    let row = Row {
+        samples: crate::results::FrameSamples {
+            total_ms: vec![1.0, 2.0, 3.0, 10.0, 20.0, 30.0],
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    assert_eq!(
+        round_values(&row, "total_ms", 2, false).unwrap(),
+        [2.0, 20.0]
+    );
+    assert_eq!(round_values(&row, "total_ms", 1, false).unwrap(), [6.5]);
+    // Samples that do not split into the rounds (a failed round) decide nothing.
+    assert_eq!(round_values(&row, "total_ms", 4, false).unwrap(), [6.5]);
+}
+
+/// Issue 25: one round of 15 frames, NEW's frames drifting up by 2 % per frame and one
+/// group even ×1.5 slower: frames of one round are one sample, so no time verdict and no
+/// time regression; the same slowdown in 5 rounds is found, and 5 rounds without it are
+/// clean (the input flips the verdict).
+#[test]
+fn one_round_never_gates_on_time_and_five_rounds_find_a_slowdown() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = |s: &str| tmp.path().join(s);
+    let out = p("out");
+    let mut slow = [1.0; 8];
+    slow[5] = 1.5;
+    for seed in 0..5 {
+        run_dir(&p("a1"), &[1.0; 8], 1, 15, 0.0, 10 + seed);
+        run_dir(&p("b1"), &slow, 1, 15, 0.02, 20 + seed);
+        let c = compare(&p("a1"), &p("b1"), &options(&out, true, 1.5)).unwrap();
+        assert!(c.regressions.is_empty(), "{:?}", c.regressions);
+        assert_eq!(c.rounds, Rounds { base: 1, new: 1 });
+        let why = c.time_refused.as_deref().unwrap();
+        assert!(
+            why.contains("too few independent samples (1 rounds"),
+            "{why}"
+        );
+        assert!(c
+            .groups
+            .iter()
+            .all(|g| g.total.verdict == Verdict::TooFewSamples));
+        assert!(c
+            .rows
+            .iter()
+            .all(|r| r.times.iter().all(|t| t.verdict == Verdict::TooFewSamples)));
+    }
+
+    run_dir(&p("a5"), &[1.0; 8], 5, 3, 0.0, 1);
+    run_dir(&p("b5"), &slow, 5, 3, 0.0, 2);
+    run_dir(&p("c5"), &[1.0; 8], 5, 3, 0.0, 3);
+    let found = compare(&p("a5"), &p("b5"), &options(&out, true, 1.5)).unwrap();
+    assert_eq!(found.time_refused, None);
+    assert!(
+        found
+            .regressions
+            .iter()
+            .any(|r| r.starts_with("slower: alg5 ")),
+        "{:?}",
+        found.regressions
+    );
+    let clean = compare(&p("a5"), &p("c5"), &options(&out, true, 1.5)).unwrap();
+    assert!(clean.regressions.is_empty(), "{:?}", clean.regressions);
+}
+
+/// A dirty or debug side is named in the warnings; a clean release build is not.
+#[test]
+fn dirty_or_debug_sides_are_warned() {
+    let mut f = ResultsFile {
+        schema_version: crate::results::SCHEMA_VERSION,
+        machine: crate::machine::MachineInfo::collect(),
+        run: Default::default(),
+        finished_utc: None,
+        rows: vec![],
+        errors: vec![],
+    };
+    f.machine.git_dirty = Some(false);
+    f.machine.build_profile = Some("release".into());
+    assert!(provenance_warnings("NEW", &f).is_empty());
+    f.machine.git_dirty = Some(true);
+    f.machine.build_profile = Some("debug".into());
+    let w = provenance_warnings("NEW", &f);
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w[0].contains("dirty") && w[1].contains("debug build"),
+        "{w:?}"
+    );
+}
