@@ -2,7 +2,7 @@
 //! with its linear integrator, which like tetbench's reference integrates a linear scalar
 //! through piecewise-linear colour and extinction exactly) against `reference::render`, on SPX
 //! and a generated non-convex mesh at 128², through the `vtk-raycast` peer with the conventions
-//! of `vtk_peer::conventions`.
+//! of `peers/vtk/src/vtk_peer.py` (spoken to over the external renderer protocol).
 //!
 //! The exact comparison reads VTK's per-pixel integration in float (`readout=rays`, early
 //! termination off); VTK's own 8-bit display (`readout=framebuffer`) and its PT and ZSweep

@@ -11,6 +11,7 @@ pub mod compare_plot;
 pub mod compare_report;
 pub mod compare_time;
 pub mod datasets_cmd;
+pub mod external_cmd;
 pub mod history;
 pub mod machine;
 pub mod metrics;

@@ -235,8 +235,9 @@ figure img {{ width: 160px; height: 160px; object-fit: contain; background: #000
     h.push_str("<h2>Summary</h2><p>Mean over viewpoints (min–max in brackets).");
     if file.rows.iter().any(|r| is_peer(&r.algorithm)) {
         h.push_str(
-            " <em>peer</em>: another package's renderer (VTK, through its Python package) \
-             measured in the same run; VTK reports no GPU memory.",
+            " <em>peer</em>: another package's renderer (VTK, through its Python package, or \
+             an external renderer given with <code>--external</code>, \
+             docs/external-renderers.md) measured in the same run; VTK reports no GPU memory.",
         );
     }
     h.push_str(

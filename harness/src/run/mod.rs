@@ -66,6 +66,8 @@ pub struct RunConfig {
     pub shard: Option<crate::shard::Shard>,
     /// Calibrate the backend (or reuse the cached figures) and add the roofline columns.
     pub calibrate: bool,
+    /// External renderers (`--external`): each spec is one variant of the algorithm it names.
+    pub externals: Vec<external_peer::ExternalSpec>,
 }
 
 /// Makes the variants of an algorithm by name (normally
@@ -301,6 +303,12 @@ fn check_datasets(config: &RunConfig) -> anyhow::Result<()> {
 /// report into `config.out`.
 pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOutcome> {
     let started = Instant::now();
+    // External renderers are built from the run's own specs, whatever factory the caller gave.
+    let with_externals = |name: &str| match external_variants(config, name) {
+        Some(v) => Ok(v),
+        None => factory(name),
+    };
+    let factory: VariantFactory = &with_externals;
     let plan = plan_variants(config, factory)?;
     check_datasets(config)?;
     let variants_total: usize = plan.iter().map(|(_, n)| n).sum();
@@ -450,6 +458,18 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     }
     outcome.seconds = started.elapsed().as_secs_f64();
     Ok(outcome)
+}
+
+/// The variants of an external renderer named `name` (one per `--external` spec with that
+/// name), or `None` when `name` is not one.
+fn external_variants(config: &RunConfig, name: &str) -> Option<Vec<Box<dyn Renderer>>> {
+    let v: Vec<Box<dyn Renderer>> = config
+        .externals
+        .iter()
+        .filter(|s| s.name == name)
+        .map(|s| Box::new(external_peer::ExternalRenderer::new(s.clone())) as Box<dyn Renderer>)
+        .collect();
+    (!v.is_empty()).then_some(v)
 }
 
 /// Every (data set, algorithm, settings) of the run, for `--shard`.
