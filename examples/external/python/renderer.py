@@ -89,9 +89,9 @@ class Renderer:
         eye, target = np.array(cam["eye"]), np.array(cam["target"])
         f = normalise(target - eye)
         r = normalise(np.cross(f, np.array(cam["up"])))
-        if "--mirror" in FLAGS:
-            r = -r
         u = np.cross(r, f)
+        if "--mirror" in FLAGS:
+            r = -r  # a left-handed camera: right = up x forward
         ndc_x = 2.0 * (np.arange(w) + 0.5) / w - 1.0
         ndc_y = 1.0 - 2.0 * (np.arange(h) + 0.5) / h
         nx, ny = np.meshgrid(ndc_x, ndc_y)  # (h, w)

@@ -227,6 +227,15 @@ class Peer:
         return {"type": "rendered", "wall_ms": self.draw(),
                 "counters": {"camera_nudge_deg": NUDGE_DEG}}
 
+    def behind_camera(self):
+        cam = self.renderer.GetActiveCamera()
+        eye = np.array(cam.GetPosition())
+        forward = np.array(cam.GetDirectionOfProjection())
+        b = self.volume.GetBounds()
+        corners = np.array([[b[i], b[2 + j], b[4 + k]] for i in (0, 1) for j in (0, 1)
+                            for k in (0, 1)])
+        return bool(((corners - eye) @ forward <= 0).all())
+
     def framebuffer(self):
         w, h = self.width, self.height
         data = vtkUnsignedCharArray()
@@ -241,6 +250,11 @@ class Peer:
             raise RuntimeError("image before setup")
         if self.kind != "raycast":
             raise RuntimeError("readout=rays needs the ray cast mapper")
+        w, h = self.width, self.height
+        if self.behind_camera():
+            # VTK's mapper casts no ray at a volume behind the camera (its image size is empty);
+            # its ray functions crash when asked to.
+            return np.zeros((h, w, 4), dtype=np.float32)
         func = self.mapper.GetRayCastFunction()
         integrator = self.mapper.GetRayIntegrator()
         func.Initialize(self.renderer, self.volume)
@@ -249,7 +263,6 @@ class Peer:
         lengths = vtkDoubleArray()
         near = self.scalars.NewInstance()
         far = self.scalars.NewInstance()
-        w, h = self.width, self.height
         out = np.zeros((h, w, 4), dtype=np.float32)
         for j in range(h):
             for i in range(w):
