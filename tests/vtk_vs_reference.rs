@@ -155,3 +155,28 @@ fn vtk_projected_tetrahedra_and_zsweep_see_the_same_scene() {
         }
     }
 }
+
+/// `tetbench external check` on the VTK peers: the projected tetrahedra and the ray caster's
+/// float image pass; the ray caster's displayed image fails only where VTK's texture display
+/// shows, and the check names that (docs/external-renderers.md, "The conformance check").
+#[test]
+fn vtk_peers_pass_the_conformance_check() {
+    let gpu = gpu();
+    let check = |peer: VtkPeer| {
+        let mut peer = peer;
+        let report = external_peer::conformance::check(&mut peer, &gpu, None).unwrap();
+        eprintln!("{report}");
+        report
+    };
+    let pt = check(displayed(VtkMapper::ProjectedTetrahedra));
+    assert!(pt.passed(), "{pt}");
+    let rays = check(exact_ray_caster());
+    assert!(rays.passed(), "{rays}");
+    let shown = check(displayed(VtkMapper::RayCast));
+    for failure in shown.failures() {
+        assert!(
+            failure.message.starts_with("image is scaled by (W−1)/W"),
+            "{failure:?}"
+        );
+    }
+}
