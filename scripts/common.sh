@@ -95,3 +95,14 @@ ensure_vtk_python() {
 tetbench_release_bin() {
     printf '%s/release/tetbench' "${CARGO_TARGET_DIR:-$PWD/target}"
 }
+
+# numpy for the Python example of an external renderer (examples/external/python, and
+# tests/external_renderers.rs), in VTK's virtual environment: pip's vtk normally brings numpy
+# along; installed here when it did not. Exports TETBENCH_VTK_PYTHON (ensure_vtk_python).
+ensure_numpy_python() {
+    ensure_vtk_python || return 1
+    if ! "$TETBENCH_VTK_PYTHON" -c 'import numpy' >/dev/null 2>&1; then
+        echo "tetbench: installing numpy into $("$TETBENCH_VTK_PYTHON" -c 'import sys; print(sys.prefix)')" >&2
+        "$TETBENCH_VTK_PYTHON" -m pip install --quiet --disable-pip-version-check numpy || return 1
+    fi
+}

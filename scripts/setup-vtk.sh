@@ -5,4 +5,5 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/common.sh
 ensure_vtk_python
+ensure_numpy_python
 "$TETBENCH_VTK_PYTHON" -c 'import vtk; print("VTK", vtk.vtkVersion.GetVTKVersion(), "in", __import__("sys").prefix)'

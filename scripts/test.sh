@@ -9,4 +9,6 @@ ensure_prerequisites
 # The outside check of the reference (tests/vtk_vs_reference.rs) needs VTK; when it cannot be
 # installed the test fails with the reason instead of being skipped.
 ensure_vtk_python || echo "tetbench: could not install VTK (see above); tests/vtk_vs_reference.rs will fail" >&2
+# The Python example of an external renderer (tests/external_renderers.rs) needs numpy.
+ensure_numpy_python || echo "tetbench: could not install numpy (see above); tests/external_renderers.rs will fail" >&2
 exec cargo test --workspace "$@"

@@ -2,7 +2,7 @@
 //! with its linear integrator, which like tetbench's reference integrates a linear scalar
 //! through piecewise-linear colour and extinction exactly) against `reference::render`, on SPX
 //! and a generated non-convex mesh at 128², through the `vtk-raycast` peer with the conventions
-//! of `vtk_peer::conventions`.
+//! of `peers/vtk/src/vtk_peer.py` (spoken to over the external renderer protocol).
 //!
 //! The exact comparison reads VTK's per-pixel integration in float (`readout=rays`, early
 //! termination off); VTK's own 8-bit display (`readout=framebuffer`) and its PT and ZSweep
@@ -153,5 +153,30 @@ fn vtk_projected_tetrahedra_and_zsweep_see_the_same_scene() {
         for e in check(mapper.class_name(), &mesh, &cams, || displayed(mapper)) {
             assert!(e.psnr_db >= 45.0, "PSNR {:.2} dB", e.psnr_db);
         }
+    }
+}
+
+/// `tetbench external check` on the VTK peers: the projected tetrahedra and the ray caster's
+/// float image pass; the ray caster's displayed image fails only where VTK's texture display
+/// shows, and the check names that (docs/external-renderers.md, "The conformance check").
+#[test]
+fn vtk_peers_pass_the_conformance_check() {
+    let gpu = gpu();
+    let check = |peer: VtkPeer| {
+        let mut peer = peer;
+        let report = external_peer::conformance::check(&mut peer, &gpu, None).unwrap();
+        eprintln!("{report}");
+        report
+    };
+    let pt = check(displayed(VtkMapper::ProjectedTetrahedra));
+    assert!(pt.passed(), "{pt}");
+    let rays = check(exact_ray_caster());
+    assert!(rays.passed(), "{rays}");
+    let shown = check(displayed(VtkMapper::RayCast));
+    for failure in shown.failures() {
+        assert!(
+            failure.message.starts_with("image is scaled by (W−1)/W"),
+            "{failure:?}"
+        );
     }
 }

@@ -37,9 +37,47 @@ const TABLE: &[(&str, Variants, Variants)] = &[
 /// part of "all algorithms" and are marked as peers in the reports.
 pub const PEERS: &[(&str, &[&str])] = &[("vtk", &["vtk-pt", "vtk-raycast", "vtk-zsweep"])];
 
-/// Whether `name` is a peer (another package's renderer) rather than a tetbench algorithm.
+/// Whether `name` is a peer (another package's renderer, or an external renderer given with
+/// `--external`) rather than a tetbench algorithm.
 pub fn is_peer(name: &str) -> bool {
-    PEERS.iter().any(|(_, names)| names.contains(&name))
+    peer_kind(name).is_some()
+}
+
+/// The kind of peer `name` is: its group in [`PEERS`] (`vtk`), or `external` for a renderer
+/// given with `--external` (or met in results with the `peer=external` setting).
+pub fn peer_kind(name: &str) -> Option<&'static str> {
+    if let Some((group, _)) = PEERS.iter().find(|(_, names)| names.contains(&name)) {
+        return Some(group);
+    }
+    let known = EXTERNAL_NAMES.lock().unwrap_or_else(|p| p.into_inner());
+    known.iter().any(|n| n == name).then_some("external")
+}
+
+/// Names of external renderers this process has met. The name alone is what reports and
+/// charts ask about, so `--external` and results read back register them here.
+static EXTERNAL_NAMES: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+
+/// Registers `name` as an external renderer (a peer of kind `external`).
+pub fn note_external(name: &str) {
+    let mut known = EXTERNAL_NAMES.lock().unwrap_or_else(|p| p.into_inner());
+    if !known.iter().any(|n| n == name) {
+        known.push(name.to_string());
+    }
+}
+
+/// Registers the algorithm of every row whose settings carry the external marker
+/// (`peer=external`), so results read back mark those rows as peers too.
+pub fn note_external_rows<'a>(rows: impl IntoIterator<Item = (&'a str, &'a str)>) {
+    let marker = format!(
+        "{}={}",
+        external_peer::PEER_SETTING.0,
+        external_peer::PEER_SETTING.1
+    );
+    for (algorithm, settings) in rows {
+        if settings.split(';').any(|s| s == marker) {
+            note_external(algorithm);
+        }
+    }
 }
 
 /// The algorithms of a peer group (`vtk`), or an error listing the groups.
@@ -193,6 +231,18 @@ impl std::fmt::Display for SettingsFilter {
 mod tests {
     use super::*;
     use render_core::Setting;
+
+    #[test]
+    fn external_renderers_are_peers_once_met() {
+        assert_eq!(peer_kind("vtk-pt"), Some("vtk"));
+        assert!(!is_peer("mine-from-a-test"));
+        note_external_rows([
+            ("mine-from-a-test", "peer=external;step=1"),
+            ("havs", "k=2"),
+        ]);
+        assert_eq!(peer_kind("mine-from-a-test"), Some("external"));
+        assert!(!is_peer("havs"));
+    }
 
     #[test]
     fn filter_matches_alternatives_and_ignores_foreign_keys() {

@@ -101,6 +101,9 @@ pub enum Command {
     /// Draw comparison charts (speed-error, scaling, resolution, bars, all) from any results,
     /// or run a sweep first (--sweep).
     Plot(crate::plot_cli::PlotArgs),
+    /// Renderers in other processes and languages (docs/external-renderers.md): `check`.
+    #[command(subcommand)]
+    External(crate::external_cmd::ExternalCommand),
 }
 
 #[derive(Debug, Clone, clap::Args)]
@@ -218,6 +221,8 @@ pub struct RunArgs {
     /// VTK's Python package; see scripts/setup-vtk.sh).
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     pub peers: Vec<String>,
+    #[command(flatten)]
+    pub external: crate::external_cmd::ExternalArgs,
 }
 
 impl RunArgs {
@@ -243,6 +248,7 @@ impl RunArgs {
             shard: self.shard.clone(),
             no_calibrate: self.no_calibrate,
             peers: self.peers.clone(),
+            external: self.external.clone(),
         }
     }
 
@@ -403,6 +409,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Plot(args) => crate::plot_cli::run(args, cli.data_dir, command_line),
+        Command::External(cmd) => crate::external_cmd::run(cmd),
     }
 }
 
@@ -462,5 +469,27 @@ mod tests {
         let one = run_algorithms(&["--algorithms", "vtk-pt", "--peers", "vtk"]).unwrap();
         assert_eq!(one, ["vtk-pt", "vtk-raycast", "vtk-zsweep"]);
         assert!(run_algorithms(&["--peers", "nope"]).is_err());
+    }
+
+    #[test]
+    fn external_renderers_join_a_run_as_peers() {
+        let plain = run_algorithms(&[]).unwrap();
+        let with = run_algorithms(&[
+            "--external",
+            "ext-a=python3 r.py",
+            "--external",
+            "ext-a[step=0.5]=python3 r.py",
+            "--external",
+            "ext-b=./b",
+        ])
+        .unwrap();
+        assert_eq!(with.len(), plain.len() + 2);
+        assert!(with.ends_with(&["ext-a".into(), "ext-b".into()]));
+        assert!(algorithms::is_peer("ext-a") && algorithms::is_peer("ext-b"));
+        let only = run_algorithms(&["--algorithms", "ext-b", "--external", "ext-b=./b"]).unwrap();
+        assert_eq!(only, ["ext-b"]);
+        assert!(run_algorithms(&["--external", "havs=./b"]).is_err());
+        assert!(run_algorithms(&["--external", "noequals"]).is_err());
+        assert!(run_algorithms(&["--external", "x=./b", "--external-timeout", "0"]).is_err());
     }
 }

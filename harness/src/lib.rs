@@ -12,6 +12,7 @@ pub mod compare_report;
 pub mod compare_time;
 pub mod datasets_cmd;
 pub mod export;
+pub mod external_cmd;
 pub mod history;
 pub mod html;
 pub mod machine;

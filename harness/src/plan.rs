@@ -45,6 +45,8 @@ pub struct RunPlan {
     pub no_calibrate: bool,
     /// Peer groups as `--peers`.
     pub peers: Vec<String>,
+    /// External renderers as `--external` (docs/external-renderers.md).
+    pub external: crate::external_cmd::ExternalArgs,
 }
 
 impl RunPlan {
@@ -129,6 +131,7 @@ impl RunPlan {
         }
 
         let known = algorithms::names();
+        let externals = self.external.specs()?;
         let mut algorithms: Vec<String> = if self.algorithms.is_empty() {
             // "All" means tetbench's own; peers come with --peers or by name.
             known
@@ -144,7 +147,7 @@ impl RunPlan {
                 .collect()
         };
         for a in &algorithms {
-            if !known.contains(&a.as_str()) {
+            if !known.contains(&a.as_str()) && !externals.iter().any(|s| s.name == *a) {
                 anyhow::bail!(
                     "--algorithms: unknown algorithm {a:?}; known: {}",
                     known.join(", ")
@@ -163,6 +166,11 @@ impl RunPlan {
                 if !algorithms.iter().any(|a| a == name) {
                     algorithms.push(name.to_string());
                 }
+            }
+        }
+        for spec in &externals {
+            if !algorithms.contains(&spec.name) {
+                algorithms.push(spec.name.clone());
             }
         }
         if algorithms.is_empty() {
@@ -204,6 +212,7 @@ impl RunPlan {
             shard: self.shard.as_deref().map(str::parse).transpose()?,
             calibrate: !self.no_calibrate,
             resume: false,
+            externals,
         })
     }
 }

@@ -53,6 +53,9 @@ pub struct PlotArgs {
     /// Sweep: transfer function preset or file.
     #[arg(long, value_name = "NAME|FILE", default_value = "low-opacity")]
     pub tf: String,
+    /// Sweep: external renderers (as `tetbench run --external`).
+    #[command(flatten)]
+    pub external: crate::external_cmd::ExternalArgs,
 }
 
 /// `box:10k,100k,1m` → `box:10k`, `box:100k`, `box:1m`; names and paths are kept as given.
@@ -104,6 +107,7 @@ impl PlotArgs {
             shard: None,
             no_calibrate: false,
             peers: vec![],
+            external: self.external.clone(),
         }
     }
 }

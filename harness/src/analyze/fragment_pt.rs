@@ -339,6 +339,7 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
             shard: None,
             no_calibrate: false,
             peers: vec![],
+            external: Default::default(),
         };
         let config = plan.to_config(
             ctx.data_dir.clone(),

@@ -87,6 +87,12 @@ impl Inputs {
 
     /// Adds one run (its raw JSON, when at hand, for fields this version does not know).
     pub fn add(&mut self, file: &ResultsFile, raw: Option<&serde_json::Value>) {
+        // Rows of external renderers (`peer=external`) are peers in every chart and table.
+        crate::algorithms::note_external_rows(
+            file.rows
+                .iter()
+                .map(|r| (r.algorithm.as_str(), r.settings.as_str())),
+        );
         let adapter = file
             .machine
             .adapter

@@ -51,6 +51,10 @@ pub struct Args {
     /// Reference image cache (as `tetbench run --cache-dir`).
     #[arg(long, value_name = "DIR")]
     pub cache_dir: Option<PathBuf>,
+    /// External renderers measured in every run beside the paper's algorithms (as
+    /// `tetbench run --external`).
+    #[command(flatten)]
+    pub external: crate::external_cmd::ExternalArgs,
 }
 
 /// One paper: what it is, on what it was measured, and how to reproduce it.
@@ -201,6 +205,8 @@ pub struct Session {
     pub machine: Option<MachineInfo>,
     /// The equivalent `tetbench run` command of every run, and its outcome.
     pub log: Vec<String>,
+    /// External renderers added to every run (`--external`).
+    pub external: crate::external_cmd::ExternalArgs,
 }
 
 impl Session {
@@ -276,6 +282,7 @@ impl Session {
             shard: None,
             no_calibrate: false,
             peers: vec![],
+            external: self.external.clone(),
         };
         let command = format!(
             "tetbench run --algorithms {} --datasets {} --viewpoints {viewpoints} --resolution {}{}{}{}",
@@ -375,6 +382,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             resolution: args.resolution,
             machine: None,
             log: vec![],
+            external: args.external.clone(),
         };
         eprintln!("tetbench reproduce: {} ({})", p.id, p.title);
         let report = (p.reproduce)(&mut session)?;

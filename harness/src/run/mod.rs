@@ -71,6 +71,8 @@ pub struct RunConfig {
     /// Keep the finished units of an earlier run of the same plan in `out` and measure only
     /// the rest (`run --resume`, [`resume`]).
     pub resume: bool,
+    /// External renderers (`--external`): each spec is one variant of the algorithm it names.
+    pub externals: Vec<external_peer::ExternalSpec>,
 }
 
 /// Makes the variants of an algorithm by name (normally
@@ -306,6 +308,12 @@ fn check_datasets(config: &RunConfig) -> anyhow::Result<()> {
 /// report into `config.out`.
 pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOutcome> {
     let started = Instant::now();
+    // External renderers are built from the run's own specs, whatever factory the caller gave.
+    let with_externals = |name: &str| match external_variants(config, name) {
+        Some(v) => Ok(v),
+        None => factory(name),
+    };
+    let factory: VariantFactory = &with_externals;
     let plan = plan_variants(config, factory)?;
     check_datasets(config)?;
     let variants_total: usize = plan.iter().map(|(_, n)| n).sum();
@@ -486,6 +494,18 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     }
     outcome.seconds = started.elapsed().as_secs_f64();
     Ok(outcome)
+}
+
+/// The variants of an external renderer named `name` (one per `--external` spec with that
+/// name), or `None` when `name` is not one.
+fn external_variants(config: &RunConfig, name: &str) -> Option<Vec<Box<dyn Renderer>>> {
+    let v: Vec<Box<dyn Renderer>> = config
+        .externals
+        .iter()
+        .filter(|s| s.name == name)
+        .map(|s| Box::new(external_peer::ExternalRenderer::new(s.clone())) as Box<dyn Renderer>)
+        .collect();
+    (!v.is_empty()).then_some(v)
 }
 
 /// Every (data set, algorithm, settings) of the run, for `--shard`.

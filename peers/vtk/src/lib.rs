@@ -1,7 +1,10 @@
 //! VTK's unstructured-grid volume mappers as peers of tetbench's algorithms: the same mesh
 //! (handed over as a `.vtu` written by [`datasets::write_vtu`]), camera, viewport and transfer
-//! function, rendered offscreen by VTK through its Python package in one persistent process
-//! per renderer ([`process`], the script `vtk_peer.py`).
+//! function, rendered offscreen by VTK through its Python package. Each is a configuration of
+//! the external renderer client ([`external_peer::ExternalRenderer`]): the script
+//! `vtk_peer.py` speaks the external renderer protocol (`docs/external-renderers.md`), so there
+//! is one out-of-process mechanism, not two; the mapping of tetbench's conventions onto VTK's
+//! lives in the script's header.
 //!
 //! Three algorithms, HAVS Table 5's classes (Callahan et al. 2005, §6):
 //! * `vtk-pt` — `vtkProjectedTetrahedraMapper` (Shirley–Tuchman projected tetrahedra, cell
@@ -10,26 +13,22 @@
 //!   integrator as a setting;
 //! * `vtk-zsweep` — `vtkUnstructuredGridVolumeZSweepMapper` (Farias et al. ZSweep).
 //!
-//! Every timed frame is a full re-render: the camera is turned about the up axis by
-//! ±[`NUDGE_DEG`] on alternate frames, so no mapper can reuse a sort or a projection; the
-//! counters say so (`camera_nudge_deg`). The image is read after one more render at the exact
-//! camera. VTK reports no GPU memory, so peer rows have 0 persistent bytes and no GPU time.
+//! Every timed frame is a full re-render: the script turns the camera about the up axis by
+//! ±0.01° on alternate frames, so no mapper can reuse a sort or a projection; the counters say
+//! so (`camera_nudge_deg`). The image is read after one more render at the exact camera. VTK
+//! reports no GPU memory, so peer rows have 0 persistent bytes and no GPU time.
 
-pub mod conventions;
 pub mod process;
 
-use std::time::Instant;
+use std::time::Duration;
 
-use anyhow::{anyhow, Context};
+use anyhow::Context;
 use datasets::TetMesh;
+use external_peer::{ExternalRenderer, ExternalSpec};
 use render_core::{Camera, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting};
-use serde_json::json;
 
-use conventions::{camera_request, vtk_transfer, PixelSampling};
-use process::PeerProcess;
-
-/// The camera turn (degrees, about the up axis) between consecutive timed frames.
-pub const NUDGE_DEG: f64 = 0.01;
+/// How long one exchange with VTK may take: its float readout walks every pixel in Python.
+pub const TIMEOUT: Duration = Duration::from_secs(600);
 
 /// Which VTK mapper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -120,49 +119,48 @@ pub struct VtkPeer {
     /// Early ray termination of the float readout (`readout=rays`); VTK's mapper always stops
     /// a ray at α ≥ 0.99, checked after each batch of intersections.
     early_termination: bool,
-    process: Option<PeerProcess>,
-    /// The `.vtu` handed to VTK.
-    mesh_dir: Option<tempfile::TempDir>,
-    frame: u64,
-    last_camera: Option<Camera>,
+    client: ExternalRenderer,
 }
 
 impl VtkPeer {
     pub fn new(mapper: VtkMapper, integrator: Integrator, readout: Readout, et: bool) -> VtkPeer {
+        let settings = [
+            ("mapper", mapper.protocol_name()),
+            ("integrator", integrator.name()),
+            ("readout", readout.name()),
+            ("et", if et { "on" } else { "off" }),
+        ];
+        let python = process::python_interpreter();
+        let spec = ExternalSpec {
+            name: mapper.algorithm().to_string(),
+            // The script is embedded and handed over as `-c`, so the binary needs nothing
+            // beside it but Python with `vtk`.
+            argv: vec![
+                python.to_string_lossy().into_owned(),
+                "-u".into(),
+                "-c".into(),
+                process::SCRIPT.into(),
+            ],
+            settings: settings
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect(),
+            env: vec![],
+            timeout: TIMEOUT,
+            mark_external: false,
+        };
         VtkPeer {
             mapper,
             integrator,
             readout,
             early_termination: et,
-            process: None,
-            mesh_dir: None,
-            frame: 0,
-            last_camera: None,
+            client: ExternalRenderer::new(spec),
         }
-    }
-
-    fn sampling(&self) -> PixelSampling {
-        match self.mapper {
-            VtkMapper::RayCast => PixelSampling::Corners,
-            _ => PixelSampling::Centres,
-        }
-    }
-
-    fn process(&mut self) -> anyhow::Result<&mut PeerProcess> {
-        self.process
-            .as_mut()
-            .ok_or_else(|| anyhow!("VTK peer: render before prepare"))
     }
 
     /// The VTK and Python versions the running script reported.
     pub fn versions(&self) -> Option<String> {
-        self.process.as_ref().map(|p| {
-            format!(
-                "VTK {} on Python {}",
-                p.hello["vtk_version"].as_str().unwrap_or("?"),
-                p.hello["python"].as_str().unwrap_or("?")
-            )
-        })
+        self.client.hello().map(|h| h.version.clone())
     }
 }
 
@@ -250,120 +248,21 @@ impl Renderer for VtkPeer {
     }
 
     fn prepare(&mut self, _gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
-        if self.process.is_none() {
-            self.process = Some(PeerProcess::start()?);
-        }
-        let dir = tempfile::Builder::new()
-            .prefix("tetbench-vtk-mesh-")
-            .tempdir()
-            .context("cannot create a temporary directory for the .vtu")?;
-        let vtu = dir.path().join("mesh.vtu");
-        datasets::write_vtu::write_vtu(mesh, &vtu).map_err(|e| anyhow!("{e}"))?;
-        let tf = vtk_transfer(optics);
-        // A camera is needed before the first render; the real one comes with each frame.
-        let request = json!({
-            "cmd": "setup",
-            "vtu": vtu,
-            "mapper": self.mapper.protocol_name(),
-            "integrator": self.integrator.name(),
-            "points": tf.points,
-            "unit_distance": tf.unit_distance,
-            "width": 64,
-            "height": 64,
-        });
-        let answer = self.process()?.request(&request).with_context(|| {
+        self.client.prepare_mesh(mesh, optics).with_context(|| {
             format!(
-                "VTK peer {} could not set up the mesh",
-                self.mapper.class_name()
+                "VTK peer {} under {} could not set up the mesh; if VTK is missing: {}",
+                self.mapper.class_name(),
+                process::python_interpreter().display(),
+                process::INSTALL_HINT
             )
-        })?;
-        let cells = answer["cells"].as_u64().unwrap_or(0);
-        if cells != mesh.num_tets() as u64 {
-            anyhow::bail!(
-                "VTK read {cells} cells from {}, tetbench wrote {}",
-                vtu.display(),
-                mesh.num_tets()
-            );
-        }
-        self.mesh_dir = Some(dir);
-        self.frame = 0;
-        Ok(Prepared {
-            persistent_bytes: 0,
-            tets: mesh.num_tets() as u64,
         })
     }
 
     fn render(&mut self, _gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
-        self.frame += 1;
-        let nudge = if self.frame.is_multiple_of(2) {
-            NUDGE_DEG
-        } else {
-            -NUDGE_DEG
-        };
-        let request = json!({
-            "cmd": "render",
-            "size": [camera.width, camera.height],
-            "camera": camera_request(camera, self.sampling()),
-            "nudge_deg": nudge,
-        });
-        let t0 = Instant::now();
-        let answer = self.process()?.request(&request)?;
-        let total_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let vtk_ms = answer["ms"].as_f64().unwrap_or(f64::NAN);
-        self.last_camera = Some(camera.clone());
-        Ok(FrameStats {
-            // tetbench's own host work in the frame: the request and answer on the pipe.
-            cpu_ms: (total_ms - vtk_ms).max(0.0),
-            gpu_ms: None,
-            total_ms,
-            frame_bytes: 0,
-            stages: vec![("vtk_render".into(), vtk_ms)],
-            counters: vec![("camera_nudge_deg".into(), NUDGE_DEG)],
-        })
+        self.client.render_camera(camera)
     }
 
     fn read_image(&mut self, _gpu: &Gpu) -> anyhow::Result<Image> {
-        let camera = self
-            .last_camera
-            .clone()
-            .ok_or_else(|| anyhow!("VTK peer: read_image before render"))?;
-        let path = self
-            .mesh_dir
-            .as_ref()
-            .ok_or_else(|| anyhow!("VTK peer: read_image before prepare"))?
-            .path()
-            .join("image.f32");
-        let request = json!({
-            "cmd": "image",
-            "size": [camera.width, camera.height],
-            "camera": camera_request(&camera, self.sampling()),
-            "readout": self.readout.name(),
-            "early_termination": self.early_termination,
-            "path": path,
-        });
-        self.process()?.request(&request)?;
-        let bytes =
-            std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
-        let n = (camera.width * camera.height) as usize;
-        if bytes.len() != n * 16 {
-            anyhow::bail!(
-                "VTK peer image {} has {} bytes, expected {}",
-                path.display(),
-                bytes.len(),
-                n * 16
-            );
-        }
-        let pixels = bytes
-            .chunks_exact(16)
-            .map(|p| {
-                let f = |i: usize| f32::from_le_bytes([p[i], p[i + 1], p[i + 2], p[i + 3]]);
-                [f(0), f(4), f(8), f(12)]
-            })
-            .collect();
-        Ok(Image {
-            width: camera.width,
-            height: camera.height,
-            pixels,
-        })
+        self.client.read_last_image()
     }
 }

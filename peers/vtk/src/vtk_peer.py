@@ -1,24 +1,42 @@
 """tetbench's VTK peer: renders a .vtu with one of VTK's unstructured-grid volume mappers,
-offscreen, driven by tetbench over stdin/stdout (one JSON object per line each way).
+offscreen, as an external renderer speaking tetbench's protocol version 1
+(docs/external-renderers.md): one JSON object per line on stdin, one reply line on stdout.
 
-Requests (each answered by one line, {"ok": true, ...} or {"ok": false, "error": "..."}):
-  setup   mesh, mapper (pt | raycast | zsweep), integrator, size, transfer function points
-  render  one frame with the given camera; answers the wall ms of that frame
-  image   re-renders the exact camera and writes the image (f32 RGBA, premultiplied, linear,
-          row 0 at the top) to a file: from the framebuffer, or (ray caster only) from VTK's
-          own traversal and integrator per pixel, before VTK's 8-bit image and its display
-  quit
+Settings (hello): mapper (pt | raycast | zsweep), integrator (linear | partial-preintegration |
+preintegration), readout (framebuffer | rays: the ray caster's own per-pixel integration in
+float, before VTK's 8-bit image and its display), et (on | off: early ray termination of the
+rays readout).
+
+How tetbench's scene maps onto VTK's (the conventions the outside check needed):
+* Extinction: tetbench's kappa(s) is per unit of the bounding-box diagonal (optics.length_unit);
+  VTK attenuates by opacity / ScalarOpacityUnitDistance per world unit. With K = max kappa,
+  opacity = kappa / K and unit distance = length_unit / K attenuate alike, opacities in [0, 1].
+* Control points: VTK's linear and partial pre-integration integrators split a segment only at
+  the opacity function's points, so colour and opacity use the protocol's shared points
+  (optics.points), each carrying both values; between them both functions are linear.
+* Colour: RGB interpolation over the raw scalar x = scalar_min + s (scalar_max - scalar_min).
+* Camera: same eye, focal point, up, vertical view angle (or parallel scale) and clipping range.
+  VTK's ray caster samples pixel X at NDC 2X/W - 1, half a pixel off the protocol's pixel
+  centres; a window centre of (1/W, 1/H) moves its rays onto the centres.
+* Every timed frame is a full re-render: the camera turns about the up axis by +-NUDGE_DEG on
+  alternate frames so no mapper reuses a sort (counter camera_nudge_deg); read_image renders
+  once more at the exact camera.
 
 stdout carries only the protocol; VTK's own messages go to stderr.
 """
 
 import json
+import os
 import sys
 import time
 
 PROTOCOL_OUT = sys.stdout
 # Anything a library prints must not corrupt the protocol.
 sys.stdout = sys.stderr
+# Offscreen through EGL (Mesa's llvmpipe without a GPU): no X display needed.
+os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+
+NUDGE_DEG = 0.01
 
 
 def reply(obj):
@@ -51,7 +69,10 @@ try:
         vtkUnstructuredGridVolumeZSweepMapper,
     )
 except Exception as e:  # noqa: BLE001  (any import failure means: no usable VTK)
-    reply({"ok": False, "error": f"cannot import VTK in {sys.executable}: {e}"})
+    print(f"cannot import VTK in {sys.executable}: {e}", file=sys.stderr)
+    # Answer the hello with the reason, so tetbench can say it.
+    sys.stdin.readline()
+    reply({"type": "error", "message": f"cannot import VTK in {sys.executable}: {e}"})
     sys.exit(1)
 
 vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
@@ -61,54 +82,81 @@ INTEGRATORS = {
     "partial-preintegration": vtkUnstructuredGridPartialPreIntegration,
     "preintegration": vtkUnstructuredGridPreIntegration,
 }
+DEFAULTS = {"mapper": "raycast", "integrator": "linear", "readout": "framebuffer", "et": "on"}
+CHOICES = {"mapper": ["pt", "raycast", "zsweep"], "integrator": list(INTEGRATORS),
+           "readout": ["framebuffer", "rays"], "et": ["on", "off"]}
 
 
 class Peer:
     def __init__(self):
         self.window = None
+        self.settings = dict(DEFAULTS)
 
-    def setup(self, req):
+    def hello(self, req):
+        if req.get("protocol") != 1:
+            raise RuntimeError(f"this peer speaks protocol 1, not {req.get('protocol')}")
+        for key, value in (req.get("settings") or {}).items():
+            if key not in CHOICES:
+                raise RuntimeError(f"unknown setting {key!r}; known: {', '.join(CHOICES)}")
+            if value not in CHOICES[key]:
+                raise RuntimeError(f"{key}={value!r}: one of {', '.join(CHOICES[key])}")
+            self.settings[key] = value
+        if self.settings["readout"] == "rays" and self.settings["mapper"] != "raycast":
+            raise RuntimeError("readout=rays needs mapper=raycast")
+        return {"type": "hello", "protocol": 1, "name": f"vtk-{self.settings['mapper']}",
+                "version": f"VTK {vtkVersion.GetVTKVersion()} on Python {sys.version.split()[0]}",
+                "settings": self.settings,
+                "capabilities": {"projections": ["perspective", "orthographic"],
+                                 "mesh_formats": ["vtu"]}}
+
+    def prepare(self, req):
+        vtu = req["mesh"]["vtu"]
         reader = vtkXMLUnstructuredGridReader()
-        reader.SetFileName(req["vtu"])
+        reader.SetFileName(vtu)
         reader.Update()
         grid = reader.GetOutput()
         if grid.GetNumberOfCells() == 0:
-            raise RuntimeError(f"VTK read no cells from {req['vtu']}")
+            raise RuntimeError(f"VTK read no cells from {vtu}")
         scalars = grid.GetPointData().GetScalars()
         if scalars is None:
-            raise RuntimeError(f"{req['vtu']} has no point scalars")
+            raise RuntimeError(f"{vtu} has no point scalars")
         self.grid, self.scalars = grid, scalars
 
+        optics = req["optics"]
+        points = optics["points"]
+        k_max = max(p[4] for p in points)
+        k_max = k_max if k_max > 0 else 1.0
+        lo, hi = optics["scalar_min"], optics["scalar_max"]
         colour = vtkColorTransferFunction()
         # tetbench interpolates colour linearly in RGB (exact integration needs it).
         colour.SetColorSpaceToRGB()
         colour.ClampingOn()
         opacity = vtkPiecewiseFunction()
         opacity.ClampingOn()
-        for x, r, g, b, o in req["points"]:
+        for s, r, g, b, kappa in points:
+            x = lo + s * (hi - lo)
             colour.AddRGBPoint(x, r, g, b)
-            opacity.AddPoint(x, o)
+            opacity.AddPoint(x, kappa / k_max)
         prop = vtkVolumeProperty()
         prop.SetColor(colour)
         prop.SetScalarOpacity(opacity)
-        prop.SetScalarOpacityUnitDistance(req["unit_distance"])
+        prop.SetScalarOpacityUnitDistance(optics["length_unit"] / k_max)
         prop.SetInterpolationTypeToLinear()
         prop.ShadeOff()
 
-        kind = req["mapper"]
+        kind = self.settings["mapper"]
+        integrator = INTEGRATORS[self.settings["integrator"]]
         if kind == "pt":
             mapper = vtkProjectedTetrahedraMapper()
         elif kind == "zsweep":
             mapper = vtkUnstructuredGridVolumeZSweepMapper()
-            mapper.SetRayIntegrator(INTEGRATORS[req.get("integrator") or "linear"]())
-        elif kind == "raycast":
+            mapper.SetRayIntegrator(integrator())
+        else:
             mapper = vtkUnstructuredGridVolumeRayCastMapper()
-            mapper.SetRayIntegrator(INTEGRATORS[req["integrator"]]())
+            mapper.SetRayIntegrator(integrator())
             # One ray per pixel, always (VTK would otherwise coarsen to meet a frame rate).
             mapper.AutoAdjustSampleDistancesOff()
             mapper.SetImageSampleDistance(1.0)
-        else:
-            raise RuntimeError(f"unknown mapper {kind!r}")
         mapper.SetInputData(grid)
         self.mapper, self.kind = mapper, kind
 
@@ -117,6 +165,8 @@ class Peer:
         volume.SetProperty(prop)
         self.volume = volume
 
+        if self.window is not None:
+            self.window.Finalize()
         renderer = vtkRenderer()
         renderer.SetBackground(0.0, 0.0, 0.0)
         renderer.SetBackgroundAlpha(0.0)
@@ -126,37 +176,41 @@ class Peer:
         window.SetAlphaBitPlanes(1)
         window.SetMultiSamples(0)
         window.AddRenderer(renderer)
-        window.SetSize(req["width"], req["height"])
+        window.SetSize(64, 64)
         self.renderer, self.window = renderer, window
-        self.width, self.height = req["width"], req["height"]
+        self.width, self.height = 64, 64
         window.Render()
         caps = window.ReportCapabilities() or ""
         gl = next((line.split(":", 1)[1].strip() for line in caps.splitlines()
                    if line.startswith("OpenGL renderer string")), "")
-        return {
-            "cells": grid.GetNumberOfCells(),
-            "points": grid.GetNumberOfPoints(),
-            "vtk_version": vtkVersion.GetVTKVersion(),
-            "window": window.GetClassName(),
-            "gl_renderer": gl,
-        }
+        print(f"vtk peer: {kind} on {window.GetClassName()} ({gl}), "
+              f"{grid.GetNumberOfCells()} cells", file=sys.stderr)
+        return {"type": "prepared", "tets": grid.GetNumberOfCells(), "persistent_bytes": 0}
 
-    def set_camera(self, req, nudge_deg=0.0):
-        cam = self.renderer.GetActiveCamera()
-        cam.SetPosition(*req["eye"])
-        cam.SetFocalPoint(*req["focal"])
-        cam.SetViewUp(*req["up"])
-        if req.get("parallel_scale") is not None:
-            cam.ParallelProjectionOn()
-            cam.SetParallelScale(req["parallel_scale"])
+    def set_camera(self, cam, nudge_deg=0.0):
+        w, h = int(cam["width"]), int(cam["height"])
+        if (w, h) != (self.width, self.height):
+            self.window.SetSize(w, h)
+            self.width, self.height = w, h
+        vc = self.renderer.GetActiveCamera()
+        vc.SetPosition(*cam["eye"])
+        vc.SetFocalPoint(*cam["target"])
+        vc.SetViewUp(*cam["up"])
+        if cam["projection"] == "orthographic":
+            vc.ParallelProjectionOn()
+            vc.SetParallelScale(cam["ortho_half_height"])
         else:
-            cam.ParallelProjectionOff()
-            cam.SetViewAngle(req["view_angle"])
-        cam.SetWindowCenter(*req["window_center"])
+            vc.ParallelProjectionOff()
+            vc.SetViewAngle(cam["fovy_deg"])
+        # The ray caster samples pixel corners; this moves its rays onto the pixel centres.
+        if self.kind == "raycast":
+            vc.SetWindowCenter(1.0 / w, 1.0 / h)
+        else:
+            vc.SetWindowCenter(0.0, 0.0)
         if nudge_deg:
-            cam.Azimuth(nudge_deg)
-            cam.OrthogonalizeViewUp()
-        cam.SetClippingRange(req["near"], req["far"])
+            vc.Azimuth(nudge_deg)
+            vc.OrthogonalizeViewUp()
+        vc.SetClippingRange(cam["near"], cam["far"])
 
     def draw(self):
         t0 = time.perf_counter()
@@ -164,16 +218,23 @@ class Peer:
         self.window.WaitForCompletion()
         return (time.perf_counter() - t0) * 1e3
 
-    def resize(self, size):
-        w, h = int(size[0]), int(size[1])
-        if (w, h) != (self.width, self.height):
-            self.window.SetSize(w, h)
-            self.width, self.height = w, h
-
     def render(self, req):
-        self.resize(req["size"])
-        self.set_camera(req["camera"], req.get("nudge_deg", 0.0))
-        return {"ms": self.draw()}
+        if self.window is None:
+            raise RuntimeError("render before prepare")
+        nudge = NUDGE_DEG if req.get("frame", 0) % 2 == 0 else -NUDGE_DEG
+        self.camera = req["camera"]
+        self.set_camera(self.camera, nudge)
+        return {"type": "rendered", "wall_ms": self.draw(),
+                "counters": {"camera_nudge_deg": NUDGE_DEG}}
+
+    def behind_camera(self):
+        cam = self.renderer.GetActiveCamera()
+        eye = np.array(cam.GetPosition())
+        forward = np.array(cam.GetDirectionOfProjection())
+        b = self.volume.GetBounds()
+        corners = np.array([[b[i], b[2 + j], b[4 + k]] for i in (0, 1) for j in (0, 1)
+                            for k in (0, 1)])
+        return bool(((corners - eye) @ forward <= 0).all())
 
     def framebuffer(self):
         w, h = self.width, self.height
@@ -189,6 +250,11 @@ class Peer:
             raise RuntimeError("image before setup")
         if self.kind != "raycast":
             raise RuntimeError("readout=rays needs the ray cast mapper")
+        w, h = self.width, self.height
+        if self.behind_camera():
+            # VTK's mapper casts no ray at a volume behind the camera (its image size is empty);
+            # its ray functions crash when asked to.
+            return np.zeros((h, w, 4), dtype=np.float32)
         func = self.mapper.GetRayCastFunction()
         integrator = self.mapper.GetRayIntegrator()
         func.Initialize(self.renderer, self.volume)
@@ -197,7 +263,6 @@ class Peer:
         lengths = vtkDoubleArray()
         near = self.scalars.NewInstance()
         far = self.scalars.NewInstance()
-        w, h = self.width, self.height
         out = np.zeros((h, w, 4), dtype=np.float32)
         for j in range(h):
             for i in range(w):
@@ -215,41 +280,40 @@ class Peer:
         func.Finalize()
         return out
 
-    def image(self, req):
-        self.resize(req["size"])
-        self.set_camera(req["camera"])
+    def read_image(self, req):
+        if self.window is None:
+            raise RuntimeError("read_image before render")
+        self.set_camera(self.camera)
         self.draw()
-        t0 = time.perf_counter()
-        if req["readout"] == "rays":
-            img = self.rays(req.get("early_termination", True))
+        if self.settings["readout"] == "rays":
+            img = self.rays(self.settings["et"] == "on")
         else:
             img = self.framebuffer()
         np.ascontiguousarray(img, dtype="<f4").tofile(req["path"])
-        return {"ms": (time.perf_counter() - t0) * 1e3}
+        return {"type": "image"}
 
 
 def main():
     vtkObject.GlobalWarningDisplayOn()
     peer = Peer()
-    reply({"ok": True, "vtk_version": vtkVersion.GetVTKVersion(), "python": sys.version.split()[0]})
+    handlers = {"hello": peer.hello, "prepare": peer.prepare, "render": peer.render,
+                "read_image": peer.read_image}
     for line in sys.stdin:
         line = line.strip()
         if not line:
             continue
         try:
             req = json.loads(line)
-            cmd = req.get("cmd")
-            if cmd == "quit":
-                reply({"ok": True})
+            kind = req.get("type")
+            if kind == "shutdown":
+                reply({"type": "bye"})
                 break
-            handler = {"setup": peer.setup, "render": peer.render, "image": peer.image}.get(cmd)
+            handler = handlers.get(kind)
             if handler is None:
-                raise RuntimeError(f"unknown request {cmd!r}")
-            answer = handler(req)
-            answer["ok"] = True
-            reply(answer)
+                raise RuntimeError(f"unknown request {kind!r}")
+            reply(handler(req))
         except Exception as e:  # noqa: BLE001  (reported to tetbench, which fails the row)
-            reply({"ok": False, "error": f"{type(e).__name__}: {e}"})
+            reply({"type": "error", "message": f"{type(e).__name__}: {e}"})
 
 
 if __name__ == "__main__":
