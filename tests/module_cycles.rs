@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::process::Command;
 
-const CRATES: [&str; 10] = [
+const CRATES: [&str; 11] = [
     "datasets/src",
     "renderers/core/src",
     "renderers/reference/src",
@@ -16,6 +16,7 @@ const CRATES: [&str; 10] = [
     "renderers/raycast/src",
     "renderers/splat/src",
     "peers/vtk/src",
+    "peers/external/src",
     "harness/src",
 ];
 
