@@ -147,7 +147,7 @@ fn gator_sizes_fail_when_a_tet_is_lost() {
     let ok = evaluate_claims("gator", &m, &sizes(187_395));
     assert_eq!(verdict_of(&ok, "G2", Some("bluntfin")), Verdict::Holds);
     assert_eq!(verdict_of(&ok, "G3", Some("post")), Verdict::Holds);
-    let lost = evaluate_claims("gator", &m, &sizes(187_394));
+    let lost = evaluate_claims("gator", &m, &sizes(187_317));
     assert_eq!(
         verdict_of(&lost, "G2", Some("bluntfin")),
         Verdict::DoesNotHold

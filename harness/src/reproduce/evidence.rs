@@ -121,6 +121,19 @@ fn analysis_side(
                 .ok_or_else(|| format!("data set {d}: not loaded"))?;
             match metric {
                 "dataset_tets" => exact(format!("{d} as loaded, tets"), &d, *tets as f64),
+                // The split's own count: what we load plus the zero-volume tets we drop.
+                "dataset_tets_split" => {
+                    let dropped = x
+                        .dropped
+                        .iter()
+                        .find(|(n, _)| *n == d)
+                        .map_or(0, |(_, n)| *n);
+                    exact(
+                        format!("{d}: {tets} tets loaded + {dropped} of zero volume dropped"),
+                        &d,
+                        (*tets + dropped) as f64,
+                    )
+                }
                 "dataset_vertices" => exact(format!("{d} as loaded, vertices"), &d, *points as f64),
                 _ => Err(format!("dataset has no metric {metric}")),
             }

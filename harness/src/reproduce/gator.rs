@@ -151,11 +151,15 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
     let registry = datasets::registry::Registry::new(s.data_dir.clone());
     for (_, d) in DATASETS {
         match registry.resolve(&s.dataset(d), &datasets::LoadOptions::default()) {
-            Ok(ds) => x.sizes.push((
-                d.to_string(),
-                ds.mesh.num_points() as u64,
-                ds.mesh.num_tets() as u64,
-            )),
+            Ok(ds) => {
+                x.sizes.push((
+                    d.to_string(),
+                    ds.mesh.num_points() as u64,
+                    ds.mesh.num_tets() as u64,
+                ));
+                x.dropped
+                    .push((d.to_string(), ds.mesh.repair.degenerate_dropped as u64));
+            }
             Err(e) => m
                 .errors
                 .push(format!("data set \"{d}\" could not be loaded: {e}")),

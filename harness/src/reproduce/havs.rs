@@ -206,7 +206,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         key: "table2".into(),
         title: "Table 2 — k-buffer analysis (exact A-buffer, maxima over the viewpoints)".into(),
         conditions: format!(
-            "Paper: software A-buffer, 512², maximum over 14 viewpoints. Ours: the CPU model of `tetbench analyze kbuffer`, {}², over {} viewpoint(s). Counts are geometric (no GPU); they match only on the same mesh, camera, viewport and face order.",
+            "Paper: software A-buffer, 512², maximum over 14 viewpoints. Ours: the CPU model of `tetbench analyze kbuffer`, {}², over {} viewpoint(s). Counts are geometric (no GPU); they can equal the paper's only on the same mesh, camera, viewport, rasterisation rule and face order, so the cells are compared exactly here and claims H3–H5 compare spx2 (the paper's own mesh) within a stated tolerance.",
             x.kbuffer_resolution, x.kbuffer_views
         ),
         metrics: cols.iter().map(|(_, n)| Metric::exact(*n, 0)).collect(),

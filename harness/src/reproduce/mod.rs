@@ -763,6 +763,8 @@ pub struct Extra {
     pub truth_table: Option<Vec<gator::ObservedCase>>,
     /// Data set sizes: (plan name, points, tets).
     pub sizes: Vec<(String, u64, u64)>,
+    /// Zero-volume tets the loader dropped, per data set (plan name, count).
+    pub dropped: Vec<(String, u64)>,
     /// How many viewpoints and what viewport the k analysis used.
     pub kbuffer_views: usize,
     pub kbuffer_resolution: u32,
