@@ -29,6 +29,15 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// `tetbench analyze`: the CPU analyses and summaries, and one subcommand per paper.
+#[derive(Debug, Subcommand)]
+pub enum AnalyzeAny {
+    #[command(flatten)]
+    Tool(AnalyzeCommand),
+    #[command(flatten)]
+    Paper(crate::reproduce::from_run::PaperAnalysis),
+}
+
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Measure algorithms over data sets and viewpoints; write results.csv, results.json,
@@ -37,9 +46,11 @@ pub enum Command {
     /// Inspect, list and convert data sets.
     #[command(subcommand)]
     Datasets(DatasetsCommand),
-    /// Analyses that reproduce the papers' tables.
+    /// Analyses that reproduce the papers' tables: `analyze PAPER RUN_DIR` writes a paper's
+    /// tables and claims from finished runs (the same code as `reproduce`); the others are the
+    /// CPU analyses and summaries.
     #[command(subcommand)]
-    Analyze(AnalyzeCommand),
+    Analyze(AnalyzeAny),
     /// Reproduce a paper's tables with one command: runs what they need, then writes
     /// OUT/<paper>/report.md and report.html with the paper's values beside ours.
     Reproduce(crate::reproduce::Args),
@@ -338,12 +349,13 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Datasets(cmd) => datasets_cmd::run(cmd, cli.data_dir),
-        Command::Analyze(cmd) => analyze::run(
+        Command::Analyze(AnalyzeAny::Tool(cmd)) => analyze::run(
             cmd,
             &analyze::Context {
                 data_dir: cli.data_dir,
             },
         ),
+        Command::Analyze(AnalyzeAny::Paper(cmd)) => crate::reproduce::from_run::run(cmd),
         Command::Reproduce(args) => crate::reproduce::run(args, cli.data_dir),
         Command::Report {
             dir,

@@ -1,16 +1,14 @@
 //! Reproductions of Marroquim, Maximo, Farias and Esperança (2006), "GPU-based cell projection
 //! for interactive volume rendering":
 //!
-//! * `tetbench analyze fragment-pt OUT` — Table 1 (fps and K tets/s per data set for fragment
-//!   PT) and Table 2 (fragment PT beside GATOR and every other algorithm of the same run) from a
-//!   finished run's `results.json`, as Markdown (`OUT/fragment_pt_tables.md`);
 //! * `tetbench analyze resolution …` — Fig. 8: average K tets/s against viewport size (256²,
 //!   512², 768², 1024² by default), one `tetbench run` per size (timing only), plotted as
 //!   `fig8.png` / `fig8.svg` with `fig8.md` and `fig8.csv`.
 //!
 //! The paper's figures come from its transcribed tables (`reports/papers/fragment-pt_table*.csv`,
 //! provenance in `reports/papers/fragment-pt.md`); Fig. 8 is a plot whose numbers the text does
-//! not give. `tetbench reproduce fragment-pt` runs the paper's own data sets.
+//! not give. Tables 1–2 are `tetbench reproduce fragment-pt` (or `tetbench analyze fragment-pt
+//! RUN_DIR` for finished runs), written once, in `reproduce/fragment_pt.rs`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -20,210 +18,14 @@ use anyhow::{anyhow, Context as _};
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
-use crate::report::{aggregate, Aggregate};
+use crate::report::aggregate;
 use crate::results::{ResultsFile, Row};
-
-/// The data sets of the paper's Table 1, in its order (names as the registry knows them).
-pub const TABLE1_DATASETS: [&str; 4] = ["spx", "bluntfin", "comb", "post"];
-
-/// The paper's Table 1 (fps, K tets/s) for a registry data set, if the paper has it.
-fn paper_table1(dataset: &str) -> Option<(Option<f64>, Option<f64>)> {
-    let name = crate::papers::paper_name("fragment-pt", dataset)?;
-    let t = crate::papers::table("fragment-pt_table1").ok()?;
-    Some((
-        t.value(name, "fps"),
-        t.value(name, "tets_per_sec").map(|v| v / 1e3),
-    ))
-}
-
-/// The paper's Table 2 fps on Blunt and Post for one of its rows.
-fn paper_table2(row: &str) -> Option<(f64, f64)> {
-    let t = crate::papers::table("fragment-pt_table2").ok()?;
-    Some((t.value(row, "blunt_fps")?, t.value(row, "post_fps")?))
-}
-
-/// The paper's headline rate (abstract): "over 2.0 M Tets/s".
-pub const PAPER_PEAK_K_TETS_PER_SEC: f64 = 2000.0;
-/// The paper's model size (§3.1): about 20 bytes per tet (tet indices + vertices).
-pub const PAPER_BYTES_PER_TET: f64 = 20.0;
 
 fn fmt_opt(v: Option<f64>, digits: usize) -> String {
     match v {
         Some(x) if x.is_finite() => format!("{x:.digits$}"),
         _ => "–".to_string(),
     }
-}
-
-/// The `model_bytes_per_tet` counter fragment PT records (tet indices + vertices only).
-fn model_bytes_per_tet(rows: &[Row], a: &Aggregate) -> Option<f64> {
-    rows.iter()
-        .filter(|r| {
-            r.algorithm == a.algorithm && r.settings == a.settings && r.dataset == a.dataset
-        })
-        .find_map(|r| r.counter("model_bytes_per_tet"))
-}
-
-/// Orders data sets as the paper's Table 1, then any others in order of appearance.
-fn dataset_order(aggs: &[Aggregate]) -> Vec<String> {
-    let mut names: Vec<String> = vec![];
-    for d in TABLE1_DATASETS {
-        if aggs.iter().any(|a| a.dataset == d) {
-            names.push(d.to_string());
-        }
-    }
-    for a in aggs {
-        if !names.contains(&a.dataset) {
-            names.push(a.dataset.clone());
-        }
-    }
-    names
-}
-
-/// Table 1 (fragment PT: fps and K tets/s per data set and variant) and Table 2 (every
-/// algorithm of the run, same machine) as Markdown, from the rows of one run.
-pub fn tables_markdown(file: &ResultsFile) -> String {
-    let rows = &file.rows;
-    let aggs = aggregate(rows);
-    let adapter = file
-        .machine
-        .adapter
-        .as_ref()
-        .map(|a| format!("{} ({}, {})", a.name, a.backend, a.device_type))
-        .unwrap_or_else(|| "unknown adapter".into());
-    let mut md = String::new();
-    let _ = writeln!(
-        md,
-        "Means over viewpoints ({}) at {}×{}, {} timed frames each; adapter {adapter}.\n",
-        file.run.viewpoints, file.run.width, file.run.height, file.run.frames
-    );
-    let _ = writeln!(
-        md,
-        "### Table 1 — fragment PT per data set (Marroquim et al. 2006, Table 1)\n"
-    );
-    let _ = writeln!(
-        md,
-        "| data set | tets | settings | fps | K tets/s | CPU ms | GPU ms | model B/tet | all B/tet | PSNR dB | paper fps | paper K tets/s |"
-    );
-    let _ = writeln!(
-        md,
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
-    );
-    let datasets = dataset_order(&aggs);
-    let mut any = false;
-    for d in &datasets {
-        for a in aggs
-            .iter()
-            .filter(|a| a.algorithm == "fragment-pt" && &a.dataset == d)
-        {
-            any = true;
-            let paper = paper_table1(d);
-            let paper_cell = |v: Option<f64>| match (paper, v) {
-                (Some(_), Some(x)) => format!("{x:.1}"),
-                (Some(_), None) => "–".into(),
-                (None, _) => "not in paper".into(),
-            };
-            let _ = writeln!(
-                md,
-                "| {d} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                a.tets,
-                a.settings,
-                fmt_opt(a.fps.map(|s| s.mean), 2),
-                fmt_opt(a.tets_per_sec.map(|s| s.mean / 1e3), 1),
-                fmt_opt(a.cpu_ms.map(|s| s.mean), 2),
-                fmt_opt(a.gpu_ms.map(|s| s.mean), 2),
-                fmt_opt(model_bytes_per_tet(rows, a), 1),
-                fmt_opt(a.bytes_per_tet, 1),
-                fmt_opt(a.psnr_db.map(|s| s.mean), 1),
-                paper_cell(paper.and_then(|p| p.0)),
-                paper_cell(paper.and_then(|p| p.1)),
-            );
-        }
-    }
-    if !any {
-        let _ = writeln!(md, "| (no fragment-pt rows in this run) |||||||||||| ");
-    }
-    let _ = writeln!(
-        md,
-        "\nPaper: GeForce 6800, 512², model rotating (reports/papers/fragment-pt_table1.csv); its \
-         abstract reports over {:.1} M tets/s and §4 about {PAPER_BYTES_PER_TET:.0} bytes/tet for the \
-         model (our `model B/tet` column: tet indices + vertices; `all B/tet` adds the shading \
-         tables).\n",
-        PAPER_PEAK_K_TETS_PER_SEC / 1e3
-    );
-
-    let _ = writeln!(
-        md,
-        "### Table 2 — algorithms compared on the same run (Marroquim et al. 2006, Table 2)\n"
-    );
-    let mut header = String::from("| algorithm | settings |");
-    let mut rule = String::from("|---|---|");
-    for d in &datasets {
-        let tets = aggs
-            .iter()
-            .find(|a| &a.dataset == d)
-            .map(|a| a.tets)
-            .unwrap_or(0);
-        let _ = write!(header, " {d} ({tets} tets) K tets/s | {d} PSNR dB |");
-        rule.push_str("---:|---:|");
-    }
-    header.push_str(" B/tet |");
-    rule.push_str("---:|");
-    let _ = writeln!(md, "{header}\n{rule}");
-    let mut series: Vec<(String, String)> = vec![];
-    for a in &aggs {
-        let k = (a.algorithm.clone(), a.settings.clone());
-        if !series.contains(&k) {
-            series.push(k);
-        }
-    }
-    for (alg, set) in &series {
-        let mut line = format!("| {alg} | {set} |");
-        let mut bpt = None;
-        for d in &datasets {
-            let a = aggs
-                .iter()
-                .find(|a| &a.algorithm == alg && &a.settings == set && &a.dataset == d);
-            let _ = write!(
-                line,
-                " {} | {} |",
-                fmt_opt(a.and_then(|a| a.tets_per_sec).map(|s| s.mean / 1e3), 1),
-                fmt_opt(a.and_then(|a| a.psnr_db).map(|s| s.mean), 1)
-            );
-            bpt = bpt.or(a.and_then(|a| a.bytes_per_tet));
-        }
-        let _ = write!(line, " {} |", fmt_opt(bpt, 1));
-        let _ = writeln!(md, "{line}");
-    }
-    let _ = writeln!(
-        md,
-        "\nPaper's Table 2 (fps, GeForce 6800, reports/papers/fragment-pt_table2.csv), Blunt / Post: {}. \
-         Only this run's algorithms are measured above (same machine, viewpoints and transfer \
-         function); `tetbench reproduce fragment-pt` prints them side by side.",
-        ["GPU CP for Int. VR", "GATOR", "HARC", "HARC PPI", "VICP"]
-            .iter()
-            .filter_map(|r| paper_table2(r).map(|(b, p)| format!("{r} {b:.2} / {p:.2}")))
-            .collect::<Vec<_>>()
-            .join("; ")
-    );
-    md
-}
-
-/// `tetbench analyze fragment-pt OUT`.
-#[derive(Debug, clap::Args)]
-pub struct TablesArgs {
-    /// Output directory of a `tetbench run` (holds results.json), e.g. of
-    /// `tetbench run --algorithms fragment-pt,gator-pt --datasets spx,bluntfin,comb,post`.
-    pub out: PathBuf,
-}
-
-pub fn run_tables(args: TablesArgs, _ctx: &super::Context) -> anyhow::Result<()> {
-    let file = ResultsFile::read(&args.out)?;
-    let md = tables_markdown(&file);
-    let path = args.out.join("fragment_pt_tables.md");
-    std::fs::write(&path, &md).with_context(|| format!("cannot write {}", path.display()))?;
-    print!("{md}");
-    eprintln!("wrote {}", path.display());
-    Ok(())
 }
 
 /// `tetbench analyze resolution`: Fig. 8, performance against viewport size.

@@ -6,9 +6,10 @@
 //! * `tetbench analyze kbuffer --datasets spx,bluntfin,comb,post` — Table 2: the sorted faces
 //!   rasterised at 512² into an exact A-buffer (a CPU model): total fragments, longest
 //!   per-pixel list, largest k needed, pixels needing k > 2 and k > 6, maxima over the 14
-//!   viewpoints; and Fig. 6's maps of where k > 2 and k > 6 are needed;
-//! * `tetbench analyze havs-tables OUT` — Tables 3 and 4 from a finished `tetbench run` of
-//!   `havs` ([`tables_3_4`]).
+//!   viewpoints; and Fig. 6's maps of where k > 2 and k > 6 are needed.
+//!
+//! Tables 3–5 are written once, by `reproduce/havs.rs` (`tetbench reproduce havs`, or
+//! `tetbench analyze havs RUN_DIR` for finished runs).
 //!
 //! The paper's figures come from its transcribed tables (`reports/papers/havs_table*.csv`,
 //! provenance in `reports/papers/havs.md`); `tetbench reproduce havs` runs the paper's own data
@@ -21,9 +22,6 @@ use std::time::Instant;
 use anyhow::Context as _;
 use rayon::prelude::*;
 use render_core::{fixed_viewpoints, Camera, Optics, Projection, TransferFunction};
-
-use crate::report::{aggregate, Aggregate};
-use crate::results::{value_of, ResultsFile, Row};
 
 /// What the paper reports that we could verify: its abstract's range of rates.
 pub const PAPER_RATE_RANGE_TETS_PER_SEC: (f64, f64) = (1.0e6, 6.0e6);
@@ -58,7 +56,11 @@ pub struct SortArgs {
 #[derive(Debug, Clone)]
 pub struct SortRow {
     pub name: &'static str,
+    /// Median over the repeats, and the fastest and slowest repeat.
     pub ms: f64,
+    pub min_ms: f64,
+    pub max_ms: f64,
+    pub repeats: u32,
     pub keys_per_sec: f64,
 }
 
@@ -117,6 +119,9 @@ pub fn table1(n: usize, repeats: usize) -> anyhow::Result<Vec<SortRow>> {
         rows.push(SortRow {
             name,
             ms,
+            min_ms: times[0],
+            max_ms: times[times.len() - 1],
+            repeats: times.len() as u32,
             keys_per_sec: n as f64 / (ms * 1e-3),
         });
     }
@@ -379,137 +384,6 @@ pub fn table2_markdown(rows: &[KbufferRow], resolution: u32) -> String {
             r.pixels_k_gt6,
             r.worst_viewpoint
         );
-    }
-    md
-}
-
-#[derive(Debug, clap::Args)]
-pub struct TablesArgs {
-    /// Output directory of a `tetbench run --algorithms havs` (holds results.json).
-    pub out: PathBuf,
-}
-
-pub fn run_tables(args: TablesArgs, _ctx: &super::Context) -> anyhow::Result<()> {
-    let file = ResultsFile::read(&args.out)?;
-    let adapter = file
-        .machine
-        .adapter
-        .as_ref()
-        .map(|a| format!("{} ({})", a.name, a.backend))
-        .unwrap_or_default();
-    let md = format!(
-        "Adapter: {adapter}; {}×{}.\n\n{}",
-        file.run.width,
-        file.run.height,
-        tables_3_4(&file.rows)
-    );
-    let path = args.out.join("havs_tables_3_4.md");
-    std::fs::write(&path, &md).with_context(|| format!("cannot write {}", path.display()))?;
-    println!("{md}");
-    Ok(())
-}
-
-fn cell(v: Option<f64>, digits: usize) -> String {
-    match v {
-        Some(x) if x.is_finite() => format!("{x:.digits$}"),
-        _ => "–".into(),
-    }
-}
-
-/// HAVS Tables 3 and 4 from result rows of `havs` (means over viewpoints):
-///
-/// * Table 3, GPU only: the GPU time of sorting (GPU-sort rows) or only drawing (CPU-sort rows)
-///   and drawing, as fps and tets/s, for k = 2 and k = 6;
-/// * Table 4, the whole frame with the paper's CPU sort: CPU ms (sort + upload), GPU ms,
-///   total ms, fps and tets/s for k = 2 and k = 6, with PSNR against the reference.
-pub fn tables_3_4(rows: &[Row]) -> String {
-    let havs_rows: Vec<Row> = rows
-        .iter()
-        .filter(|r| r.algorithm == "havs")
-        .cloned()
-        .collect();
-    let aggs = aggregate(&havs_rows);
-    let mut datasets: Vec<String> = vec![];
-    for a in &aggs {
-        if !datasets.contains(&a.dataset) {
-            datasets.push(a.dataset.clone());
-        }
-    }
-    let find = |ds: &str, k: &str, sort: &str| -> Option<&Aggregate> {
-        aggs.iter().find(|a| {
-            a.dataset == ds
-                && value_of(&a.settings, "k") == Some(k)
-                && value_of(&a.settings, "sort") == Some(sort)
-                && value_of(&a.settings, "mode").is_none_or(|m| m == "fragment-race")
-        })
-    };
-    let mut md = String::from(
-        "HAVS Table 3: GPU time only (timestamp queries), means over viewpoints. \"draw\": faces \
-         sorted on the CPU, GPU time of drawing and draining; \"sort+draw\": faces sorted on the GPU too. \
-         Paper (reports/papers/havs_table3.csv, ATI Radeon 9800 Pro): GPU-only fps at k = 2 / k = 6 where \
-         the data set is one of its own (f117, kew, spx2, torso, fighter).\n\n\
-         | data set | tets | k=2 draw fps | k=2 draw tets/s | k=2 sort+draw fps | k=2 sort+draw tets/s | k=6 draw fps | k=6 draw tets/s | k=6 sort+draw fps | k=6 sort+draw tets/s | paper |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
-    );
-    for ds in &datasets {
-        let mut cells = vec![];
-        let mut tets = 0;
-        for k in ["2", "6"] {
-            for sort in ["cpu-radix", "gpu-radix"] {
-                let a = find(ds, k, sort);
-                if let Some(a) = a {
-                    tets = a.tets;
-                }
-                let gpu_ms = a.and_then(|a| a.gpu_ms.map(|s| s.mean));
-                cells.push(cell(gpu_ms.map(|ms| 1e3 / ms), 1));
-                cells.push(
-                    cell(
-                        gpu_ms.and_then(|ms| a.map(|a| a.tets as f64 / (ms * 1e-3) / 1e6)),
-                        2,
-                    ) + " M",
-                );
-            }
-        }
-        let paper = match (
-            paper_value("havs_table3", ds, "k2_fps"),
-            paper_value("havs_table3", ds, "k6_fps"),
-        ) {
-            (Some(a), Some(b)) => format!("{a:.2} / {b:.2} fps"),
-            _ => "–".into(),
-        };
-        let _ = writeln!(md, "| {ds} | {tets} | {} | {paper} |", cells.join(" | "));
-    }
-    md.push_str(
-        "\nHAVS Table 4: whole frames with the CPU radix sort (CPU ms = key computation, sort and \
-         upload; GPU ms by timestamps; total = wall clock until the GPU finished), means over viewpoints.\n\n\
-         | data set | tets | k | CPU ms | GPU ms | total ms | fps | tets/s | PSNR dB | bytes/tet | paper |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
-    );
-    for ds in &datasets {
-        for k in ["2", "6"] {
-            if let Some(a) = find(ds, k, "cpu-radix") {
-                let paper = match (
-                    k,
-                    paper_value("havs_table4", ds, "total_ms"),
-                    paper_value("havs_table4", ds, "fps"),
-                ) {
-                    ("2", Some(t), Some(f)) => format!("{t:.0} ms, {f:.1} fps"),
-                    _ => "–".into(),
-                };
-                let _ = writeln!(
-                    md,
-                    "| {ds} | {} | {k} | {} | {} | {} | {} | {} M | {} | {} | {paper} |",
-                    a.tets,
-                    cell(a.cpu_ms.map(|s| s.mean), 1),
-                    cell(a.gpu_ms.map(|s| s.mean), 1),
-                    cell(a.total_ms.map(|s| s.mean), 1),
-                    cell(a.fps.map(|s| s.mean), 2),
-                    cell(a.tets_per_sec.map(|s| s.mean / 1e6), 3),
-                    cell(a.psnr_db.map(|s| s.mean), 1),
-                    cell(a.bytes_per_tet, 1),
-                );
-            }
-        }
     }
     md
 }

@@ -7,7 +7,7 @@
 //! the paper's viewport is not stated, we use 512²).
 
 use super::papers;
-use super::table::{Cell, CompRow, Comparison, Metric, Ordering};
+use super::table::{Cell, CompRow, Comparison, Metric};
 use super::{find, is_standin, Extra, Measured, Paper, Report, RunSpec, Session};
 
 pub const PAPER: Paper = Paper {
@@ -16,7 +16,10 @@ pub const PAPER: Paper = Paper {
     citation: "B. Wylie, K. Moreland, L. A. Fisk, P. Crossno, Proc. IEEE/ACM VolVis 2002, pp. 7–12. Provenance: reports/papers/gator.md.",
     hardware: "Dell 530, Pentium 4 2 GHz, Windows 2000, nVidia GeForce4 (VisionTek; model not stated), OpenGL vertex programs over AGP; viewport not stated; many viewpoints averaged (spread under 5 %).",
     algorithm: "gator-pt",
+    datasets: &["bluntfin", "post", "deltawing"],
+    sections: &["Abstract", "§1", "§2", "§3", "§3.1", "§3.2", "§3.3", "§3.4", "§3.5", "§4", "§5", "Table 1", "Table 2", "Table 3"],
     reproduce,
+    tables,
 };
 
 /// The paper's data set names → registry names.
@@ -26,11 +29,26 @@ const DATASETS: [(&str, &str); 3] = [
     ("Delta Wing", "deltawing"),
 ];
 
-/// Random projected tets classified by the CPU twin: the distinct test outcomes per case, in
-/// the paper's test order. Our classifier (after the authors' gator.cg) numbers its tests
-/// differently: the paper's test 3 (|V0→middle| > |V0→I|, i.e. class 2) is our t4, and the
-/// paper's test 4 (cross1.z > 0) is our t3 (`classify.rs`).
-pub fn observed_truth_table(samples: usize) -> Vec<(u8, [bool; 4])> {
+/// One distinct outcome of the classifier's CPU twin: our case number, the Shirley–Tuchman
+/// class (1: three triangles, 2: four) and the test outcomes in the paper's order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub struct ObservedCase {
+    pub case: u8,
+    pub class: u8,
+    pub tests: [bool; 4],
+}
+
+/// Our case number for each of the paper's Table 1 rows (row 1 first). `classify.rs` numbers
+/// the cases by their outcomes in its own test order — `case = 2·(4·t1 + 2·t2 + t3) + 1 + t4`,
+/// 13 and 14 for the two rows where tests 1 and 2 both hold — and its t3 is the paper's test 4,
+/// its t4 the paper's test 3. Written out from the paper's rows, so a classifier that swapped
+/// two cases fails the check.
+pub const OUR_CASE_OF_PAPER_ROW: [u8; 14] = [14, 13, 9, 11, 7, 5, 3, 1, 10, 12, 8, 6, 4, 2];
+
+/// Random projected tets classified by the CPU twin: the distinct outcomes, with the tests in
+/// the paper's order (the paper's test 3, |V0→middle| > |V0→I|, is our t4; its test 4,
+/// cross1.z > 0, is our t3).
+pub fn observed_truth_table(samples: usize) -> Vec<ObservedCase> {
     let mut x = 0x9e37_79b9_7f4a_7c15u64;
     let mut rnd = || {
         x ^= x << 13;
@@ -38,24 +56,94 @@ pub fn observed_truth_table(samples: usize) -> Vec<(u8, [bool; 4])> {
         x ^= x << 17;
         (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
     };
-    let mut seen: Vec<(u8, [bool; 4])> = vec![];
+    let mut seen: Vec<ObservedCase> = vec![];
     for _ in 0..samples {
         let p: [[f64; 3]; 4] = std::array::from_fn(|_| [rnd(), rnd(), rnd()]);
         let c = gator_pt::classify_cpu(p);
         let [t1, t2, t3, t4] = c.tests;
-        let paper_order = [t1, t2, t4, t3];
-        if !seen.contains(&(c.case, paper_order)) {
-            seen.push((c.case, paper_order));
+        let o = ObservedCase {
+            case: c.case,
+            class: c.class,
+            tests: [t1, t2, t4, t3],
+        };
+        if !seen.contains(&o) {
+            seen.push(o);
         }
     }
     seen.sort();
     seen
 }
 
+/// The paper's Table 1 rows: test outcomes (None = X, either).
+pub fn paper_rows() -> Vec<[Option<bool>; 4]> {
+    let t = papers::table("gator_table1").expect("embedded paper CSV parses (tested)");
+    let cols = ["test1_bool", "test2_bool", "test3_bool", "test4_bool"];
+    t.keys()
+        .iter()
+        .map(|k| cols.map(|c| t.value(k, c).map(|v| v == 1.0)))
+        .collect()
+}
+
+/// Triangles the paper's row implies: its test 3 is the class-2 test (four triangles); rows
+/// where it fails or does not matter (X: tests 1 and 2 both hold, always class 1) take three.
+pub fn paper_row_triangles(row: &[Option<bool>; 4]) -> u8 {
+    if row[2] == Some(true) {
+        4
+    } else {
+        3
+    }
+}
+
+/// Table 1 checked both ways: every observed outcome must fit exactly one paper row, carry our
+/// case number for that row and its triangle count, and every paper row must be observed.
+/// Returns the mismatches, in words (empty: the table holds).
+pub fn table1_mismatches(observed: &[ObservedCase], rows: &[[Option<bool>; 4]]) -> Vec<String> {
+    let fits =
+        |p: &[Option<bool>; 4], o: &[bool; 4]| (0..4).all(|i| p[i].is_none_or(|v| v == o[i]));
+    let mut out = vec![];
+    for o in observed {
+        let hits: Vec<usize> = (0..rows.len())
+            .filter(|&i| fits(&rows[i], &o.tests))
+            .collect();
+        let [row] = hits[..] else {
+            out.push(format!(
+                "our case {} (tests {:?}) fits paper rows {:?}",
+                o.case,
+                o.tests.map(u8::from),
+                hits.iter().map(|i| i + 1).collect::<Vec<_>>()
+            ));
+            continue;
+        };
+        let expected_case = OUR_CASE_OF_PAPER_ROW.get(row).copied().unwrap_or(0);
+        if o.case != expected_case {
+            out.push(format!(
+                "tests {:?} are the paper's case {}, ours says case {} (expected {expected_case})",
+                o.tests.map(u8::from),
+                row + 1,
+                o.case
+            ));
+        }
+        let triangles = if o.class == 2 { 4 } else { 3 };
+        if triangles != paper_row_triangles(&rows[row]) {
+            out.push(format!(
+                "paper case {}: {} triangles, ours {triangles}",
+                row + 1,
+                paper_row_triangles(&rows[row])
+            ));
+        }
+    }
+    for (i, p) in rows.iter().enumerate() {
+        if !observed.iter().any(|o| fits(p, &o.tests)) {
+            out.push(format!("paper case {} never observed", i + 1));
+        }
+    }
+    out
+}
+
 fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
     let mut m = Measured::default();
     let mut x = Extra {
-        truth_table: observed_truth_table(200_000),
+        truth_table: Some(observed_truth_table(200_000)),
         ..Default::default()
     };
     s.log
@@ -63,11 +151,15 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
     let registry = datasets::registry::Registry::new(s.data_dir.clone());
     for (_, d) in DATASETS {
         match registry.resolve(&s.dataset(d), &datasets::LoadOptions::default()) {
-            Ok(ds) => x.sizes.push((
-                d.to_string(),
-                ds.mesh.num_points() as u64,
-                ds.mesh.num_tets() as u64,
-            )),
+            Ok(ds) => {
+                x.sizes.push((
+                    d.to_string(),
+                    ds.mesh.num_points() as u64,
+                    ds.mesh.num_tets() as u64,
+                ));
+                x.dropped
+                    .push((d.to_string(), ds.mesh.repair.degenerate_dropped as u64));
+            }
             Err(e) => m
                 .errors
                 .push(format!("data set \"{d}\" could not be loaded: {e}")),
@@ -92,69 +184,84 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     let mut report = Report::default();
     let load = |n: &str| papers::table(n).expect("embedded paper CSV parses (tested)");
 
-    // Table 1: each paper row's outcomes must be observed (X = either), and every observed
-    // outcome must be a paper row.
+    // Table 1: per paper row, the outcomes of the case our classifier numbers as that row,
+    // and the triangle counts.
     let t = load("gator_table1");
     let cols = ["test1_bool", "test2_bool", "test3_bool", "test4_bool"];
-    let paper_rows: Vec<(String, [Option<f64>; 4])> = t
+    let rows_p = paper_rows();
+    let observed = x.truth_table.as_deref().unwrap_or(&[]);
+    let rows: Vec<CompRow> = t
         .keys()
         .iter()
-        .map(|k| (k.clone(), cols.map(|c| t.value(k, c))))
-        .collect();
-    let fits = |p: &[Option<f64>; 4], o: &[bool; 4]| {
-        (0..4).all(|i| p[i].is_none_or(|v| (v == 1.0) == o[i]))
-    };
-    let rows: Vec<CompRow> = paper_rows
-        .iter()
-        .map(|(k, p)| {
-            let hit = x.truth_table.iter().find(|(_, o)| fits(p, o));
+        .enumerate()
+        .map(|(i, k)| {
+            let ours_case = OUR_CASE_OF_PAPER_ROW[i];
+            let hits: Vec<&ObservedCase> =
+                observed.iter().filter(|o| o.case == ours_case).collect();
+            let why = if x.truth_table.is_none() {
+                Some("not run (`tetbench reproduce gator` classifies random tets)".to_string())
+            } else if hits.is_empty() {
+                Some(format!("our case {ours_case} was never observed"))
+            } else {
+                None
+            };
+            let mut cells: Vec<Cell> = (0..4)
+                .map(|c| {
+                    // An X cell takes whatever ours gives; a cell where two observed outcomes
+                    // of one case differ is shown as missing.
+                    let values: Vec<bool> = hits.iter().map(|o| o.tests[c]).collect();
+                    let ours = match (rows_p[i][c], values.first()) {
+                        (_, None) => None,
+                        (None, _) => None,
+                        (Some(_), Some(&v)) if values.iter().all(|&w| w == v) => {
+                            Some(v as u8 as f64)
+                        }
+                        _ => None,
+                    };
+                    Cell {
+                        paper: t.value(k, cols[c]),
+                        ours,
+                        why_no_ours: why.clone().filter(|_| rows_p[i][c].is_some()),
+                        uncertain: t.uncertain(k, cols[c]),
+                    }
+                })
+                .collect();
+            let tri: Option<f64> = hits.first().map(|o| if o.class == 2 { 4.0 } else { 3.0 });
+            cells.push(Cell {
+                paper: Some(paper_row_triangles(&rows_p[i]) as f64),
+                ours: tri,
+                why_no_ours: why,
+                uncertain: None,
+            });
             CompRow {
-                label: format!("case {k}"),
+                label: format!("case {k} (our case {ours_case})"),
                 standin: false,
-                cells: (0..4)
-                    .map(|i| Cell {
-                        paper: p[i],
-                        // Don't-care cells (no paper value) cannot disagree.
-                        ours: hit.and_then(|(_, o)| p[i].map(|_| o[i] as u8 as f64)),
-                        why_no_ours: hit.is_none().then(|| {
-                            if x.truth_table.is_empty() {
-                                "not run".into()
-                            } else {
-                                "no sampled tet has these outcomes".into()
-                            }
-                        }),
-                        uncertain: t.uncertain(k, cols[i]),
-                    })
-                    .collect(),
+                cells,
             }
         })
         .collect();
-    let unexplained: Vec<String> = x
-        .truth_table
-        .iter()
-        .filter(|(_, o)| !paper_rows.iter().any(|(_, p)| fits(p, o)))
-        .map(|(c, o)| format!("our case {c} {o:?}"))
-        .collect();
+    let mismatches = table1_mismatches(observed, &rows_p);
     let mut notes = vec![format!(
-        "{} distinct (case, outcome) pairs observed over the samples; paper rows with X (don't care) accept either value.",
-        x.truth_table.len()
+        "{} distinct (case, class, outcome) triples observed; X (don't care) cells accept either value and are left out of the comparison. The paper prints no triangle counts: a row's count follows from its test 3, the class-2 test (four triangles; otherwise three).",
+        observed.len()
     )];
-    if !x.truth_table.is_empty() {
-        notes.push(if unexplained.is_empty() {
-            "Every observed outcome is a row of the paper's table: **the truth table matches**."
-                .into()
+    if x.truth_table.is_some() {
+        notes.push(if mismatches.is_empty() {
+            "Every observed outcome fits exactly one paper row, with that row's case number and triangle count, and every row is observed.".into()
         } else {
-            format!(
-                "Outcomes not in the paper's table: {}.",
-                unexplained.join("; ")
-            )
+            format!("Mismatches: {}.", mismatches.join("; "))
         });
     }
+    let mut metrics: Vec<Metric> = cols
+        .iter()
+        .map(|c| Metric::exact(c.replace("_bool", ""), 0))
+        .collect();
+    metrics.push(Metric::exact("triangles", 0));
     report.comparisons.push(Comparison {
         key: "table1".into(),
         title: "Table 1 — truth table of the 14 projection cases".into(),
-        conditions: "No GPU involved: the paper's four tests (test 3: the intersection is nearer V0 than the middle vertex; test 4: cross1.z > 0) against the outcomes of our classifier's CPU twin (the same tests and table as the vertex shader) on random projected tets.".into(),
-        metrics: cols.iter().map(|c| Metric::exact(c.replace("_bool", ""), 0)).collect(),
+        conditions: "No GPU involved: the paper's four tests (test 3: the intersection is nearer V0 than the middle vertex; test 4: cross1.z > 0) against the outcomes of our classifier's CPU twin (the same tests and table as the vertex shader) on 200,000 random projected tets; each paper row is compared with the case our classifier numbers as that row.".into(),
+        metrics,
         rows,
         notes,
     });
@@ -222,15 +329,6 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
                 uncertain: t.uncertain(paper, &rc),
             });
         }
-        report.orderings.push(Ordering {
-            claim: format!(
-                "Table 3, GPU time on {paper}: constant cells < linear cells (paper: ≈1.9×)"
-            ),
-            items: vec![
-                ("constant".into(), cells[0].paper, cells[0].ours),
-                ("linear".into(), cells[2].paper, cells[2].ours),
-            ],
-        });
         rows.push(CompRow {
             label: format!("{paper} ({d})"),
             standin: is_standin(d),
@@ -250,5 +348,6 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         rows,
         notes: vec![],
     });
+    report.claims = super::evaluate_claims(PAPER.id, m, x);
     report
 }

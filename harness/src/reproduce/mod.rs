@@ -2,7 +2,8 @@
 //! every measurement a paper's tables need (its data sets, viewpoints, settings and
 //! resolution, from the transcription in `reports/papers/`), then writes `OUT/<paper>/report.md`
 //! and `report.html`: each table in the paper's shape with paper | ours | ours/paper, the
-//! conditions of both, bar charts, and the orderings the paper claims with whether ours agree.
+//! conditions of both, bar charts, and the paper's claims (`reports/papers/claims.csv`), each
+//! with a verdict of [`crate::papers::verdict`] and the numbers and variants it rests on.
 //!
 //! Each paper is one module with (a) its run plan (`measure`, built on the run loop
 //! [`crate::run`] and the analyses of [`crate::analyze`]) and (b) its table writer (`tables`,
@@ -20,7 +21,9 @@ use crate::machine::MachineInfo;
 use crate::report::{aggregate, Aggregate};
 use crate::results::{ResultsFile, Row};
 
+pub mod evidence;
 pub mod fragment_pt;
+pub mod from_run;
 pub mod gator;
 pub mod havs;
 pub use crate::papers;
@@ -28,7 +31,9 @@ pub mod raycast;
 pub mod splat;
 pub mod table;
 
-use table::{Comparison, Ordering};
+use crate::papers::claims::{self, ClaimResult};
+pub use evidence::evaluate_claims;
+use table::Comparison;
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
@@ -55,6 +60,10 @@ pub struct Args {
     /// `tetbench run --external`).
     #[command(flatten)]
     pub external: crate::external_cmd::ExternalArgs,
+    /// Run although the working tree has uncommitted changes (the reports then say so; by
+    /// default `reproduce` refuses, so every report names the one commit it came from).
+    #[arg(long)]
+    pub allow_dirty: bool,
 }
 
 /// One paper: what it is, on what it was measured, and how to reproduce it.
@@ -67,7 +76,15 @@ pub struct Paper {
     pub hardware: &'static str,
     /// The tetbench algorithm the paper describes (must be built in to reproduce it alone).
     pub algorithm: &'static str,
+    /// Every data set the plan loads (registry names): the rows a claim may name.
+    pub datasets: &'static [&'static str],
+    /// The places of the paper a claim may cite (its numbered sections, tables, abstract,
+    /// captions), from its source text.
+    pub sections: &'static [&'static str],
     pub reproduce: fn(&mut Session) -> anyhow::Result<Report>,
+    /// Its tables and claims from what was measured: the one writer, shared by `reproduce` and
+    /// `analyze PAPER RUN_DIR`.
+    pub tables: fn(&Measured, &Extra) -> Report,
 }
 
 /// Every paper, in the order `all` runs them.
@@ -85,7 +102,8 @@ pub fn papers() -> [&'static Paper; 5] {
 #[derive(Debug, Clone, Default)]
 pub struct Report {
     pub comparisons: Vec<Comparison>,
-    pub orderings: Vec<Ordering>,
+    /// The paper's claims (`reports/papers/claims.csv`), one verdict per data set.
+    pub claims: Vec<ClaimResult>,
     pub notes: Vec<String>,
 }
 
@@ -177,20 +195,24 @@ impl Measured {
 
 pub use crate::results::value_of;
 
-/// The aggregate of `algorithm` on `dataset` whose settings include every `want` pair.
+/// The aggregate of `algorithm` on `dataset` whose settings include every `want` pair, if
+/// exactly one does: where several variants match, none is taken (the first one found must
+/// never stand for the algorithm silently; the table's plan names the variant).
 pub fn find<'a>(
     aggs: &'a [Aggregate],
     algorithm: &str,
     dataset: &str,
     want: &[(&str, &str)],
 ) -> Option<&'a Aggregate> {
-    aggs.iter().find(|a| {
+    let mut hits = aggs.iter().filter(|a| {
         a.algorithm == algorithm
             && a.dataset == dataset
             && want
                 .iter()
                 .all(|(k, v)| value_of(&a.settings, k) == Some(*v))
-    })
+    });
+    let first = hits.next()?;
+    hits.next().is_none().then_some(first)
 }
 
 /// The state of one paper's reproduction: where it writes, the mode, and what it ran.
@@ -207,6 +229,10 @@ pub struct Session {
     pub log: Vec<String>,
     /// External renderers added to every run (`--external`).
     pub external: crate::external_cmd::ExternalArgs,
+    /// The commit the binary was built from and whether the tree was clean.
+    pub source: SourceState,
+    /// Set by `tetbench analyze PAPER RUN_DIR`: the runs the tables come from.
+    pub from_run: Option<PathBuf>,
 }
 
 impl Session {
@@ -359,11 +385,9 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             .ok_or_else(|| anyhow::anyhow!("--substitute {s:?}: expected NAME=SPEC"))?;
         substitutes.push((a.trim().to_string(), b.trim().to_string()));
     }
+    let mut source = SourceState::read();
+    source.check(args.allow_dirty)?;
     let started = Instant::now();
-    let mut index = format!(
-        "# Papers reproduced ({})\n\n| paper | seconds | exact tables | claims that hold | report |\n|---|---:|---|---|---|\n",
-        if args.quick { "quick" } else { "full" }
-    );
     for p in chosen {
         let t0 = Instant::now();
         let dir = args.out.join(p.id);
@@ -383,6 +407,8 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             machine: None,
             log: vec![],
             external: args.external.clone(),
+            source: source.clone(),
+            from_run: None,
         };
         eprintln!("tetbench reproduce: {} ({})", p.id, p.title);
         let report = (p.reproduce)(&mut session)?;
@@ -396,39 +422,95 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
                     .map(|v| format!("{}: {}", c.key, if v { "match" } else { "differ" }))
             })
             .collect();
-        let holds = report
-            .orderings
-            .iter()
-            .filter(|o| o.verdict() == table::OrderVerdict::Holds)
-            .count();
-        let checkable = report
-            .orderings
-            .iter()
-            .filter(|o| o.verdict() != table::OrderVerdict::CannotCheck)
-            .count();
-        let _ = writeln!(
-            index,
-            "| {} | {seconds:.0} | {} | {holds} of {checkable} checkable ({} claims) | [{0}/report.md]({0}/report.md) |",
-            p.id,
-            if exact.is_empty() { "–".into() } else { exact.join(", ") },
-            report.orderings.len()
-        );
+        let summary = PaperSummary {
+            paper: p.id.to_string(),
+            mode: if args.quick { "quick" } else { "full" }.into(),
+            seconds,
+            source: session.source.describe(),
+            exact_tables: if exact.is_empty() {
+                "–".into()
+            } else {
+                exact.join(", ")
+            },
+            claims: tally_text(&report.claims),
+        };
+        write_file(
+            &dir.join(SUMMARY_FILE),
+            &serde_json::to_string_pretty(&summary)?,
+        )?;
         eprintln!(
             "{}: {seconds:.0} s, report {}",
             p.id,
             dir.join("report.md").display()
         );
     }
-    let _ = writeln!(index, "\nTotal: {:.0} s.", started.elapsed().as_secs_f64());
-    if all {
-        std::fs::write(args.out.join("README.md"), &index)?;
-        std::fs::write(
-            args.out.join("index.html"),
-            table::markdown_to_html(&index, "Papers reproduced"),
-        )?;
-    }
+    eprintln!("total: {:.0} s", started.elapsed().as_secs_f64());
+    // Rebuilt after every command from the summaries of every paper under OUT, so README.md
+    // and index.html come from the same data as the reports beside them.
+    let index = index_markdown(&args.out)?;
+    write_file(&args.out.join("README.md"), &index)?;
+    write_file(
+        &args.out.join("index.html"),
+        &table::markdown_to_html(&index, "Papers reproduced"),
+    )?;
     print!("{index}");
     Ok(())
+}
+
+/// What the index says of one paper's report (`OUT/<paper>/summary.json`).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct PaperSummary {
+    pub paper: String,
+    pub mode: String,
+    pub seconds: f64,
+    /// The commit sentence of [`SourceState::describe`].
+    pub source: String,
+    pub exact_tables: String,
+    pub claims: String,
+}
+
+pub const SUMMARY_FILE: &str = "summary.json";
+
+/// The index of every paper reproduced under `out`, from their summaries.
+pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
+    let mut md = String::from("# Papers reproduced\n\nWritten by `tetbench reproduce` from each paper's `summary.json`; nothing here is edited by hand.\n\n| paper | mode | seconds | commit | exact tables | claims (verdicts per data set) | report |\n|---|---|---:|---|---|---|---|\n");
+    let mut total = 0.0;
+    let mut sources = vec![];
+    for p in papers() {
+        let path = out.join(p.id).join(SUMMARY_FILE);
+        if !path.exists() {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let s: PaperSummary = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not a paper summary", path.display()))?;
+        total += s.seconds;
+        if !sources.contains(&s.source) {
+            sources.push(s.source.clone());
+        }
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.0} | {} | {} | {} | [{0}/report.md]({0}/report.md) |",
+            s.paper,
+            s.mode,
+            s.seconds,
+            sources
+                .iter()
+                .position(|x| *x == s.source)
+                .map_or(0, |i| i + 1),
+            s.exact_tables,
+            s.claims
+        );
+    }
+    let _ = writeln!(md, "\nTotal: {total:.0} s.\n");
+    for (i, s) in sources.iter().enumerate() {
+        let _ = writeln!(md, "Commit {}: {s}\n", i + 1);
+    }
+    if sources.len() > 1 {
+        md.push_str("**These reports come from more than one build**: regenerate them with one `tetbench reproduce all` to compare like with like.\n");
+    }
+    Ok(md)
 }
 
 /// Our side of the conditions: adapter, driver, CPU, commit, date.
@@ -460,6 +542,64 @@ fn our_conditions(machine: Option<&MachineInfo>) -> String {
     )
 }
 
+/// Counts of each verdict, as one line.
+pub fn tally_text(results: &[ClaimResult]) -> String {
+    let parts: Vec<String> = claims::tally(results)
+        .into_iter()
+        .filter(|(_, n)| *n > 0)
+        .map(|(v, n)| format!("{n} {}", v.label()))
+        .collect();
+    if parts.is_empty() {
+        "none".into()
+    } else {
+        parts.join(", ")
+    }
+}
+
+/// The commit `reproduce` runs from and whether the tree has uncommitted changes (read the
+/// way the run's machine record reads it, [`MachineInfo::collect`]).
+#[derive(Debug, Clone, Default)]
+pub struct SourceState {
+    pub commit: Option<String>,
+    pub dirty: Option<bool>,
+    /// `--allow-dirty` was given.
+    pub allowed_dirty: bool,
+}
+
+impl SourceState {
+    pub fn read() -> SourceState {
+        let m = MachineInfo::collect();
+        SourceState {
+            commit: m.git_commit,
+            dirty: m.git_dirty,
+            allowed_dirty: false,
+        }
+    }
+
+    /// Refuses a tree with uncommitted changes unless allowed.
+    pub fn check(&mut self, allow_dirty: bool) -> anyhow::Result<()> {
+        if self.dirty == Some(true) && !allow_dirty {
+            anyhow::bail!(
+                "the working tree has uncommitted changes: commit them so the reports name one commit, or pass --allow-dirty (the reports will say so)"
+            );
+        }
+        self.allowed_dirty = allow_dirty && self.dirty == Some(true);
+        Ok(())
+    }
+
+    /// One sentence for the reports.
+    pub fn describe(&self) -> String {
+        let commit = self.commit.as_deref().unwrap_or("unknown (no git)");
+        match self.dirty {
+            Some(true) => format!(
+                "Built from commit `{commit}` **with uncommitted changes** (`--allow-dirty`): these figures are not reproducible from the commit alone."
+            ),
+            Some(false) => format!("Built from commit `{commit}`, clean tree."),
+            None => format!("Commit `{commit}`; whether the tree was clean is unknown."),
+        }
+    }
+}
+
 fn write_report(
     paper: &Paper,
     session: &Session,
@@ -468,7 +608,13 @@ fn write_report(
 ) -> anyhow::Result<()> {
     let dir = &session.dir;
     let mut md = format!("# {} — reproduced\n\n{}\n\n", paper.title, paper.citation);
-    let mode = if session.quick {
+    let mode = if let Some(dir) = &session.from_run {
+        format!(
+            "**From finished runs** (`tetbench analyze {} {}`): their viewpoints, viewport and frames as run. The CPU analyses (sorts, k-buffer, classifier, data set sizes) are not part of a run: their cells and claims are left empty, with why.",
+            paper.id,
+            dir.display()
+        )
+    } else if session.quick {
         format!(
             "**Quick mode**: viewpoint(s) {QUICK_VIEWPOINTS} instead of the paper's, the viewport side divided by {QUICK_RESOLUTION_DIVISOR} (e.g. 256² for the papers' 512²), {QUICK_FRAMES} timed frame after {QUICK_WARMUP} warm-up, no reference images (no PSNR); data sets at the papers' sizes. Figures are indicative only."
         )
@@ -477,7 +623,12 @@ fn write_report(
             "**Full mode**: the paper's viewpoints and viewport, {FULL_FRAMES} timed frames after {FULL_WARMUP} warm-up, reference images and PSNR."
         )
     };
-    let _ = writeln!(md, "{mode} Took {seconds:.0} s.\n");
+    if session.from_run.is_some() {
+        let _ = writeln!(md, "{mode}\n");
+    } else {
+        let _ = writeln!(md, "{mode} Took {seconds:.0} s.\n");
+    }
+    let _ = writeln!(md, "{}\n", session.source.describe());
     if let Some(r) = session.resolution {
         let _ = writeln!(md, "Viewport overridden: {r}×{r} (`--resolution`).\n");
     }
@@ -496,11 +647,16 @@ fn write_report(
     let _ = writeln!(md, "## Conditions\n");
     let _ = writeln!(md, "- Paper: {}", paper.hardware);
     let _ = writeln!(md, "- Ours: {}\n", our_conditions(session.machine.as_ref()));
-    let _ = writeln!(md, "## The paper's claims on this adapter\n");
-    if report.orderings.is_empty() {
-        let _ = writeln!(md, "(none stated as an ordering)\n");
+    let _ = writeln!(md, "## The paper's claims\n");
+    if report.claims.is_empty() {
+        let _ = writeln!(md, "(none listed in reports/papers/claims.csv)\n");
     } else {
-        md.push_str(&table::orderings_markdown(&report.orderings));
+        let _ = writeln!(
+            md,
+            "From `reports/papers/claims.csv`; one verdict per data set: {}. The rule (`harness/src/papers/verdict.rs`): a difference inside the samples' spread (frames' range) or the claim's tolerance is *within noise*, and one frame per side never orders two sides; a claim about GPU speed measured on a software rasteriser is *not testable on this adapter* (its numbers are still shown); *not checkable* says what is missing.\n",
+            tally_text(&report.claims)
+        );
+        md.push_str(&claims::markdown(&report.claims));
         md.push('\n');
     }
     let _ = writeln!(md, "## Tables\n");
@@ -607,15 +763,20 @@ mod tests {
 /// every table writer alike.
 #[derive(Debug, Clone, Default)]
 pub struct Extra {
-    /// HAVS Table 1: (sort name, ms).
-    pub sorts: Vec<(String, f64)>,
+    /// HAVS Table 1: each sort's median, fastest and slowest run.
+    pub sorts: Vec<crate::analyze::havs::SortRow>,
     /// HAVS Table 2 rows.
     pub kbuffer: Vec<crate::analyze::havs::KbufferRow>,
-    /// GATOR Table 1: observed test outcomes (paper's test order) per case.
-    pub truth_table: Vec<(u8, [bool; 4])>,
+    /// GATOR Table 1: the classifier's distinct outcomes (`None`: not run).
+    pub truth_table: Option<Vec<gator::ObservedCase>>,
     /// Data set sizes: (plan name, points, tets).
     pub sizes: Vec<(String, u64, u64)>,
+    /// Zero-volume tets the loader dropped, per data set (plan name, count).
+    pub dropped: Vec<(String, u64)>,
     /// How many viewpoints and what viewport the k analysis used.
     pub kbuffer_views: usize,
     pub kbuffer_resolution: u32,
 }
+
+#[cfg(test)]
+mod claims_tests;

@@ -10,7 +10,7 @@
 use datasets::standins::{self, Recipe};
 
 use super::papers;
-use super::table::{Cell, CompRow, Comparison, Metric, Ordering};
+use super::table::{Cell, CompRow, Comparison, Metric};
 use super::{find, Extra, Measured, Paper, Report, RunSpec, Session};
 
 pub const PAPER: Paper = Paper {
@@ -19,7 +19,10 @@ pub const PAPER: Paper = Paper {
     citation: "S. Grau, D. Tost, UPC Barcelona, 2007 (venue not in the source). Provenance: reports/papers/splat.md.",
     hardware: "Pentium Dual Core 3.2 GHz, \"3.2 Gb\" memory, NVIDIA GeForce 7900 GTX 512 MB, OpenGL; camera moving, semi-transparent rendering; viewport and frame count not stated.",
     algorithm: "splat",
+    datasets: &["lobster", "engine", "teapot", "aneurism", "bonsai", "stagbeetle"],
+    sections: &["Abstract", "§1", "§2", "§3", "§3.1", "§3.2", "§3.3", "§3.4", "§3.5", "§3.6", "§4", "§5", "§6", "Table 1"],
     reproduce,
+    tables,
 };
 
 /// The transfer function of the Table 1 runs: κ(0) = 0, so the effective voxels are exactly
@@ -58,7 +61,7 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
     Ok(tables(&m, &Extra::default()))
 }
 
-pub fn tables(m: &Measured, _x: &Extra) -> Report {
+pub fn tables(m: &Measured, x: &Extra) -> Report {
     let mut report = Report::default();
     let t = papers::table("splat_table1").expect("embedded paper CSV parses (tested)");
     let aggs = m.aggregates();
@@ -116,18 +119,6 @@ pub fn tables(m: &Measured, _x: &Extra) -> Report {
                 uncertain: t.uncertain(paper, col),
             });
         }
-        let (pc, pg) = (cells[4].paper, cells[5].paper);
-        let (oc, og) = (cells[4].ours, cells[5].ours);
-        report.orderings.push(Ordering {
-            claim: format!(
-                "Table 1, ms per frame on {paper}: GPU buckets < CPU buckets (paper: {:.2}× faster)",
-                pg.zip(pc).map(|(g, c)| g / c).unwrap_or(f64::NAN)
-            ),
-            items: vec![
-                ("GPU buckets".into(), pg.map(|f| 1e3 / f), og.map(|f| 1e3 / f)),
-                ("CPU buckets".into(), pc.map(|f| 1e3 / f), oc.map(|f| 1e3 / f)),
-            ],
-        });
         rows.push(CompRow {
             label: format!("{paper} ({d})"),
             standin: true,
@@ -149,5 +140,6 @@ pub fn tables(m: &Measured, _x: &Extra) -> Report {
         rows,
         notes: radix_notes,
     });
+    report.claims = super::evaluate_claims(PAPER.id, m, x);
     report
 }

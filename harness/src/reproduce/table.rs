@@ -1,6 +1,6 @@
 //! What every paper's report is made of: comparison tables (paper | ours | ours/paper, or an
-//! exact verdict for tables that do not depend on the GPU), the orderings the paper claims
-//! with whether ours agree, and their Markdown, HTML and bar charts.
+//! exact verdict for tables that do not depend on the GPU), their Markdown, HTML and bar
+//! charts. The paper's claims and their verdicts are [`crate::papers::claims`].
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -172,91 +172,6 @@ impl Comparison {
     }
 }
 
-/// A claim of the paper about the relative order of items (faster, slower, larger…), checked
-/// on our measurements.
-#[derive(Debug, Clone)]
-pub struct Ordering {
-    /// The claim in words, e.g. "total ms on f117: HAVS < GATOR < PT < ZSWEEP".
-    pub claim: String,
-    /// (item, paper value, our value), in any order.
-    pub items: Vec<(String, Option<f64>, Option<f64>)>,
-}
-
-/// Whether our values order the items as the paper's do.
-#[derive(Debug, Clone, PartialEq)]
-pub enum OrderVerdict {
-    Holds,
-    DoesNotHold {
-        ours: String,
-    },
-    /// Fewer than two items measured by us.
-    CannotCheck,
-}
-
-impl Ordering {
-    fn sorted(items: &[(String, f64)]) -> Vec<String> {
-        let mut v = items.to_vec();
-        v.sort_by(|a, b| a.1.total_cmp(&b.1));
-        v.into_iter().map(|(n, _)| n).collect()
-    }
-
-    /// The items both have, in the paper's ascending order and ours.
-    pub fn verdict(&self) -> OrderVerdict {
-        let both: Vec<&(String, Option<f64>, Option<f64>)> = self
-            .items
-            .iter()
-            .filter(|(_, p, o)| p.is_some() && o.is_some())
-            .collect();
-        if both.len() < 2 {
-            return OrderVerdict::CannotCheck;
-        }
-        let paper = Self::sorted(
-            &both
-                .iter()
-                .map(|(n, p, _)| (n.clone(), p.unwrap_or(0.0)))
-                .collect::<Vec<_>>(),
-        );
-        let ours = Self::sorted(
-            &both
-                .iter()
-                .map(|(n, _, o)| (n.clone(), o.unwrap_or(0.0)))
-                .collect::<Vec<_>>(),
-        );
-        if paper == ours {
-            OrderVerdict::Holds
-        } else {
-            OrderVerdict::DoesNotHold {
-                ours: ours.join(" < "),
-            }
-        }
-    }
-
-    /// Items the paper orders but we did not measure.
-    pub fn missing(&self) -> Vec<String> {
-        self.items
-            .iter()
-            .filter(|(_, p, o)| p.is_some() && o.is_none())
-            .map(|(n, _, _)| n.clone())
-            .collect()
-    }
-
-    pub fn verdict_text(&self) -> String {
-        let missing = self.missing();
-        let tail = if missing.is_empty() {
-            String::new()
-        } else {
-            format!(" (not measured here: {})", missing.join(", "))
-        };
-        match self.verdict() {
-            OrderVerdict::Holds => format!("holds for the items measured{tail}"),
-            OrderVerdict::DoesNotHold { ours } => {
-                format!("does not hold: ours is {ours}{tail}")
-            }
-            OrderVerdict::CannotCheck => format!("cannot be checked{tail}"),
-        }
-    }
-}
-
 /// A number as printed in tables: fixed digits, `–` for none.
 pub fn num(v: Option<f64>, digits: usize) -> String {
     match v {
@@ -360,15 +275,6 @@ pub fn markdown(c: &Comparison) -> String {
     }
     for n in &c.notes {
         let _ = writeln!(md, "\n{n}");
-    }
-    md
-}
-
-/// The orderings as a Markdown list.
-pub fn orderings_markdown(orderings: &[Ordering]) -> String {
-    let mut md = String::new();
-    for o in orderings {
-        let _ = writeln!(md, "- {} — {}", o.claim, o.verdict_text());
     }
     md
 }
@@ -715,25 +621,6 @@ mod tests {
             html.contains("<table>") && html.contains("<td>2.000</td>"),
             "{html}"
         );
-    }
-
-    #[test]
-    fn orderings() {
-        let o = Ordering {
-            claim: "x".into(),
-            items: vec![
-                ("HAVS".into(), Some(148.0), Some(900.0)),
-                ("GATOR".into(), Some(270.0), Some(2000.0)),
-                ("PT".into(), Some(298.0), None),
-            ],
-        };
-        assert_eq!(o.verdict(), OrderVerdict::Holds);
-        assert_eq!(o.missing(), vec!["PT"]);
-        let mut bad = o.clone();
-        bad.items[0].2 = Some(3000.0);
-        assert!(matches!(bad.verdict(), OrderVerdict::DoesNotHold { .. }));
-        bad.items[1].2 = None;
-        assert_eq!(bad.verdict(), OrderVerdict::CannotCheck);
     }
 
     #[test]

@@ -2,74 +2,80 @@
 //! per table) and the side list of cells the transcription calls uncertain
 //! (`reports/papers/uncertain.csv`). They are compiled into the binary, so `tetbench
 //! reproduce` works from any directory.
+//!
+//! Beside them: [`claims`] (the papers' claims as data, `reports/papers/claims.csv`) and
+//! [`verdict`] (the one rule that decides them).
 
 use anyhow::{anyhow, Context};
+
+pub mod claims;
+pub mod verdict;
 
 /// Every paper table CSV, by name (file name without `.csv`).
 pub const CSVS: &[(&str, &str)] = &[
     (
         "havs_table1",
-        include_str!("../../reports/papers/havs_table1.csv"),
+        include_str!("../../../reports/papers/havs_table1.csv"),
     ),
     (
         "havs_table2",
-        include_str!("../../reports/papers/havs_table2.csv"),
+        include_str!("../../../reports/papers/havs_table2.csv"),
     ),
     (
         "havs_table3",
-        include_str!("../../reports/papers/havs_table3.csv"),
+        include_str!("../../../reports/papers/havs_table3.csv"),
     ),
     (
         "havs_table4",
-        include_str!("../../reports/papers/havs_table4.csv"),
+        include_str!("../../../reports/papers/havs_table4.csv"),
     ),
     (
         "havs_table5",
-        include_str!("../../reports/papers/havs_table5.csv"),
+        include_str!("../../../reports/papers/havs_table5.csv"),
     ),
     (
         "gator_table1",
-        include_str!("../../reports/papers/gator_table1.csv"),
+        include_str!("../../../reports/papers/gator_table1.csv"),
     ),
     (
         "gator_table2",
-        include_str!("../../reports/papers/gator_table2.csv"),
+        include_str!("../../../reports/papers/gator_table2.csv"),
     ),
     (
         "gator_table3",
-        include_str!("../../reports/papers/gator_table3.csv"),
+        include_str!("../../../reports/papers/gator_table3.csv"),
     ),
     (
         "fragment-pt_table1",
-        include_str!("../../reports/papers/fragment-pt_table1.csv"),
+        include_str!("../../../reports/papers/fragment-pt_table1.csv"),
     ),
     (
         "fragment-pt_table2",
-        include_str!("../../reports/papers/fragment-pt_table2.csv"),
+        include_str!("../../../reports/papers/fragment-pt_table2.csv"),
     ),
     (
         "raycast_table3",
-        include_str!("../../reports/papers/raycast_table3.csv"),
+        include_str!("../../../reports/papers/raycast_table3.csv"),
     ),
     (
         "raycast_table4",
-        include_str!("../../reports/papers/raycast_table4.csv"),
+        include_str!("../../../reports/papers/raycast_table4.csv"),
     ),
     (
         "raycast_table5",
-        include_str!("../../reports/papers/raycast_table5.csv"),
+        include_str!("../../../reports/papers/raycast_table5.csv"),
     ),
     (
         "raycast_table6",
-        include_str!("../../reports/papers/raycast_table6.csv"),
+        include_str!("../../../reports/papers/raycast_table6.csv"),
     ),
     (
         "splat_table1",
-        include_str!("../../reports/papers/splat_table1.csv"),
+        include_str!("../../../reports/papers/splat_table1.csv"),
     ),
 ];
 
-const UNCERTAIN: &str = include_str!("../../reports/papers/uncertain.csv");
+const UNCERTAIN: &str = include_str!("../../../reports/papers/uncertain.csv");
 
 /// One paper table: header and rows of text cells (empty = not given by the paper).
 #[derive(Debug, Clone)]
@@ -146,6 +152,14 @@ pub fn paper_name(paper: &str, dataset: &str) -> Option<&'static str> {
             ("brain", "Brain"),
         ],
         "raycast" => &[("spx1", "spx1"), ("bluntfin", "blunt"), ("f117", "f117")],
+        "splat" => &[
+            ("lobster", "Lobster"),
+            ("engine", "Engine"),
+            ("teapot", "BostonTeapot"),
+            ("aneurism", "Aneurism"),
+            ("bonsai", "Bonsai"),
+            ("stagbeetle", "StagBeetle"),
+        ],
         _ => &[],
     };
     names

@@ -1,0 +1,340 @@
+//! The claims file against the papers' plans, and the checks that must be able to fail: each
+//! exact claim is fed a changed input (two cases swapped, four bytes per tet added, a fragment
+//! dropped, a tet lost) and its verdict must flip.
+
+use super::*;
+use crate::papers::claims::{self, ClaimResult};
+use crate::papers::verdict::Verdict;
+
+const ANALYSES: [&str; 4] = [
+    "sort-analysis",
+    "kbuffer-analysis",
+    "classifier-twin",
+    "dataset",
+];
+
+#[test]
+fn every_claim_names_a_paper_section_data_sets_and_variants_that_exist() {
+    let all = claims::all().unwrap();
+    for p in papers() {
+        let n = all
+            .iter()
+            .filter(|c| c.paper == p.id && c.source == claims::Source::Paper)
+            .count();
+        assert!(n >= 3, "{}: {n} claims of the paper's own", p.id);
+    }
+    for c in &all {
+        let p = papers()
+            .into_iter()
+            .find(|p| p.id == c.paper)
+            .unwrap_or_else(|| panic!("{} {}: unknown paper", c.paper, c.id));
+        for part in c.cites.split(" and ") {
+            assert!(
+                p.sections.contains(&part),
+                "{} {}: cites {part:?}, not a section of the paper ({:?})",
+                c.paper,
+                c.id,
+                p.sections
+            );
+        }
+        let pinned = [Some(&c.a), c.b.as_ref()]
+            .into_iter()
+            .flatten()
+            .filter_map(|s| s.dataset.clone());
+        for d in c.datasets.iter().cloned().chain(pinned) {
+            assert!(
+                p.datasets.contains(&d.as_str()),
+                "{} {}: data set {d} is not in the plan {:?}",
+                c.paper,
+                c.id,
+                p.datasets
+            );
+        }
+        for spec in [Some(&c.a), c.b.as_ref()].into_iter().flatten() {
+            if ANALYSES.contains(&spec.algorithm.as_str()) {
+                continue;
+            }
+            let variants = crate::algorithms::all_variants(&spec.algorithm)
+                .unwrap_or_else(|e| panic!("{} {}: {e}", c.paper, c.id));
+            let exists = variants.iter().any(|v| {
+                let settings = v.settings();
+                spec.settings
+                    .iter()
+                    .all(|(k, val)| settings.iter().any(|s| s.key == k && s.value == *val))
+            });
+            assert!(
+                exists,
+                "{} {}: no variant of {} has {}",
+                c.paper,
+                c.id,
+                spec.algorithm,
+                spec.settings_text()
+            );
+        }
+        // Every paper cell a claim compares with exists.
+        if let claims::ExpectSpec::PaperCell { table, column } = &c.expect {
+            let t = papers::table(table).unwrap();
+            for d in &c.datasets {
+                let row = papers::paper_name(&c.paper, d).unwrap_or(d);
+                assert!(
+                    t.value(row, column).is_some(),
+                    "{} {}: {table} {row} {column}",
+                    c.paper,
+                    c.id
+                );
+            }
+        }
+    }
+}
+
+fn verdict_of(results: &[ClaimResult], id: &str, dataset: Option<&str>) -> Verdict {
+    results
+        .iter()
+        .find(|r| r.claim.id == id && r.dataset.as_deref() == dataset)
+        .unwrap_or_else(|| panic!("no verdict for {id} on {dataset:?}"))
+        .evaluation
+        .verdict
+}
+
+#[test]
+fn gator_table1_fails_when_two_cases_are_swapped() {
+    let observed = gator::observed_truth_table(50_000);
+    assert_eq!(observed.len(), 14, "{observed:?}");
+    let x = Extra {
+        truth_table: Some(observed.clone()),
+        ..Default::default()
+    };
+    let m = Measured::default();
+    let ok = evaluate_claims("gator", &m, &x);
+    assert_eq!(verdict_of(&ok, "G1", None), Verdict::Holds);
+    // Swap the case numbers of two outcomes.
+    let mut swapped = observed.clone();
+    let (a, b) = (swapped[0].case, swapped[5].case);
+    swapped[0].case = b;
+    swapped[5].case = a;
+    let x2 = Extra {
+        truth_table: Some(swapped),
+        ..Default::default()
+    };
+    assert_eq!(
+        verdict_of(&evaluate_claims("gator", &m, &x2), "G1", None),
+        Verdict::DoesNotHold
+    );
+    // A wrong triangle count alone fails too.
+    let mut tri = observed.clone();
+    tri[3].class = 3 - tri[3].class;
+    assert!(!gator::table1_mismatches(&tri, &gator::paper_rows()).is_empty());
+    // And the table shows ours beside the paper's in every non-X cell.
+    let report = gator::tables(&m, &x);
+    assert_eq!(report.comparisons[0].verdict(), Some(true));
+    let report = gator::tables(&m, &x2);
+    assert_eq!(report.comparisons[0].verdict(), Some(false));
+    // Not run: not checkable, with why.
+    let none = evaluate_claims("gator", &m, &Extra::default());
+    assert_eq!(verdict_of(&none, "G1", None), Verdict::NotCheckable);
+}
+
+#[test]
+fn gator_sizes_fail_when_a_tet_is_lost() {
+    let m = Measured::default();
+    let sizes = |tets: u64| Extra {
+        sizes: vec![
+            ("bluntfin".into(), 40_960, tets),
+            ("post".into(), 109_744, 513_375),
+        ],
+        ..Default::default()
+    };
+    let ok = evaluate_claims("gator", &m, &sizes(187_395));
+    assert_eq!(verdict_of(&ok, "G2", Some("bluntfin")), Verdict::Holds);
+    assert_eq!(verdict_of(&ok, "G3", Some("post")), Verdict::Holds);
+    let lost = evaluate_claims("gator", &m, &sizes(187_317));
+    assert_eq!(
+        verdict_of(&lost, "G2", Some("bluntfin")),
+        Verdict::DoesNotHold
+    );
+}
+
+fn counter_row(algorithm: &str, settings: &str, dataset: &str, counters: &str) -> Row {
+    Row {
+        algorithm: algorithm.into(),
+        settings: settings.into(),
+        dataset: dataset.into(),
+        tets: 1000,
+        viewpoint: "+x+y+z".into(),
+        total_ms: Some(10.0),
+        frames: 1,
+        counters: counters.into(),
+        device_type: "Cpu".into(),
+        ..Default::default()
+    }
+}
+
+#[test]
+fn memory_claims_fail_with_four_more_bytes_per_tet() {
+    let frag = |b: f64| Measured {
+        rows: vec![counter_row(
+            "fragment-pt",
+            "shading=average;sort=bucket",
+            "bluntfin",
+            &format!("model_bytes_per_tet={b}"),
+        )],
+        errors: vec![],
+    };
+    let x = Extra::default();
+    let ok = evaluate_claims("fragment-pt", &frag(19.5), &x);
+    assert_eq!(verdict_of(&ok, "F2", Some("bluntfin")), Verdict::Holds);
+    assert_eq!(verdict_of(&ok, "F3", Some("bluntfin")), Verdict::Holds);
+    let fat = evaluate_claims("fragment-pt", &frag(23.5), &x);
+    assert_eq!(
+        verdict_of(&fat, "F2", Some("bluntfin")),
+        Verdict::DoesNotHold
+    );
+    // Not measured on comb: not checkable, never a pass.
+    assert_eq!(verdict_of(&ok, "F2", Some("comb")), Verdict::NotCheckable);
+
+    let ray = |b: f64| Measured {
+        rows: vec![counter_row(
+            "raycast",
+            "tiles=5x5;table=2d;mode=passes;et=on;layers=8",
+            "spx1",
+            &format!("mesh_bytes_per_tet={b}"),
+        )],
+        errors: vec![],
+    };
+    let ok = evaluate_claims("raycast", &ray(144.0), &x);
+    assert_eq!(verdict_of(&ok, "R4", Some("spx1")), Verdict::Holds);
+    assert_eq!(verdict_of(&ok, "R5", Some("spx1")), Verdict::Holds);
+    let fat = evaluate_claims("raycast", &ray(148.0), &x);
+    assert_eq!(verdict_of(&fat, "R4", Some("spx1")), Verdict::DoesNotHold);
+    // The memory table compares with the paper's own 144, exactly.
+    assert_eq!(
+        raycast::tables(&ray(144.0), &x)
+            .comparisons
+            .last()
+            .unwrap()
+            .verdict(),
+        Some(true)
+    );
+    assert_eq!(
+        raycast::tables(&ray(148.0), &x)
+            .comparisons
+            .last()
+            .unwrap()
+            .verdict(),
+        Some(false)
+    );
+}
+
+#[test]
+fn havs_table2_fails_when_a_fragment_is_dropped_past_the_tolerance() {
+    let paper = 6_615_778u64;
+    // The last count inside the claim's 2 %, then one fragment fewer.
+    let edge = (paper as f64 * 0.98).ceil() as u64;
+    let x = |fragments: u64| Extra {
+        kbuffer: vec![crate::analyze::havs::KbufferRow {
+            dataset: "spx2".into(),
+            fragments,
+            pixels_k_gt2: 10_626,
+            pixels_k_gt6: 512,
+            ..Default::default()
+        }],
+        kbuffer_views: 14,
+        kbuffer_resolution: 512,
+        ..Default::default()
+    };
+    let m = Measured::default();
+    let at = evaluate_claims("havs", &m, &x(edge));
+    assert_eq!(verdict_of(&at, "H4", Some("spx2")), Verdict::Holds);
+    assert_eq!(verdict_of(&at, "H5", Some("spx2")), Verdict::Holds);
+    // 512 of 512² pixels is 0.2 %: a small k suffices.
+    assert_eq!(verdict_of(&at, "H3", Some("spx2")), Verdict::Holds);
+    let dropped = evaluate_claims("havs", &m, &x(edge - 1));
+    assert_eq!(
+        verdict_of(&dropped, "H4", Some("spx2")),
+        Verdict::DoesNotHold
+    );
+}
+
+#[test]
+fn gpu_speed_claims_on_lavapipe_are_not_testable_and_name_their_variants() {
+    let row = |settings: &str, ms: f64| Row {
+        algorithm: "havs".into(),
+        settings: settings.into(),
+        dataset: "spx2".into(),
+        tets: 827_904,
+        viewpoint: "+x".into(),
+        total_ms: Some(ms),
+        gpu_ms: Some(ms),
+        gpu_ms_min: Some(ms - 1.0),
+        gpu_ms_max: Some(ms + 1.0),
+        frames: 5,
+        device_type: "Cpu".into(),
+        ..Default::default()
+    };
+    let m = Measured {
+        rows: vec![
+            row(
+                "k=2;sort=cpu-radix;tags=two;mode=fragment-race;et=off",
+                100.0,
+            ),
+            row(
+                "k=6;sort=cpu-radix;tags=two;mode=fragment-race;et=off",
+                200.0,
+            ),
+        ],
+        errors: vec![],
+    };
+    let r = evaluate_claims("havs", &m, &Extra::default());
+    let h6 = r
+        .iter()
+        .find(|r| r.claim.id == "H6" && r.dataset.as_deref() == Some("spx2"))
+        .unwrap();
+    assert_eq!(h6.evaluation.verdict, Verdict::NotTestableOnThisAdapter);
+    assert!(h6.evaluation.numbers.contains("would read \"holds\""));
+    assert!(h6
+        .evaluation
+        .variants
+        .iter()
+        .all(|v| v.contains("mode=fragment-race")));
+    // On a hardware adapter the same numbers decide.
+    let mut hw = m.clone();
+    for r in &mut hw.rows {
+        r.device_type = "DiscreteGpu".into();
+    }
+    let r = evaluate_claims("havs", &hw, &Extra::default());
+    assert_eq!(verdict_of(&r, "H6", Some("spx2")), Verdict::Holds);
+}
+
+#[test]
+fn peers_have_no_cpu_gpu_split_in_havs_table5() {
+    let row = Row {
+        algorithm: "vtk-pt".into(),
+        settings: "sort=cell-centre".into(),
+        dataset: "f117".into(),
+        tets: 240_122,
+        viewpoint: "+x".into(),
+        total_ms: Some(300.0),
+        cpu_ms: Some(0.4),
+        gpu_ms: None,
+        frames: 1,
+        ..Default::default()
+    };
+    let m = Measured {
+        rows: vec![row],
+        errors: vec![],
+    };
+    let report = havs::tables(&m, &Extra::default());
+    let t5 = report
+        .comparisons
+        .iter()
+        .find(|c| c.key == "table5")
+        .unwrap();
+    let pt = t5.rows.iter().find(|r| r.label.starts_with("PT")).unwrap();
+    assert_eq!(pt.cells[0].ours, None, "CPU ms of a peer");
+    assert!(pt.cells[0]
+        .why_no_ours
+        .as_deref()
+        .unwrap()
+        .contains("no CPU/GPU split"));
+    assert_eq!(pt.cells[2].ours, Some(300.0), "total ms of a peer");
+}
