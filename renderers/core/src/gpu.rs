@@ -67,7 +67,12 @@ impl DeviceRequest {
     /// The request `TETBENCH_MAX_STORAGE_BINDING=BYTES` and `TETBENCH_TIMESTAMPS=off` describe
     /// (neither set: the adapter as it is).
     pub fn from_env() -> anyhow::Result<DeviceRequest> {
-        let var = |k: &str| std::env::var(k).ok().filter(|v| !v.trim().is_empty());
+        Self::from_vars(|k| std::env::var(k).ok())
+    }
+
+    /// [`DeviceRequest::from_env`] with `lookup` in place of the environment.
+    pub fn from_vars(lookup: impl Fn(&str) -> Option<String>) -> anyhow::Result<DeviceRequest> {
+        let var = |k: &str| lookup(k).filter(|v| !v.trim().is_empty());
         let max_storage_binding = match var(ENV_MAX_STORAGE_BINDING) {
             None => None,
             Some(v) => Some(v.trim().parse::<u64>().map_err(|_| {
@@ -625,6 +630,46 @@ impl FrameTimer {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The environment's device request: unset is the adapter as it is; a wrong value is an
+    /// error naming the variable.
+    #[test]
+    fn device_request_from_variables() {
+        let vars = |pairs: &'static [(&'static str, &'static str)]| {
+            move |k: &str| {
+                pairs
+                    .iter()
+                    .find(|(n, _)| *n == k)
+                    .map(|(_, v)| v.to_string())
+            }
+        };
+        assert_eq!(
+            DeviceRequest::from_vars(vars(&[])).unwrap(),
+            DeviceRequest::default()
+        );
+        assert_eq!(
+            DeviceRequest::from_vars(vars(&[
+                (ENV_MAX_STORAGE_BINDING, "262144"),
+                (ENV_TIMESTAMPS, "off")
+            ]))
+            .unwrap(),
+            DeviceRequest {
+                max_storage_binding: Some(262144),
+                no_timestamps: true
+            }
+        );
+        let e = DeviceRequest::from_vars(vars(&[(ENV_MAX_STORAGE_BINDING, "4k")]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("TETBENCH_MAX_STORAGE_BINDING=\"4k\""), "{e}");
+        let e = DeviceRequest::from_vars(vars(&[(ENV_TIMESTAMPS, "no")]))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("TETBENCH_TIMESTAMPS") && e.contains("on or off"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn chunks_cover_everything_once() {
