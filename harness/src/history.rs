@@ -414,26 +414,6 @@ fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<(
     Ok(())
 }
 
-/// The page: every value goes through minijinja's HTML auto-escaping (on for a template named
-/// `*.html`), so a data set or settings string with markup in it lands as text.
-const PAGE: &str = r#"<!doctype html>
-<html><head><meta charset="utf-8"><title>tetbench history</title>
-<style>body{font-family:sans-serif;margin:1.5em}table{border-collapse:collapse;font-size:13px}
-td,th{border:1px solid #ccc;padding:2px 6px}.step{background:#fdd}</style></head><body>
-<h1>tetbench history</h1>
-<p>Adapter: {{ adapter }}</p>
-<p>Runs (by start date): {% for r in runs %}{{ r.label }}{% if not loop.last %} → {% endif %}{% endfor %}</p>
-<p>Changes against the run before are compare's test (rounds as samples, run-wide factor
-divided out, Holm); a step is where the piecewise-constant fit of the whole series changes level.</p>
-<table><tr><th>algorithm</th><th>settings</th><th>data set</th><th>ms per run</th><th>steps</th></tr>
-{% for s in series %}<tr><td>{{ s.algorithm }}</td><td>{{ s.settings }}</td><td>{{ s.dataset }}</td>
-<td>{% for p in s.points %}{{ "%.2f"|format(p.total_ms) }}{% if p.changes %} ({{ p.changes|join(", ") }}){% endif %}{% if not loop.last %} → {% endif %}{% endfor %}</td>
-<td{% if s.steps %} class="step"{% endif %}>{{ s.steps|join(", ") }}</td></tr>
-{% endfor %}</table>
-{% for c in charts %}<h2>{{ c.title }}</h2><img src="charts/{{ c.file }}">
-{% endfor %}</body></html>
-"#;
-
 #[derive(Serialize)]
 struct PageSeries<'a> {
     algorithm: &'a str,
@@ -461,8 +441,6 @@ fn step_labels(h: &History, s: &Series) -> Vec<String> {
 
 /// history.html: the runs, each series with its changes and steps, and the charts.
 pub fn page(h: &History, charts: &[(String, String)]) -> anyhow::Result<String> {
-    let mut env = minijinja::Environment::new();
-    env.add_template("history.html", PAGE)?;
     let series: Vec<PageSeries> = h
         .series
         .iter()
@@ -494,10 +472,8 @@ pub fn page(h: &History, charts: &[(String, String)]) -> anyhow::Result<String> 
         series,
         charts,
     };
-    let html = env
-        .get_template("history.html")?
-        .render(minijinja::Value::from(minijinja::value::Serde(&page)))?;
-    Ok(html)
+    // templates/history.html: every value HTML-escaped (crate::html).
+    crate::html::render("history.html", &page)
 }
 
 /// `tetbench history`: history.json, history.md, history.html and one chart per algorithm ×

@@ -14,6 +14,7 @@ const TEMPLATES: &[(&str, &str)] = &[
     ("base.html", include_str!("../templates/base.html")),
     ("charts.html", include_str!("../templates/charts.html")),
     ("report.html", include_str!("../templates/report.html")),
+    ("history.html", include_str!("../templates/history.html")),
 ];
 
 fn environment() -> &'static minijinja::Environment<'static> {
@@ -22,12 +23,39 @@ fn environment() -> &'static minijinja::Environment<'static> {
         let mut env = minijinja::Environment::new();
         // Undefined values are template bugs: fail the page instead of printing nothing.
         env.set_undefined_behavior(minijinja::UndefinedBehavior::Strict);
+        env.set_formatter(escape_markup);
         for (name, source) in TEMPLATES {
             env.add_template(name, source)
                 .unwrap_or_else(|e| panic!("template {name} does not compile: {e:#}"));
         }
         env
     })
+}
+
+/// minijinja's own HTML escaping also writes '/' as `&#x2f;`, which turns every path and URL
+/// in a page into entities; a slash cannot start markup in text or in a quoted attribute, so
+/// only `& < > " '` are escaped here, as in Python's `html.escape`.
+fn escape_markup(
+    out: &mut minijinja::Output,
+    state: &mut minijinja::State,
+    value: &minijinja::Value,
+) -> Result<(), minijinja::Error> {
+    if *state.auto_escape() != minijinja::AutoEscape::Html || value.is_safe() {
+        return minijinja::escape_formatter(out, state, value);
+    }
+    let text = value.to_string();
+    let mut escaped = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => escaped.push_str("&amp;"),
+            '<' => escaped.push_str("&lt;"),
+            '>' => escaped.push_str("&gt;"),
+            '"' => escaped.push_str("&quot;"),
+            '\'' => escaped.push_str("&#x27;"),
+            c => escaped.push(c),
+        }
+    }
+    out.write_str(&escaped).map_err(minijinja::Error::from)
 }
 
 /// Renders the page `template` with `context`.
