@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Context;
+use serde::Serialize;
 
 use crate::compare::{CompareOptions, Comparison, FailOn, RowComparison, TimeTest};
 use crate::compare_plot::{ratio_plot, Strip};
@@ -185,75 +186,95 @@ fn markdown(c: &Comparison) -> String {
     s
 }
 
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
+/// One row of compare.html, every cell already formatted (the template escapes them).
+#[derive(Serialize)]
+struct HtmlRow {
+    class: String,
+    status: String,
+    algorithm: String,
+    settings: String,
+    dataset: String,
+    viewpoint: String,
+    total_ms: String,
+    cpu_ms: String,
+    gpu_ms: String,
+    psnr_delta: String,
+    heatmap: String,
+    changed_pixels: u64,
+    image_verdict: String,
+    memory: String,
+    notes: String,
 }
 
-fn html(c: &Comparison) -> String {
-    let mut s = String::from(
-        "<!doctype html><html><head><meta charset=\"utf-8\"><title>tetbench compare</title>\
-         <style>body{font-family:sans-serif;margin:1.5em}table{border-collapse:collapse;font-size:13px}\
-         td,th{border:1px solid #ccc;padding:2px 6px}.regression{background:#fdd}.improvement{background:#dfd}\
-         .changed{background:#ffd}img{max-width:100%}</style></head><body><h1>tetbench compare</h1><ul>",
-    );
-    for l in header(c) {
-        let _ = write!(s, "<li>{}</li>", esc(&l));
-    }
-    s.push_str("</ul>");
-    for (title, list) in [
-        ("Regressions", &c.regressions),
-        ("Improvements", &c.improvements),
-        ("Other changes", &c.changes),
-    ] {
-        if !list.is_empty() {
-            let _ = write!(s, "<h2>{title}</h2><ul>");
-            for l in list {
-                let _ = write!(s, "<li>{}</li>", esc(l));
+#[derive(Serialize)]
+struct HtmlSection<'a> {
+    title: &'static str,
+    lines: &'a [String],
+}
+
+#[derive(Serialize)]
+struct ComparePage<'a> {
+    header: Vec<String>,
+    sections: Vec<HtmlSection<'a>>,
+    rows: Vec<HtmlRow>,
+}
+
+/// compare.html, from `templates/compare.html` (every value escaped, crate::html).
+fn html(c: &Comparison) -> anyhow::Result<String> {
+    let rows = c
+        .rows
+        .iter()
+        .map(|r| {
+            let img = r.image.as_ref();
+            let heatmap = img.map(|i| i.heatmap.clone()).unwrap_or_default();
+            HtmlRow {
+                class: r.status.replace(' ', "-"),
+                status: r.status.to_string(),
+                algorithm: r.algorithm.clone(),
+                settings: r.settings.clone(),
+                dataset: r.dataset.clone(),
+                viewpoint: r.viewpoint.clone(),
+                total_ms: time_cell(metric(r, "total_ms")),
+                cpu_ms: time_cell(metric(r, "cpu_ms")),
+                gpu_ms: time_cell(metric(r, "gpu_ms")),
+                psnr_delta: img
+                    .and_then(|i| i.psnr_delta_db)
+                    .map(|d| format!("{d:+.3}"))
+                    .unwrap_or_default(),
+                changed_pixels: img.and_then(|i| i.changed_pixels).unwrap_or(0),
+                image_verdict: img.map(|i| i.verdict.clone()).unwrap_or_default(),
+                heatmap,
+                memory: r
+                    .memory
+                    .iter()
+                    .map(|m| format!("{} {}→{}", m.what, m.base, m.new))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                notes: r.notes.join("; "),
             }
-            s.push_str("</ul>");
-        }
-    }
-    s.push_str(
-        "<h2>Ratio plots</h2><p>Each strip: grey dots are BASE's frames, coloured dots NEW's, both \
-         divided by BASE's median (red: slower, green: faster, blue: no change); vertical lines at 1 \
-         and at the threshold factors.</p><h3>Groups (viewpoints pooled)</h3>\
-         <img src=\"charts/ratio_groups.png\"><h3>Rows (total_ms)</h3><img src=\"charts/ratio_rows.png\">",
-    );
-    s.push_str("<h2>Rows</h2><table><tr><th>status</th><th>algorithm</th><th>settings</th><th>data set</th><th>view</th><th>total_ms</th><th>cpu_ms</th><th>gpu_ms</th><th>PSNR Δ</th><th>image</th><th>memory</th><th>notes</th></tr>");
-    for r in &c.rows {
-        let img = r.image.as_ref();
-        let heat = img
-            .filter(|i| !i.heatmap.is_empty())
-            .map(|i| {
-                format!(
-                    "<a href=\"{0}\"><img src=\"{0}\" width=64></a> {1} px",
-                    esc(&i.heatmap),
-                    i.changed_pixels.unwrap_or(0)
-                )
-            })
-            .unwrap_or_else(|| img.map(|i| i.verdict.clone()).unwrap_or_default());
-        let _ = write!(
-            s,
-            "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            r.status.replace(' ', "-"),
-            esc(&r.status),
-            esc(&r.algorithm),
-            esc(&r.settings),
-            esc(&r.dataset),
-            esc(&r.viewpoint),
-            esc(&time_cell(metric(r, "total_ms"))),
-            esc(&time_cell(metric(r, "cpu_ms"))),
-            esc(&time_cell(metric(r, "gpu_ms"))),
-            img.and_then(|i| i.psnr_delta_db).map(|d| format!("{d:+.3}")).unwrap_or_default(),
-            heat,
-            esc(&r.memory.iter().map(|m| format!("{} {}→{}", m.what, m.base, m.new)).collect::<Vec<_>>().join(", ")),
-            esc(&r.notes.join("; "))
-        );
-    }
-    s.push_str("</table></body></html>\n");
-    s
+        })
+        .collect();
+    crate::html::render(
+        "compare.html",
+        ComparePage {
+            header: header(c),
+            sections: vec![
+                HtmlSection {
+                    title: "Regressions",
+                    lines: &c.regressions,
+                },
+                HtmlSection {
+                    title: "Improvements",
+                    lines: &c.improvements,
+                },
+                HtmlSection {
+                    title: "Other changes",
+                    lines: &c.changes,
+                },
+            ],
+            rows,
+        },
+    )
 }
 
 /// Writes compare.md, compare.json, compare.html and the ratio plots into `out`.
@@ -307,7 +328,7 @@ pub fn write_outputs(c: &Comparison, out: &Path) -> anyhow::Result<()> {
         &rows,
         c.threshold,
     )?;
-    write("compare.html", html(c))
+    write("compare.html", html(c)?)
 }
 
 /// What `compare` prints on stdout.
@@ -357,11 +378,15 @@ mod tests {
 
     /// Writes a one-row results set whose f32 image is `img`, with 5 frames around `ms`.
     fn results_dir(dir: &Path, img: &render_core::Image, ms: f64) {
+        results_dir_named(dir, img, ms, "box:1k")
+    }
+
+    fn results_dir_named(dir: &Path, img: &render_core::Image, ms: f64, dataset: &str) {
         std::fs::create_dir_all(dir.join("images")).unwrap();
         let mut row = crate::results::Row {
             algorithm: "havs".into(),
             settings: "k=2".into(),
-            dataset: "box:1k".into(),
+            dataset: dataset.into(),
             viewpoint: "+x".into(),
             total_ms: Some(ms),
             psnr_db: Some(60.0),
@@ -381,6 +406,30 @@ mod tests {
             errors: vec![],
         };
         crate::results::write_json(dir, &file).unwrap();
+    }
+
+    /// Issue 23: a data set named with markup lands in compare.html as text.
+    #[test]
+    fn markup_in_names_is_escaped() {
+        use crate::html::{assert_no_live_markup, HOSTILE_NAME};
+        let tmp = tempfile::tempdir().unwrap();
+        let img = render_core::Image::new(8, 8);
+        let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+        results_dir_named(&a, &img, 10.0, HOSTILE_NAME);
+        results_dir_named(&b, &img, 10.0, HOSTILE_NAME);
+        let opt = CompareOptions {
+            threshold: 1.10,
+            alpha: 0.05,
+            normalised: false,
+            drift_correction: true,
+            drift_limit: 1.5,
+            fail_on: FailOn::Change,
+            out: tmp.path().join("out"),
+        };
+        run_command(&a, &b, &opt, CompareFormat::Text).unwrap();
+        let page = std::fs::read_to_string(tmp.path().join("out/compare.html")).unwrap();
+        assert!(page.contains("<table>"), "the page has its table");
+        assert_no_live_markup(&page);
     }
 
     /// Rendering is deterministic, so a single changed pixel — far below what PSNR or an

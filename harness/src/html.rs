@@ -15,6 +15,7 @@ const TEMPLATES: &[(&str, &str)] = &[
     ("charts.html", include_str!("../templates/charts.html")),
     ("report.html", include_str!("../templates/report.html")),
     ("history.html", include_str!("../templates/history.html")),
+    ("compare.html", include_str!("../templates/compare.html")),
 ];
 
 fn environment() -> &'static minijinja::Environment<'static> {
