@@ -451,7 +451,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
     write_file(&args.out.join("README.md"), &index)?;
     write_file(
         &args.out.join("index.html"),
-        &table::markdown_to_html(&index, "Papers reproduced"),
+        &table::markdown_to_html(&index, "Papers reproduced")?,
     )?;
     print!("{index}");
     Ok(())
@@ -685,7 +685,7 @@ fn write_report(
     write_file(&dir.join("report.md"), &md)?;
     write_file(
         &dir.join("report.html"),
-        &table::markdown_to_html(&md, paper.title),
+        &table::markdown_to_html(&md, paper.title)?,
     )
 }
 

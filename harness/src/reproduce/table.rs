@@ -279,130 +279,31 @@ pub fn markdown(c: &Comparison) -> String {
     md
 }
 
-fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-}
-
-/// A small Markdown-to-HTML pass for the report: headings, tables, lists, images, paragraphs.
-pub fn markdown_to_html(md: &str, title: &str) -> String {
-    let mut html = format!(
-        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{}</title><style>\
-         body{{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em}}\
-         table{{border-collapse:collapse;margin:1em 0;font-size:90%}}\
-         td,th{{border:1px solid #bbb;padding:2px 6px;text-align:right}}\
-         td:first-child,th:first-child{{text-align:left}}img{{max-width:100%}}\
-         </style></head><body>\n",
-        html_escape(title)
-    );
-    let mut in_table = false;
-    let mut in_list = false;
-    for line in md.lines() {
-        let t = line.trim_end();
-        if t.starts_with('|') {
-            if in_list {
-                html.push_str("</ul>\n");
-                in_list = false;
-            }
-            let cells: Vec<&str> = t.trim_matches('|').split('|').map(str::trim).collect();
-            if cells.iter().all(|c| c.chars().all(|ch| "-:".contains(ch))) {
-                continue;
-            }
-            let tag = if in_table { "td" } else { "th" };
-            if !in_table {
-                html.push_str("<table>\n");
-                in_table = true;
-            }
-            html.push_str("<tr>");
-            for c in cells {
-                let _ = write!(html, "<{tag}>{}</{tag}>", inline(c));
-            }
-            html.push_str("</tr>\n");
-            continue;
-        }
-        if in_table {
-            html.push_str("</table>\n");
-            in_table = false;
-        }
-        if let Some(item) = t.strip_prefix("- ") {
-            if !in_list {
-                html.push_str("<ul>\n");
-                in_list = true;
-            }
-            let _ = writeln!(html, "<li>{}</li>", inline(item));
-            continue;
-        }
-        if in_list {
-            html.push_str("</ul>\n");
-            in_list = false;
-        }
-        if let Some(h) = t.strip_prefix("### ") {
-            let _ = writeln!(html, "<h3>{}</h3>", inline(h));
-        } else if let Some(h) = t.strip_prefix("## ") {
-            let _ = writeln!(html, "<h2>{}</h2>", inline(h));
-        } else if let Some(h) = t.strip_prefix("# ") {
-            let _ = writeln!(html, "<h1>{}</h1>", inline(h));
-        } else if !t.is_empty() {
-            let _ = writeln!(html, "<p>{}</p>", inline(t));
-        }
+/// A report page from its Markdown: pulldown-cmark (tables on) renders the body, and raw HTML
+/// in the Markdown — a data set or file name such as `<img src=x onerror=alert(1)>` quoted in a
+/// table — is turned into text before rendering, so only the Markdown's own structure becomes
+/// markup. The page around it comes from `templates/markdown.html` (crate::html).
+pub fn markdown_to_html(md: &str, title: &str) -> anyhow::Result<String> {
+    use pulldown_cmark::{Event, Options, Parser};
+    let events = Parser::new_ext(md, Options::ENABLE_TABLES).map(|e| match e {
+        Event::Html(raw) | Event::InlineHtml(raw) => Event::Text(raw),
+        e => e,
+    });
+    let mut body = String::new();
+    pulldown_cmark::html::push_html(&mut body, events);
+    #[derive(serde::Serialize)]
+    struct Page<'a> {
+        title: &'a str,
+        body: minijinja::Value,
     }
-    if in_table {
-        html.push_str("</table>\n");
-    }
-    if in_list {
-        html.push_str("</ul>\n");
-    }
-    html.push_str("</body></html>\n");
-    html
-}
-
-/// Inline Markdown: `![alt](src)` images, `**bold**`, `` `code` ``.
-fn inline(s: &str) -> String {
-    let mut out = String::new();
-    let mut rest = s;
-    while let Some(i) = rest.find("![") {
-        out.push_str(&inline_text(&rest[..i]));
-        let after = &rest[i + 2..];
-        match (after.find("]("), after.find(')')) {
-            (Some(a), Some(b)) if a < b => {
-                let alt = &after[..a];
-                let src = &after[a + 2..b];
-                let _ = write!(
-                    out,
-                    "<img src=\"{}\" alt=\"{}\">",
-                    html_escape(src),
-                    html_escape(alt)
-                );
-                rest = &after[b + 1..];
-            }
-            _ => {
-                out.push_str("![");
-                rest = after;
-            }
-        }
-    }
-    out.push_str(&inline_text(rest));
-    out
-}
-
-fn inline_text(s: &str) -> String {
-    let e = html_escape(s);
-    let mut out = String::new();
-    for (i, part) in e.split("**").enumerate() {
-        if i % 2 == 1 {
-            let _ = write!(out, "<b>{part}</b>");
-        } else {
-            for (j, p) in part.split('`').enumerate() {
-                if j % 2 == 1 {
-                    let _ = write!(out, "<code>{p}</code>");
-                } else {
-                    out.push_str(p);
-                }
-            }
-        }
-    }
-    out
+    crate::html::render(
+        "markdown.html",
+        Page {
+            title,
+            // Escaped by pulldown-cmark above: every text and attribute, raw HTML included.
+            body: minijinja::Value::from_safe_string(body),
+        },
+    )
 }
 
 const FONT: &str = "DejaVu Sans";
@@ -616,9 +517,26 @@ mod tests {
         assert!(r.agrees(2900.0, 2896.0) && r.agrees(187000.0, 187318.0));
         assert!(r.agrees(1_500_000.0, 1_500_282.0) && !r.agrees(950_000.0, 941_192.0));
         assert!(markdown(&comparison(true, 2.0)).contains("| a | 2.0 | 2.0 | matches |"));
-        let html = markdown_to_html(&markdown(&comparison(false, 4.0)), "t");
+        let html = markdown_to_html(&markdown(&comparison(false, 4.0)), "t").unwrap();
         assert!(
-            html.contains("<table>") && html.contains("<td>2.000</td>"),
+            html.contains("<table>") && html.contains("2.000</td>"),
+            "{html}"
+        );
+    }
+
+    /// Issue 23: markup in a data set's name, in an image's alt text or path, lands as text.
+    #[test]
+    fn markup_in_a_report_lands_as_text() {
+        use crate::html::{assert_no_live_markup, HOSTILE_NAME};
+        let md = format!(
+            "# Report\n\n| data set | tets |\n|---|---:|\n| {HOSTILE_NAME} | 3 |\n\n{HOSTILE_NAME}\n\n\
+             ![x\" onerror=\"alert(1)](charts/a.png)\n"
+        );
+        let html = markdown_to_html(&md, HOSTILE_NAME).unwrap();
+        assert_no_live_markup(&html);
+        assert!(!html.contains("\" onerror"), "{html}");
+        assert!(
+            html.contains("<table>") && html.contains("<img src=\"charts/a.png\""),
             "{html}"
         );
     }
