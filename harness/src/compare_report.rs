@@ -408,6 +408,19 @@ mod tests {
         crate::results::write_json(dir, &file).unwrap();
     }
 
+    /// The default thresholds, gating on any change, writing into `out`.
+    fn gate_on_change(out: std::path::PathBuf) -> CompareOptions {
+        CompareOptions {
+            threshold: 1.10,
+            alpha: 0.05,
+            normalised: false,
+            drift_correction: true,
+            drift_limit: 1.5,
+            fail_on: FailOn::Change,
+            out,
+        }
+    }
+
     /// Issue 23: a data set named with markup lands in compare.html as text.
     #[test]
     fn markup_in_names_is_escaped() {
@@ -417,15 +430,7 @@ mod tests {
         let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
         results_dir_named(&a, &img, 10.0, HOSTILE_NAME);
         results_dir_named(&b, &img, 10.0, HOSTILE_NAME);
-        let opt = CompareOptions {
-            threshold: 1.10,
-            alpha: 0.05,
-            normalised: false,
-            drift_correction: true,
-            drift_limit: 1.5,
-            fail_on: FailOn::Change,
-            out: tmp.path().join("out"),
-        };
+        let opt = gate_on_change(tmp.path().join("out"));
         run_command(&a, &b, &opt, CompareFormat::Text).unwrap();
         let page = std::fs::read_to_string(tmp.path().join("out/compare.html")).unwrap();
         assert!(page.contains("<table>"), "the page has its table");
@@ -451,15 +456,7 @@ mod tests {
         results_dir(&a, &img, 10.0);
         results_dir(&b, &img, 10.0);
         results_dir(&c, &changed, 10.0);
-        let opt = |out: &str| CompareOptions {
-            threshold: 1.10,
-            alpha: 0.05,
-            normalised: false,
-            drift_correction: true,
-            drift_limit: 1.5,
-            fail_on: FailOn::Change,
-            out: tmp.path().join(out),
-        };
+        let opt = |out: &str| gate_on_change(tmp.path().join(out));
         let same = compare(&a, &b, &opt("ab")).unwrap();
         assert_eq!(same.outcome(), "no change", "{same:#?}");
         assert!(!run_command(&a, &b, &opt("ab"), CompareFormat::Text).unwrap());
