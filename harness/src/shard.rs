@@ -193,7 +193,8 @@ pub fn gaps(files: &[ResultsFile], dirs: &[PathBuf]) -> anyhow::Result<Vec<Gap>>
     let mut gaps = vec![];
     // Split (algorithms, N) → how many files hold each shard, and one of its files. Not keyed
     // by adapter: the shards of one split may run on different GPUs of a cluster.
-    let mut splits: Vec<((Vec<String>, usize), HashMap<usize, usize>, &ResultsFile)> = vec![];
+    type Split<'f> = ((Vec<String>, usize), HashMap<usize, usize>, &'f ResultsFile);
+    let mut splits: Vec<Split> = vec![];
     for (f, d) in files.iter().zip(dirs) {
         let shard = shard_of(f, d)?;
         if f.finished_utc.is_none() {

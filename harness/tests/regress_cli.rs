@@ -266,7 +266,7 @@ fn resume_keeps_finished_units_and_refuses_another_plan() {
     assert!(first.status.success(), "{first:?}");
     let full = harness::results::ResultsFile::read(&out).unwrap();
     assert!(
-        full.rows.len() >= 4 && full.rows.len() % 2 == 0,
+        full.rows.len() >= 4 && full.rows.len().is_multiple_of(2),
         "{}",
         full.rows.len()
     );

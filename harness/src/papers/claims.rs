@@ -322,10 +322,15 @@ pub struct ClaimResult {
 
 /// Where the numbers come from: the run's rows, the paper's own analyses, and why an
 /// algorithm has no rows.
+/// A side from the paper's CPU analyses for (metric, variant, data set), or `None` when the
+/// metric is not one of them.
+pub type AnalysisSide<'a> =
+    dyn Fn(&str, &VariantSpec, Option<&str>) -> Option<Result<Side, String>> + 'a;
+
 pub struct Inputs<'a> {
     pub rows: &'a [Row],
     /// A side from the paper's CPU analyses (`None`: the metric is not one of them).
-    pub analysis: &'a dyn Fn(&str, &VariantSpec, Option<&str>) -> Option<Result<Side, String>>,
+    pub analysis: &'a AnalysisSide<'a>,
     /// Why `algorithm` has no value on a data set.
     pub why_missing: &'a dyn Fn(&str, &str) -> String,
     /// Whether the GPU numbers came from a software rasteriser.

@@ -422,7 +422,8 @@ fn timing_problem(f: &FrameStats) -> Option<String> {
     let wall = stage("renderer_wall_ms");
     if let Some(w) = wall {
         // tetbench's own clock ran around the renderer's: a longer frame is impossible.
-        if !(w > 0.0) || w > f.total_ms + 1.0 {
+        // A NaN time fails as well as a non-positive or too long one.
+        if w.is_nan() || w <= 0.0 || w > f.total_ms + 1.0 {
             return Some(format!(
                 "wall_ms = {w:.3} but tetbench timed the whole exchange at {:.3} ms (wall_ms \
                  must be positive and no longer than that)",
