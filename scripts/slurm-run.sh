@@ -13,7 +13,7 @@
 #                     DIR/slurm/ (the two job scripts, for resubmitting a failed shard)
 #   --gpu             one GPU per task (sbatch --gres=gpu:1)
 #   --tetbench BIN    the binary (default: $CARGO_TARGET_DIR/release/tetbench, else
-#                     target/release/tetbench); it too must be on a shared file system
+#                     the repository's target/release/tetbench); it too must be on a shared file system
 #   --sbatch ARG      an extra sbatch option for both jobs, repeatable (--sbatch --partition=gpu)
 #   --shared-ok       skip the shared-path test: you know DIR and BIN are visible on every node
 #   --allow-missing   merge even when shards failed; the merged results list the missing units
@@ -66,7 +66,9 @@ command -v sbatch >/dev/null 2>&1 ||
     die "sbatch not found: run this on a Slurm login node (or install Slurm's client, e.g. apt-get install slurm-client)"
 
 if [ -z "$bin" ]; then
-    bin="${CARGO_TARGET_DIR:-target}/release/tetbench"
+    # Where cargo built it: $CARGO_TARGET_DIR, else target/ at the repository root (not the
+    # current directory, so the script works from anywhere).
+    bin="${CARGO_TARGET_DIR:-$(cd "$(dirname "$0")/.." && pwd)/target}/release/tetbench"
     [ -x "$bin" ] || die "no tetbench binary at $bin: build it (cargo build --release -p harness --bin tetbench) or pass --tetbench BIN"
 fi
 [ -x "$bin" ] && [ -f "$bin" ] || die "--tetbench $bin: not an executable file"
