@@ -2,7 +2,7 @@
 # Runs the default suite in a release build and stores it as a committed baseline:
 # reports/baselines/<adapter>-<YYYY-MM-DD>/ with results.json (samples, image hashes and the
 # backend's calibration in machine.calibration), results.csv, samples.csv and calibration.json.
-# The suite runs with --rounds 5 (README, "Regression tracking": samples from separate moments).
+# The suite runs with --rounds 5 (docs/regression.md, "Rounds are the samples").
 # No images (the hashes in the rows still show any changed pixel). Extra arguments go to
 # `tetbench run` (e.g. --cache-dir DIR). Replaces a baseline of the same adapter and day.
 set -euo pipefail

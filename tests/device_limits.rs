@@ -97,7 +97,8 @@ fn deterministic(renderer: &dyn Renderer, gpu: &Gpu) -> bool {
 /// Lowest PSNR accepted between the splatter's bricked and unbricked images (every other
 /// algorithm must match bit for bit). Bricks are sorted and bucketed apart, so voxels of equal
 /// depth from two bricks reach a sheet in another order and their f32 sums round differently;
-/// the splatter's own test measured 66 dB between 8 bricks and none (README, "Splatting").
+/// the splatter's own test measured 66 dB between 8 bricks and none (docs/reproduction.md,
+/// "Splatting").
 const SPLAT_BRICKS_MIN_PSNR_DB: f64 = 60.0;
 
 #[test]

@@ -1,5 +1,5 @@
 //! The measurements behind the decision whether vtkio should write or read tetbench's `.vtu`
-//! files (README, "Dependencies"). Blunt Fin (PLOT3D, 187,395 tets after the 5-tet split) is
+//! files (docs/dependencies.md). Blunt Fin (PLOT3D, 187,395 tets after the 5-tet split) is
 //! written by our writer and by vtkio, each file is read back by our reader and by vtkio, and
 //! every read is compared with the mesh written. Times are the best of 7 runs (the
 //! development machine is shared, so the minimum is the steadiest figure).

@@ -7,8 +7,8 @@
 //! reader can be tested against every variant VTK produces.
 //!
 //! vtkio could write `.vtu` too, and VTK reads its output back exactly, but for Blunt Fin its
-//! file is 2.4× larger (UInt64 cells, base64 only) and 6–26× slower to write (README,
-//! "Dependencies"; `datasets/examples/vtkio_measure.rs`), so this writer stays.
+//! file is 2.4× larger (UInt64 cells, base64 only) and 6–26× slower to write
+//! (docs/dependencies.md; `datasets/examples/vtkio_measure.rs`), so this writer stays.
 
 use std::io::Write;
 use std::path::Path;

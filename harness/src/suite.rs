@@ -6,7 +6,7 @@ use render_core::{fixed_viewpoints, orbit_viewpoints, Viewpoint};
 /// What `tetbench run` measures when no data set is named: generated meshes only (no files
 /// needed), every algorithm, three viewpoints, a modest viewport. Sized to finish in under two
 /// minutes on a 2-core machine without a GPU (Mesa lavapipe), reference images included; the
-/// README gives the measured time.
+/// docs/measurements.md gives the measured time.
 pub struct Suite {
     pub datasets: &'static [&'static str],
     pub viewpoints: &'static str,

@@ -9,7 +9,7 @@
 //!
 //! Hand-written rather than vtkio (which checks it: `tests/vtkio_oracle.rs`): vtkio 0.7.0-rc2
 //! refuses raw appended data, ParaView's and our writer's default layout, and its errors carry
-//! no position (measurements in the README, "Dependencies").
+//! no position (measurements in docs/dependencies.md).
 //!
 //! Non-tetrahedral cells are split into conforming tets by [`crate::cells::cell_to_tets`]
 //! (shared with the legacy reader); cell data is averaged to the points when a file has no

@@ -413,7 +413,7 @@ impl<'a> DatasetContext<'a> {
 }
 
 /// What is wrong with a frame's times, if anything: every time finite and non-negative, and the
-/// CPU part of a frame no longer than the frame (README, "Result columns").
+/// CPU part of a frame no longer than the frame (docs/results.md, "Result columns").
 fn frame_time_problem(f: &FrameStats) -> Option<String> {
     let ok = |v: f64| v.is_finite() && v >= 0.0;
     if !ok(f.total_ms) {

@@ -1,5 +1,5 @@
 //! Times tetbench's exact reference (the CPU ray walk, `reference::Prepared::render`) per view,
-//! the ray caster that `vtk-raycast` is compared with in the README's performance section:
+//! the ray caster that `vtk-raycast` is compared with in docs/peers.md's performance section:
 //!
 //! `cargo run --release -p vtk-peer --example reference_speed -- spx,bluntfin 512 14`
 //!

@@ -256,8 +256,8 @@ fn images_match_the_reference_on_a_non_convex_mesh_in_both_modes_and_across_bind
     );
     // Empirical floor, issue 9's acceptance bound for the exact-order 3D table: what remains
     // is table resolution and f32 (measured 65–99 dB over 14 views at 512² on spx, Blunt Fin
-    // and Post, README). It catches a broken walk or table; single steps are checked exactly
-    // against the CPU twin above, pass counts per pixel too.
+    // and Post, docs/reproduction.md). It catches a broken walk or table; single steps are
+    // checked exactly against the CPU twin above, pass counts per pixel too.
     assert!(p >= 45.0, "{p:.2} dB");
     let mut looped = Raycast::new(RaycastSettings {
         mode: Mode::Loop,

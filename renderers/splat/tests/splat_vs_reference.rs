@@ -218,9 +218,10 @@ fn smooth_volume_agrees_with_the_reference_of_its_tet_split() {
         );
         // Same voxels in the same order: only the rounding of depths may differ.
         assert!(d_radix < 1e-4 && d_cpu < 1e-4, "{d_radix} {d_cpu}");
-        // Post-classified splatting is not exact (README, "Splatting"): the Gaussian kernel
-        // (σ = 0.65 voxel) smooths the piecewise-linear field of the tets, and each slab is
-        // classified by its mean value rather than integrated through the transfer function.
+        // Post-classified splatting is not exact (docs/reproduction.md, "Splatting"): the
+        // Gaussian kernel (σ = 0.65 voxel) smooths the piecewise-linear field of the tets, and
+        // each slab is classified by its mean value rather than integrated through the transfer
+        // function.
         // Measured on lavapipe: 46.7 dB perspective, 46.3 dB orthographic; bricked
         // (3,000 voxels a brick) vs whole 66 dB. Bounds 3 dB below the measurements (bricks: 60 dB):
         // empirical bound (no a-priori error bound for this approximation is derived here);
