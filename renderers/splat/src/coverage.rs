@@ -13,10 +13,13 @@
 //! go either way: [`FragmentCount`] also gives the counts with every edge moved in and out by
 //! [`EDGE_MARGIN`], which bound what any conforming rasteriser yields.
 
+use anyhow::Context;
 use rayon::prelude::*;
+use render_core::Camera;
 
 use crate::buckets::{depth, SlabGeometry};
 use crate::gpu::FrameUniform;
+use crate::Splat;
 
 /// How far (pixels) an edge may move between this twin and the rasteriser: sub-pixel
 /// snapping (≤ 1/32 pixel at Vulkan's minimum 4 sub-pixel bits) plus f32 round-off.
@@ -138,6 +141,34 @@ pub fn frame_fragments(
             }
         })
         .reduce(FragmentCount::default, |a, b| a + b)
+}
+
+impl Splat {
+    /// Test hook: early splat elimination drops (and counts) every splat fragment, so the
+    /// row's `ese_dropped_fragments` is the GPU's count of the fragments `splat_fragments`
+    /// derives.
+    #[doc(hidden)]
+    pub fn counting_every_fragment(mut self) -> Splat {
+        self.count_every_fragment = true;
+        self
+    }
+
+    /// The splat coverage of `camera`'s view (derived on the CPU, cached per view), and its
+    /// bounds ([`FragmentCount`]).
+    pub fn fragment_count(&mut self, camera: &Camera) -> anyhow::Result<FragmentCount> {
+        let st = self.state.as_ref().context("splat: prepare first")?;
+        let geom = self.geometry(st, camera);
+        let quad = QuadParams::of(&self.frame_uniform(camera, &geom, 0));
+        if let Some((q, g, c)) = &self.coverage {
+            if *q == quad && *g == geom {
+                return Ok(*c);
+            }
+        }
+        let drawn = geom.num_slabs.min(st.max_slabs);
+        let c = frame_fragments(&quad, &geom, drawn, &st.set.voxels);
+        self.coverage = Some((quad, geom, c));
+        Ok(c)
+    }
 }
 
 #[cfg(test)]

@@ -218,32 +218,6 @@ impl Splat {
         }
     }
 
-    /// Test hook: early splat elimination drops (and counts) every splat fragment, so the
-    /// row's `ese_dropped_fragments` is the GPU's count of the fragments `splat_fragments`
-    /// derives.
-    #[doc(hidden)]
-    pub fn counting_every_fragment(mut self) -> Splat {
-        self.count_every_fragment = true;
-        self
-    }
-
-    /// The splat coverage of `camera`'s view (derived on the CPU, cached per view), and its
-    /// bounds ([`coverage::FragmentCount`]).
-    pub fn fragment_count(&mut self, camera: &Camera) -> anyhow::Result<FragmentCount> {
-        let st = self.state.as_ref().context("splat: prepare first")?;
-        let geom = self.geometry(st, camera);
-        let quad = QuadParams::of(&self.frame_uniform(camera, &geom, 0));
-        if let Some((q, g, c)) = &self.coverage {
-            if *q == quad && *g == geom {
-                return Ok(*c);
-            }
-        }
-        let drawn = geom.num_slabs.min(st.max_slabs);
-        let c = coverage::frame_fragments(&quad, &geom, drawn, &st.set.voxels);
-        self.coverage = Some((quad, geom, c));
-        Ok(c)
-    }
-
     /// Every GPU allocation of the prepared data (after `prepare`).
     pub fn memory(&self) -> Option<&MemoryLedger> {
         self.state.as_ref().map(|s| &s.ledger)
