@@ -1,24 +1,30 @@
 //! `tetbench calibrate`: a short, fixed micro-benchmark of the backend, and the roofline every
 //! row gets from it.
 //!
-//! Five figures, each from one kernel that stresses one resource (`calibrate.wgsl`):
+//! Eight figures, each from one kernel that stresses one resource (`calibrate.wgsl`):
 //! small-triangle setup rate (triangles covering one pixel each), fill rate (a viewport-sized
 //! triangle blended additively into the target format the algorithms use), compute throughput
-//! (vec4 FMA chains), storage-copy bandwidth (a compute copy between two storage buffers) and
-//! the CPU radix sort of `render_core::sort` (HAVS §5.1) in keys/s. Each figure is the best of
-//! five timed repetitions after one warm-up (a roofline wants the backend's peak, and on a busy
-//! machine the best repetition is the one least disturbed), by wall clock around
-//! submit-and-wait, so it is comparable with the rows' `total_ms`. The result is cached per adapter, driver and CPU in the
-//! reference cache directory, so a run pays for it once (a few seconds on lavapipe).
+//! (vec4 FMA chains), storage-copy bandwidth (a compute copy between two storage buffers), the
+//! CPU radix sort of `render_core::sort` (HAVS §5.1) in keys/s, and the work-specific ones of
+//! `calibrate_work.rs`: ray steps (a walk through 144-byte cells), splat fragments (a
+//! footprint lookup blended into a two-channel float sheet) and render-core's GPU radix sort.
+//! Each figure is the best of five timed repetitions after one warm-up (a roofline wants the
+//! backend's peak, and on a busy machine the best repetition is the one least disturbed), by
+//! wall clock around submit-and-wait, so it is comparable with the rows' `total_ms`. The
+//! result is cached per adapter, driver and CPU in the reference cache directory, so a run
+//! pays for it once (a few seconds on lavapipe).
 //!
-//! The roofline ([`annotate`]): for each row, the time each modelled resource alone would need
-//! for the row's work — triangles / setup rate, fragments / fill rate, per-frame GPU bytes
-//! (scratch, k-buffers, targets: each written at least once a frame) / copy bandwidth, keys
-//! sorted on the CPU / sort rate — the largest of them (`roofline_ms`,
-//! `bound_by`) and how close the row gets to it (`limit_fraction = roofline_ms / total_ms`).
-//! `normalized_time = total_ms / roofline_ms` is what `compare --normalised` compares across
-//! machines. The compute figure is recorded but enters no row's roofline: no algorithm reports
-//! its arithmetic count, and inventing one would make the bound fiction.
+//! The roofline ([`annotate`]) reads work counters, never names: each [`Resource`] lists the
+//! counters that measure a row's work on it (`triangles`, `fragments`, `splat_fragments`,
+//! `ray_steps`, `cpu_sort_keys`, `gpu_sort_keys`) and its calibrated rate; a row's time on a
+//! resource is its counters over the rate, plus per-frame GPU bytes (scratch, k-buffers,
+//! targets: each written at least once a frame) over the copy bandwidth. The largest is the
+//! bound (`roofline_ms`, `bound_by`), and `limit_fraction = roofline_ms / total_ms` says how
+//! close the row gets to it. `normalized_time = total_ms / roofline_ms` is what
+//! `compare --normalised` compares across machines. A renderer gets a meaningful bound by
+//! reporting its work under these names (docs/roofline.md). The compute figure is recorded but
+//! enters no row's roofline: no renderer reports its arithmetic count, and inventing one would
+//! make the bound fiction.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -26,11 +32,12 @@ use std::time::Instant;
 use anyhow::Context;
 use render_core::Gpu;
 
+use crate::calibrate_work::best_seconds;
 use crate::machine::MachineInfo;
 use crate::results::Row;
 
 /// Bumped whenever a kernel or its size changes (old cache files are then re-measured).
-pub const CALIBRATION_VERSION: u32 = 2;
+pub const CALIBRATION_VERSION: u32 = 3;
 
 const GRID: u64 = 256; // calibrate.wgsl GRID
 const TRIANGLES: u64 = GRID * GRID * 2;
@@ -40,7 +47,6 @@ const FMA_ITERS: u64 = 256; // calibrate.wgsl FMA_ITERS
 const FMA_INVOCATIONS: u64 = 64 * 1024;
 const COPY_BYTES: u64 = 32 << 20;
 const SORT_KEYS: usize = 1 << 20;
-const REPS: usize = 5;
 
 pub use crate::machine::Calibration;
 
@@ -94,19 +100,7 @@ pub fn cached_or_measure(
     Ok((c, false))
 }
 
-/// Best seconds of `REPS` runs of `f` after one warm-up.
-fn best_seconds(mut f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Result<f64> {
-    f()?;
-    let mut t = Vec::with_capacity(REPS);
-    for _ in 0..REPS {
-        let t0 = Instant::now();
-        f()?;
-        t.push(t0.elapsed().as_secs_f64());
-    }
-    Ok(t.into_iter().fold(f64::INFINITY, f64::min).max(1e-9))
-}
-
-/// Runs the five micro-benchmarks (a few seconds on lavapipe, well under one on a GPU).
+/// Runs the eight micro-benchmarks (a few seconds on lavapipe, well under one on a GPU).
 pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> {
     let started = Instant::now();
     let module = gpu.shader("calibrate", include_str!("calibrate.wgsl"));
@@ -295,6 +289,11 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         "the calibration's radix sort did not sort"
     );
 
+    // 6–8. The work of the counters no generic figure prices (calibrate_work.rs).
+    let ray_steps_per_sec = crate::calibrate_work::ray_steps_per_sec(gpu, &module)?;
+    let splat_fragments_per_sec = crate::calibrate_work::splat_fragments_per_sec(gpu, &module)?;
+    let gpu_sort_keys_per_sec = crate::calibrate_work::gpu_sort_keys_per_sec(gpu)?;
+
     Ok(Calibration {
         version: CALIBRATION_VERSION,
         adapter: gpu.adapter.name.clone(),
@@ -309,6 +308,9 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         compute_gflops: (FMA_INVOCATIONS * FMA_ITERS * 4 * 4 * 2) as f64 / fma_s * 1e-9,
         copy_bytes_per_sec: (2 * copy_bytes) as f64 / copy_s,
         sort_keys_per_sec: SORT_KEYS as f64 / sort_s,
+        ray_steps_per_sec,
+        splat_fragments_per_sec,
+        gpu_sort_keys_per_sec,
     })
 }
 
@@ -316,76 +318,76 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
 // Roofline
 // ---------------------------------------------------------------------------------------------
 
-/// Triangles the row draws per frame: a `triangles` counter when the algorithm reports one,
-/// else the algorithm's fixed count — GATOR draws each tet as the 4 triangles of its basis
-/// graph (Wylie et al. 2002 §4), fragment PT 4 triangles per tet (Marroquim et al. 2006 §3.2,
-/// `tets·12` vertices), HAVS each unique face once (Callahan et al. 2005 §4, the `faces` counter).
-fn triangles(row: &Row) -> Option<f64> {
-    row.counter("triangles")
-        .or_else(|| match row.algorithm.as_str() {
-            "gator-pt" | "fragment-pt" => Some(4.0 * row.tets as f64),
-            "havs" => row.counter("faces"),
-            _ => None,
-        })
+/// One resource of the roofline: the work counters a row reports on it (summed) and the
+/// calibrated rate at which the backend does that work.
+pub struct Resource {
+    pub name: &'static str,
+    pub counters: &'static [&'static str],
+    pub rate: fn(&Calibration) -> f64,
 }
 
-/// Keys the row sorts on the CPU per frame (none for the GPU-resident sorts).
-fn cpu_sort_keys(row: &Row) -> Option<f64> {
-    let sort = row.setting("sort")?;
-    if sort.starts_with("gpu") {
-        return None;
-    }
-    match row.algorithm.as_str() {
-        "havs" => row.counter("faces"),
-        "gator-pt" | "fragment-pt" => Some(row.tets as f64),
-        _ => None,
-    }
-}
+/// Every counter-priced resource. A renderer opts in by reporting the counter; nothing here
+/// knows which renderer reports what.
+pub const RESOURCES: [Resource; 6] = [
+    Resource {
+        name: "triangle setup",
+        counters: &["triangles"],
+        rate: |c| c.triangles_per_sec,
+    },
+    Resource {
+        name: "fill",
+        counters: &["fragments"],
+        rate: |c| c.fill_fragments_per_sec,
+    },
+    Resource {
+        name: "splat fill",
+        counters: &["splat_fragments"],
+        rate: |c| c.splat_fragments_per_sec,
+    },
+    Resource {
+        name: "ray steps",
+        counters: &["ray_steps"],
+        rate: |c| c.ray_steps_per_sec,
+    },
+    Resource {
+        name: "cpu sort",
+        counters: &["cpu_sort_keys"],
+        rate: |c| c.sort_keys_per_sec,
+    },
+    Resource {
+        name: "gpu sort",
+        counters: &["gpu_sort_keys"],
+        rate: |c| c.gpu_sort_keys_per_sec,
+    },
+];
 
-/// Fragments per frame: the row's `fragments` counter (HAVS counts every rasterised face
-/// fragment); a projected-tetrahedra row borrows it from a HAVS row of the same data set, view
-/// and size — a ray through the mesh yields one PT fragment per tet it crosses, i.e. about one
-/// per face crossing, which is what HAVS counts.
-fn fragments(row: &Row, rows: &[Row]) -> Option<f64> {
-    row.counter("fragments").or_else(|| {
-        rows.iter()
-            .filter(|r| {
-                r.algorithm == "havs"
-                    && r.dataset == row.dataset
-                    && r.viewpoint == row.viewpoint
-                    && (r.width, r.height) == (row.width, row.height)
-            })
-            .find_map(|r| r.counter("fragments"))
-            .filter(|_| matches!(row.algorithm.as_str(), "gator-pt" | "fragment-pt"))
-    })
-}
-
-/// The time (ms) each modelled resource alone needs for the row's work.
-pub fn resource_times(row: &Row, rows: &[Row], cal: &Calibration) -> Vec<(&'static str, f64)> {
+/// The time (ms) each modelled resource alone needs for the row's work: each resource whose
+/// counters the row reports (and whose rate the calibration has), and the per-frame GPU bytes
+/// (scratch, targets: each written at least once a frame) at the copy bandwidth.
+pub fn resource_times(row: &Row, cal: &Calibration) -> Vec<(&'static str, f64)> {
     let mut t = vec![];
-    if let Some(n) = triangles(row) {
-        t.push(("triangle setup", n / cal.triangles_per_sec * 1e3));
-    }
-    if let Some(n) = fragments(row, rows) {
-        t.push(("fill", n / cal.fill_fragments_per_sec * 1e3));
+    for r in &RESOURCES {
+        let work: Vec<f64> = r.counters.iter().filter_map(|c| row.counter(c)).collect();
+        let rate = (r.rate)(cal);
+        if !work.is_empty() && rate > 0.0 {
+            t.push((r.name, work.iter().sum::<f64>() / rate * 1e3));
+        }
     }
     if let Some(b) = row.gpu_bytes_frame {
-        t.push(("memory", b as f64 / cal.copy_bytes_per_sec * 1e3));
-    }
-    if let Some(n) = cpu_sort_keys(row) {
-        t.push(("cpu sort", n / cal.sort_keys_per_sec * 1e3));
+        if cal.copy_bytes_per_sec > 0.0 {
+            t.push(("memory", b as f64 / cal.copy_bytes_per_sec * 1e3));
+        }
     }
     t
 }
 
 /// Fills each measured row's roofline columns from `cal`.
 pub fn annotate(rows: &mut [Row], cal: &Calibration) {
-    let snapshot = rows.to_vec();
     for row in rows.iter_mut() {
         let Some(total) = row.total_ms.filter(|t| *t > 0.0) else {
             continue;
         };
-        let bound = resource_times(row, &snapshot, cal)
+        let bound = resource_times(row, cal)
             .into_iter()
             .max_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((name, ms)) = bound.filter(|b| b.1 > 0.0) {
@@ -434,47 +436,113 @@ mod tests {
             compute_gflops: 10.0,
             copy_bytes_per_sec: 1e10,
             sort_keys_per_sec: 1e7,
+            ray_steps_per_sec: 2e6,
+            splat_fragments_per_sec: 5e7,
+            gpu_sort_keys_per_sec: 4e7,
         }
     }
 
-    /// The bound is the resource with the largest time: 40 k triangles at 1 M/s = 40 ms beats
-    /// the fill (borrowed from the HAVS row: 1 M fragments at 100 M/s = 10 ms) and the sort.
-    #[test]
-    fn roofline_picks_the_slowest_resource() {
-        let gator = Row {
-            algorithm: "gator-pt".into(),
-            settings: "variant=linear;sort=radix".into(),
-            tets: 10_000,
-            total_ms: Some(80.0),
+    /// A row named after no algorithm: only its counters and its time count.
+    fn row(counters: &str, total_ms: f64) -> Row {
+        Row {
+            algorithm: "anything".into(),
+            counters: counters.into(),
+            total_ms: Some(total_ms),
             gpu_bytes_frame: Some(1_000_000),
             ..Row::default()
-        };
-        let havs = Row {
-            algorithm: "havs".into(),
-            settings: "k=2;sort=gpu-radix".into(),
-            counters: "fragments=1000000;faces=20000".into(),
-            total_ms: Some(50.0),
-            ..Row::default()
-        };
-        let mut rows = vec![gator, havs];
-        annotate(&mut rows, &cal());
-        let times = resource_times(&rows[0], &rows, &cal());
+        }
+    }
+
+    /// Each counter is priced at its resource's rate; the bound is the slowest resource, its
+    /// fraction the resource's time over the frame's.
+    #[test]
+    fn the_bound_is_the_counter_whose_work_takes_longest() {
+        let mut rows = vec![row(
+            "triangles=40000;fragments=1000000;cpu_sort_keys=10000;ray_steps=20000;\
+             splat_fragments=500000;gpu_sort_keys=40000;rays=7000",
+            80.0,
+        )];
         assert_eq!(
-            times,
+            resource_times(&rows[0], &cal()),
             vec![
                 ("triangle setup", 40.0),
                 ("fill", 10.0),
+                ("splat fill", 10.0),
+                ("ray steps", 10.0),
+                ("cpu sort", 1.0),
+                ("gpu sort", 1.0),
                 ("memory", 0.1),
-                ("cpu sort", 1.0)
             ]
         );
+        annotate(&mut rows, &cal());
         assert_eq!(rows[0].bound_by, "triangle setup");
+        assert_eq!(rows[0].roofline_ms, Some(40.0));
         assert_eq!(rows[0].limit_fraction, Some(0.5));
         assert_eq!(rows[0].normalized_time, Some(2.0));
-        // HAVS with a GPU sort: 20 k faces = 20 ms of setup, no CPU sort term.
-        assert_eq!(rows[1].roofline_ms, Some(20.0));
-        assert!(!resource_times(&rows[1], &rows, &cal())
-            .iter()
-            .any(|(n, _)| *n == "cpu sort"));
+    }
+
+    /// Changing one counter flips the bound: more ray steps make the row ray-step bound, more
+    /// splat fragments splat-fill bound, more sorted keys CPU-sort bound.
+    #[test]
+    fn changing_a_counter_flips_the_bound() {
+        for (counters, bound, ms) in [
+            ("triangles=1000;ray_steps=200000", "ray steps", 100.0),
+            ("triangles=150000;ray_steps=200000", "triangle setup", 150.0),
+            (
+                "triangles=1000;splat_fragments=10000000",
+                "splat fill",
+                200.0,
+            ),
+            (
+                "triangles=1000;cpu_sort_keys=100000000",
+                "cpu sort",
+                10_000.0,
+            ),
+            (
+                "triangles=1000;gpu_sort_keys=100000000",
+                "gpu sort",
+                2_500.0,
+            ),
+            ("fragments=20000000", "fill", 200.0),
+        ] {
+            let mut rows = vec![row(counters, 400.0)];
+            annotate(&mut rows, &cal());
+            assert_eq!(rows[0].bound_by, bound, "{counters}");
+            assert_eq!(rows[0].roofline_ms, Some(ms), "{counters}");
+            assert_eq!(rows[0].limit_fraction, Some(ms / 400.0), "{counters}");
+        }
+    }
+
+    /// Without work counters only the memory term remains; a resource the calibration did not
+    /// measure (rate 0, an older calibration file) prices nothing.
+    #[test]
+    fn unknown_work_and_unmeasured_rates_are_left_out() {
+        let mut rows = vec![row("rays=7000;steps_mean=24", 50.0)];
+        annotate(&mut rows, &cal());
+        assert_eq!(rows[0].bound_by, "memory");
+        let old = Calibration {
+            ray_steps_per_sec: 0.0,
+            ..cal()
+        };
+        let r = row("ray_steps=200000", 50.0);
+        assert_eq!(resource_times(&r, &old), vec![("memory", 0.1)]);
+        assert_eq!(
+            resource_times(&r, &cal()),
+            vec![("ray steps", 100.0), ("memory", 0.1)]
+        );
+    }
+
+    /// The roofline never looks at a row's algorithm or settings: this file quotes no
+    /// algorithm name of the registry (tests included), reads no row's algorithm and no
+    /// setting (counter names such as `ray_steps` are the only vocabulary).
+    #[test]
+    fn calibrate_names_no_algorithm() {
+        let source = include_str!("calibrate.rs");
+        for name in crate::algorithms::names() {
+            let quoted = format!("\"{name}\"");
+            assert!(!source.contains(&quoted), "calibrate.rs names {quoted}");
+        }
+        assert!(!source.contains(concat!(".algo", "rithm")));
+        assert!(!source.contains(concat!(".set", "ting")));
     }
 }

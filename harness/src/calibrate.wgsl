@@ -81,3 +81,102 @@ fn copy_main(@builtin(global_invocation_id) id: vec3<u32>) {
         copy_dst[i] = copy_src[i];
     }
 }
+
+// Ray steps: a walk through a table of 144-byte cells (8 vec4 of geometry + 1 vec4 of
+// neighbours, the ray caster's tet record, renderers/raycast layout.rs), each step a dependent
+// gather: read the cell's four planes, take the nearest exit among faces the ray leaves
+// through (Bernardon et al. 2005 §2.2), read the scalar at the exit, look up one table entry,
+// composite, and move to the neighbour across the exit face. WALK_STEPS steps per invocation.
+const WALK_STEPS: u32 = 32u;
+const WALK_TABLE: u32 = 4096u;
+
+@group(0) @binding(3) var<storage, read> walk_cells: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> walk_next: array<vec4<u32>>;
+@group(0) @binding(5) var<storage, read> walk_table: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read_write> walk_out: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn walk_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let cells = arrayLength(&walk_next);
+    var cell = (id.x * 2654435761u) % cells;
+    let o = vec3<f32>(f32(id.x & 15u), f32((id.x >> 4u) & 15u), 0.5) * 0.01;
+    let d = normalize(vec3<f32>(0.3, 0.2, 1.0) + o);
+    var lambda = 0.0;
+    var colour = vec4<f32>(0.0);
+    for (var i = 0u; i < WALK_STEPS; i++) {
+        let b = cell * 8u;
+        var best = 3.0e38;
+        var face = 0u;
+        for (var f = 0u; f < 4u; f++) {
+            let p = walk_cells[b + f];
+            let den = dot(d, p.xyz);
+            let l = (p.w - dot(o, p.xyz)) / den;
+            if den > 0.0 && l < best {
+                best = l;
+                face = f;
+            }
+        }
+        let g = walk_cells[b + 4u];
+        let s = clamp(dot(g.xyz, o + best * d) + g.w, 0.0, 1.0);
+        let e = walk_table[u32(s * f32(WALK_TABLE - 1u))];
+        colour += (1.0 - colour.a) * e * (best - lambda + walk_cells[b + 5u + (i % 3u)].x);
+        lambda = best;
+        cell = walk_next[cell][face];
+    }
+    walk_out[id.x] = colour;
+}
+
+// Splat fill: instanced SPLAT_PX-pixel quads on a grid over the target, each fragment doing
+// what a splat fragment does (Grau & Tost 2007 §3.6): a bilinear lookup in two footprint
+// slices of a storage table, blended additively into a two-channel float sheet.
+const SPLAT_PX: f32 = 16.0;
+const SPLAT_GRID: u32 = 32u;
+const SPLAT_TARGET: f32 = 512.0;
+const SPLAT_SLICE: u32 = 32u;
+
+@group(0) @binding(7) var<storage, read> splat_table: array<f32>;
+
+struct SplatFill {
+    @builtin(position) pos: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) @interpolate(flat) q: u32,
+}
+
+@vertex
+fn splat_vs(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> SplatFill {
+    var corners = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0),
+        vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0));
+    let c = corners[vi];
+    let cell = ii % (SPLAT_GRID * SPLAT_GRID);
+    // Quads half a quad apart: each pixel is covered several times, as overlapping splats are.
+    let origin = vec2<f32>(f32(cell % SPLAT_GRID), f32(cell / SPLAT_GRID)) * (SPLAT_PX * 0.5) + 0.25;
+    let p = (origin + c * SPLAT_PX) / SPLAT_TARGET * 2.0 - 1.0;
+    var out: SplatFill;
+    out.pos = vec4<f32>(p.x, -p.y, 0.5, 1.0);
+    out.uv = c * f32(SPLAT_SLICE) - 0.5;
+    out.q = ii % 7u;
+    return out;
+}
+
+fn splat_texel(q: u32, x: i32, y: i32) -> f32 {
+    let n = i32(SPLAT_SLICE);
+    if x < 0 || y < 0 || x >= n || y >= n {
+        return 0.0;
+    }
+    return splat_table[q * SPLAT_SLICE * SPLAT_SLICE + u32(y) * SPLAT_SLICE + u32(x)];
+}
+
+fn splat_bilinear(q: u32, uv: vec2<f32>) -> f32 {
+    let f = floor(uv);
+    let t = uv - f;
+    let i = vec2<i32>(f);
+    return mix(mix(splat_texel(q, i.x, i.y), splat_texel(q, i.x + 1, i.y), t.x),
+               mix(splat_texel(q, i.x, i.y + 1), splat_texel(q, i.x + 1, i.y + 1), t.x), t.y);
+}
+
+@fragment
+fn splat_fs(in: SplatFill) -> @location(0) vec4<f32> {
+    let w = mix(splat_bilinear(in.q, in.uv), splat_bilinear(in.q + 1u, in.uv), 0.5);
+    return vec4<f32>(w * 0.5, w, 0.0, 0.0);
+}

@@ -5,6 +5,7 @@
 pub mod algorithms;
 pub mod analyze;
 pub mod calibrate;
+pub mod calibrate_work;
 pub mod cli;
 pub mod compare;
 pub mod compare_plot;

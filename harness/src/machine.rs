@@ -208,6 +208,18 @@ pub struct Calibration {
     pub copy_bytes_per_sec: f64,
     /// `render_core::sort::radix_sort_indices` on 2^20 f32 keys.
     pub sort_keys_per_sec: f64,
+    /// Steps of a walk through 144-byte cells (a dependent gather, four plane tests, one
+    /// table lookup each), the ray caster's unit of work. 0 in calibrations made before it.
+    #[serde(default)]
+    pub ray_steps_per_sec: f64,
+    /// Quad fragments doing a two-slice bilinear footprint lookup, blended into Rg32Float
+    /// (the splatter's sheet); 0 where the adapter cannot blend 32-bit floats, and in
+    /// calibrations made before it.
+    #[serde(default)]
+    pub splat_fragments_per_sec: f64,
+    /// render-core's GPU radix sort on 2^18 f32 keys. 0 in calibrations made before it.
+    #[serde(default)]
+    pub gpu_sort_keys_per_sec: f64,
 }
 
 impl Calibration {
@@ -220,6 +232,9 @@ impl Calibration {
              compute           {:.2} GFLOP/s (f32 FMA)\n\
              storage copy      {:.2} GB/s (read + write)\n\
              CPU radix sort    {:.1} M keys/s (2^20 f32 keys)\n\
+             GPU radix sort    {:.1} M keys/s (2^18 f32 keys)\n\
+             ray steps         {:.2} M steps/s (144-byte cell walk)\n\
+             splat fill        {:.1} M fragments/s (footprint lookup, Rg32Float)\n\
              measured in {:.1} s on {}",
             self.adapter,
             self.driver,
@@ -231,6 +246,9 @@ impl Calibration {
             self.compute_gflops,
             self.copy_bytes_per_sec * 1e-9,
             self.sort_keys_per_sec * 1e-6,
+            self.gpu_sort_keys_per_sec * 1e-6,
+            self.ray_steps_per_sec * 1e-6,
+            self.splat_fragments_per_sec * 1e-6,
             self.seconds,
             self.date_utc
         )

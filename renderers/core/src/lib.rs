@@ -12,6 +12,7 @@ pub mod image_error;
 pub mod preintegration;
 pub mod renderer;
 pub mod scene;
+pub mod silhouette;
 pub mod sort;
 pub mod transfer;
 pub mod visibility;

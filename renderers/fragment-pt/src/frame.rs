@@ -185,6 +185,24 @@ pub(crate) fn render(
             camera.tets_behind_eye(&st.mesh) as f64,
         ),
         ("mesh_bindings".to_string(), st.mesh_bindings as f64),
+        // The roofline's work: pass 2 draws 12 vertices (4 triangles) per tet, and the
+        // visibility order covers every tet, on the device or on the host.
+        ("triangles".to_string(), 4.0 * st.tets as f64),
+        // Outside the timed frame, once per view: the pixel centres of every tet's projection,
+        // which its fan covers once.
+        (
+            "fragments".to_string(),
+            st.fragments.get(camera, &st.mesh) as f64,
+        ),
+        (
+            if sort_mode == SortMode::Gpu {
+                "gpu_sort_keys"
+            } else {
+                "cpu_sort_keys"
+            }
+            .to_string(),
+            st.tets as f64,
+        ),
     ];
     Ok(times
         .with_stages(stages)

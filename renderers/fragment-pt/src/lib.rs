@@ -188,6 +188,8 @@ struct State {
     /// The device-resident sort of the `gpu` variant: sorts pass 1's centroid depths (keys)
     /// with the tet ids pass 1 wrote into `order` (payload), in place.
     gpu_sort: Option<render_core::gpu_sort::GpuRadixSort>,
+    /// The fragments counter, derived once per view (render_core::silhouette).
+    fragments: render_core::silhouette::FragmentsPerView,
 }
 
 /// Fragment PT renderer (`fragment-pt`).
@@ -635,6 +637,7 @@ impl Renderer for FragmentPt {
             merge: Vec::new(),
             visibility,
             gpu_sort,
+            fragments: Default::default(),
         });
         Ok(Prepared {
             persistent_bytes: persistent,

@@ -466,6 +466,8 @@ struct State {
     order: Vec<u32>,
     timer: FrameTimer,
     target: Option<Target>,
+    /// The fragments counter, derived once per view (render_core::silhouette).
+    fragments: render_core::silhouette::FragmentsPerView,
 }
 
 fn max_binding(gpu: &Gpu, over: Option<u64>) -> u64 {
@@ -601,6 +603,7 @@ impl Renderer for GatorPt {
             order,
             timer: FrameTimer::new(gpu),
             target: None,
+            fragments: Default::default(),
         });
         Ok(Prepared {
             persistent_bytes: persistent,
@@ -692,6 +695,16 @@ impl Renderer for GatorPt {
             ("tets".to_string(), n),
             ("basis_graph_vertices".to_string(), NODES as f64 * n),
             ("cycle_breaks".to_string(), sort.cycle_breaks as f64),
+            // The roofline's work: the basis graph's 4 triangles per tet (12 indices), every
+            // tet ordered on the CPU.
+            ("triangles".to_string(), 4.0 * n),
+            ("cpu_sort_keys".to_string(), n),
+            // Outside the timed frame, once per view: the pixel centres of every tet's
+            // projection, which its four triangles cover once each.
+            (
+                "fragments".to_string(),
+                st.fragments.get(camera, &st.host_mesh) as f64,
+            ),
             // Tets with a vertex at or behind the eye: the vertex shader drops them (no
             // near-plane clipping, as the paper); counted outside the timed frame.
             (

@@ -377,6 +377,14 @@ impl State {
             counters.push(("nodes".to_string(), c[3] as f64));
         }
         counters.push(("faces".to_string(), self.num_faces as f64));
+        // The roofline's work: every unique face is one triangle, and the sort orders them all.
+        counters.push(("triangles".to_string(), self.num_faces as f64));
+        let sorted_on = if self.gpu_sort.is_some() {
+            "gpu_sort_keys"
+        } else {
+            "cpu_sort_keys"
+        };
+        counters.push((sorted_on.to_string(), self.num_faces as f64));
         counters.push((
             "table_filter_nearest".to_string(),
             self.table_nearest as u8 as f64,

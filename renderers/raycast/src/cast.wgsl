@@ -13,6 +13,9 @@ const STAT_DROPPED: u32 = 3u;
 const STAT_SKIPPED: u32 = 4u;
 const STAT_STEPS: u32 = 5u;
 const STAT_MAX_STEPS: u32 = 6u;
+// Carry of STAT_STEPS: the sum over all rays is a 64-bit count (high word here), since a large
+// mesh at a large viewport can cross more than 2^32 tets per frame.
+const STAT_STEPS_HIGH: u32 = 7u;
 
 struct TileRect {
     origin: vec2<u32>,
@@ -98,7 +101,10 @@ fn store(i: u32, st: State) {
 
 fn finish(st: ptr<function, State>) {
     (*st).tet = vec2<u32>(NONE, NONE);
-    atomicAdd(&stats[STAT_STEPS], (*st).steps);
+    let before = atomicAdd(&stats[STAT_STEPS], (*st).steps);
+    if before > 0xffffffffu - (*st).steps {
+        atomicAdd(&stats[STAT_STEPS_HIGH], 1u);
+    }
     atomicMax(&stats[STAT_MAX_STEPS], (*st).steps);
 }
 

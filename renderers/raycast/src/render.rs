@@ -26,6 +26,7 @@ const STAT_DROPPED: usize = 3;
 const STAT_SKIPPED: usize = 4;
 const STAT_STEPS: usize = 5;
 const STAT_MAX_STEPS: usize = 6;
+const STAT_STEPS_HIGH: usize = 7;
 
 /// Tiled ray caster (`raycast`).
 pub struct Raycast {
@@ -476,6 +477,7 @@ fn frame(
     // Phases 1–2: peel until a layer is empty (occlusion query) or the maximum is reached; then
     // one more layer into the spare slot, only to count the re-entries that are dropped.
     let mut layers_used = 0u32;
+    let mut peel_draws = 0u32;
     let mut dropped_check = false;
     let t_peel = Instant::now();
     for l in 0..slots {
@@ -531,6 +533,7 @@ fn frame(
             l as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
         );
         clock.submit(gpu, [enc.finish()]);
+        peel_draws += 1;
         let q = clock.read_buffer(
             gpu,
             &t.occlusion_resolve,
@@ -644,6 +647,9 @@ fn frame(
     let gpu_ms = st.timer.gpu_ms(gpu)?;
     let stats: &[u32] = bytemuck::cast_slice(&stats_bytes);
     let entered = stats[STAT_ENTERED] as f64;
+    // Tets crossed by all rays together (one step = one ray-tet exit computation and one
+    // composited segment), the work the roofline's ray-step rate measures.
+    let ray_steps = ((stats[STAT_STEPS_HIGH] as u64) << 32 | stats[STAT_STEPS] as u64) as f64;
     let max_passes = tile_passes.iter().copied().max().unwrap_or(0);
     let mean_passes = tile_passes.iter().map(|&p| p as f64).sum::<f64>() / ntiles as f64;
     let counters = vec![
@@ -659,12 +665,19 @@ fn frame(
         (
             "steps_mean".to_string(),
             if entered > 0.0 {
-                stats[STAT_STEPS] as f64 / entered
+                ray_steps / entered
             } else {
                 0.0
             },
         ),
         ("steps_max".to_string(), stats[STAT_MAX_STEPS] as f64),
+        ("ray_steps".to_string(), ray_steps),
+        // Every peeling layer draws all boundary faces (the last draw finds its layer empty or
+        // fills the spare slot that counts dropped re-entries).
+        (
+            "triangles".to_string(),
+            (st.face_vertices / 3) as f64 * peel_draws as f64,
+        ),
         (
             "early_terminated_rays".to_string(),
             stats[STAT_TERMINATED] as f64,

@@ -190,7 +190,7 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
     };
     let mut r = Raycast::new(settings);
     // View 6 is the first diagonal: the sphere leaves the screen's corner tiles empty.
-    let (_, d, stats, _) = render(&gpu, &mut r, &mesh, &optics, 6, 72);
+    let (_, d, stats, camera) = render(&gpu, &mut r, &mesh, &optics, 6, 72);
     assert!(
         d.layers_used >= 2,
         "a shell needs at least two layers, got {}",
@@ -198,6 +198,7 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
     );
     let layout = r.layout().unwrap();
     let mut reentering = 0;
+    let mut twin_steps = 0u64;
     for y in 0..d.height {
         for x in 0..d.width {
             let i = (y * d.width + x) as usize;
@@ -206,12 +207,29 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
             let w = step::walk(layout, &entries, o, dir, d.bias, d.max_steps);
             assert_eq!(w.steps, d.steps[i], "pixel ({x}, {y})");
             assert!(!w.stalled);
+            twin_steps += w.steps as u64;
             if entries.iter().filter(|e| e.is_some()).count() > 1 {
                 reentering += 1;
             }
         }
     }
     assert!(reentering > 0, "no ray re-entered the shell");
+    // The roofline's work: every tet crossing of every ray, summed on the GPU.
+    assert_eq!(counter(&stats, "ray_steps"), twin_steps as f64);
+    // A pixel ray crosses the tets whose projection holds its centre: the projected-tetrahedra
+    // renderers' `fragments` (render_core::silhouette) count the same work, up to centres on
+    // a projected edge.
+    let projected = render_core::silhouette::projected_fragments(&camera, &mesh);
+    let gap = projected.abs_diff(twin_steps);
+    assert!(
+        gap * 1000 <= twin_steps,
+        "{projected} projected fragments, {twin_steps} ray steps"
+    );
+    // Each peeling draw rasterises all boundary faces; the last one finds its layer empty.
+    assert_eq!(
+        counter(&stats, "triangles"),
+        (mesh.boundary_faces().len() as u32 * (d.layers_used + 1)) as f64
+    );
     let n = settings.tiles;
     let mut empty = 0;
     for ty in 0..n {
@@ -238,6 +256,40 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
     assert_eq!(counter(&stats, "tiles_empty"), empty as f64);
     assert_eq!(counter(&stats, "stalled_rays"), 0.0);
     assert_eq!(counter(&stats, "mesh_bytes_per_tet"), 144.0);
+}
+
+/// One tet: every ray that enters crosses exactly one tet, so the frame's `ray_steps` is its
+/// `rays`, and that is the number of pixel centres inside the tet's silhouette.
+#[test]
+fn one_tet_costs_one_step_per_covered_pixel() {
+    let gpu = gpu();
+    let points = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let mesh = TetMesh::new(
+        "one tet",
+        points,
+        vec![0.0, 0.3, 0.6, 1.0],
+        "s",
+        vec![[0, 1, 2, 3]],
+    )
+    .expect("a valid tet");
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    for mode in [Mode::Passes, Mode::Loop] {
+        let mut r = Raycast::new(RaycastSettings { mode, ..exact() });
+        let (_, d, stats, _) = render(&gpu, &mut r, &mesh, &optics, 6, 48);
+        let covered = d.steps.iter().filter(|&&s| s > 0).count() as f64;
+        assert!(covered > 100.0, "{covered} pixels cover the tet");
+        assert!(
+            d.steps.iter().all(|&s| s <= 1),
+            "{mode:?}: a ray crossed a tet twice"
+        );
+        assert_eq!(counter(&stats, "rays"), covered, "{mode:?}");
+        assert_eq!(counter(&stats, "ray_steps"), covered, "{mode:?}");
+    }
 }
 
 #[test]

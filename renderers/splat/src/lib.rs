@@ -23,6 +23,7 @@
 //! ray's length through the slab.
 
 mod buckets;
+pub mod coverage;
 mod gpu;
 #[doc(hidden)]
 pub use gpu::gpu_layouts;
@@ -41,6 +42,7 @@ use render_core::{
 };
 
 pub use buckets::{bucket_ends, depth, SlabGeometry};
+use coverage::{FragmentCount, QuadParams};
 use gpu::{FrameUniform, Pipelines, IMAGE_FORMAT, SHEET_FORMAT, UNIFORM_STRIDE};
 use kernel::{FootprintTable, Kernel, SIGMA};
 use voxels::VoxelSet;
@@ -189,6 +191,11 @@ pub struct Splat {
     pub settings: SplatSettings,
     state: Option<State>,
     targets: Option<Targets>,
+    /// The last view's splat coverage (work counters are derived once per view).
+    coverage: Option<(QuadParams, SlabGeometry, FragmentCount)>,
+    /// Test hook: every splat fragment is counted as dropped (`ese_dropped_fragments` becomes
+    /// the rasteriser's own count of splat fragments) and the image stays empty.
+    count_every_fragment: bool,
 }
 
 /// What one brick of one frame did.
@@ -206,6 +213,8 @@ impl Splat {
             settings,
             state: None,
             targets: None,
+            coverage: None,
+            count_every_fragment: false,
         }
     }
 
@@ -381,6 +390,13 @@ impl Splat {
     }
 
     fn write_frame(&self, gpu: &Gpu, camera: &Camera, geom: &SlabGeometry, brick: usize) {
+        let u = self.frame_uniform(camera, geom, brick);
+        let st = self.state.as_ref().unwrap();
+        gpu.queue
+            .write_buffer(&st.frame_buf, 0, bytemuck::bytes_of(&u));
+    }
+
+    fn frame_uniform(&self, camera: &Camera, geom: &SlabGeometry, brick: usize) -> FrameUniform {
         let st = self.state.as_ref().unwrap();
         let n = st.set.bricks.get(brick).map_or(0, |b| b.range.len()) as u32;
         let padded = match (self.settings.buckets, self.settings.sort) {
@@ -398,7 +414,7 @@ impl Splat {
             }
         };
         let unit = st.set.kernel_unit;
-        let u = FrameUniform {
+        FrameUniform {
             view_proj: camera.view_proj_f32(),
             depth_row: depth_row(camera),
             viewport: [w as f32, h as f32],
@@ -418,13 +434,16 @@ impl Splat {
             kernel_radius: self.settings.radius as f32,
             kernel_unit: unit as f32,
             density_scale: st.set.density_scale as f32,
-            ese_alpha: if self.settings.ese { ESE_ALPHA } else { 2.0 },
+            ese_alpha: match (self.count_every_fragment, self.settings.ese) {
+                // Every fragment's alpha is at least −1: all are counted and dropped.
+                (true, _) => -1.0,
+                (false, true) => ESE_ALPHA,
+                (false, false) => 2.0,
+            },
             kernel_radius_world: (self.settings.radius * unit) as f32,
             length_unit: st.length_unit as f32,
             pad: [0.0; 2],
-        };
-        gpu.queue
-            .write_buffer(&st.frame_buf, 0, bytemuck::bytes_of(&u));
+        }
     }
 
     fn ensure_targets(&mut self, gpu: &Gpu, width: u32, height: u32) -> anyhow::Result<()> {
@@ -816,6 +835,10 @@ impl Renderer for Splat {
             ("splat".into(), stats.splat_ms),
         ]);
         let total_ms = times.total_ms;
+        // Work counters, after the timed frame: the quads' pixels are derived on the CPU once
+        // per view (`coverage.rs`).
+        let cover = self.fragment_count(camera)?;
+        let st = self.state.as_ref().unwrap();
         let gpu_ms = st.timer.gpu_ms(gpu)?;
         // Counter readback, after the timed frame.
         let ese_dropped = u32::from_le_bytes(
@@ -839,6 +862,21 @@ impl Renderer for Splat {
                 ("border_voxels".into(), st.set.border_voxels as f64),
                 ("slabs".into(), stats.slabs as f64),
                 ("splats".into(), stats.splats as f64),
+                ("splat_fragments".into(), cover.fragments as f64),
+                // Each drawn slab composites one viewport-covering triangle.
+                (
+                    "fragments".into(),
+                    stats.slabs as f64 * camera.width as f64 * camera.height as f64,
+                ),
+                ("triangles".into(), (2 * stats.splats + stats.slabs) as f64),
+                (
+                    match self.settings.buckets {
+                        Buckets::Cpu => "cpu_sort_keys",
+                        Buckets::Gpu => "gpu_sort_keys",
+                    }
+                    .into(),
+                    eff,
+                ),
                 // Early splat elimination drops these; each pixel it touches is already at
                 // least ESE_ALPHA opaque, so it changes that pixel by at most 1 − ESE_ALPHA.
                 ("ese_dropped_fragments".into(), ese_dropped as f64),

@@ -1,0 +1,131 @@
+//! The fragments a projected-tetrahedra renderer rasterises, counted on the CPU: each tet's
+//! triangles (GATOR's basis graph, fragment PT's fans) partition the convex hull of its four
+//! projected vertices, so its fragments are the pixel centres inside that hull. The sum over
+//! the mesh is the roofline's `fragments` work for those renderers, derived once per view and
+//! outside the timed frame (a GPU count would cost an atomic per fragment, and occlusion
+//! queries are only exact where the adapter offers precise ones).
+//!
+//! A pixel ray crosses exactly the tets whose hull holds its centre, so the sum equals the
+//! ray caster's `ray_steps` without early termination, up to centres on a hull edge (where the
+//! rasteriser's tie rule and f32 round-off decide); the ray caster's tests check that.
+
+use rayon::prelude::*;
+
+use crate::Camera;
+
+/// Pixel centres inside the projections of every tet of `mesh` (tets with a vertex at or
+/// behind the eye count nothing: the shaders drop them or cannot project them).
+pub fn projected_fragments(camera: &Camera, mesh: &datasets::TetMesh) -> u64 {
+    let m = camera.view_proj_f32();
+    let (w, h) = (camera.width as f64, camera.height as f64);
+    // Pixel coordinates (x right, y down) of every vertex, None at or behind the eye.
+    let screen: Vec<Option<[f64; 2]>> = mesh
+        .points
+        .par_iter()
+        .map(|p| {
+            let c: [f32; 4] =
+                std::array::from_fn(|r| m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r]);
+            (c[3] > 0.0).then(|| {
+                let (x, y) = ((c[0] / c[3]) as f64, (c[1] / c[3]) as f64);
+                [(x + 1.0) * 0.5 * w, (1.0 - y) * 0.5 * h]
+            })
+        })
+        .collect();
+    mesh.tets
+        .par_iter()
+        .map(|t| {
+            let mut q = [[0.0; 2]; 4];
+            for (k, &v) in t.iter().enumerate() {
+                match screen[v as usize] {
+                    Some(p) => q[k] = p,
+                    None => return 0,
+                }
+            }
+            hull_pixels(&q, w, h)
+        })
+        .sum()
+}
+
+/// [`projected_fragments`] of the last view asked for: a renderer derives its counters once
+/// per view, not once per frame.
+#[derive(Debug, Default)]
+pub struct FragmentsPerView {
+    last: Option<(Camera, u64)>,
+}
+
+impl FragmentsPerView {
+    pub fn get(&mut self, camera: &Camera, mesh: &datasets::TetMesh) -> u64 {
+        match &self.last {
+            Some((c, n)) if c == camera => *n,
+            _ => {
+                let n = projected_fragments(camera, mesh);
+                self.last = Some((camera.clone(), n));
+                n
+            }
+        }
+    }
+}
+
+/// Pixel centres (k + ½, j + ½), 0 ≤ k < w, 0 ≤ j < h, inside the convex hull of `q`: per
+/// row, the hull's span is the extent of the row's crossings of the six segments between
+/// the points; centres from its left end (included) to its right end (excluded).
+pub fn hull_pixels(q: &[[f64; 2]; 4], w: f64, h: f64) -> u64 {
+    let ymin = q.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
+    let ymax = q.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max);
+    let first_row = (ymin - 0.5).ceil().clamp(0.0, h) as u32;
+    let end_row = (ymax - 0.5).ceil().clamp(0.0, h) as u32;
+    let mut n = 0u64;
+    for j in first_row..end_row {
+        let y = j as f64 + 0.5;
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for a in 0..4 {
+            for b in a + 1..4 {
+                let (p, r) = (q[a], q[b]);
+                let (y0, y1) = (p[1].min(r[1]), p[1].max(r[1]));
+                if y < y0 || y > y1 {
+                    continue;
+                }
+                // A horizontal segment on the row contributes both ends.
+                let (x0, x1) = if r[1] == p[1] {
+                    (p[0].min(r[0]), p[0].max(r[0]))
+                } else {
+                    let x = p[0] + (y - p[1]) / (r[1] - p[1]) * (r[0] - p[0]);
+                    (x, x)
+                };
+                lo = lo.min(x0);
+                hi = hi.max(x1);
+            }
+        }
+        if lo <= hi {
+            let first = (lo - 0.5).ceil().clamp(0.0, w);
+            let end = (hi - 0.5).ceil().clamp(0.0, w);
+            n += (end - first).max(0.0) as u64;
+        }
+    }
+    n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_hull_holds_the_centres_inside_it() {
+        // The square [1, 5) × [1, 5) as four corners: 4 × 4 centres.
+        let square = [[1.0, 1.0], [5.0, 1.0], [5.0, 5.0], [1.0, 5.0]];
+        assert_eq!(hull_pixels(&square, 16.0, 16.0), 16);
+        // A triangle with the fourth point inside it: the triangle's centres. Row y = j + ½
+        // spans [0, 7.5 − j), so it holds the centres k + ½ with k < 7 − j.
+        let tri = [[0.0, 0.0], [8.0, 0.0], [0.0, 8.0], [1.0, 1.0]];
+        assert_eq!(
+            hull_pixels(&tri, 16.0, 16.0),
+            (0..8u64).map(|j| 7 - j).sum::<u64>()
+        );
+        // Clipped to the viewport.
+        let big = [[-10.0, -10.0], [30.0, -10.0], [30.0, 30.0], [-10.0, 30.0]];
+        assert_eq!(hull_pixels(&big, 16.0, 8.0), 128);
+        // A degenerate (flat) tet covers nothing.
+        let flat = [[1.0, 2.0], [5.0, 2.0], [3.0, 2.0], [4.0, 2.0]];
+        assert_eq!(hull_pixels(&flat, 16.0, 16.0), 0);
+    }
+}
