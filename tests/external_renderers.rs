@@ -87,13 +87,24 @@ fn both_examples_pass_the_conformance_check() {
     assert_eq!(report.cases.len(), 6);
 }
 
-/// Each deliberately broken convention fails the check, and the check names that one.
+/// Each deliberately broken convention fails the check, and the check names that one; also
+/// when the renderer declares the lowest accuracy the protocol allows (20 dB), which excuses
+/// approximation, never a convention.
 #[test]
 fn wrong_examples_fail_with_the_right_message() {
     for (flag, words) in [
         ("--flip-rows", "image is upside down"),
         ("--straight-alpha", "colour is not premultiplied"),
         ("--mirror", "image is mirrored left-right"),
+        ("--flip-rows --declare-accuracy", "image is upside down"),
+        (
+            "--straight-alpha --declare-accuracy",
+            "colour is not premultiplied",
+        ),
+        (
+            "--mirror --declare-accuracy",
+            "image is mirrored left-right",
+        ),
     ] {
         let report = check(&python_example(flag));
         assert!(!report.passed(), "{flag} passed:\n{report}");
@@ -103,6 +114,46 @@ fn wrong_examples_fail_with_the_right_message() {
             .count();
         // Every view with an image that shows the mistake names it (not the empty view).
         assert!(named >= 3, "{flag}: expected {words:?}:\n{report}");
+    }
+}
+
+/// The correct example under the same declaration still passes, and says it was judged at it.
+#[test]
+fn a_declared_accuracy_is_reported_and_the_right_example_passes_under_it() {
+    let report = check(&python_example("--declare-accuracy"));
+    assert!(report.passed(), "{report}");
+    assert!(report
+        .cases
+        .iter()
+        .any(|c| c.name == "declared accuracy" && c.message.starts_with("20.0 dB")));
+}
+
+/// VTK's three mappers, as `tetbench run --peers vtk` runs them by default, pass the check:
+/// the projected tetrahedra and the ray caster's float readout at full accuracy, the ray
+/// caster's and ZSweep's displayed images at the accuracy they declare (docs, "Declared
+/// accuracy"), nearer the reference than any convention mistake.
+#[test]
+fn vtk_peers_pass_the_conformance_check() {
+    let gpu = gpu();
+    let mut peers = vtk_peer::pt_variants();
+    peers.extend(vtk_peer::raycast_default_variants());
+    peers.extend(vtk_peer::zsweep_default_variants());
+    peers.push(Box::new(vtk_peer::VtkPeer::new(
+        vtk_peer::VtkMapper::RayCast,
+        vtk_peer::Integrator::Linear,
+        vtk_peer::Readout::Rays,
+        false,
+    )));
+    for mut peer in peers {
+        let name = format!("{} {:?}", peer.algorithm(), peer.settings());
+        let report = conformance::check(peer.as_mut(), &gpu, None).unwrap();
+        eprintln!("{name}:\n{report}");
+        assert!(report.passed(), "{name}:\n{report}");
+        let declared = report.cases.iter().any(|c| c.name == "declared accuracy");
+        let framebuffer = peer.algorithm() != "vtk-pt"
+            && peer.settings().iter().any(|s| s.value == "framebuffer")
+            || peer.algorithm() == "vtk-zsweep";
+        assert_eq!(declared, framebuffer, "{name}:\n{report}");
     }
 }
 
