@@ -435,10 +435,10 @@ fn judge(
             (
                 psnr,
                 Ok(format!(
-                    "PSNR {psnr:.1} dB, within the declared accuracy ({:.1} dB: {}) and \
-                     nearer the reference than any convention mistake (closest: {db:.1} dB); \
-                     sub-pixel conventions not judged at this accuracy",
-                    d.min_psnr_db, d.reason
+                    "PSNR {psnr:.1} dB, within the declared {:.1} dB and nearer the reference \
+                     than any convention mistake (closest: {db:.1} dB; sub-pixel conventions \
+                     not judged at this accuracy)",
+                    d.min_psnr_db
                 )),
             )
         };
