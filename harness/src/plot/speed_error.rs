@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use super::data::{distinct, write_csv, Point};
 use super::draw::{self, err, Chart, LegendEntry, FONT, MAX_LEGEND_ROWS, PLOT_WIDTH};
-use super::style::{Style, StyleBook};
+use super::style::{Marker, Style, StyleBook};
 use super::ChartFile;
 use crate::metrics::PSNR_CAP_DB;
 
@@ -113,10 +113,23 @@ impl SpeedError<'_> {
             .iter()
             .find(|o| o.algorithm == r.algorithm)
             .unwrap_or(r);
-        Style {
+        let mut style = Style {
             label: r.algorithm.clone(),
             ..self.book.get(&first.algorithm, &first.settings)
+        };
+        // Peers share one grey family and their first variants may share a marker shape:
+        // here each peer algorithm gets a shape of its own.
+        if crate::plot::style::is_peer(&r.algorithm) {
+            let peers = distinct(
+                self.records
+                    .iter()
+                    .filter(|o| crate::plot::style::is_peer(&o.algorithm))
+                    .map(|o| o.algorithm.clone()),
+            );
+            let i = peers.iter().position(|a| *a == r.algorithm).unwrap_or(0);
+            style.marker = Marker::ALL[i % Marker::ALL.len()];
         }
+        style
     }
 
     fn entries(&self) -> Vec<LegendEntry> {
@@ -508,6 +521,11 @@ mod tests {
         assert_eq!(legend.len(), 4, "{legend:?}");
         assert!(legend[0].starts_with("havs  12 of 12"), "{legend:?}");
         assert!(legend[3].ends_with("(peer)"), "{legend:?}");
+        let peer_markers: Vec<Marker> = chart.entries()[2..]
+            .iter()
+            .map(|e| e.style.marker)
+            .collect();
+        assert_ne!(peer_markers[0], peer_markers[1]);
 
         let few: Vec<Point> = points[10..].to_vec();
         let one = write(dir.path(), &few, &crate::plot::book_of(&few)).unwrap();
