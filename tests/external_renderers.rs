@@ -128,35 +128,6 @@ fn a_declared_accuracy_is_reported_and_the_right_example_passes_under_it() {
         .any(|c| c.name == "declared accuracy" && c.message.starts_with("20.0 dB")));
 }
 
-/// VTK's three mappers, as `tetbench run --peers vtk` runs them by default, pass the check:
-/// the projected tetrahedra and the ray caster's float readout at full accuracy, the ray
-/// caster's and ZSweep's displayed images at the accuracy they declare (docs, "Declared
-/// accuracy"), nearer the reference than any convention mistake.
-#[test]
-fn vtk_peers_pass_the_conformance_check() {
-    let gpu = gpu();
-    let mut peers = vtk_peer::pt_variants();
-    peers.extend(vtk_peer::raycast_default_variants());
-    peers.extend(vtk_peer::zsweep_default_variants());
-    peers.push(Box::new(vtk_peer::VtkPeer::new(
-        vtk_peer::VtkMapper::RayCast,
-        vtk_peer::Integrator::Linear,
-        vtk_peer::Readout::Rays,
-        false,
-    )));
-    for mut peer in peers {
-        let name = format!("{} {:?}", peer.algorithm(), peer.settings());
-        let report = conformance::check(peer.as_mut(), &gpu, None).unwrap();
-        eprintln!("{name}:\n{report}");
-        assert!(report.passed(), "{name}:\n{report}");
-        let declared = report.cases.iter().any(|c| c.name == "declared accuracy");
-        let framebuffer = peer.algorithm() != "vtk-pt"
-            && peer.settings().iter().any(|s| s.value == "framebuffer")
-            || peer.algorithm() == "vtk-zsweep";
-        assert_eq!(declared, framebuffer, "{name}:\n{report}");
-    }
-}
-
 fn run_tetbench(args: &[&str]) -> anyhow::Result<()> {
     let mut all = vec!["tetbench", "run"];
     all.extend_from_slice(args);
