@@ -87,13 +87,24 @@ fn both_examples_pass_the_conformance_check() {
     assert_eq!(report.cases.len(), 6);
 }
 
-/// Each deliberately broken convention fails the check, and the check names that one.
+/// Each deliberately broken convention fails the check, and the check names that one; also
+/// when the renderer declares the lowest accuracy the protocol allows (20 dB), which excuses
+/// approximation, never a convention.
 #[test]
 fn wrong_examples_fail_with_the_right_message() {
     for (flag, words) in [
         ("--flip-rows", "image is upside down"),
         ("--straight-alpha", "colour is not premultiplied"),
         ("--mirror", "image is mirrored left-right"),
+        ("--flip-rows --declare-accuracy", "image is upside down"),
+        (
+            "--straight-alpha --declare-accuracy",
+            "colour is not premultiplied",
+        ),
+        (
+            "--mirror --declare-accuracy",
+            "image is mirrored left-right",
+        ),
     ] {
         let report = check(&python_example(flag));
         assert!(!report.passed(), "{flag} passed:\n{report}");
@@ -104,6 +115,17 @@ fn wrong_examples_fail_with_the_right_message() {
         // Every view with an image that shows the mistake names it (not the empty view).
         assert!(named >= 3, "{flag}: expected {words:?}:\n{report}");
     }
+}
+
+/// The correct example under the same declaration still passes, and says it was judged at it.
+#[test]
+fn a_declared_accuracy_is_reported_and_the_right_example_passes_under_it() {
+    let report = check(&python_example("--declare-accuracy"));
+    assert!(report.passed(), "{report}");
+    assert!(report
+        .cases
+        .iter()
+        .any(|c| c.name == "declared accuracy" && c.message.starts_with("20.0 dB")));
 }
 
 fn run_tetbench(args: &[&str]) -> anyhow::Result<()> {

@@ -14,7 +14,8 @@ sum per pixel.
 
 The mesh comes as raw arrays (capabilities.mesh_formats = ["raw"]). Flags that break a
 convention on purpose, to see the conformance check name it: --flip-rows (row 0 at the
-bottom), --straight-alpha (colour not premultiplied), --mirror (left-handed camera).
+bottom), --straight-alpha (colour not premultiplied), --mirror (left-handed camera);
+--declare-accuracy declares 20 dB in the hello, the lowest accuracy the protocol allows.
 
     tetbench external check "python3 examples/external/python/renderer.py"
 """
@@ -54,10 +55,15 @@ class Renderer:
                 raise ValueError(f"substeps={value!r}: a whole number >= 1")
             self.settings[key] = value
         self.substeps = int(self.settings["substeps"])
-        return {"type": "hello", "protocol": 1, "name": "numpy ray-cell caster", "version": "1",
-                "settings": self.settings,
-                "capabilities": {"projections": ["perspective", "orthographic"],
-                                 "mesh_formats": ["raw"]}}
+        hello = {"type": "hello", "protocol": 1, "name": "numpy ray-cell caster", "version": "1",
+                 "settings": self.settings,
+                 "capabilities": {"projections": ["perspective", "orthographic"],
+                                  "mesh_formats": ["raw"]}}
+        if "--declare-accuracy" in FLAGS:
+            # The most lenient declaration the protocol allows: the check must still name a
+            # broken convention under it.
+            hello["accuracy"] = {"min_psnr_db": 20, "reason": "--declare-accuracy (a test)"}
+        return hello
 
     def prepare(self, req):
         mesh, optics = req["mesh"], req["optics"]

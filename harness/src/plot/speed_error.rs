@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use super::data::{distinct, write_csv, Point};
 use super::draw::{self, err, Chart, LegendEntry, FONT, MAX_LEGEND_ROWS, PLOT_WIDTH};
-use super::style::StyleBook;
+use super::style::{Marker, Style, StyleBook};
 use super::ChartFile;
 use crate::metrics::PSNR_CAP_DB;
 
@@ -95,10 +95,66 @@ struct SpeedError<'a> {
     records: Vec<Record>,
     book: &'a StyleBook,
     viewpoints: usize,
+    /// Every variant of every algorithm on one chart, one legend line and one style per
+    /// algorithm, no whiskers: drawn when the per-variant legend is too long for one chart, so
+    /// that tetbench's algorithms and the peers (VTK's, `--external` ones) still share a chart.
+    overview: bool,
 }
 
 impl SpeedError<'_> {
+    /// The style a record is drawn with: its own, or in the overview its algorithm's (the style
+    /// of the algorithm's first variant, named after the algorithm).
+    fn style(&self, r: &Record) -> Style {
+        if !self.overview {
+            return self.book.get(&r.algorithm, &r.settings);
+        }
+        let first = self
+            .records
+            .iter()
+            .find(|o| o.algorithm == r.algorithm)
+            .unwrap_or(r);
+        let mut style = Style {
+            label: r.algorithm.clone(),
+            ..self.book.get(&first.algorithm, &first.settings)
+        };
+        // Peers share one grey family and their first variants may share a marker shape:
+        // here each peer algorithm gets a shape of its own.
+        if crate::plot::style::is_peer(&r.algorithm) {
+            let peers = distinct(
+                self.records
+                    .iter()
+                    .filter(|o| crate::plot::style::is_peer(&o.algorithm))
+                    .map(|o| o.algorithm.clone()),
+            );
+            let i = peers.iter().position(|a| *a == r.algorithm).unwrap_or(0);
+            style.marker = Marker::ALL[i % Marker::ALL.len()];
+        }
+        style
+    }
+
     fn entries(&self) -> Vec<LegendEntry> {
+        if self.overview {
+            return distinct(self.records.iter().map(|r| r.algorithm.clone()))
+                .into_iter()
+                .map(|a| {
+                    let of: Vec<&Record> =
+                        self.records.iter().filter(|r| r.algorithm == a).collect();
+                    let plotted = of
+                        .iter()
+                        .filter(|r| r.tets_per_sec_mean.is_some() && r.psnr_db_mean.is_some())
+                        .count();
+                    let mut extra = format!("{plotted} of {} variant(s) plotted", of.len());
+                    if crate::plot::style::is_peer(&a) {
+                        extra.push_str(" (peer)");
+                    }
+                    LegendEntry {
+                        style: self.style(of[0]),
+                        line: false,
+                        extra,
+                    }
+                })
+                .collect();
+        }
         self.records
             .iter()
             .map(|r| LegendEntry {
@@ -118,10 +174,15 @@ impl SpeedError<'_> {
     }
 
     fn heading(&self) -> Vec<String> {
+        let spread = if self.overview {
+            "every variant; whiskers: per-algorithm charts"
+        } else {
+            "whiskers: min–max over viewpoints"
+        };
         vec![
             "up and right is better".into(),
             format!("point: mean over {} viewpoint(s)", self.viewpoints),
-            "whiskers: min–max over viewpoints".into(),
+            spread.into(),
             "dashed: Pareto front".into(),
             "red ring: suspect row(s)".into(),
             "hollow grey: outside peers".into(),
@@ -230,8 +291,8 @@ impl Chart for SpeedError<'_> {
                 )))
                 .map_err(err)?;
         }
-        for r in &plotted {
-            let st = self.book.get(&r.algorithm, &r.settings);
+        for r in plotted.iter().filter(|_| !self.overview) {
+            let st = self.style(r);
             let (x, y) = (r.tets_per_sec_mean.unwrap(), r.psnr_db_mean.unwrap());
             let line = st.color.mix(0.8).stroke_width(2);
             if let (Some(a), Some(b)) = (r.tets_per_sec_min, r.tets_per_sec_max) {
@@ -252,7 +313,7 @@ impl Chart for SpeedError<'_> {
             }
         }
         for r in &plotted {
-            let st = self.book.get(&r.algorithm, &r.settings);
+            let st = self.style(r);
             let c = chart.backend_coord(&at(r.tets_per_sec_mean.unwrap(), r.psnr_db_mean.unwrap()));
             if r.suspect {
                 plot.draw(&Circle::new(c, 13, RED.stroke_width(2)))
@@ -298,16 +359,43 @@ pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<V
                 })
                 .collect()
         } else {
-            vec![(String::new(), pts)]
+            vec![(String::new(), pts.clone())]
         };
+        let mut stem_base = format!("speed_error_{}", crate::names::slug(&dataset));
+        if many_sizes {
+            stem_base.push_str(&format!("_{width}x{height}"));
+        }
+        let tets = pts.first().map(|p| p.tets).unwrap_or(0);
+        if parts.len() > 1 {
+            // Too many variants for one legend: one chart of them all first, a legend line per
+            // algorithm, so every algorithm and peer is compared on one chart.
+            let stem = format!("{stem_base}_overview");
+            let title = format!(
+                "Speed vs error — {dataset} ({} tets, {width}×{height}), every algorithm",
+                draw::si(tets as f64)
+            );
+            let chart = SpeedError {
+                title: title.clone(),
+                records: records(&pts, book),
+                book,
+                viewpoints: pts.iter().map(|p| p.rows).max().unwrap_or(0),
+                overview: true,
+            };
+            draw::save(&chart, dir, &stem)?;
+            write_csv(dir, &stem, &chart.records)?;
+            files.push(ChartFile {
+                kind: super::Kind::SpeedError,
+                title,
+                stem,
+                note: "every variant, one legend line per algorithm; the charts below split it \
+                       per algorithm"
+                    .into(),
+            });
+        }
         for (alg, part) in parts {
             let records = records(&part, book);
-            let tets = part.first().map(|p| p.tets).unwrap_or(0);
             let viewpoints = part.iter().map(|p| p.rows).max().unwrap_or(0);
-            let mut stem = format!("speed_error_{}", crate::names::slug(&dataset));
-            if many_sizes {
-                stem.push_str(&format!("_{width}x{height}"));
-            }
+            let mut stem = stem_base.clone();
             if !alg.is_empty() {
                 stem.push_str(&format!("_{}", crate::names::slug(&alg)));
             }
@@ -325,6 +413,7 @@ pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<V
                 records: records.clone(),
                 book,
                 viewpoints,
+                overview: false,
             };
             draw::save(&chart, dir, &stem)?;
             write_csv(dir, &stem, &records)?;
@@ -353,5 +442,94 @@ mod tests {
             (3.0, 10.0),
         ]);
         assert_eq!(f, [true, true, false, true, true]);
+    }
+
+    fn point(algorithm: &str, settings: &str, speed: f64, psnr: f64) -> Point {
+        let spread = |v: f64| crate::stats::Spread {
+            mean: v,
+            min: v,
+            max: v,
+        };
+        Point {
+            algorithm: algorithm.into(),
+            settings: settings.into(),
+            dataset: "spx".into(),
+            tets: 12936,
+            width: 64,
+            height: 64,
+            rows: 2,
+            failed: 0,
+            error: String::new(),
+            tets_per_sec: Some(spread(speed)),
+            psnr_db: Some(spread(psnr)),
+            gpu_bytes: None,
+            bytes_per_tet: None,
+            suspect: false,
+        }
+    }
+
+    /// More variants than one legend holds: the chart is split per algorithm, and an overview
+    /// first puts every variant of every algorithm, peers included, on one chart with a legend
+    /// line per algorithm; with few variants there is one chart and no overview.
+    #[test]
+    fn many_variants_get_an_overview_with_every_algorithm() {
+        crate::algorithms::note_external("overview-test-mine");
+        let mut points: Vec<Point> = (0..12)
+            .map(|k| point("havs", &format!("k={k}"), 1e6 + k as f64, 40.0))
+            .collect();
+        points.extend((0..8).map(|k| point("raycast", &format!("step={k}"), 2e5, 60.0 + k as f64)));
+        points.push(point("vtk-zsweep", "integrator=linear", 5e4, 50.0));
+        points.push(point("overview-test-mine", "peer=external", 3e4, 99.0));
+        let book = crate::plot::book_of(&points);
+        let dir = tempfile::tempdir().unwrap();
+        let files = write(dir.path(), &points, &book).unwrap();
+        let stems: Vec<&str> = files.iter().map(|f| f.stem.as_str()).collect();
+        assert_eq!(stems[0], "speed_error_spx_overview", "{stems:?}");
+        assert!(stems.contains(&"speed_error_spx_havs"), "{stems:?}");
+        assert!(
+            stems.contains(&"speed_error_spx_overview-test-mine"),
+            "{stems:?}"
+        );
+        let recs: Vec<Record> =
+            csv::Reader::from_path(dir.path().join("speed_error_spx_overview.csv"))
+                .unwrap()
+                .deserialize()
+                .map(Result::unwrap)
+                .collect();
+        assert_eq!(recs.len(), points.len());
+        let peers: Vec<&str> = recs
+            .iter()
+            .filter(|r| r.peer)
+            .map(|r| r.algorithm.as_str())
+            .collect();
+        assert_eq!(peers, ["vtk-zsweep", "overview-test-mine"]);
+        // The external renderer is the most exact; the fastest HAVS variant the fastest.
+        assert!(
+            recs.iter()
+                .find(|r| r.algorithm == "overview-test-mine")
+                .unwrap()
+                .pareto
+        );
+        let chart = SpeedError {
+            title: String::new(),
+            records: recs,
+            book: &book,
+            viewpoints: 2,
+            overview: true,
+        };
+        let legend: Vec<String> = chart.entries().iter().map(|e| e.text()).collect();
+        assert_eq!(legend.len(), 4, "{legend:?}");
+        assert!(legend[0].starts_with("havs  12 of 12"), "{legend:?}");
+        assert!(legend[3].ends_with("(peer)"), "{legend:?}");
+        let peer_markers: Vec<Marker> = chart.entries()[2..]
+            .iter()
+            .map(|e| e.style.marker)
+            .collect();
+        assert_ne!(peer_markers[0], peer_markers[1]);
+
+        let few: Vec<Point> = points[10..].to_vec();
+        let one = write(dir.path(), &few, &crate::plot::book_of(&few)).unwrap();
+        assert_eq!(one.len(), 1);
+        assert_eq!(one[0].stem, "speed_error_spx");
     }
 }

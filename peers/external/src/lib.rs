@@ -18,7 +18,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Context};
 use datasets::TetMesh;
-use render_core::{Camera, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting};
+use render_core::{
+    Camera, DeclaredAccuracy, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting,
+};
 use serde_json::{json, Value};
 
 use process::{Failure, Process};
@@ -355,6 +357,10 @@ impl Renderer for ExternalRenderer {
 
     fn read_image(&mut self, _gpu: &Gpu) -> anyhow::Result<Image> {
         self.read_last_image()
+    }
+
+    fn declared_accuracy(&self) -> Option<DeclaredAccuracy> {
+        self.hello.as_ref().and_then(|h| h.accuracy.clone())
     }
 }
 

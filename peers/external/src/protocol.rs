@@ -4,7 +4,9 @@
 use std::path::Path;
 
 use datasets::TetMesh;
-use render_core::{Camera, FrameStats, Optics, Projection};
+use render_core::{Camera, DeclaredAccuracy, FrameStats, Optics, Projection};
+
+use crate::conformance::{LOWEST_DECLARED_DB, PASS_DB};
 use serde_json::{json, Map, Value};
 
 /// The protocol version tetbench speaks.
@@ -30,6 +32,8 @@ pub struct Hello {
     pub perspective: bool,
     pub orthographic: bool,
     pub formats: Vec<MeshFormat>,
+    /// The accuracy it declares when it approximates by design (`accuracy` in the hello).
+    pub accuracy: Option<DeclaredAccuracy>,
 }
 
 /// The `hello` request.
@@ -104,6 +108,7 @@ pub fn parse_hello(
     if formats.is_empty() {
         anyhow::bail!("{label}'s hello lists no mesh format (\"vtu\" or \"raw\")");
     }
+    let accuracy = parse_accuracy(label, &reply["accuracy"])?;
     Ok(Hello {
         name: reply["name"].as_str().unwrap_or(label).to_string(),
         version: reply["version"]
@@ -113,7 +118,32 @@ pub fn parse_hello(
         perspective: projections.iter().any(|p| p == "perspective"),
         orthographic: projections.iter().any(|p| p == "orthographic"),
         formats,
+        accuracy,
     })
+}
+
+/// The optional `accuracy` of a hello: `{"min_psnr_db": 20…35, "reason": "…"}`. Below
+/// [`LOWEST_DECLARED_DB`] the check could no longer tell a renderer's approximation from a
+/// convention mistake, so such a declaration is refused.
+fn parse_accuracy(label: &str, v: &Value) -> anyhow::Result<Option<DeclaredAccuracy>> {
+    if v.is_null() {
+        return Ok(None);
+    }
+    let db = v["min_psnr_db"].as_f64();
+    let reason = v["reason"].as_str().map(str::trim).unwrap_or("");
+    match db {
+        Some(db) if (LOWEST_DECLARED_DB..=PASS_DB).contains(&db) && !reason.is_empty() => {
+            Ok(Some(DeclaredAccuracy {
+                min_psnr_db: db,
+                reason: reason.to_string(),
+            }))
+        }
+        _ => anyhow::bail!(
+            "{label}'s hello declares the accuracy {v}; expected {{\"min_psnr_db\": a number \
+             from {LOWEST_DECLARED_DB} to {PASS_DB}, \"reason\": \"why, in words\"}} (below \
+             {LOWEST_DECLARED_DB} dB no convention mistake could be told from the approximation)"
+        ),
+    }
 }
 
 /// Writes the mesh in the asked-for formats into `dir`; returns the `mesh` object of
@@ -391,6 +421,35 @@ mod tests {
         let h = parse_hello("mine", &silent, &[]).unwrap();
         assert_eq!(h.formats, [MeshFormat::Vtu]);
         assert!(h.perspective && h.orthographic);
+        assert_eq!(h.accuracy, None);
+    }
+
+    /// A declared accuracy is read when it is a PSNR the check can still judge conventions
+    /// at, with a reason; outside 20–35 dB or without a reason the hello is refused.
+    #[test]
+    fn declared_accuracy_is_read_and_bounded() {
+        let hello = |acc: Value| json!({"type": "hello", "protocol": 1, "accuracy": acc});
+        let h = parse_hello(
+            "z",
+            &hello(json!({"min_psnr_db": 25, "reason": "vertices snapped to pixels"})),
+            &[],
+        )
+        .unwrap();
+        let acc = h.accuracy.unwrap();
+        assert_eq!(acc.min_psnr_db, 25.0);
+        assert_eq!(acc.reason, "vertices snapped to pixels");
+        for bad in [
+            json!({"min_psnr_db": 12, "reason": "coarse"}),
+            json!({"min_psnr_db": 40, "reason": "why"}),
+            json!({"min_psnr_db": 25}),
+            json!({"min_psnr_db": "25", "reason": "text"}),
+            json!(25),
+        ] {
+            let e = parse_hello("z", &hello(bad.clone()), &[])
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("declares the accuracy"), "{bad}: {e}");
+        }
     }
 
     #[test]

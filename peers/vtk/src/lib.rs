@@ -25,7 +25,9 @@ use std::time::Duration;
 use anyhow::Context;
 use datasets::TetMesh;
 use external_peer::{ExternalRenderer, ExternalSpec};
-use render_core::{Camera, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting};
+use render_core::{
+    Camera, DeclaredAccuracy, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting,
+};
 
 /// How long one exchange with VTK may take: its float readout walks every pixel in Python.
 pub const TIMEOUT: Duration = Duration::from_secs(600);
@@ -264,5 +266,11 @@ impl Renderer for VtkPeer {
 
     fn read_image(&mut self, _gpu: &Gpu) -> anyhow::Result<Image> {
         self.client.read_last_image()
+    }
+
+    /// What the script declared in its hello (the framebuffer readouts of the ray caster and
+    /// ZSweep, see `vtk_peer.py`).
+    fn declared_accuracy(&self) -> Option<DeclaredAccuracy> {
+        self.client.declared_accuracy()
     }
 }

@@ -17,7 +17,10 @@ How tetbench's scene maps onto VTK's (the conventions the outside check needed):
 * Colour: RGB interpolation over the raw scalar x = scalar_min + s (scalar_max - scalar_min).
 * Camera: same eye, focal point, up, vertical view angle (or parallel scale) and clipping range.
   VTK's ray caster samples pixel X at NDC 2X/W - 1, half a pixel off the protocol's pixel
-  centres; a window centre of (1/W, 1/H) moves its rays onto the centres.
+  centres; for readout=rays a window centre of (1/W, 1/H) moves its rays onto the centres; for
+  the displayed image, display_alignment also undoes the display's (W - 1)/W scaling.
+* The framebuffer readouts of the ray caster and ZSweep declare their accuracy in the hello
+  (FRAMEBUFFER_ACCURACY): their display filter and ZSweep's vertex snapping are VTK's.
 * Every timed frame is a full re-render: the camera turns about the up axis by +-NUDGE_DEG on
   alternate frames so no mapper reuses a sort (counter camera_nudge_deg); read_image renders
   once more at the exact camera.
@@ -60,6 +63,7 @@ try:
         vtkVolumeProperty,
     )
     from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
+    from vtkmodules.vtkCommonTransforms import vtkTransform
     from vtkmodules.vtkRenderingVolume import (
         vtkProjectedTetrahedraMapper,
         vtkUnstructuredGridLinearRayIntegrator,
@@ -87,6 +91,33 @@ CHOICES = {"mapper": ["pt", "raycast", "zsweep"], "integrator": list(INTEGRATORS
            "readout": ["framebuffer", "rays"], "et": ["on", "off"]}
 
 
+def display_alignment(w, h):
+    """A clip-space transform for the ray caster's displayed image. VTK casts ray i through
+    NDC 2i/W - 1 (a pixel corner), stores the W x H image as a texture and draws it with its
+    first and last texel centres on the viewport's edges, so display pixel x shows the image
+    at (x + 1/2)(W - 1)/W. Shrinking NDC by (W - 1)/W and moving it by -1/W puts ray i at
+    i W/(W - 1), where the display shows it: each pixel centre then falls between the rays
+    around it (the texture's bilinear filter still blends a silhouette pixel with its
+    neighbour). Applied last, in clip space (vtkCamera's UserTransform)."""
+    m = vtkTransform()
+    m.SetMatrix([(w - 1) / w, 0, 0, -1.0 / w,
+                 0, (h - 1) / h, 0, -1.0 / h,
+                 0, 0, 1, 0,
+                 0, 0, 0, 1])
+    return m
+
+
+# What the framebuffer readouts cannot reach, declared in the hello so that the conformance
+# check judges them at this accuracy (docs/external-renderers.md, "Declared accuracy").
+FRAMEBUFFER_ACCURACY = {
+    "raycast": "VTK draws its 8-bit ray-cast image as a bilinearly filtered texture: a "
+               "silhouette between pixel centres spreads over the neighbouring pixel",
+    "zsweep": "ZSweep snaps every vertex to the pixel grid (integer screen coordinates) and VTK "
+              "draws its 8-bit image as a bilinearly filtered texture",
+}
+FRAMEBUFFER_MIN_PSNR_DB = 28.0
+
+
 class Peer:
     def __init__(self):
         self.window = None
@@ -103,11 +134,15 @@ class Peer:
             self.settings[key] = value
         if self.settings["readout"] == "rays" and self.settings["mapper"] != "raycast":
             raise RuntimeError("readout=rays needs mapper=raycast")
-        return {"type": "hello", "protocol": 1, "name": f"vtk-{self.settings['mapper']}",
-                "version": f"VTK {vtkVersion.GetVTKVersion()} on Python {sys.version.split()[0]}",
-                "settings": self.settings,
-                "capabilities": {"projections": ["perspective", "orthographic"],
-                                 "mesh_formats": ["vtu"]}}
+        reply = {"type": "hello", "protocol": 1, "name": f"vtk-{self.settings['mapper']}",
+                 "version": f"VTK {vtkVersion.GetVTKVersion()} on Python {sys.version.split()[0]}",
+                 "settings": self.settings,
+                 "capabilities": {"projections": ["perspective", "orthographic"],
+                                  "mesh_formats": ["vtu"]}}
+        reason = FRAMEBUFFER_ACCURACY.get(self.settings["mapper"])
+        if reason and self.settings["readout"] == "framebuffer":
+            reply["accuracy"] = {"min_psnr_db": FRAMEBUFFER_MIN_PSNR_DB, "reason": reason}
+        return reply
 
     def prepare(self, req):
         vtu = req["mesh"]["vtu"]
@@ -202,11 +237,13 @@ class Peer:
         else:
             vc.ParallelProjectionOff()
             vc.SetViewAngle(cam["fovy_deg"])
-        # The ray caster samples pixel corners; this moves its rays onto the pixel centres.
-        if self.kind == "raycast":
+        vc.SetWindowCenter(0.0, 0.0)
+        vc.SetUserTransform(None)
+        if self.kind == "raycast" and self.settings["readout"] == "rays":
+            # The ray caster samples pixel corners; this moves its rays onto the pixel centres.
             vc.SetWindowCenter(1.0 / w, 1.0 / h)
-        else:
-            vc.SetWindowCenter(0.0, 0.0)
+        elif self.kind == "raycast":
+            vc.SetUserTransform(display_alignment(w, h))
         if nudge_deg:
             vc.Azimuth(nudge_deg)
             vc.OrthogonalizeViewUp()

@@ -21,6 +21,6 @@ pub use bind::ChunkedBuffer;
 pub use frame::{FrameClock, FrameTimes};
 pub use gpu::{AdapterDescription, DeviceRequest, FrameTimer, Gpu, Lifetime, MemoryLedger};
 pub use image::Image;
-pub use renderer::{settings_string, FrameStats, Prepared, Renderer, Setting};
+pub use renderer::{settings_string, DeclaredAccuracy, FrameStats, Prepared, Renderer, Setting};
 pub use scene::{fixed_viewpoints, orbit_viewpoints, Camera, Projection, Ray, Viewpoint};
 pub use transfer::{Optics, TransferFunction};

@@ -84,4 +84,22 @@ pub trait Renderer {
     fn extra_image(&mut self, _gpu: &Gpu) -> anyhow::Result<Option<(&'static str, Image)>> {
         Ok(None)
     }
+
+    /// The accuracy a renderer that approximates by design declares for itself (known after
+    /// `prepare`); `None` for one that claims the conformance check's full accuracy. The check
+    /// (`tetbench external check`) passes such a renderer's views at the declared PSNR, as long
+    /// as each image is still nearer the reference than any convention mistake.
+    fn declared_accuracy(&self) -> Option<DeclaredAccuracy> {
+        None
+    }
+}
+
+/// What a renderer declares about its own accuracy (`accuracy` in an external renderer's
+/// hello, `docs/external-renderers.md`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeclaredAccuracy {
+    /// The PSNR (dB, RGBA against the exact reference) it expects to reach on the check's views.
+    pub min_psnr_db: f64,
+    /// Why it cannot do better, in plain words (e.g. "vertices snapped to the pixel grid").
+    pub reason: String,
 }
