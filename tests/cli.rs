@@ -6,7 +6,7 @@ use clap::Parser;
 use datasets::TetMesh;
 use harness::cli::{Cli, Command};
 use harness::results::ResultsFile;
-use render_core::{Camera, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting};
+use render_core::{Camera, FrameStats, Gpu, Image, Optics, Prepared, Renderer};
 
 /// Wraps a real renderer and fails on purpose at chosen viewpoints: the stand-in for an
 /// out-of-memory or device error in the middle of a run.
@@ -20,7 +20,7 @@ impl Renderer for FailsAt {
     fn algorithm(&self) -> &'static str {
         self.inner.algorithm()
     }
-    fn settings(&self) -> Vec<Setting> {
+    fn settings(&self) -> render_core::Settings {
         self.inner.settings()
     }
     fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
@@ -96,7 +96,7 @@ fn failing_rows_are_recorded_and_the_run_goes_on() {
     let json = ResultsFile::read(&out).unwrap();
     assert_eq!(json.rows.len(), 6);
     for r in &json.rows {
-        assert!(r.settings.contains("variant=constant"), "{}", r.settings);
+        assert!(r.settings.is("variant", "constant"), "{}", r.settings);
         match r.viewpoint.as_str() {
             "-x" => assert!(
                 r.error.contains("simulated out of memory") && r.total_ms.is_none(),
@@ -145,7 +145,7 @@ fn settings_filter_selects_variants() {
     assert!(outcome.all_ok());
     let json = ResultsFile::read(&out).unwrap();
     assert_eq!(json.rows.len(), 1);
-    assert!(json.rows[0].settings.contains("variant=linear"));
+    assert!(json.rows[0].settings.is("variant", "linear"));
     assert_eq!(
         json.rows[0].psnr_db, None,
         "--no-reference leaves the error metrics empty"

@@ -47,7 +47,7 @@ fn render(
     let what = format!(
         "{} {} on {}",
         renderer.algorithm(),
-        render_core::settings_string(&renderer.settings()),
+        renderer.settings(),
         gpu.adapter.driver_info
     );
     renderer
@@ -73,11 +73,11 @@ fn variants() -> Vec<Box<dyn Renderer>> {
     v.extend(fragment_pt::default_variants());
     // The ray caster's 3D table (32 MiB, fixed size) must fit one binding: its 2D-table
     // variant only.
-    v.extend(raycast::default_variants().into_iter().filter(|r| {
-        r.settings()
-            .iter()
-            .any(|s| s.key == "table" && s.value == "2d")
-    }));
+    v.extend(
+        raycast::default_variants()
+            .into_iter()
+            .filter(|r| r.settings().is("table", "2d")),
+    );
     v.extend(splat::default_variants());
     v
 }
@@ -86,11 +86,7 @@ fn variants() -> Vec<Box<dyn Renderer>> {
 /// single pass (`mode=fragment-race`) races on a GPU that shades one pixel's fragments
 /// concurrently (`renderers/havs/tests/racy_twin.rs`); a CPU adapter shades them in order.
 fn deterministic(renderer: &dyn Renderer, gpu: &Gpu) -> bool {
-    let racy = renderer.algorithm() == "havs"
-        && renderer
-            .settings()
-            .iter()
-            .any(|s| s.key == "mode" && s.value == "fragment-race");
+    let racy = renderer.algorithm() == "havs" && renderer.settings().is("mode", "fragment-race");
     !racy || gpu.adapter.device_type == "Cpu" // wgpu::DeviceType::Cpu, as Debug
 }
 
@@ -143,11 +139,7 @@ fn small_bindings_give_the_same_image_as_the_adapters_own() {
     for (mut whole, mut split) in variants().into_iter().zip(variants()) {
         let (a, _) = render(&high, whole.as_mut(), &mesh, &optics);
         let (b, _) = render(&low, split.as_mut(), &mesh, &optics);
-        let name = format!(
-            "{} {}",
-            whole.algorithm(),
-            render_core::settings_string(&whole.settings())
-        );
+        let name = format!("{} {}", whole.algorithm(), whole.settings());
         let covered = a.pixels.iter().filter(|p| p[3] > 0.0).count();
         assert!(
             covered > (SIZE * SIZE / 4) as usize,
@@ -198,11 +190,7 @@ fn gpu_time_appears_exactly_with_timestamp_queries() {
         }
     );
     for (mut on, mut off) in variants().into_iter().zip(variants()) {
-        let name = format!(
-            "{} {}",
-            on.algorithm(),
-            render_core::settings_string(&on.settings())
-        );
+        let name = format!("{} {}", on.algorithm(), on.settings());
         let (a, gpu_on) = render(&with, on.as_mut(), &mesh, &optics);
         let (b, gpu_off) = render(&without, off.as_mut(), &mesh, &optics);
         assert_eq!(gpu_off, None, "{name}: GPU time without timestamp queries");

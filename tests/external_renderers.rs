@@ -181,7 +181,7 @@ fn examples_render_the_default_suite_meshes_in_a_run() {
             row.error
         );
         assert!(
-            row.settings.starts_with("peer=external"),
+            row.settings.keys().next() == Some("peer") && row.settings.is("peer", "external"),
             "{}",
             row.settings
         );

@@ -15,7 +15,7 @@ use clap::Parser;
 use datasets::TetMesh;
 use harness::cli::{Cli, Command};
 use harness::results::{ResultsFile, Row};
-use render_core::{Camera, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting};
+use render_core::{Camera, FrameStats, Gpu, Image, Optics, Prepared, Renderer};
 
 /// Relative slack of `gpu_ms` over `total_ms`. The GPU time is timestamp ticks × the
 /// adapter's `timestamp_period` (an f32, relative rounding 2⁻²⁴ ≈ 6·10⁻⁸) and the GPU clock
@@ -222,7 +222,7 @@ impl Renderer for BadTimes {
     fn algorithm(&self) -> &'static str {
         self.inner.algorithm()
     }
-    fn settings(&self) -> Vec<Setting> {
+    fn settings(&self) -> render_core::Settings {
         self.inner.settings()
     }
     fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {

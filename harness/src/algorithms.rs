@@ -1,41 +1,107 @@
-//! The algorithms `tetbench run` knows: name → constructors of its default variants (one
-//! renderer per combination of the paper's settings that the tables compare) and of every
-//! variant it offers (what `--settings` selects from).
+//! The algorithms `tetbench run` knows: one [`AlgorithmDescription`] per algorithm crate, in
+//! [`REGISTRY`]. A description declares the algorithm's parameter grid, so variant selection
+//! and settings parsing work without building a renderer; renderers are built from typed
+//! [`Settings`] only for the variants that run.
 //!
-//! To add an algorithm, add one line to [`TABLE`].
+//! To add an algorithm: its crate (with its `DESCRIPTION`), its dependency line in
+//! `harness/Cargo.toml`, and one line in [`REGISTRY`] (docs/adding-an-algorithm.md).
 
-use render_core::Renderer;
+use render_core::{AlgorithmDescription, Origin, Renderer, Settings};
+pub use render_core::{SettingsFilter, ValueKind};
 
-type Variants = fn() -> Vec<Box<dyn Renderer>>;
-
-/// Name on the command line and in result rows → (default variants, every variant), each in
-/// the order they are run.
-const TABLE: &[(&str, Variants, Variants)] = &[
-    ("gator-pt", gator_pt::default_variants, all_gator_variants),
-    ("havs", havs::default_variants, havs::all_variants),
-    (
-        "fragment-pt",
-        fragment_pt::default_variants,
-        fragment_pt::all_variants,
-    ),
-    ("raycast", raycast::default_variants, raycast::all_variants),
-    ("splat", splat::default_variants, splat::all_variants),
-    ("vtk-pt", vtk_peer::pt_variants, vtk_peer::pt_variants),
-    (
-        "vtk-raycast",
-        vtk_peer::raycast_default_variants,
-        vtk_peer::raycast_all_variants,
-    ),
-    (
-        "vtk-zsweep",
-        vtk_peer::zsweep_default_variants,
-        vtk_peer::zsweep_all_variants,
-    ),
+/// Every algorithm, in the order reports list them: tetbench's own, then the peers.
+pub static REGISTRY: &[&AlgorithmDescription] = &[
+    &gator_pt::DESCRIPTION,
+    &havs::DESCRIPTION,
+    &fragment_pt::DESCRIPTION,
+    &raycast::DESCRIPTION,
+    &splat::DESCRIPTION,
+    &vtk_peer::PT,
+    &vtk_peer::RAYCAST,
+    &vtk_peer::ZSWEEP,
 ];
 
-/// Peers: other software's renderers measured beside tetbench's (`--peers vtk`). They are not
-/// part of "all algorithms" and are marked as peers in the reports.
-pub const PEERS: &[(&str, &[&str])] = &[("vtk", &["vtk-pt", "vtk-raycast", "vtk-zsweep"])];
+/// The description of `name`, if this build has it.
+pub fn describe(name: &str) -> Option<&'static AlgorithmDescription> {
+    REGISTRY.iter().copied().find(|d| d.name == name)
+}
+
+/// The description of `name`, or an error listing the known names.
+pub fn description(name: &str) -> anyhow::Result<&'static AlgorithmDescription> {
+    describe(name)
+        .ok_or_else(|| anyhow::anyhow!("unknown algorithm {name:?}; known: {}", names().join(", ")))
+}
+
+/// Every algorithm's name, in registry order.
+pub fn names() -> Vec<&'static str> {
+    REGISTRY.iter().map(|d| d.name).collect()
+}
+
+/// The peer groups (`vtk`) with their algorithms, in registry order.
+pub fn peer_groups() -> Vec<(&'static str, Vec<&'static str>)> {
+    let mut groups: Vec<(&'static str, Vec<&'static str>)> = vec![];
+    for d in REGISTRY {
+        if let Origin::Peer(g) = d.origin {
+            match groups.iter_mut().find(|(name, _)| *name == g) {
+                Some((_, v)) => v.push(d.name),
+                None => groups.push((g, vec![d.name])),
+            }
+        }
+    }
+    groups
+}
+
+/// Settings text of `algorithm` (the CSV column, old results) as typed settings: values typed
+/// as the algorithm declares them, inferred for an algorithm this build does not know.
+pub fn parse_settings(algorithm: &str, text: &str) -> anyhow::Result<Settings> {
+    let declared = describe(algorithm);
+    Ok(Settings::parse_with(text, |k| {
+        declared.and_then(|d| d.kind_of(k))
+    })?)
+}
+
+/// `settings` with each value retyped as `algorithm` declares it (results loaded from JSON
+/// written before a parameter's type was declared).
+pub fn retype(algorithm: &str, settings: Settings) -> Settings {
+    match describe(algorithm) {
+        Some(d) => settings.retyped(|k| d.kind_of(k)),
+        None => settings,
+    }
+}
+
+fn build_all(
+    d: &AlgorithmDescription,
+    grid: &[Settings],
+) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+    grid.iter().map(|s| (d.build)(s)).collect()
+}
+
+/// The default variants of `name`, built, or an error listing the known names.
+pub fn variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+    let d = description(name)?;
+    build_all(d, &(d.default_grid)())
+}
+
+/// Every variant `name` offers (what `--settings` selects from), built, in grid order.
+pub fn all_variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+    let d = description(name)?;
+    build_all(d, &(d.full_grid)())
+}
+
+/// The settings of the variants of `name` that `filter` selects
+/// ([`AlgorithmDescription::select`]); nothing is built.
+pub fn selected_settings(name: &str, filter: &SettingsFilter) -> anyhow::Result<Vec<Settings>> {
+    Ok(description(name)?.select(filter))
+}
+
+/// The variants of `name` that `filter` selects, built.
+pub fn selected_variants(
+    name: &str,
+    filter: &SettingsFilter,
+) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+    let d = description(name)?;
+    build_all(d, &d.select(filter))
+}
 
 /// Whether `name` is a peer (another package's renderer, or an external renderer given with
 /// `--external`) rather than a tetbench algorithm.
@@ -43,10 +109,10 @@ pub fn is_peer(name: &str) -> bool {
     peer_kind(name).is_some()
 }
 
-/// The kind of peer `name` is: its group in [`PEERS`] (`vtk`), or `external` for a renderer
+/// The kind of peer `name` is: its group in [`REGISTRY`] (`vtk`), or `external` for a renderer
 /// given with `--external` (or met in results with the `peer=external` setting).
 pub fn peer_kind(name: &str) -> Option<&'static str> {
-    if let Some((group, _)) = PEERS.iter().find(|(_, names)| names.contains(&name)) {
+    if let Some(Origin::Peer(group)) = describe(name).map(|d| d.origin) {
         return Some(group);
     }
     let known = EXTERNAL_NAMES.lock().unwrap_or_else(|p| p.into_inner());
@@ -67,231 +133,58 @@ pub fn note_external(name: &str) {
 
 /// Registers the algorithm of every row whose settings carry the external marker
 /// (`peer=external`), so results read back mark those rows as peers too.
-pub fn note_external_rows<'a>(rows: impl IntoIterator<Item = (&'a str, &'a str)>) {
-    let marker = format!(
-        "{}={}",
-        external_peer::PEER_SETTING.0,
-        external_peer::PEER_SETTING.1
-    );
+pub fn note_external_rows<'a>(rows: impl IntoIterator<Item = (&'a str, &'a Settings)>) {
+    let (key, value) = external_peer::PEER_SETTING;
     for (algorithm, settings) in rows {
-        if settings.split(';').any(|s| s == marker) {
+        if settings.is(key, value) {
             note_external(algorithm);
         }
     }
 }
 
 /// The algorithms of a peer group (`vtk`), or an error listing the groups.
-pub fn peer_group(group: &str) -> anyhow::Result<&'static [&'static str]> {
-    PEERS
-        .iter()
-        .find(|(g, _)| *g == group)
-        .map(|(_, names)| *names)
-        .ok_or_else(|| {
-            let groups: Vec<&str> = PEERS.iter().map(|(g, _)| *g).collect();
-            anyhow::anyhow!("unknown peer group {group:?}; known: {}", groups.join(", "))
-        })
-}
-
-fn all_gator_variants() -> Vec<Box<dyn Renderer>> {
-    gator_pt::variants(&render_core::visibility::VisibilityOrder::ALL)
-}
-
-/// Every algorithm's name, in table order.
-pub fn names() -> Vec<&'static str> {
-    TABLE.iter().map(|(n, _, _)| *n).collect()
-}
-
-fn entry(name: &str) -> anyhow::Result<&'static (&'static str, Variants, Variants)> {
-    TABLE
-        .iter()
-        .find(|(n, _, _)| *n == name)
-        .ok_or_else(|| anyhow::anyhow!("unknown algorithm {name:?}; known: {}", names().join(", ")))
-}
-
-/// The default variants of `name`, or an error listing the known names.
-pub fn variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
-    Ok((entry(name)?.1)())
-}
-
-/// Every variant `name` offers (what `--settings` selects from), in table order.
-pub fn all_variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
-    Ok((entry(name)?.2)())
-}
-
-/// The variants of `name` that `filter` selects. Drawn from every variant the algorithm offers:
-/// a setting the filter names must take one of the listed values; a setting it does not name
-/// keeps the values the default variants use. So no filter gives exactly the defaults,
-/// `sort=mpvonc` gives GATOR's two cell models with the exact order, and `k=8` gives HAVS k = 8
-/// with both sorts and otherwise default settings.
-pub fn selected_variants(
-    name: &str,
-    filter: &SettingsFilter,
-) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
-    let (_, defaults, all) = entry(name)?;
-    let defaults = defaults();
-    if filter.is_empty() {
-        return Ok(defaults);
-    }
-    let default_settings: Vec<Vec<render_core::Setting>> =
-        defaults.iter().map(|r| r.settings()).collect();
-    let default_has = |s: &render_core::Setting| {
-        default_settings
-            .iter()
-            .flatten()
-            .any(|d| d.key == s.key && d.value == s.value)
-    };
-    Ok(all()
-        .into_iter()
-        .filter(|r| {
-            r.settings().iter().all(|s| match filter.values(s.key) {
-                Some(values) => values.contains(&s.value),
-                None => default_has(s),
-            })
-        })
-        .collect())
-}
-
-/// A `--settings` filter: `key=value;key=value`, where a value may list alternatives
-/// (`k=2|6`). A variant is kept when, for every key it has, its value is one of those asked
-/// for; keys a variant does not have are ignored for it, so one filter can span algorithms
-/// (`--settings k=6` narrows HAVS and leaves GATOR alone).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct SettingsFilter {
-    pub terms: Vec<(String, Vec<String>)>,
-}
-
-impl SettingsFilter {
-    pub fn parse(text: &str) -> anyhow::Result<SettingsFilter> {
-        let mut terms = vec![];
-        for part in text
-            .split([';', ','])
-            .map(str::trim)
-            .filter(|p| !p.is_empty())
-        {
-            let Some((k, v)) = part.split_once('=') else {
-                anyhow::bail!("--settings: {part:?} is not key=value (e.g. variant=linear;k=2|6)");
-            };
-            let values: Vec<String> = v
-                .split('|')
-                .map(|s| s.trim().to_string())
-                .filter(|s| !s.is_empty())
-                .collect();
-            if k.trim().is_empty() || values.is_empty() {
-                anyhow::bail!("--settings: {part:?} needs a key and at least one value");
-            }
-            terms.push((k.trim().to_string(), values));
+pub fn peer_group(group: &str) -> anyhow::Result<Vec<&'static str>> {
+    let groups = peer_groups();
+    match groups.iter().find(|(g, _)| *g == group) {
+        Some((_, names)) => Ok(names.clone()),
+        None => {
+            let known: Vec<&str> = groups.iter().map(|(g, _)| *g).collect();
+            anyhow::bail!("unknown peer group {group:?}; known: {}", known.join(", "))
         }
-        Ok(SettingsFilter { terms })
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.terms.is_empty()
-    }
-
-    /// The values asked for `key`, if the filter names it.
-    pub fn values(&self, key: &str) -> Option<&[String]> {
-        self.terms
-            .iter()
-            .find(|(k, _)| k == key)
-            .map(|(_, v)| v.as_slice())
-    }
-
-    /// Whether a renderer with these settings passes the filter.
-    pub fn accepts(&self, settings: &[render_core::Setting]) -> bool {
-        self.terms
-            .iter()
-            .all(|(k, values)| match settings.iter().find(|s| s.key == k) {
-                Some(s) => values.contains(&s.value),
-                None => true,
-            })
-    }
-
-    /// Keys that none of `all` has: almost certainly a typo, reported as an error.
-    pub fn unknown_keys(&self, all: &[Vec<render_core::Setting>]) -> Vec<String> {
-        self.terms
-            .iter()
-            .filter(|(k, _)| !all.iter().flatten().any(|s| s.key == k))
-            .map(|(k, _)| k.clone())
-            .collect()
-    }
-}
-
-impl std::fmt::Display for SettingsFilter {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let parts: Vec<String> = self
-            .terms
-            .iter()
-            .map(|(k, v)| format!("{k}={}", v.join("|")))
-            .collect();
-        write!(f, "{}", parts.join(";"))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use render_core::Setting;
 
     #[test]
     fn external_renderers_are_peers_once_met() {
         assert_eq!(peer_kind("vtk-pt"), Some("vtk"));
         assert!(!is_peer("mine-from-a-test"));
-        note_external_rows([
-            ("mine-from-a-test", "peer=external;step=1"),
-            ("havs", "k=2"),
-        ]);
+        let marked = Settings::parse("peer=external;step=1").unwrap();
+        let havs = Settings::parse("k=2").unwrap();
+        note_external_rows([("mine-from-a-test", &marked), ("havs", &havs)]);
         assert_eq!(peer_kind("mine-from-a-test"), Some("external"));
         assert!(!is_peer("havs"));
     }
 
-    #[test]
-    fn filter_matches_alternatives_and_ignores_foreign_keys() {
-        let f = SettingsFilter::parse("variant=linear; k=2|6").unwrap();
-        let gator = vec![Setting::new("variant", "linear")];
-        let gator_c = vec![Setting::new("variant", "constant")];
-        let havs6 = vec![Setting::new("k", "6")];
-        let havs4 = vec![Setting::new("k", "4")];
-        assert!(f.accepts(&gator));
-        assert!(!f.accepts(&gator_c));
-        assert!(f.accepts(&havs6));
-        assert!(!f.accepts(&havs4));
-        assert!(f.unknown_keys(&[gator, havs6]).is_empty());
-        assert_eq!(
-            SettingsFilter::parse("colour=red")
-                .unwrap()
-                .unknown_keys(&[gator_c]),
-            vec!["colour"]
-        );
-        assert!(SettingsFilter::parse("variant").is_err());
-        assert!(SettingsFilter::parse("=x").is_err());
-        assert!(SettingsFilter::parse("").unwrap().is_empty());
-        assert_eq!(f.to_string(), "variant=linear;k=2|6");
-    }
-
     fn settings_of(name: &str, filter: &str) -> Vec<String> {
         let f = SettingsFilter::parse(filter).unwrap();
-        selected_variants(name, &f)
+        selected_settings(name, &f)
             .unwrap()
             .iter()
-            .map(|r| {
-                r.settings()
-                    .iter()
-                    .map(|s| format!("{}={}", s.key, s.value))
-                    .collect::<Vec<_>>()
-                    .join(";")
-            })
+            .map(Settings::to_string)
             .collect()
     }
 
     #[test]
     fn filters_select_beyond_the_defaults_and_keep_other_defaults() {
         // No filter: exactly the defaults.
-        for name in names() {
+        for d in REGISTRY {
             assert_eq!(
-                selected_variants(name, &SettingsFilter::default())
-                    .unwrap()
-                    .len(),
-                variants(name).unwrap().len()
+                selected_settings(d.name, &SettingsFilter::default()).unwrap(),
+                (d.default_grid)()
             );
         }
         assert_eq!(
@@ -314,12 +207,67 @@ mod tests {
         assert_eq!(frag.len(), 2, "{frag:?}");
     }
 
+    /// Every grid point builds a renderer that reports exactly the settings it was built
+    /// from, with each value of the declared type, and declares only its declared keys: the
+    /// grid, the constructor and the row agree without any text in between.
+    #[test]
+    fn every_declared_variant_builds_and_reports_its_own_settings() {
+        for d in REGISTRY {
+            let grid = (d.full_grid)();
+            assert!(!grid.is_empty(), "{}", d.name);
+            for defaults in (d.default_grid)() {
+                assert!(
+                    grid.contains(&defaults),
+                    "{}: default {defaults} not in the grid",
+                    d.name
+                );
+            }
+            for s in &grid {
+                let r = (d.build)(s).unwrap_or_else(|e| panic!("{}: {s}: {e}", d.name));
+                assert_eq!(r.algorithm(), d.name);
+                assert_eq!(&r.settings(), s, "{}", d.name);
+                for (k, v) in s.iter() {
+                    let p = d
+                        .param(k)
+                        .unwrap_or_else(|| panic!("{}: {k} undeclared", d.name));
+                    let int = matches!(v, render_core::SettingValue::Int(_));
+                    assert_eq!(int, p.kind == ValueKind::Int, "{}: {k}={v}", d.name);
+                }
+                // The text form parses back to the same typed settings.
+                assert_eq!(&d.parse_settings(&s.to_string()).unwrap(), s);
+            }
+        }
+    }
+
+    #[test]
+    fn havs_k_is_an_integer_from_the_filter_to_the_row() {
+        let f = SettingsFilter::parse("k=8").unwrap();
+        let v = selected_variants("havs", &f).unwrap();
+        assert!(v
+            .iter()
+            .all(|r| r.settings().get("k") == Some(&render_core::SettingValue::Int(8))));
+        assert!(description("havs")
+            .unwrap()
+            .parse_settings("k=eight")
+            .is_err());
+        assert!(description("havs")
+            .unwrap()
+            .parse_settings("colour=red")
+            .is_err());
+        // Old results: a splat length written `2` is retyped to the declared word.
+        let old = Settings::parse("radius=2;grid=32").unwrap();
+        let typed = retype("splat", old);
+        assert_eq!(typed.text("radius").as_deref(), Some("2"));
+        assert_eq!(typed.int("radius"), None);
+        assert_eq!(typed.int("grid"), Some(32));
+    }
+
     #[test]
     fn peers_are_registered_and_marked() {
-        for (_, peers) in PEERS {
-            for p in *peers {
-                assert!(names().contains(p) && is_peer(p), "{p}");
-                assert_eq!(variants(p).unwrap()[0].algorithm(), *p);
+        for (_, peers) in peer_groups() {
+            for p in peers {
+                assert!(names().contains(&p) && is_peer(p), "{p}");
+                assert_eq!(variants(p).unwrap()[0].algorithm(), p);
             }
         }
         assert!(!is_peer("gator-pt"));

@@ -25,6 +25,7 @@
 //! by its row's roofline time (from that machine's calibration, [`crate::calibrate`]), images
 //! are not compared pixel by pixel (adapters legitimately differ), and every output says so.
 
+use render_core::Settings;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
@@ -230,7 +231,7 @@ pub fn adapter_of(f: &ResultsFile) -> String {
     }
 }
 
-type Key = (String, String, String, String, u32, u32);
+type Key = (String, Settings, String, String, u32, u32);
 
 fn key(r: &Row) -> Key {
     (
@@ -476,7 +477,7 @@ pub fn provenance_warnings(side: &str, f: &ResultsFile) -> Vec<String> {
 fn only(r: &Row, status: &str) -> RowComparison {
     RowComparison {
         algorithm: r.algorithm.clone(),
-        settings: r.settings.clone(),
+        settings: r.settings.to_string(),
         dataset: r.dataset.clone(),
         viewpoint: r.viewpoint.clone(),
         width: r.width,
@@ -648,7 +649,7 @@ fn image_change(
                     crate::names::slug(&b.dataset),
                     crate::names::viewpoint_slug(&b.viewpoint),
                     crate::names::slug(&b.algorithm),
-                    crate::names::slug(&b.settings)
+                    crate::names::slug(&b.settings.to_string())
                 );
                 let path = heat_dir.join(&name);
                 d.heatmap
@@ -676,7 +677,7 @@ fn group_tests(
     scale: f64,
     rounds: Rounds,
 ) -> anyhow::Result<Vec<GroupComparison>> {
-    let mut groups: Vec<(String, String, String)> = vec![];
+    let mut groups: Vec<(String, Settings, String)> = vec![];
     for r in base {
         let g = (r.algorithm.clone(), r.settings.clone(), r.dataset.clone());
         if !groups.contains(&g) {
@@ -713,7 +714,7 @@ fn group_tests(
         out.push(GroupComparison {
             total: round_test("total_ms", &bs, &ns, opt, rounds),
             algorithm,
-            settings,
+            settings: settings.to_string(),
             dataset,
             viewpoints: views,
         });

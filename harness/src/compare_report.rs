@@ -385,7 +385,7 @@ mod tests {
         std::fs::create_dir_all(dir.join("images")).unwrap();
         let mut row = crate::results::Row {
             algorithm: "havs".into(),
-            settings: "k=2".into(),
+            settings: "k=2".parse().unwrap(),
             dataset: dataset.into(),
             viewpoint: "+x".into(),
             total_ms: Some(ms),

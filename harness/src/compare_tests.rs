@@ -13,7 +13,7 @@ fn run_dir(dir: &Path, factors: &[f64], rounds: u32, frames: u32, drift: f64, se
         for vp in ["+x", "+x+y+z", "-x+y-z"] {
             let mut row = crate::results::Row {
                 algorithm: format!("alg{i}"),
-                settings: "k=2".into(),
+                settings: "k=2".parse().unwrap(),
                 dataset: "box:1k".into(),
                 viewpoint: vp.into(),
                 frames: rounds * frames,

@@ -116,7 +116,7 @@ mod tests {
     fn file() -> ResultsFile {
         let row = |vp: &str, ms: Option<f64>, error: &str| Row {
             algorithm: "havs".into(),
-            settings: "k=2".into(),
+            settings: "k=2".parse().unwrap(),
             dataset: "box:1k".into(),
             viewpoint: vp.into(),
             width: 16,

@@ -14,6 +14,7 @@
 //!   than the threshold factor is not one.
 //! - Runs of different adapters are refused: a step between two machines is not a change.
 
+use render_core::Settings;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -65,7 +66,7 @@ pub struct History {
     pub series: Vec<Series>,
 }
 
-fn group_rows<'a>(f: &'a ResultsFile, g: &(String, String, String)) -> Vec<&'a Row> {
+fn group_rows<'a>(f: &'a ResultsFile, g: &(String, Settings, String)) -> Vec<&'a Row> {
     f.rows
         .iter()
         .filter(|r| (&r.algorithm, &r.settings, &r.dataset) == (&g.0, &g.1, &g.2) && r.ok())
@@ -210,7 +211,7 @@ pub fn history(
         };
         pairs.push(Some(crate::compare::compare(&w[0].0, &w[1].0, &opt)?));
     }
-    let mut groups: Vec<(String, String, String)> = vec![];
+    let mut groups: Vec<(String, Settings, String)> = vec![];
     for (_, f) in &files {
         for r in &f.rows {
             let g = (r.algorithm.clone(), r.settings.clone(), r.dataset.clone());
@@ -242,11 +243,9 @@ pub fn history(
                 .as_ref()
                 .filter(|_| points.last().is_some_and(|p| p.run + 1 == i))
             {
-                if let Some(gc) = cmp
-                    .groups
-                    .iter()
-                    .find(|c| (&c.algorithm, &c.settings, &c.dataset) == (&g.0, &g.1, &g.2))
-                {
+                if let Some(gc) = cmp.groups.iter().find(|c| {
+                    (&c.algorithm, &c.settings, &c.dataset) == (&g.0, &g.1.to_string(), &g.2)
+                }) {
                     match gc.total.verdict {
                         Verdict::Slower => changes.push(format!("slower ×{:.3}", gc.total.ratio)),
                         Verdict::Faster => changes.push(format!("faster ×{:.3}", gc.total.ratio)),
@@ -254,10 +253,9 @@ pub fn history(
                         Verdict::NoChange => {}
                     }
                 }
-                let rows_here = cmp
-                    .rows
-                    .iter()
-                    .filter(|r| (&r.algorithm, &r.settings, &r.dataset) == (&g.0, &g.1, &g.2));
+                let rows_here = cmp.rows.iter().filter(|r| {
+                    (&r.algorithm, &r.settings, &r.dataset) == (&g.0, &g.1.to_string(), &g.2)
+                });
                 let mut psnr_moved = false;
                 let mut memory = false;
                 for r in rows_here {
@@ -307,7 +305,7 @@ pub fn history(
         }
         series.push(Series {
             algorithm: g.0,
-            settings: g.1,
+            settings: g.1.to_string(),
             dataset: g.2,
             points,
         });
@@ -641,7 +639,7 @@ mod tests {
                 for (v, vp) in ["+x", "-x", "+y"].iter().enumerate() {
                     let mut row = Row {
                         algorithm: format!("alg{g}"),
-                        settings: "k=2".into(),
+                        settings: "k=2".parse().unwrap(),
                         dataset: "box:1k".into(),
                         viewpoint: vp.to_string(),
                         ..Default::default()

@@ -22,7 +22,7 @@ pub use crate::stats::{spread, Spread};
 #[derive(Debug, Clone, PartialEq)]
 pub struct Aggregate {
     pub algorithm: String,
-    pub settings: String,
+    pub settings: render_core::Settings,
     pub dataset: String,
     pub tets: u64,
     pub rows: usize,
@@ -44,13 +44,13 @@ pub struct Aggregate {
 impl Aggregate {
     /// `algorithm settings` as one label.
     pub fn series(&self) -> String {
-        series_label(&self.algorithm, &self.settings)
+        series_label(&self.algorithm, &self.settings.to_string())
     }
 }
 
 /// Groups rows by (algorithm, settings, data set), in order of first appearance.
 pub fn aggregate(rows: &[Row]) -> Vec<Aggregate> {
-    let mut keys: Vec<(String, String, String)> = vec![];
+    let mut keys: Vec<(String, render_core::Settings, String)> = vec![];
     for r in rows {
         let k = (r.algorithm.clone(), r.settings.clone(), r.dataset.clone());
         if !keys.contains(&k) {
@@ -300,7 +300,7 @@ fn summary_lines(file: &ResultsFile, aggs: &[Aggregate], suspect: &[bool]) -> Ve
                 classes: row_classes(a.failed > 0, any_suspect, &a.algorithm),
                 algorithm: a.algorithm.clone(),
                 peer,
-                settings: a.settings.clone(),
+                settings: a.settings.to_string(),
                 dataset: a.dataset.clone(),
                 tets: a.tets,
                 rows: a.rows,
@@ -342,7 +342,7 @@ fn suspect_figures(file: &ResultsFile) -> Vec<SuspectFigure> {
             })
             .collect(),
             algorithm: row.algorithm.clone(),
-            settings: row.settings.clone(),
+            settings: row.settings.to_string(),
             dataset: row.dataset.clone(),
             viewpoint: row.viewpoint.clone(),
             why: row.suspect.clone(),
@@ -379,7 +379,7 @@ fn views(file: &ResultsFile) -> Vec<View> {
                     .map(|row| ViewFigure {
                         image: row.image.clone(),
                         heatmap: row.heatmap.clone(),
-                        label: series_label(&row.algorithm, &row.settings),
+                        label: series_label(&row.algorithm, &row.settings.to_string()),
                         psnr: opt(row.psnr_db, 2),
                         mtets: opt(row.tets_per_sec.map(|v| v * 1e-6), 3),
                     })
@@ -397,7 +397,7 @@ fn row_lines(file: &ResultsFile, suspect: &[bool]) -> Vec<RowLine> {
             classes: row_classes(!row.ok(), *suspect, &row.algorithm),
             algorithm: row.algorithm.clone(),
             peer: is_peer(&row.algorithm),
-            settings: row.settings.clone(),
+            settings: row.settings.to_string(),
             dataset: row.dataset.clone(),
             viewpoint: row.viewpoint.clone(),
             cells: vec![
@@ -541,7 +541,7 @@ mod tests {
         let mut f = file();
         for r in &mut f.rows {
             r.dataset = HOSTILE_NAME.into();
-            r.settings = format!("k={HOSTILE_NAME}");
+            r.settings = render_core::Settings::new().with("k", HOSTILE_NAME);
             r.image = format!("images/{HOSTILE_NAME}.png");
         }
         f.rows[3].error = HOSTILE_NAME.into();

@@ -15,6 +15,8 @@ use anyhow::Context;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+use render_core::Settings;
+
 use crate::machine::MachineInfo;
 
 /// Bumped whenever a field changes meaning or is removed (adding a field does not bump it).
@@ -35,7 +37,11 @@ pub const JSON_FILE: &str = "results.json";
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Row {
     pub algorithm: String,
-    pub settings: String,
+    /// The variant's typed settings: a map in `results.json` (`{"k": 6, …}`; the text form
+    /// of older files still loads), `key=value;…` text in `results.csv`.
+    #[serde(serialize_with = "settings_column")]
+    #[schemars(with = "SettingsSchema")]
+    pub settings: Settings,
     pub dataset: String,
     pub tets: u64,
     pub viewpoint: String,
@@ -116,7 +122,7 @@ pub struct Row {
     pub samples: FrameSamples,
 }
 
-/// The value of `key` in a `key=value;key=value` list: a row's `settings` or `counters`.
+/// The value of `key` in a `name=value;name=value` list: a row's `stages` or `counters`.
 pub fn value_of<'a>(list: &'a str, key: &str) -> Option<&'a str> {
     list.split(';').find_map(|kv| {
         kv.split_once('=')
@@ -125,10 +131,52 @@ pub fn value_of<'a>(list: &'a str, key: &str) -> Option<&'a str> {
     })
 }
 
+/// The settings as JSON Schema sees them: a map of integers and words, or the text form of
+/// files written before settings were typed.
+#[derive(JsonSchema)]
+#[allow(dead_code)]
+#[schemars(untagged)]
+enum SettingsSchema {
+    Map(std::collections::BTreeMap<String, SettingValueSchema>),
+    Text(String),
+}
+
+#[derive(JsonSchema)]
+#[allow(dead_code)]
+#[schemars(untagged)]
+enum SettingValueSchema {
+    Int(i64),
+    Text(String),
+}
+
+thread_local! {
+    /// Set while a row is written to `results.csv`, whose cells cannot hold a map.
+    static SETTINGS_AS_TEXT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+fn settings_column<S: serde::Serializer>(s: &Settings, ser: S) -> Result<S::Ok, S::Error> {
+    if SETTINGS_AS_TEXT.get() {
+        ser.collect_str(s)
+    } else {
+        s.serialize(ser)
+    }
+}
+
+/// Writes one row to `results.csv`: flat (no samples), settings as text.
+fn serialize_csv_row<W: Write>(csv: &mut csv::Writer<W>, row: &Row) -> csv::Result<()> {
+    SETTINGS_AS_TEXT.set(true);
+    let written = csv.serialize(Row {
+        samples: FrameSamples::default(),
+        ..row.clone()
+    });
+    SETTINGS_AS_TEXT.set(false);
+    written
+}
+
 impl Row {
-    /// A setting of the row's variant (`key=value;…` in `settings`).
-    pub fn setting(&self, key: &str) -> Option<&str> {
-        value_of(&self.settings, key)
+    /// A setting of the row's variant, as written (`cpu-radix`, `6`).
+    pub fn setting(&self, key: &str) -> Option<String> {
+        self.settings.text(key)
     }
 
     /// A counter of the row (`name=value;…` in `counters`), if present and numeric.
@@ -215,8 +263,15 @@ impl ResultsFile {
                 version
             );
         }
-        serde_json::from_value(value)
-            .with_context(|| format!("{}: unexpected layout", path.display()))
+        // From the text, not the parsed value: a value's maps are sorted, and a row's settings
+        // keep their declared order.
+        let mut file: ResultsFile = serde_json::from_str(&text)
+            .with_context(|| format!("{}: unexpected layout", path.display()))?;
+        for row in &mut file.rows {
+            let settings = std::mem::take(&mut row.settings);
+            row.settings = crate::algorithms::retype(&row.algorithm, settings);
+        }
+        Ok(file)
     }
 }
 
@@ -269,10 +324,7 @@ impl ResultsWriter {
     /// Appends a row to both files; both are on disk when this returns.
     pub fn push(&mut self, row: Row) -> anyhow::Result<()> {
         // The samples go to samples.csv; results.csv keeps one flat line per row.
-        self.csv.serialize(Row {
-            samples: FrameSamples::default(),
-            ..row.clone()
-        })?;
+        serialize_csv_row(&mut self.csv, &row)?;
         self.csv.flush().context("writing results.csv")?;
         self.samples.push(&row)?;
         self.file.rows.push(row);
@@ -285,10 +337,7 @@ impl ResultsWriter {
             return Ok(());
         }
         for row in rows {
-            self.csv.serialize(Row {
-                samples: FrameSamples::default(),
-                ..row.clone()
-            })?;
+            serialize_csv_row(&mut self.csv, &row)?;
             self.samples.push(&row)?;
             self.file.rows.push(row);
         }
@@ -325,10 +374,7 @@ pub fn write_csv(dir: &Path, rows: &[Row]) -> anyhow::Result<()> {
     let mut csv = csv::WriterBuilder::new().has_headers(false).from_writer(f);
     csv.write_record(csv_header())?;
     for r in rows {
-        csv.serialize(Row {
-            samples: FrameSamples::default(),
-            ..r.clone()
-        })?;
+        serialize_csv_row(&mut csv, r)?;
     }
     csv.flush()
         .with_context(|| format!("cannot write {}", path.display()))
@@ -348,7 +394,7 @@ pub fn write_json(dir: &Path, file: &ResultsFile) -> anyhow::Result<()> {
 /// The CSV header: [`Row`]'s field names in order (taken from serde so they cannot drift).
 pub fn csv_header() -> Vec<String> {
     let mut w = csv::Writer::from_writer(vec![]);
-    w.serialize(Row::default()).expect("row serialises");
+    serialize_csv_row(&mut w, &Row::default()).expect("row serialises");
     let bytes = w.into_inner().expect("in-memory writer");
     let text = String::from_utf8(bytes).expect("utf-8");
     text.lines()
@@ -449,7 +495,7 @@ pub fn sample_lines(row: &Row) -> Vec<SampleLine> {
         for (i, &ms) in row.samples.metric(metric).iter().enumerate() {
             out.push(SampleLine {
                 algorithm: row.algorithm.clone(),
-                settings: row.settings.clone(),
+                settings: row.settings.to_string(),
                 dataset: row.dataset.clone(),
                 viewpoint: row.viewpoint.clone(),
                 width: row.width,
@@ -511,7 +557,7 @@ pub fn write_samples_csv(dir: &Path, rows: &[Row]) -> anyhow::Result<()> {
 pub(crate) fn test_row(i: u32) -> Row {
     Row {
         algorithm: "test".into(),
-        settings: "variant=a;sort=radix".into(),
+        settings: "variant=a;sort=radix".parse().unwrap(),
         dataset: "box:1k".into(),
         tets: 1000,
         viewpoint: format!("v{i}"),

@@ -8,6 +8,7 @@
 //! and in every order the command line lists them), and rank r goes to shard r mod N + 1, so
 //! shard sizes differ by at most one unit.
 
+use render_core::Settings;
 use std::collections::{HashMap, HashSet};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -45,8 +46,8 @@ impl fmt::Display for Shard {
     }
 }
 
-/// One unit of the run matrix: (data set label, algorithm, settings string).
-pub type Unit = (String, String, String);
+/// One unit of the run matrix: (data set label, algorithm, settings).
+pub type Unit = (String, String, render_core::Settings);
 
 fn fnv1a(s: &str) -> u64 {
     let mut h = 0xcbf2_9ce4_8422_2325u64;
@@ -115,7 +116,7 @@ fn adapter_of(f: &ResultsFile) -> Option<(String, String, String)> {
 }
 
 /// A row's identity in the matrix (one per adapter: runs of several machines sit side by side).
-fn row_key(r: &Row) -> (String, String, String, String, u32, u32, String) {
+fn row_key(r: &Row) -> (String, Settings, String, String, u32, u32, String) {
     (
         r.algorithm.clone(),
         r.settings.clone(),
@@ -163,8 +164,7 @@ pub fn units_of(run: &RunDescription) -> Vec<Unit> {
     for spec in &run.datasets {
         let label = crate::names::dataset_label(spec);
         for a in &run.algorithms {
-            for r in crate::algorithms::selected_variants(a, &filter).unwrap_or_default() {
-                let settings = render_core::settings_string(&r.settings());
+            for settings in crate::algorithms::selected_settings(a, &filter).unwrap_or_default() {
                 units.push((label.clone(), a.clone(), settings));
             }
         }
@@ -398,16 +398,11 @@ pub fn sort_like_a_run(rows: &mut [Row], run: &RunDescription) {
         .map(|v| v.into_iter().map(|v| v.name).collect())
         .unwrap_or_default();
     let filter = crate::algorithms::SettingsFilter::parse(&run.settings_filter).ok();
-    let mut variant_order: HashMap<String, Vec<String>> = HashMap::new();
+    let mut variant_order: HashMap<String, Vec<Settings>> = HashMap::new();
     for a in &run.algorithms {
         let order = filter
             .as_ref()
-            .and_then(|f| crate::algorithms::selected_variants(a, f).ok())
-            .map(|v| {
-                v.iter()
-                    .map(|r| render_core::settings_string(&r.settings()))
-                    .collect()
-            })
+            .and_then(|f| crate::algorithms::selected_settings(a, f).ok())
             .unwrap_or_default();
         variant_order.insert(a.clone(), order);
     }
@@ -417,7 +412,11 @@ pub fn sort_like_a_run(rows: &mut [Row], run: &RunDescription) {
             pos(&run.algorithms, &r.algorithm),
             variant_order
                 .get(&r.algorithm)
-                .map(|v| pos(v, &r.settings))
+                .map(|v| {
+                    v.iter()
+                        .position(|s| *s == r.settings)
+                        .unwrap_or(usize::MAX)
+                })
                 .unwrap_or(usize::MAX),
             r.settings.clone(),
             pos(&viewpoints, &r.viewpoint),
@@ -436,7 +435,11 @@ mod tests {
         for d in ["box:10k", "shell:10k", "spx"] {
             for (a, n) in [("gator-pt", 2), ("havs", 4), ("fragment-pt", 6)] {
                 for i in 0..n {
-                    u.push((d.to_string(), a.to_string(), format!("v={i}")));
+                    u.push((
+                        d.to_string(),
+                        a.to_string(),
+                        format!("v={i}").parse().unwrap(),
+                    ));
                 }
             }
         }

@@ -433,10 +433,7 @@ fn every_algorithm_is_close_to_the_reference_on_the_non_convex_suite_mesh() {
             r.settings
         );
         assert!(r.suspect.is_empty(), "{}: {}", r.algorithm, r.suspect);
-        if r.algorithm == "raycast"
-            && r.settings.contains("table=3d")
-            && r.settings.contains("et=off")
-        {
+        if r.algorithm == "raycast" && r.settings.is("table", "3d") && r.settings.is("et", "off") {
             assert!(p >= 90.0, "exact ray caster at {p} dB");
         }
     }

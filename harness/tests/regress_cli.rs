@@ -23,7 +23,7 @@ fn results(dir: &Path, factors: &[f64], rounds: u32, adapter_cpu: &str) {
         for vp in ["+x", "+x+y+z", "-x+y-z"] {
             let mut row = Row {
                 algorithm: format!("alg{i}"),
-                settings: "k=2".into(),
+                settings: "k=2".parse().unwrap(),
                 dataset: "box:1k".into(),
                 viewpoint: vp.into(),
                 frames: rounds,
@@ -212,8 +212,8 @@ fn a_second_run_into_a_busy_directory_refuses_and_nothing_is_lost() {
     let status = first.wait().unwrap();
     assert!(status.success());
     let f = harness::results::ResultsFile::read(&out).unwrap();
-    let variants: std::collections::HashSet<&str> =
-        f.rows.iter().map(|r| r.settings.as_str()).collect();
+    let variants: std::collections::HashSet<String> =
+        f.rows.iter().map(|r| r.settings.to_string()).collect();
     assert_eq!(
         f.rows.len(),
         14 * variants.len(),

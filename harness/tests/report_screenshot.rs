@@ -20,7 +20,7 @@ fn row(algorithm: &str, settings: &str, dataset: &str, viewpoint: &str, i: usize
     };
     Row {
         algorithm: algorithm.into(),
-        settings: settings.into(),
+        settings: settings.parse().unwrap(),
         dataset: dataset.into(),
         tets: 10_000,
         viewpoint: viewpoint.into(),
@@ -82,7 +82,7 @@ fn synthetic_run() -> ResultsFile {
             .filter(|n| !harness::algorithms::is_peer(n))
         {
             for r in harness::algorithms::variants(name).unwrap() {
-                let settings = render_core::settings_string(&r.settings());
+                let settings = r.settings().to_string();
                 for vp in ["+x", "+x+y+z", "-x+y-z"] {
                     rows.push(row(name, &settings, dataset, vp, i));
                 }
@@ -152,12 +152,12 @@ fn report_screenshot_in_headless_chromium() {
     assert_eq!(shot.dimensions(), (1400, 1400));
     // The first chart is on screen: the markers' exact colours appear in the screenshot (the
     // chart is shown at its own size, so marker interiors are not resampled).
-    let points: Vec<(&str, &str)> = file
+    let points: Vec<(&str, String)> = file
         .rows
         .iter()
-        .map(|r| (r.algorithm.as_str(), r.settings.as_str()))
+        .map(|r| (r.algorithm.as_str(), r.settings.to_string()))
         .collect();
-    let book = StyleBook::new(points);
+    let book = StyleBook::new(points.iter().map(|(a, s)| (*a, s.as_str())));
     for name in harness::algorithms::names()
         .into_iter()
         .filter(|n| !harness::algorithms::is_peer(n))

@@ -92,7 +92,7 @@ pub fn run(args: Args, _ctx: &super::Context) -> anyhow::Result<()> {
     for a in &aggs {
         w.write_record([
             a.algorithm.clone(),
-            a.settings.clone(),
+            a.settings.to_string(),
             a.dataset.clone(),
             a.tets.to_string(),
             a.rows.to_string(),

@@ -16,6 +16,7 @@
 //! the k-buffer, the classifier, data set sizes) come from the paper's own measurements.
 
 use anyhow::{bail, Context as _};
+use render_core::Settings;
 
 use super::verdict::{self, Check, Evaluation, Expect, Hardware, Sample, Side};
 use crate::results::Row;
@@ -36,7 +37,7 @@ pub enum Source {
 #[derive(Debug, Clone, PartialEq)]
 pub struct VariantSpec {
     pub algorithm: String,
-    pub settings: Vec<(String, String)>,
+    pub settings: Settings,
     /// Pins the side to one data set whatever the claim's data sets are.
     pub dataset: Option<String>,
 }
@@ -54,26 +55,19 @@ impl VariantSpec {
         if algorithm.is_empty() {
             return Err(format!("{text:?}: no algorithm"));
         }
-        let mut pairs = vec![];
-        for kv in settings.split(';').map(str::trim).filter(|s| !s.is_empty()) {
-            let (k, v) = kv
-                .split_once('=')
-                .ok_or_else(|| format!("{text:?}: setting {kv:?} is not key=value"))?;
-            pairs.push((k.trim().to_string(), v.trim().to_string()));
-        }
+        // The papers' CPU analyses (`sort-analysis`) are not algorithms: their settings are
+        // typed by inference.
+        let settings = crate::algorithms::parse_settings(algorithm, settings)
+            .map_err(|e| format!("{text:?}: {e}"))?;
         Ok(VariantSpec {
             algorithm: algorithm.to_string(),
-            settings: pairs,
+            settings,
             dataset,
         })
     }
 
     pub fn settings_text(&self) -> String {
-        self.settings
-            .iter()
-            .map(|(k, v)| format!("{k}={v}"))
-            .collect::<Vec<_>>()
-            .join(";")
+        self.settings.to_string()
     }
 
     /// `algorithm settings on dataset`: what a verdict names.
@@ -91,11 +85,8 @@ impl VariantSpec {
     }
 
     /// The value this side asks for a setting, if it pins it.
-    pub fn setting(&self, key: &str) -> Option<&str> {
-        self.settings
-            .iter()
-            .find(|(k, _)| k == key)
-            .map(|(_, v)| v.as_str())
+    pub fn setting(&self, key: &str) -> Option<String> {
+        self.settings.text(key)
     }
 
     fn matches(&self, row: &Row) -> bool {
@@ -103,7 +94,7 @@ impl VariantSpec {
             && self
                 .settings
                 .iter()
-                .all(|(k, v)| row.setting(k) == Some(v.as_str()))
+                .all(|(k, v)| row.settings.get(k) == Some(v))
     }
 }
 
@@ -443,14 +434,18 @@ pub fn side_from_rows(
         .iter()
         .filter(|r| r.dataset == dataset && r.ok() && spec.matches(r))
         .collect();
-    let mut variants: Vec<&str> = rows.iter().map(|r| r.settings.as_str()).collect();
+    let mut variants: Vec<&Settings> = rows.iter().map(|r| &r.settings).collect();
     variants.sort();
     variants.dedup();
     if variants.len() > 1 {
         return Err(format!(
             "{label}: {} variants match ({}); the claim must name one",
             variants.len(),
-            variants.join(" | ")
+            variants
+                .iter()
+                .map(|v| v.to_string())
+                .collect::<Vec<_>>()
+                .join(" | ")
         ));
     }
     if rows.is_empty() {
@@ -650,7 +645,7 @@ mod tests {
     fn variant_specs_and_expectations_parse() {
         let v = VariantSpec::parse("havs:k=2;sort=cpu-radix@spx2").unwrap();
         assert_eq!(v.algorithm, "havs");
-        assert_eq!(v.setting("k"), Some("2"));
+        assert_eq!(v.settings.int("k"), Some(2));
         assert_eq!(v.dataset.as_deref(), Some("spx2"));
         assert_eq!(v.label(Some("spx2")), "havs k=2;sort=cpu-radix on spx2");
         assert!(VariantSpec::parse("havs:k2").is_err());
@@ -695,7 +690,7 @@ mod tests {
     fn row(settings: &str, viewpoint: &str, total: f64, frames: u32) -> Row {
         Row {
             algorithm: "raycast".into(),
-            settings: settings.into(),
+            settings: Settings::parse(settings).unwrap(),
             dataset: "spx1".into(),
             tets: 1000,
             viewpoint: viewpoint.into(),

@@ -173,7 +173,7 @@ pub fn paper_name(paper: &str, dataset: &str) -> Option<&'static str> {
 /// Returns (source, value).
 pub fn paper_tets_per_sec(
     algorithm: &str,
-    settings: &str,
+    settings: &render_core::Settings,
     dataset: &str,
 ) -> Option<(&'static str, f64)> {
     let get = |paper: &str, t: &str, col: &str| {
@@ -182,11 +182,11 @@ pub fn paper_tets_per_sec(
     };
     match algorithm {
         "gator-pt" => {
-            let v = crate::results::value_of(settings, "variant")?;
+            let v = settings.text("variant")?;
             let col = format!("{v}_tets_per_sec");
             get("gator", "gator_table3", &col).map(|x| ("GATOR Table 3", x))
         }
-        "havs" if crate::results::value_of(settings, "k") == Some("2") => {
+        "havs" if settings.int("k") == Some(2) => {
             get("havs", "havs_table4", "tets_per_sec").map(|x| ("HAVS Table 4 (k=2)", x))
         }
         "fragment-pt" => get("fragment-pt", "fragment-pt_table1", "tets_per_sec")

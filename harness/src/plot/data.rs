@@ -91,7 +91,7 @@ impl Inputs {
         crate::algorithms::note_external_rows(
             file.rows
                 .iter()
-                .map(|r| (r.algorithm.as_str(), r.settings.as_str())),
+                .map(|r| (r.algorithm.as_str(), &r.settings)),
         );
         let adapter = file
             .machine
@@ -221,7 +221,7 @@ pub fn points(rows: &[Row]) -> Vec<Point> {
     for (i, r) in rows.iter().enumerate() {
         let pos = out.iter().position(|p| {
             p.algorithm == r.algorithm
-                && p.settings == r.settings
+                && p.settings == r.settings.to_string()
                 && p.dataset == r.dataset
                 && p.width == r.width
                 && p.height == r.height
@@ -232,7 +232,7 @@ pub fn points(rows: &[Row]) -> Vec<Point> {
                 members.push(vec![i]);
                 out.push(Point {
                     algorithm: r.algorithm.clone(),
-                    settings: r.settings.clone(),
+                    settings: r.settings.to_string(),
                     dataset: r.dataset.clone(),
                     tets: r.tets,
                     width: r.width,
@@ -312,7 +312,7 @@ pub(crate) mod tests {
                 for v in 0..2u32 {
                     let mut r = test_row(v);
                     r.algorithm = a.into();
-                    r.settings = s.into();
+                    r.settings = s.parse().unwrap();
                     r.dataset = d.into();
                     r.tets = tets;
                     let f = if a == "havs" { 1.0 } else { 2.0 };
@@ -325,7 +325,7 @@ pub(crate) mod tests {
         }
         let mut failed = test_row(2);
         failed.algorithm = "havs".into();
-        failed.settings = "k=2;sort=cpu-radix".into();
+        failed.settings = "k=2;sort=cpu-radix".parse().unwrap();
         failed.dataset = "box:100k".into();
         failed.tets = 100_000;
         failed.tets_per_sec = None;

@@ -247,7 +247,9 @@ mod tests {
     ) -> Option<(f64, f64, f64)> {
         let v: Vec<f64> = rows
             .iter()
-            .filter(|r| r.algorithm == alg && r.settings == settings && r.dataset == dataset)
+            .filter(|r| {
+                r.algorithm == alg && r.settings.to_string() == settings && r.dataset == dataset
+            })
             .filter_map(f)
             .collect();
         if v.is_empty() {
@@ -324,7 +326,9 @@ mod tests {
                 let count = rows
                     .iter()
                     .filter(|x| {
-                        x.algorithm == r.algorithm && x.settings == r.settings && x.dataset == d
+                        x.algorithm == r.algorithm
+                            && x.settings.to_string() == r.settings
+                            && x.dataset == d
                     })
                     .count();
                 assert_eq!(r.rows, count);

@@ -110,15 +110,24 @@ const TEALS: Family = [
     RGBColor(54, 144, 192),
 ];
 
-/// Algorithms with a family of their own; others get one of [`SPARE_FAMILIES`] by a hash of
-/// their name (stable, but two unknown algorithms may then share a family).
-const KNOWN_FAMILIES: [(&str, Family); 5] = [
-    ("gator-pt", BLUES),
-    ("havs", ORANGES),
-    ("fragment-pt", GREENS),
-    ("raycast", PURPLES),
-    ("splat", MAGENTAS),
-];
+/// The palette of a description's hue.
+fn hue_family(hue: render_core::Hue) -> Family {
+    use render_core::Hue;
+    match hue {
+        Hue::Blues => BLUES,
+        Hue::Oranges => ORANGES,
+        Hue::Greens => GREENS,
+        Hue::Purples => PURPLES,
+        Hue::Magentas => MAGENTAS,
+        Hue::Browns => BROWNS,
+        Hue::Teals => TEALS,
+        Hue::Greys => GREYS,
+    }
+}
+
+/// Algorithms this build does not describe (results of other builds, external renderers
+/// that are not peers) get one of these by a hash of their name (stable, but two unknown
+/// algorithms may then share a family).
 const SPARE_FAMILIES: [Family; 2] = [BROWNS, TEALS];
 
 /// Whether `algorithm` is an outside peer (VTK's mappers, issue 13) rather than one of
@@ -131,9 +140,9 @@ pub fn is_peer(algorithm: &str) -> bool {
 /// Peers share the grey family, so each peer's slots start at its own offset (its place among
 /// the peers × 4): `vtk-pt`, `vtk-raycast` and `vtk-zsweep` never share a style.
 fn peer_slot_offset(algorithm: &str) -> usize {
-    let peers: Vec<&str> = crate::algorithms::PEERS
-        .iter()
-        .flat_map(|(_, names)| names.iter().copied())
+    let peers: Vec<&str> = crate::algorithms::peer_groups()
+        .into_iter()
+        .flat_map(|(_, names)| names)
         .collect();
     let index = peers
         .iter()
@@ -175,10 +184,8 @@ fn family(algorithm: &str) -> Family {
     if is_peer(algorithm) {
         return GREYS;
     }
-    KNOWN_FAMILIES
-        .iter()
-        .find(|(n, _)| *n == algorithm)
-        .map(|(_, f)| *f)
+    crate::algorithms::describe(algorithm)
+        .map(|d| hue_family(d.hue))
         .unwrap_or_else(|| {
             SPARE_FAMILIES[(fnv1a(algorithm) % SPARE_FAMILIES.len() as u64) as usize]
         })
@@ -221,29 +228,14 @@ pub struct StyleBook {
     styles: BTreeMap<VariantKey, Style>,
 }
 
-/// Settings strings of an algorithm's default and of all its variants (empty when the
-/// algorithm is not in this build's table, e.g. results from another version).
+/// Settings texts of an algorithm's default and of all its variants, from its declared grid
+/// (empty when this build does not describe the algorithm, e.g. results of another version).
 fn known_settings(algorithm: &str) -> (Vec<String>, Vec<String>) {
-    let strings = |v: Vec<Box<dyn render_core::Renderer>>| {
-        v.iter()
-            .map(|r| render_core::settings_string(&r.settings()))
-            .collect::<Vec<_>>()
-    };
-    let defaults = crate::algorithms::variants(algorithm)
-        .map(strings)
-        .unwrap_or_default();
-    (defaults, all_settings(algorithm))
-}
-
-/// Every variant the algorithm offers, as settings strings, in its table's order.
-fn all_settings(algorithm: &str) -> Vec<String> {
-    crate::algorithms::all_variants(algorithm)
-        .map(|v| {
-            v.iter()
-                .map(|r| render_core::settings_string(&r.settings()))
-                .collect()
-        })
-        .unwrap_or_default()
+    let texts = |grid: Vec<render_core::Settings>| grid.iter().map(|s| s.to_string()).collect();
+    match crate::algorithms::describe(algorithm) {
+        Some(d) => (texts((d.default_grid)()), texts((d.full_grid)())),
+        None => (vec![], vec![]),
+    }
 }
 
 /// The preferred slot of a variant and a sort key that puts default variants first.
@@ -266,15 +258,16 @@ fn value_text(key: &str, value: &str) -> String {
     }
 }
 
+/// A legend's settings as (key, value) texts; text that does not parse (a foreign results
+/// file) is shown whole.
 fn parse_settings(settings: &str) -> Vec<(String, String)> {
-    settings
-        .split(';')
-        .filter(|p| !p.is_empty())
-        .map(|p| match p.split_once('=') {
-            Some((k, v)) => (k.to_string(), v.to_string()),
-            None => (p.to_string(), String::new()),
-        })
-        .collect()
+    match render_core::Settings::parse(settings) {
+        Ok(s) => s
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect(),
+        Err(_) => vec![(settings.to_string(), String::new())],
+    }
 }
 
 impl StyleBook {
@@ -454,11 +447,8 @@ mod tests {
     fn suite_variants() -> Vec<(String, String)> {
         let mut v = vec![];
         for name in crate::algorithms::names() {
-            for r in crate::algorithms::variants(name).unwrap() {
-                v.push((
-                    name.to_string(),
-                    render_core::settings_string(&r.settings()),
-                ));
+            for s in known_settings(name).0 {
+                v.push((name.to_string(), s));
             }
         }
         v
@@ -499,7 +489,8 @@ mod tests {
     #[test]
     fn up_to_32_variants_of_one_algorithm_never_share() {
         for name in crate::algorithms::names() {
-            let all: Vec<(String, String)> = all_settings(name)
+            let all: Vec<(String, String)> = known_settings(name)
+                .1
                 .into_iter()
                 .take(SLOTS)
                 .map(|s| (name.to_string(), s))

@@ -60,7 +60,7 @@ fn every_claim_names_a_paper_section_data_sets_and_variants_that_exist() {
                 let settings = v.settings();
                 spec.settings
                     .iter()
-                    .all(|(k, val)| settings.iter().any(|s| s.key == k && s.value == *val))
+                    .all(|(k, val)| settings.get(k) == Some(val))
             });
             assert!(
                 exists,
@@ -157,7 +157,7 @@ fn gator_sizes_fail_when_a_tet_is_lost() {
 fn counter_row(algorithm: &str, settings: &str, dataset: &str, counters: &str) -> Row {
     Row {
         algorithm: algorithm.into(),
-        settings: settings.into(),
+        settings: settings.parse().unwrap(),
         dataset: dataset.into(),
         tets: 1000,
         viewpoint: "+x+y+z".into(),
@@ -259,7 +259,7 @@ fn havs_table2_fails_when_a_fragment_is_dropped_past_the_tolerance() {
 fn gpu_speed_claims_on_lavapipe_are_not_testable_and_name_their_variants() {
     let row = |settings: &str, ms: f64| Row {
         algorithm: "havs".into(),
-        settings: settings.into(),
+        settings: settings.parse().unwrap(),
         dataset: "spx2".into(),
         tets: 827_904,
         viewpoint: "+x".into(),
@@ -309,7 +309,7 @@ fn gpu_speed_claims_on_lavapipe_are_not_testable_and_name_their_variants() {
 fn peers_have_no_cpu_gpu_split_in_havs_table5() {
     let row = Row {
         algorithm: "vtk-pt".into(),
-        settings: "sort=cell-centre".into(),
+        settings: "sort=cell-centre".parse().unwrap(),
         dataset: "f117".into(),
         tets: 240_122,
         viewpoint: "+x".into(),

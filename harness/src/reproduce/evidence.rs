@@ -37,12 +37,12 @@ fn analysis_side(
     };
     Some(match spec.algorithm.as_str() {
         "sort-analysis" => {
-            let name = spec.setting("sort").unwrap_or("");
+            let name = spec.setting("sort").unwrap_or_default();
             // Table 1's radix sort is §5.1's one-core LSD sort.
             let prefix = if name == "radixsort" {
                 "radix sort (HAVS §5.1, one core)"
             } else {
-                name
+                name.as_str()
             };
             let Some(r) = x.sorts.iter().find(|r| r.name.starts_with(prefix)) else {
                 return Some(Err(format!(

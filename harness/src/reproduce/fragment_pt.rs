@@ -10,7 +10,7 @@
 
 use super::papers;
 use super::table::{Cell, CompRow, Comparison, Metric};
-use super::{find, is_standin, Extra, Measured, Paper, Report, RunSpec, Session};
+use super::{find_including, is_standin, Extra, Measured, Paper, Report, RunSpec, Session};
 
 pub const PAPER: Paper = Paper {
     id: "fragment-pt",
@@ -98,11 +98,8 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
     Ok(tables(&m, &x))
 }
 
-fn want(settings: &str) -> Vec<(&str, &str)> {
-    settings
-        .split(';')
-        .filter_map(|kv| kv.split_once('='))
-        .collect()
+fn want(settings: &str) -> render_core::Settings {
+    crate::algorithms::parse_settings("fragment-pt", settings).expect("the table's own settings")
 }
 
 pub fn tables(m: &Measured, x: &Extra) -> Report {
@@ -115,7 +112,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     let mut rows = vec![];
     let mut bytes_rows = vec![];
     for (paper, d) in DATASETS {
-        let a = find(&aggs, "fragment-pt", d, &want(FRAGMENT_SETTINGS));
+        let a = find_including(&aggs, "fragment-pt", d, &want(FRAGMENT_SETTINGS));
         let size = x.sizes.iter().find(|(n, _, _)| n == d);
         let why = m.why("fragment-pt", d);
         let fps = a.and_then(|a| a.fps.map(|s| s.mean));
@@ -179,7 +176,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         let mut cells = vec![];
         for (col, d) in [("blunt_fps", "bluntfin"), ("post_fps", "post")] {
             let ours = alg
-                .and_then(|a| find(&aggs, a, d, &want(settings)))
+                .and_then(|a| find_including(&aggs, a, d, &want(settings)))
                 .and_then(|a| a.fps.map(|s| s.mean));
             let why = match alg {
                 Some(a) => m.why(a, d),

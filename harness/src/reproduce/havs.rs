@@ -11,7 +11,7 @@ use render_core::TransferFunction;
 
 use super::papers::{self, PaperTable};
 use super::table::{Cell, CompRow, Comparison, Metric};
-use super::{find, is_standin, Extra, Measured, Paper, Report, RunSpec, Session};
+use super::{find, find_including, is_standin, Extra, Measured, Paper, Report, RunSpec, Session};
 
 pub const PAPER: Paper = Paper {
     id: "havs",
@@ -338,12 +338,12 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     let t = load("havs_table5");
     let mut rows = vec![];
     for (label, alg, settings) in TABLE5_ALGORITHMS {
-        let want: Vec<(&str, &str)> = settings
-            .map(|s| s.split(';').filter_map(|kv| kv.split_once('=')).collect())
+        let want = settings
+            .map(|s| crate::algorithms::parse_settings(alg, s).expect("Table 5's own settings"))
             .unwrap_or_default();
         let mut cells = vec![];
         for d in TABLE5_DATASETS {
-            let a = find(&aggs, alg, d, &want);
+            let a = find_including(&aggs, alg, d, &want);
             for (part, col) in [("cpu", "cpu_ms"), ("gpu", "gpu_ms"), ("total", "total_ms")] {
                 // A peer's frame is VTK's mapper timed whole: its CPU/GPU split is unknown, not
                 // zero (what remains of our CPU time is the harness's own overhead).

@@ -202,15 +202,30 @@ pub fn find<'a>(
     aggs: &'a [Aggregate],
     algorithm: &str,
     dataset: &str,
-    want: &[(&str, &str)],
+    pins: &[(&str, &str)],
 ) -> Option<&'a Aggregate> {
-    let mut hits = aggs.iter().filter(|a| {
-        a.algorithm == algorithm
-            && a.dataset == dataset
-            && want
-                .iter()
-                .all(|(k, v)| value_of(&a.settings, k) == Some(*v))
-    });
+    let want = pins
+        .iter()
+        .fold(render_core::Settings::new(), |s, (k, v)| s.with(k, *v));
+    find_including(
+        aggs,
+        algorithm,
+        dataset,
+        &want.retyped(|k| crate::algorithms::describe(algorithm).and_then(|d| d.kind_of(k))),
+    )
+}
+
+/// The one aggregate of `algorithm` on `dataset` whose settings include `want` (`None` when
+/// none or several do).
+pub fn find_including<'a>(
+    aggs: &'a [Aggregate],
+    algorithm: &str,
+    dataset: &str,
+    want: &render_core::Settings,
+) -> Option<&'a Aggregate> {
+    let mut hits = aggs
+        .iter()
+        .filter(|a| a.algorithm == algorithm && a.dataset == dataset && a.settings.includes(want));
     let first = hits.next()?;
     hits.next().is_none().then_some(first)
 }

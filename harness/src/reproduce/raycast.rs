@@ -61,8 +61,8 @@ fn rows_of<'a>(
     m.rows
         .iter()
         .filter(|r| r.algorithm == "raycast" && r.dataset == dataset && r.ok())
-        .filter(|r| tiles.is_none_or(|t| r.setting("tiles") == Some(t)))
-        .filter(|r| table.is_none_or(|t| r.setting("table") == Some(t)))
+        .filter(|r| tiles.is_none_or(|t| r.settings.is("tiles", t)))
+        .filter(|r| table.is_none_or(|t| r.settings.is("table", t)))
         .collect()
 }
 

@@ -24,7 +24,7 @@ fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Ro
     let a = &ctx.gpu.adapter;
     Row {
         algorithm: renderer.algorithm().to_string(),
-        settings: settings_string(&renderer.settings()),
+        settings: renderer.settings(),
         dataset: ctx.label.clone(),
         tets: ctx.mesh.num_tets() as u64,
         viewpoint: vp.name.clone(),
@@ -237,7 +237,7 @@ impl<'a> DatasetContext<'a> {
         format!(
             "{} {} on {}",
             renderer.algorithm(),
-            settings_string(&renderer.settings()),
+            renderer.settings(),
             self.label
         )
     }
@@ -367,7 +367,11 @@ impl<'a> DatasetContext<'a> {
         let (dir, rel) = self.images_dir(vp);
         std::fs::create_dir_all(&dir)
             .with_context(|| format!("cannot create {}", dir.display()))?;
-        let stem = format!("{}__{}", slug(&row.algorithm), slug(&row.settings));
+        let stem = format!(
+            "{}__{}",
+            slug(&row.algorithm),
+            slug(&row.settings.to_string())
+        );
         image.save_png(&dir.join(format!("{stem}.png")))?;
         row.image = format!("{rel}/{stem}.png");
         let exact = format!("{stem}.{}", crate::samples::IMAGE_EXTENSION);

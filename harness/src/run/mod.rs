@@ -17,8 +17,7 @@ use anyhow::{anyhow, Context};
 use datasets::TetMesh;
 use indicatif::{ProgressBar, ProgressStyle};
 use render_core::{
-    settings_string, Camera, FrameStats, Gpu, Image, Optics, Projection, Renderer,
-    TransferFunction, Viewpoint,
+    Camera, FrameStats, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint,
 };
 
 pub use crate::names::{dataset_label, slug, viewpoint_slug};
@@ -218,9 +217,9 @@ fn plan_variants(
         }
         kept.push((name.clone(), n));
     }
-    let unknown = config.settings_filter.unknown_keys(&all_settings);
+    let unknown = config.settings_filter.unknown_keys(all_settings.iter());
     if !unknown.is_empty() {
-        let mut keys: Vec<&str> = all_settings.iter().flatten().map(|s| s.key).collect();
+        let mut keys: Vec<&str> = all_settings.iter().flat_map(|s| s.keys()).collect();
         keys.sort();
         keys.dedup();
         anyhow::bail!(
@@ -236,12 +235,12 @@ fn plan_variants(
         let Ok(all) = crate::algorithms::all_variants(name) else {
             continue; // not in the table (tests pass their own factories)
         };
-        let offered: Vec<render_core::Setting> = all.iter().flat_map(|r| r.settings()).collect();
+        let offered: Vec<render_core::Settings> = all.iter().map(|r| r.settings()).collect();
         for (key, values) in &config.settings_filter.terms {
-            let mut has: Vec<&str> = vec![];
-            for s in offered.iter().filter(|s| s.key == key) {
-                if !has.contains(&s.value.as_str()) {
-                    has.push(&s.value);
+            let mut has: Vec<String> = vec![];
+            for value in offered.iter().filter_map(|s| s.text(key)) {
+                if !has.contains(&value) {
+                    has.push(value);
                 }
             }
             if has.is_empty() {
@@ -250,7 +249,7 @@ fn plan_variants(
             let unknown: Vec<&str> = values
                 .iter()
                 .map(String::as_str)
-                .filter(|v| !has.contains(v))
+                .filter(|v| !has.iter().any(|h| h == v))
                 .collect();
             if !unknown.is_empty() {
                 anyhow::bail!(
@@ -262,8 +261,7 @@ fn plan_variants(
             }
         }
         if *n == 0 {
-            let variants: Vec<String> =
-                all.iter().map(|r| settings_string(&r.settings())).collect();
+            let variants: Vec<String> = all.iter().map(|r| r.settings().to_string()).collect();
             anyhow::bail!(
                 "--settings {} leaves no variant of {name} to run: each value exists, but no \
                  variant combines them; its variants are:\n  {}",
@@ -341,10 +339,10 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         Some(shard) => Some(crate::shard::select(shard, &matrix_units(config, factory)?)),
         None => None,
     };
-    let in_shard = |label: &str, alg: &str, settings: &str| {
+    let in_shard = |label: &str, alg: &str, settings: &render_core::Settings| {
         shard_units
             .as_ref()
-            .is_none_or(|u| u.contains(&(label.to_string(), alg.to_string(), settings.to_string())))
+            .is_none_or(|u| u.contains(&(label.to_string(), alg.to_string(), settings.clone())))
     };
     let description = RunDescription {
         command_line: config.command_line.clone(),
@@ -452,8 +450,8 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         let mut renderers = vec![];
         for (name, _) in &plan {
             renderers.extend(factory(name)?.into_iter().filter(|r| {
-                let settings = settings_string(&r.settings());
-                config.settings_filter.accepts(&r.settings())
+                let settings = r.settings();
+                config.settings_filter.accepts(&settings)
                     && in_shard(&label, name, &settings)
                     && !done.contains(&(label.clone(), name.clone(), settings))
             }));
@@ -520,11 +518,7 @@ fn matrix_units(
                 .iter()
                 .filter(|r| config.settings_filter.accepts(&r.settings()))
             {
-                units.push((
-                    dataset_label(spec),
-                    name.clone(),
-                    settings_string(&r.settings()),
-                ));
+                units.push((dataset_label(spec), name.clone(), r.settings()));
             }
         }
     }

@@ -13,7 +13,7 @@ use crate::machine::MachineInfo;
 use crate::results::{ResultsFile, Row, RunDescription, JSON_FILE};
 
 /// A unit of the run matrix: (data set label, algorithm, settings).
-pub type Unit = (String, String, String);
+pub type Unit = (String, String, render_core::Settings);
 
 /// What of the plan differs between an earlier run and this one (empty: the same plan).
 pub fn plan_differences(old: &RunDescription, new: &RunDescription) -> Vec<String> {
@@ -126,7 +126,7 @@ mod tests {
     fn row(alg: &str, vp: &str) -> Row {
         Row {
             algorithm: alg.into(),
-            settings: "k=2".into(),
+            settings: "k=2".parse().unwrap(),
             dataset: "box:1k".into(),
             viewpoint: vp.into(),
             ..Default::default()

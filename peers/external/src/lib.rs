@@ -19,7 +19,8 @@ use std::time::{Duration, Instant};
 use anyhow::{anyhow, Context};
 use datasets::TetMesh;
 use render_core::{
-    Camera, DeclaredAccuracy, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting,
+    Camera, DeclaredAccuracy, FrameStats, Gpu, Image, Optics, Prepared, Renderer, SettingValue,
+    Settings,
 };
 use serde_json::{json, Value};
 
@@ -87,16 +88,10 @@ impl ExternalSpec {
             let close = inner
                 .find(']')
                 .ok_or_else(|| anyhow!("--external {text:?}: no ']' after the settings"))?;
-            for part in inner[..close]
-                .split(';')
-                .map(str::trim)
-                .filter(|p| !p.is_empty())
-            {
-                let (k, v) = part.split_once('=').ok_or_else(|| {
-                    anyhow!("--external {text:?}: setting {part:?} is not key=value")
-                })?;
-                let (k, v) = (k.trim(), v.trim());
-                if k.is_empty() || k == PEER_SETTING.0 || !k.chars().all(valid) {
+            let given = Settings::parse(&inner[..close])
+                .map_err(|e| anyhow!("--external {text:?}: {e}"))?;
+            for (k, v) in given.iter() {
+                if k == PEER_SETTING.0 || !k.chars().all(valid) {
                     anyhow::bail!("--external {text:?}: {k:?} cannot be a setting's name");
                 }
                 settings.push((k.to_string(), v.to_string()));
@@ -119,16 +114,14 @@ impl ExternalSpec {
     }
 
     /// The row's settings: the marker (if any), then the given settings.
-    pub fn row_settings(&self) -> Vec<Setting> {
-        let mut v = vec![];
+    pub fn row_settings(&self) -> Settings {
+        let mut v = Settings::new();
         if self.mark_external {
-            v.push(Setting::new(PEER_SETTING.0, PEER_SETTING.1));
+            v.set(PEER_SETTING.0, PEER_SETTING.1);
         }
-        v.extend(
-            self.settings
-                .iter()
-                .map(|(k, val)| Setting::new(intern(k), val)),
-        );
+        for (k, val) in &self.settings {
+            v.set(k, SettingValue::infer(val));
+        }
         v
     }
 }
@@ -343,7 +336,7 @@ impl Renderer for ExternalRenderer {
         self.name
     }
 
-    fn settings(&self) -> Vec<Setting> {
+    fn settings(&self) -> Settings {
         self.spec.row_settings()
     }
 
@@ -380,12 +373,9 @@ mod tests {
             [("step".into(), "0.5".into()), ("grid".into(), "8".into())]
         );
         assert_eq!(s.argv, ["./r", "--x=1"]);
-        let row: Vec<String> = s
-            .row_settings()
-            .iter()
-            .map(|s| format!("{}={}", s.key, s.value))
-            .collect();
-        assert_eq!(row, ["peer=external", "step=0.5", "grid=8"]);
+        let row = s.row_settings();
+        assert_eq!(row.to_string(), "peer=external;step=0.5;grid=8");
+        assert_eq!(row.int("grid"), Some(8));
         for bad in [
             "mine",
             "=cmd",

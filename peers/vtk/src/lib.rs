@@ -26,8 +26,11 @@ use anyhow::Context;
 use datasets::TetMesh;
 use external_peer::{ExternalRenderer, ExternalSpec};
 use render_core::{
-    Camera, DeclaredAccuracy, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting,
+    Camera, DeclaredAccuracy, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Settings,
 };
+
+mod description;
+pub use description::{PT, RAYCAST, ZSWEEP};
 
 /// How long one exchange with VTK may take: its float readout walks every pixel in Python.
 pub const TIMEOUT: Duration = Duration::from_secs(600);
@@ -166,87 +169,18 @@ impl VtkPeer {
     }
 }
 
-/// `vtk-pt`'s variants (it has one).
-pub fn pt_variants() -> Vec<Box<dyn Renderer>> {
-    vec![Box::new(VtkPeer::new(
-        VtkMapper::ProjectedTetrahedra,
-        Integrator::Linear,
-        Readout::Framebuffer,
-        true,
-    ))]
-}
-
-/// `vtk-raycast` by default: the linear integrator, framebuffer image.
-pub fn raycast_default_variants() -> Vec<Box<dyn Renderer>> {
-    vec![Box::new(VtkPeer::new(
-        VtkMapper::RayCast,
-        Integrator::Linear,
-        Readout::Framebuffer,
-        true,
-    ))]
-}
-
-/// Every `vtk-raycast` variant: each integrator with the framebuffer image, and with the float
-/// image with and without early termination.
-pub fn raycast_all_variants() -> Vec<Box<dyn Renderer>> {
-    let mut v: Vec<Box<dyn Renderer>> = vec![];
-    for integrator in Integrator::ALL {
-        for (readout, et) in [
-            (Readout::Framebuffer, true),
-            (Readout::Rays, true),
-            (Readout::Rays, false),
-        ] {
-            v.push(Box::new(VtkPeer::new(
-                VtkMapper::RayCast,
-                integrator,
-                readout,
-                et,
-            )));
-        }
-    }
-    v
-}
-
-/// `vtk-zsweep` by default: the linear integrator.
-pub fn zsweep_default_variants() -> Vec<Box<dyn Renderer>> {
-    vec![Box::new(VtkPeer::new(
-        VtkMapper::ZSweep,
-        Integrator::Linear,
-        Readout::Framebuffer,
-        true,
-    ))]
-}
-
-/// Every `vtk-zsweep` variant: one per integrator.
-pub fn zsweep_all_variants() -> Vec<Box<dyn Renderer>> {
-    Integrator::ALL
-        .iter()
-        .map(|&i| {
-            Box::new(VtkPeer::new(
-                VtkMapper::ZSweep,
-                i,
-                Readout::Framebuffer,
-                true,
-            )) as Box<dyn Renderer>
-        })
-        .collect()
-}
-
 impl Renderer for VtkPeer {
     fn algorithm(&self) -> &'static str {
         self.mapper.algorithm()
     }
 
-    fn settings(&self) -> Vec<Setting> {
-        match self.mapper {
-            VtkMapper::ProjectedTetrahedra => vec![Setting::new("sort", "cell-centre")],
-            VtkMapper::ZSweep => vec![Setting::new("integrator", self.integrator.name())],
-            VtkMapper::RayCast => vec![
-                Setting::new("integrator", self.integrator.name()),
-                Setting::new("readout", self.readout.name()),
-                Setting::new("et", if self.early_termination { "on" } else { "off" }),
-            ],
-        }
+    fn settings(&self) -> Settings {
+        description::settings_of(
+            self.mapper,
+            self.integrator,
+            self.readout,
+            self.early_termination,
+        )
     }
 
     fn prepare(&mut self, _gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {

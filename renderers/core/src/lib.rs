@@ -3,6 +3,7 @@
 //! and the CPU sorts used for visibility ordering.
 
 pub mod bind;
+pub mod description;
 pub mod frame;
 pub mod gpu;
 pub mod gpu_layout;
@@ -12,15 +13,18 @@ pub mod image_error;
 pub mod preintegration;
 pub mod renderer;
 pub mod scene;
+pub mod settings;
 pub mod silhouette;
 pub mod sort;
 pub mod transfer;
 pub mod visibility;
 
 pub use bind::ChunkedBuffer;
+pub use description::{AlgorithmDescription, Hue, Origin, Param, Tolerance};
 pub use frame::{FrameClock, FrameTimes};
 pub use gpu::{AdapterDescription, DeviceRequest, FrameTimer, Gpu, Lifetime, MemoryLedger};
 pub use image::Image;
-pub use renderer::{settings_string, DeclaredAccuracy, FrameStats, Prepared, Renderer, Setting};
+pub use renderer::{DeclaredAccuracy, FrameStats, Prepared, Renderer};
 pub use scene::{fixed_viewpoints, orbit_viewpoints, Camera, Projection, Ray, Viewpoint};
+pub use settings::{Setting, SettingValue, Settings, SettingsError, SettingsFilter, ValueKind};
 pub use transfer::{Optics, TransferFunction};

@@ -9,32 +9,8 @@ use datasets::TetMesh;
 use crate::gpu::Gpu;
 use crate::image::Image;
 use crate::scene::Camera;
+use crate::settings::Settings;
 use crate::transfer::Optics;
-
-/// One named knob of the paper, as it appears in result rows (`key=value`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Setting {
-    pub key: &'static str,
-    pub value: String,
-}
-
-impl Setting {
-    pub fn new(key: &'static str, value: impl ToString) -> Setting {
-        Setting {
-            key,
-            value: value.to_string(),
-        }
-    }
-}
-
-/// Renders settings as `key=value;key=value`, the `settings` column of the results.
-pub fn settings_string(settings: &[Setting]) -> String {
-    settings
-        .iter()
-        .map(|s| format!("{}={}", s.key, s.value))
-        .collect::<Vec<_>>()
-        .join(";")
-}
 
 /// What [`Renderer::prepare`] uploaded.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -67,8 +43,9 @@ pub trait Renderer {
     /// Stable short name used in result rows and on the command line (`gator-pt`, `havs`…).
     fn algorithm(&self) -> &'static str;
 
-    /// The paper's knobs with their values for this instance.
-    fn settings(&self) -> Vec<Setting>;
+    /// The paper's knobs with their values for this instance (the same [`Settings`] its
+    /// description's `build` takes).
+    fn settings(&self) -> Settings;
 
     /// Uploads the mesh and every view-independent table.
     fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared>;

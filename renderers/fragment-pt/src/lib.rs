@@ -20,6 +20,7 @@
 //!   §3.4); back-to-front premultiplied blending into an `Rgba32Float` target.
 
 pub mod classify;
+mod description;
 mod frame;
 
 use anyhow::{anyhow, bail, Context};
@@ -29,7 +30,9 @@ use render_core::bind::{
 };
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::sort;
-use render_core::{Camera, FrameStats, Gpu, Image, Optics, Prepared, Renderer, Setting};
+use render_core::{Camera, FrameStats, Gpu, Image, Optics, Prepared, Renderer};
+
+pub use description::{from_settings, DESCRIPTION};
 
 use classify::packed_table;
 
@@ -275,33 +278,24 @@ impl FragmentPt {
     }
 }
 
-/// Both shadings × the paper's orders (bucket while moving, merge when still) and the
-/// GPU-resident variant; `radix` and `mpvonc` are available through [`FragmentPtSettings`].
+/// The variants `tetbench run` measures by default ([`DESCRIPTION`]'s default grid).
 pub fn default_variants() -> Vec<Box<dyn Renderer>> {
-    let mut v: Vec<Box<dyn Renderer>> = Vec::new();
-    for shading in [Shading::Average, Shading::Psi] {
-        for sort in [SortMode::Bucket, SortMode::Merge, SortMode::Gpu] {
-            v.push(Box::new(FragmentPt::new(FragmentPtSettings {
-                shading,
-                sort,
-            })));
-        }
-    }
-    v
+    build_all((DESCRIPTION.default_grid)())
 }
 
-/// Every combination of shading and order (for `--settings` filters that ask for radix/mpvonc).
+/// Every variant `--settings` selects from ([`DESCRIPTION`]'s full grid).
 pub fn all_variants() -> Vec<Box<dyn Renderer>> {
-    let mut v: Vec<Box<dyn Renderer>> = Vec::new();
-    for shading in [Shading::Average, Shading::Psi] {
-        for sort in SortMode::ALL {
-            v.push(Box::new(FragmentPt::new(FragmentPtSettings {
-                shading,
-                sort,
-            })));
-        }
-    }
-    v
+    build_all((DESCRIPTION.full_grid)())
+}
+
+fn build_all(grid: Vec<render_core::Settings>) -> Vec<Box<dyn Renderer>> {
+    grid.iter()
+        .map(|s| {
+            Box::new(FragmentPt::new(
+                description::from_settings(s).expect("declared grid"),
+            )) as Box<dyn Renderer>
+        })
+        .collect()
 }
 
 fn project_params(st: &State, camera: &Camera) -> classify::ProjectParams {
@@ -330,11 +324,8 @@ impl Renderer for FragmentPt {
         "fragment-pt"
     }
 
-    fn settings(&self) -> Vec<Setting> {
-        vec![
-            Setting::new("shading", self.settings.shading.name()),
-            Setting::new("sort", self.settings.sort.name()),
-        ]
+    fn settings(&self) -> render_core::Settings {
+        description::settings_of(&self.settings)
     }
 
     fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {

@@ -28,6 +28,9 @@
 //! shader's own function in a compute pass and reads the results back, so tests compare them.
 
 mod classify;
+mod description;
+
+pub use description::DESCRIPTION;
 
 use std::time::Instant;
 
@@ -39,7 +42,7 @@ pub use render_core::visibility::VisibilityOrder;
 use render_core::visibility::VisibilitySorter;
 use render_core::{
     Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics,
-    Prepared, Renderer, Setting,
+    Prepared, Renderer, Settings,
 };
 
 pub use classify::{
@@ -480,11 +483,8 @@ impl Renderer for GatorPt {
         "gator-pt"
     }
 
-    fn settings(&self) -> Vec<Setting> {
-        vec![
-            Setting::new("variant", self.cells.name()),
-            Setting::new("sort", self.order),
-        ]
+    fn settings(&self) -> Settings {
+        description::settings_of(self.cells, self.order)
     }
 
     fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {

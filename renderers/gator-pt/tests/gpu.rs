@@ -505,10 +505,7 @@ fn chunked_bindings_draw_the_same_image() {
 #[test]
 fn settings_and_variants() {
     let v = gator_pt::default_variants();
-    let rows: Vec<String> = v
-        .iter()
-        .map(|r| render_core::settings_string(&r.settings()))
-        .collect();
+    let rows: Vec<String> = v.iter().map(|r| r.settings().to_string()).collect();
     assert_eq!(
         rows,
         ["variant=constant;sort=radix", "variant=linear;sort=radix"]

@@ -15,6 +15,7 @@
 //! (`kbuffer.wgsl`; CPU twin in [`kbuffer`]).
 
 pub mod abuffer;
+mod description;
 mod frame;
 pub mod kbuffer;
 
@@ -26,9 +27,10 @@ use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::preintegration::Table3d;
 use render_core::sort::RadixScratch;
 use render_core::{
-    Camera, ChunkedBuffer, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Setting,
+    Camera, ChunkedBuffer, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer,
 };
 
+pub use description::{from_settings, DESCRIPTION};
 pub use kbuffer::{Tag, TagScheme};
 
 /// Where the per-frame face sort runs.
@@ -102,46 +104,24 @@ impl Default for HavsSettings {
 /// Largest k the shaders are built for (the k-buffer lives in registers during a fragment).
 pub const MAX_K: u32 = 16;
 
-/// The variants `tetbench run` measures by default: k ∈ {2, 6} × sort ∈ {CPU, GPU}, faithful
-/// single-pass mode (the paper's Tables 3 and 4 use k = 2 and k = 6).
+/// The variants `tetbench run` measures by default ([`DESCRIPTION`]'s default grid).
 pub fn default_variants() -> Vec<Box<dyn Renderer>> {
-    let mut v: Vec<Box<dyn Renderer>> = Vec::new();
-    for sort in [SortMode::CpuRadix, SortMode::GpuRadix] {
-        for k in [2, 6] {
-            v.push(Box::new(Havs::new(HavsSettings {
-                k,
-                sort,
-                ..Default::default()
-            })));
-        }
-    }
-    v
+    build_all((DESCRIPTION.default_grid)())
 }
 
-/// Every combination the paper's analysis and this harness vary, from which `tetbench run
-/// --settings …` selects: k ∈ {2, 3, 4, 5, 6, 8, 16} × sort × tag scheme × race mode × early
-/// termination (the table sizes stay at their defaults).
+/// Every variant `tetbench run --settings …` selects from ([`DESCRIPTION`]'s full grid).
 pub fn all_variants() -> Vec<Box<dyn Renderer>> {
-    let mut v: Vec<Box<dyn Renderer>> = Vec::new();
-    for sort in [SortMode::CpuRadix, SortMode::GpuRadix] {
-        for k in [2, 3, 4, 5, 6, 8, 16] {
-            for tags in [TagScheme::Two, TagScheme::Single] {
-                for mode in [Mode::FragmentRace, Mode::RaceFree] {
-                    for early_termination in [true, false] {
-                        v.push(Box::new(Havs::new(HavsSettings {
-                            k,
-                            sort,
-                            tags,
-                            mode,
-                            early_termination,
-                            ..Default::default()
-                        })));
-                    }
-                }
-            }
-        }
-    }
-    v
+    build_all((DESCRIPTION.full_grid)())
+}
+
+fn build_all(grid: Vec<render_core::Settings>) -> Vec<Box<dyn Renderer>> {
+    grid.iter()
+        .map(|s| {
+            Box::new(Havs::new(
+                description::from_settings(s).expect("declared grid"),
+            )) as Box<dyn Renderer>
+        })
+        .collect()
 }
 
 /// The HAVS renderer.
@@ -391,22 +371,8 @@ impl Renderer for Havs {
         "havs"
     }
 
-    fn settings(&self) -> Vec<Setting> {
-        let s = &self.settings;
-        vec![
-            Setting::new("k", s.k),
-            Setting::new("sort", s.sort.name()),
-            Setting::new(
-                "tags",
-                if s.tags == TagScheme::Two {
-                    "two"
-                } else {
-                    "single"
-                },
-            ),
-            Setting::new("mode", s.mode.name()),
-            Setting::new("et", if s.early_termination { "on" } else { "off" }),
-        ]
+    fn settings(&self) -> render_core::Settings {
+        description::settings_of(&self.settings)
     }
 
     fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {

@@ -28,7 +28,7 @@ pub mod settings;
 pub mod step;
 
 pub use render::{PassData, Raycast};
-pub use settings::{Mode, RaycastSettings, TableKind};
+pub use settings::{Mode, RaycastSettings, TableKind, DESCRIPTION};
 
 /// The default variants ([`settings::default_settings`]) as renderers.
 pub fn default_variants() -> Vec<Box<dyn render_core::Renderer>> {

@@ -7,7 +7,7 @@ use datasets::TetMesh;
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::preintegration::{Table2d, Table3d};
 use render_core::{
-    Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Setting,
+    Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Settings,
 };
 
 use crate::layout::{MeshLayout, TetRef};
@@ -247,7 +247,7 @@ impl Renderer for Raycast {
         "raycast"
     }
 
-    fn settings(&self) -> Vec<Setting> {
+    fn settings(&self) -> Settings {
         self.settings.to_settings()
     }
 

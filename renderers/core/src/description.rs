@@ -1,0 +1,135 @@
+//! What the harness knows of an algorithm without constructing it: its name, the paper it
+//! reproduces or the package it comes from, its declared parameter grid, the constructor from
+//! typed settings, its colour, its tolerance against the exact reference and the work
+//! counters it reports. One [`AlgorithmDescription`] per algorithm crate; the harness lists
+//! them in one table.
+
+use crate::renderer::Renderer;
+use crate::settings::{Settings, SettingsError, SettingsFilter, ValueKind};
+
+/// One knob of the algorithm.
+#[derive(Debug, Clone, Copy)]
+pub struct Param {
+    pub key: &'static str,
+    pub kind: ValueKind,
+    /// What the knob does, in a few words.
+    pub meaning: &'static str,
+    /// Where the paper describes it (`§3.2`), or where the choice is ours.
+    pub section: &'static str,
+}
+
+/// Whether the algorithm is one of tetbench's own or another package's renderer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Origin {
+    /// A tetbench algorithm reproducing a paper (the paper's id in `tetbench reproduce`).
+    Paper(&'static str),
+    /// Another package's renderer measured beside ours (`--peers GROUP`).
+    Peer(&'static str),
+}
+
+/// The colour family of an algorithm's variants in every chart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Hue {
+    Blues,
+    Oranges,
+    Greens,
+    Purples,
+    Magentas,
+    Browns,
+    Teals,
+    /// Peers: grey with hollow markers.
+    Greys,
+}
+
+/// How close a variant must come to the exact reference on the common check scene (a smooth
+/// field on a structured grid, 128², the low-opacity transfer function; `tests/vs_reference.rs`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerance {
+    pub min_psnr_db: f64,
+    /// Why the bound is where it is (what was measured, what the margin covers).
+    pub why: &'static str,
+}
+
+/// What the harness knows of one algorithm.
+pub struct AlgorithmDescription {
+    /// Name on the command line and in result rows (`havs`).
+    pub name: &'static str,
+    /// A line for listings (`HAVS, Callahan et al. 2005`).
+    pub title: &'static str,
+    pub origin: Origin,
+    /// Every knob, in the order settings are written.
+    pub params: &'static [Param],
+    /// The variants run when no `--settings` is given.
+    pub default_grid: fn() -> Vec<Settings>,
+    /// Every variant `--settings` selects from.
+    pub full_grid: fn() -> Vec<Settings>,
+    /// Builds the variant with these settings (every key declared, every value valid).
+    pub build: fn(&Settings) -> anyhow::Result<Box<dyn Renderer>>,
+    pub hue: Hue,
+    pub tolerance: fn(&Settings) -> Tolerance,
+    /// Names of the work counters each frame reports (`triangles`, `fragments`, `ray_steps`).
+    pub counters: &'static [&'static str],
+}
+
+impl std::fmt::Debug for AlgorithmDescription {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("AlgorithmDescription")
+            .field("name", &self.name)
+            .field("origin", &self.origin)
+            .finish_non_exhaustive()
+    }
+}
+
+impl AlgorithmDescription {
+    pub fn is_peer(&self) -> bool {
+        matches!(self.origin, Origin::Peer(_))
+    }
+
+    pub fn param(&self, key: &str) -> Option<&Param> {
+        self.params.iter().find(|p| p.key == key)
+    }
+
+    /// The declared type of `key`'s values.
+    pub fn kind_of(&self, key: &str) -> Option<ValueKind> {
+        self.param(key).map(|p| p.kind)
+    }
+
+    /// Parses this algorithm's settings text, typing each value as declared; a key the
+    /// algorithm does not declare is an error.
+    pub fn parse_settings(&self, text: &str) -> Result<Settings, SettingsError> {
+        let s = Settings::parse_with(text, |k| self.kind_of(k))?;
+        if let Some(k) = s.keys().find(|k| self.param(k).is_none()) {
+            let known: Vec<&str> = self.params.iter().map(|p| p.key).collect();
+            return Err(SettingsError(format!(
+                "{} has no setting {k:?}; it has {}",
+                self.name,
+                known.join(", ")
+            )));
+        }
+        Ok(s)
+    }
+
+    /// The variants `filter` selects, from the declared grid (no renderer is built). A key
+    /// the filter names must take one of the listed values; a key it does not name keeps the
+    /// values the default variants use. So no filter gives exactly the defaults, and `k=8`
+    /// gives HAVS k = 8 with both sorts and otherwise default settings.
+    pub fn select(&self, filter: &SettingsFilter) -> Vec<Settings> {
+        let defaults = (self.default_grid)();
+        if filter.is_empty() {
+            return defaults;
+        }
+        let default_has = |key: &str, value: &str| defaults.iter().any(|d| d.is(key, value));
+        (self.full_grid)()
+            .into_iter()
+            .filter(|s| {
+                s.iter().all(|(k, v)| {
+                    let v = v.to_string();
+                    match filter.values(k) {
+                        Some(values) => values.contains(&v),
+                        None => default_has(k, &v),
+                    }
+                })
+            })
+            .collect()
+    }
+}

