@@ -12,9 +12,11 @@
 #
 # Environment: AB_POWER_WORK (default target/ab-power: worktree, target, binaries, trials),
 # AB_POWER_FACTORS (default "1.05 1.10 1.25"), AB_POWER_ALGORITHM (gator-pt),
-# AB_POWER_PAIRS (5), AB_POWER_THRESHOLD (1.10), AB_POWER_MATRIX (the run options; default
-# the default suite's box:10k: 3 viewpoints, 128 px, 1 warm-up + 1 frame, every algorithm,
-# without the reference and the calibration), AB_POWER_TARGET_DIR, AB_POWER_SRC,
+# AB_POWER_PAIRS (5), AB_POWER_THRESHOLDS ("1.10 1.05": `ab` runs with the first, compare
+# judges the same rounds again with the others), AB_POWER_MATRIX (the run options; default the
+# default suite's box:10k, 3 viewpoints, 128 px, without splat — a second per frame on
+# lavapipe, half of each round — 2 frames after 1 warm-up, without the reference and the
+# calibration), AB_POWER_TARGET_DIR, AB_POWER_SRC,
 # AB_POWER_DEADLINE (a `date -d` time: no trial starts after it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -29,8 +31,8 @@ target=$(realpath -m "${AB_POWER_TARGET_DIR:-$work/target}")
 factors=${AB_POWER_FACTORS:-1.05 1.10 1.25}
 algorithm=${AB_POWER_ALGORITHM:-gator-pt}
 pairs=${AB_POWER_PAIRS:-5}
-threshold=${AB_POWER_THRESHOLD:-1.10}
-matrix=${AB_POWER_MATRIX:---datasets box:10k --viewpoints +x,+x+y+z,-x+y-z --resolution 128 --frames 1 --warmup 1 --no-reference --no-calibrate}
+thresholds=${AB_POWER_THRESHOLDS:-1.10 1.05}
+matrix=${AB_POWER_MATRIX:---datasets box:10k --viewpoints +x,+x+y+z,-x+y-z --resolution 128 --algorithms gator-pt,havs,fragment-pt,raycast --frames 2 --warmup 1 --no-reference --no-calibrate}
 deadline=${AB_POWER_DEADLINE:+$(date -d "$AB_POWER_DEADLINE" +%s)}
 head=$(git rev-parse HEAD)
 mkdir -p "$work/bin" "$work/trials"
@@ -90,26 +92,12 @@ touch "$stamp"
 fi
 
 csv="$work/trials.csv"
-[ -e "$csv" ] || echo "trial,factor,exit,found,false_calls,run_factor,seconds,load_start,utc" >"$csv"
-# One trial: `ab` into its own folder, then what compare.json says.
-trial() {
-    local n=$1 factor=$2 out new env_factor
-    out="$work/trials/$n-$factor"
-    rm -rf "$out"
-    if [ "$factor" = same ]; then
-        new="$work/bin/base-copy" env_factor=""
-    else
-        new="$work/bin/slow" env_factor="$algorithm=$factor"
-    fi
-    local start=$SECONDS status=0 load
-    load=$(cut -d' ' -f1 /proc/loadavg)
-    # shellcheck disable=SC2086
-    TETBENCH_SCRATCH_SLOWDOWN=$env_factor "$work/bin/base" ab "$work/bin/base" "$new" \
-        --pairs "$pairs" --threshold "$threshold" --out "$out" $matrix >"$out.log" 2>&1 || status=$?
-    python3 - "$out/compare/compare.json" "$algorithm" "$n" "$factor" "$status" \
-        "$((SECONDS - start))" "$load" >>"$csv" <<'EOF'
+[ -e "$csv" ] || echo "trial,factor,threshold,exit,found,false_calls,run_factor,seconds,load_start,utc" >"$csv"
+# What a compare.json says about the slowdown: one CSV line.
+verdict() {
+    python3 - "$@" >>"$csv" <<'EOF'
 import json, sys, datetime
-path, alg, n, factor, status, seconds, load = sys.argv[1:]
+path, alg, n, factor, threshold, status, seconds, load = sys.argv[1:]
 try:
     c = json.load(open(path))
     regs = c["regressions"]
@@ -122,9 +110,36 @@ else:
     found = sum(r.startswith(f"slower: {alg} ") for r in regs)
     false = len(regs) - found
 now = datetime.datetime.now(datetime.timezone.utc).strftime("%H:%M:%S")
-print(f"{n},{factor},{status},{found},{false},{run_factor},{seconds},{load},{now}")
+print(f"{n},{factor},{threshold},{status},{found},{false},{run_factor},{seconds},{load},{now}")
 EOF
     tail -n 1 "$csv" >&2
+}
+# One trial: `ab` into its own folder at the first threshold; the other thresholds judge the
+# same merged rounds again with `compare` (the same samples, another threshold).
+trial() {
+    local n=$1 factor=$2 out new env_factor first rest t
+    out="$work/trials/$n-$factor"
+    rm -rf "$out"
+    if [ "$factor" = same ]; then
+        new="$work/bin/base-copy" env_factor=""
+    else
+        new="$work/bin/slow" env_factor="$algorithm=$factor"
+    fi
+    read -r first rest <<<"$thresholds"
+    local start=$SECONDS status=0 load
+    load=$(cut -d' ' -f1 /proc/loadavg)
+    # shellcheck disable=SC2086
+    TETBENCH_SCRATCH_SLOWDOWN=$env_factor "$work/bin/base" ab "$work/bin/base" "$new" \
+        --pairs "$pairs" --threshold "$first" --out "$out" $matrix >"$out.log" 2>&1 || status=$?
+    verdict "$out/compare/compare.json" "$algorithm" "$n" "$factor" "$first" "$status" \
+        "$((SECONDS - start))" "$load"
+    for t in $rest; do
+        status=0
+        "$work/bin/base" compare "$out/base" "$out/new" --threshold "$t" --fail-on regression \
+            --out "$out/compare-$t" >"$out-$t.log" 2>&1 || status=$?
+        verdict "$out/compare-$t/compare.json" "$algorithm" "$n" "$factor" "$t" "$status" \
+            "$((SECONDS - start))" "$load"
+    done
 }
 
 for n in $(seq 1 "$trials"); do
@@ -141,19 +156,21 @@ python3 - "$csv" "$algorithm" <<'EOF'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 alg = sys.argv[2]
-print(f"| NEW | trials | {alg} found slower | trials with a false call | exit 3 | seconds per trial |")
-print("|---|---:|---:|---:|---:|---:|")
-for factor in dict.fromkeys(r["factor"] for r in rows):
-    rs = [r for r in rows if r["factor"] == factor and r["found"] != "error"]
-    if not rs:
-        continue
-    found = sum(int(r["found"]) > 0 for r in rs)
-    false = sum(int(r["false_calls"]) > 0 for r in rs)
-    exit3 = sum(r["exit"] == "3" for r in rs)
-    secs = sorted(int(r["seconds"]) for r in rs)
-    name = "same build" if factor == "same" else f"{alg} ×{factor}"
-    found_cell = "—" if factor == "same" else f"{found} of {len(rs)}"
-    print(f"| {name} | {len(rs)} | {found_cell} | {false} of {len(rs)} | {exit3} | {secs[len(secs)//2]} |")
+print(f"| threshold | NEW | trials | {alg} found slower | trials with a false call | exit 3 | seconds per trial |")
+print("|---:|---|---:|---:|---:|---:|---:|")
+for threshold in dict.fromkeys(r["threshold"] for r in rows):
+    for factor in dict.fromkeys(r["factor"] for r in rows):
+        rs = [r for r in rows if (r["threshold"], r["factor"]) == (threshold, factor)
+              and r["found"] != "error"]
+        if not rs:
+            continue
+        found = sum(int(r["found"]) > 0 for r in rs)
+        false = sum(int(r["false_calls"]) > 0 for r in rs)
+        exit3 = sum(r["exit"] == "3" for r in rs)
+        secs = sorted(int(r["seconds"]) for r in rs)
+        name = "same build" if factor == "same" else f"{alg} ×{factor}"
+        found_cell = "—" if factor == "same" else f"{found} of {len(rs)}"
+        print(f"| {threshold} | {name} | {len(rs)} | {found_cell} | {false} of {len(rs)} | {exit3} | {secs[len(secs) // 2]} |")
 errors = sum(r["found"] == "error" for r in rows)
 if errors:
     print(f"\n{errors} trial(s) ended without a comparison (see their .log)")
