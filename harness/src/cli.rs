@@ -116,6 +116,11 @@ pub enum Command {
     /// Renderers in other processes and languages (docs/external-renderers.md): `check`.
     #[command(subcommand)]
     External(crate::external_cmd::ExternalCommand),
+    /// Run two builds (binaries or git revisions) in turns, A B B A …, over one matrix and
+    /// compare them with compare's test (docs/regression.md, "A/B").
+    Ab(crate::regress::AbArgs),
+    /// Find the first commit between GOOD and BAD that an A/B against GOOD calls a regression.
+    Bisect(crate::regress::BisectArgs),
 }
 
 #[derive(Debug, Clone, clap::Args)]
@@ -423,6 +428,13 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
         }
         Command::Plot(args) => crate::plot_cli::run(args, cli.data_dir, command_line),
         Command::External(cmd) => crate::external_cmd::run(cmd),
+        Command::Ab(args) => {
+            if crate::regress::run_ab_command(args, cli.data_dir)? {
+                std::process::exit(crate::compare::EXIT_REGRESSION);
+            }
+            Ok(())
+        }
+        Command::Bisect(args) => crate::regress::run_bisect_command(args, cli.data_dir),
     }
 }
 

@@ -23,6 +23,7 @@ pub mod papers;
 pub mod plan;
 pub mod plot;
 pub mod plot_cli;
+pub mod regress;
 pub mod report;
 pub mod reproduce;
 pub mod results;

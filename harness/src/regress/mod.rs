@@ -1,0 +1,273 @@
+//! Regression hunting across builds (issue 25): `tetbench ab BASE NEW` runs two builds
+//! interleaved on one machine and compares them with compare's test ([`ab`]); `tetbench bisect
+//! GOOD BAD` searches the commits between for the first one an A/B calls a regression
+//! ([`bisect`]). A side is a tetbench binary or a git revision, built in a worktree and cached
+//! by commit ([`build`]).
+//!
+//! Why interleave: on the shared development VM two runs of one binary a minute apart differed
+//! as a whole by ×0.53–×1.98 (docs/regression.md), far more than the changes worth catching.
+//! Rounds of the two builds taken in turns (A B B A A B …) see the same stretches of that drift,
+//! so it falls on both sides alike instead of on one.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+
+pub mod ab;
+pub mod bisect;
+pub mod build;
+
+/// The run matrix of `ab` and `bisect`: the options of `tetbench run` that choose what is
+/// measured, handed on unchanged to every side's `run`. Only options given are passed, so an
+/// older build that lacks a newer option still runs a matrix that does not use it. Each side's
+/// invocation adds `--rounds 1 --no-report --out DIR` itself.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct MatrixArgs {
+    /// Comma-separated algorithms (as for run; default: all).
+    #[arg(long, value_name = "LIST")]
+    pub algorithms: Option<String>,
+    /// Comma-separated data sets (as for run; default: the embedded suite).
+    #[arg(long, value_name = "LIST")]
+    pub datasets: Option<String>,
+    /// Viewpoints (as for run).
+    #[arg(long, value_name = "SPEC")]
+    pub viewpoints: Option<String>,
+    /// Square viewport size in pixels (as for run).
+    #[arg(long, value_name = "PIXELS")]
+    pub resolution: Option<u32>,
+    /// Transfer function (as for run).
+    #[arg(long, value_name = "NAME|FILE")]
+    pub tf: Option<String>,
+    /// Timed frames per viewpoint in each round (as for run).
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u32>,
+    /// Untimed warm-up frames per viewpoint in each round (as for run).
+    #[arg(long, value_name = "N")]
+    pub warmup: Option<u32>,
+    /// Settings filter (as for run).
+    #[arg(long, value_name = "FILTER")]
+    pub settings: Option<String>,
+    /// Every variant of each algorithm (as for run).
+    #[arg(long)]
+    pub all_variants: bool,
+    /// Skip the reference and the error metrics (as for run).
+    #[arg(long)]
+    pub no_reference: bool,
+    /// Reference image cache (as for run).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+    /// Orthographic projection (as for run).
+    #[arg(long)]
+    pub orthographic: bool,
+    /// Point array to use as the scalar (as for run).
+    #[arg(long, value_name = "NAME")]
+    pub scalar: Option<String>,
+    /// Skip the backend calibration (as for run).
+    #[arg(long)]
+    pub no_calibrate: bool,
+    /// Other packages' renderers as peers (as for run).
+    #[arg(long, value_name = "LIST")]
+    pub peers: Option<String>,
+}
+
+impl MatrixArgs {
+    /// The `tetbench run` options these stand for (only those given).
+    pub fn run_args(&self) -> Vec<String> {
+        let mut out = vec![];
+        let mut value = |flag: &str, v: Option<String>| {
+            if let Some(v) = v {
+                out.push(format!("--{flag}"));
+                out.push(v);
+            }
+        };
+        value("algorithms", self.algorithms.clone());
+        value("datasets", self.datasets.clone());
+        value("viewpoints", self.viewpoints.clone());
+        value("resolution", self.resolution.map(|v| v.to_string()));
+        value("tf", self.tf.clone());
+        value("frames", self.frames.map(|v| v.to_string()));
+        value("warmup", self.warmup.map(|v| v.to_string()));
+        value("settings", self.settings.clone());
+        value(
+            "cache-dir",
+            self.cache_dir.as_ref().map(|p| p.display().to_string()),
+        );
+        value("scalar", self.scalar.clone());
+        value("peers", self.peers.clone());
+        for (flag, on) in [
+            ("--all-variants", self.all_variants),
+            ("--no-reference", self.no_reference),
+            ("--orthographic", self.orthographic),
+            ("--no-calibrate", self.no_calibrate),
+        ] {
+            if on {
+                out.push(flag.to_string());
+            }
+        }
+        out
+    }
+}
+
+/// compare's options as `ab` and `bisect` take them.
+#[derive(Debug, Clone, clap::Args)]
+pub struct JudgeArgs {
+    /// Factor a group's median must move by (and p < alpha) to count as slower / faster.
+    #[arg(long, default_value_t = 1.10)]
+    pub threshold: f64,
+    /// Significance level of the Mann–Whitney U test.
+    #[arg(long, default_value_t = 0.05)]
+    pub alpha: f64,
+    /// Test NEW's absolute times, without dividing out the run-wide factor.
+    #[arg(long)]
+    pub no_drift_correction: bool,
+    /// A run-wide factor beyond this (either way) is itself a regression or an improvement.
+    #[arg(long, default_value_t = 1.5)]
+    pub drift_limit: f64,
+}
+
+impl JudgeArgs {
+    pub fn check(&self) -> anyhow::Result<()> {
+        anyhow::ensure!(self.threshold >= 1.0, "--threshold must be at least 1");
+        anyhow::ensure!(self.drift_limit >= 1.0, "--drift-limit must be at least 1");
+        anyhow::ensure!(
+            self.alpha > 0.0 && self.alpha < 1.0,
+            "--alpha must lie between 0 and 1"
+        );
+        Ok(())
+    }
+}
+
+/// `tetbench ab BASE NEW`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct AbArgs {
+    /// The reference build: a tetbench binary, or a git revision to build.
+    pub base: String,
+    /// The build to judge: a tetbench binary, or a git revision to build.
+    pub new: String,
+    /// Rounds per side, run in pairs A B, B A, … (at least 3: compare's minimum).
+    #[arg(long, default_value_t = 5)]
+    pub pairs: u32,
+    /// Output directory: each side's rounds and merged results, compare's files, ab.json.
+    #[arg(long, value_name = "DIR", default_value = "ab")]
+    pub out: PathBuf,
+    /// Exit with status 3 on a regression (default) or on any change; `never`: always 0.
+    #[arg(long, value_enum, default_value = "regression")]
+    pub fail_on: crate::compare::FailOn,
+    #[command(flatten)]
+    pub judge: JudgeArgs,
+    #[command(flatten)]
+    pub matrix: MatrixArgs,
+    #[command(flatten)]
+    pub build: build::BuildArgs,
+}
+
+/// `tetbench bisect GOOD BAD`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct BisectArgs {
+    /// A revision without the regression.
+    pub good: String,
+    /// A later revision with it (a descendant of GOOD).
+    pub bad: String,
+    /// Rounds per side in each step's A/B.
+    #[arg(long, default_value_t = 5)]
+    pub pairs: u32,
+    /// Output directory: one A/B folder per step, bisect.json.
+    #[arg(long, value_name = "DIR", default_value = "bisect")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub judge: JudgeArgs,
+    #[command(flatten)]
+    pub matrix: MatrixArgs,
+    #[command(flatten)]
+    pub build: build::BuildArgs,
+}
+
+fn ab_options(
+    out: PathBuf,
+    pairs: u32,
+    judge: &JudgeArgs,
+    fail_on: crate::compare::FailOn,
+    matrix: &MatrixArgs,
+    data_dir: Option<PathBuf>,
+) -> anyhow::Result<ab::AbOptions> {
+    judge.check()?;
+    Ok(ab::AbOptions {
+        pairs,
+        global_args: data_dir
+            .map(|d| vec!["--data-dir".to_string(), d.display().to_string()])
+            .unwrap_or_default(),
+        run_args: matrix.run_args(),
+        compare: crate::compare::CompareOptions {
+            threshold: judge.threshold,
+            alpha: judge.alpha,
+            normalised: false,
+            drift_correction: !judge.no_drift_correction,
+            drift_limit: judge.drift_limit,
+            fail_on,
+            out: out.join("compare"),
+        },
+        out,
+    })
+}
+
+/// `tetbench ab`; returns whether to exit with status 3.
+pub fn run_ab_command(args: AbArgs, data_dir: Option<PathBuf>) -> anyhow::Result<bool> {
+    let opt = ab_options(
+        args.out.clone(),
+        args.pairs,
+        &args.judge,
+        args.fail_on,
+        &args.matrix,
+        data_dir,
+    )?;
+    let base = build::resolve(&args.base, &args.build).context("resolving BASE")?;
+    let new = build::resolve(&args.new, &args.build).context("resolving NEW")?;
+    ab::run_command(&base, &new, &opt)
+}
+
+/// `tetbench bisect`.
+pub fn run_bisect_command(args: BisectArgs, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
+    let ab = ab_options(
+        args.out.clone(),
+        args.pairs,
+        &args.judge,
+        crate::compare::FailOn::Regression,
+        &args.matrix,
+        data_dir,
+    )?;
+    let _lock = crate::run::lock::acquire(&args.out, &["tetbench".into(), "bisect".into()])?;
+    bisect::run_command(&bisect::BisectOptions {
+        good: args.good,
+        bad: args.bad,
+        build: args.build,
+        ab,
+    })?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Only the options given travel to the sides' `run`, flags without a value.
+    #[test]
+    fn matrix_args_pass_only_what_was_given() {
+        assert!(MatrixArgs::default().run_args().is_empty());
+        let m = MatrixArgs {
+            algorithms: Some("gator-pt,havs".into()),
+            resolution: Some(64),
+            no_reference: true,
+            ..Default::default()
+        };
+        assert_eq!(
+            m.run_args(),
+            [
+                "--algorithms",
+                "gator-pt,havs",
+                "--resolution",
+                "64",
+                "--no-reference"
+            ]
+        );
+    }
+}
