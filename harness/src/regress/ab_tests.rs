@@ -13,7 +13,7 @@ fn schedule_alternates_which_side_goes_first() {
 fn row(alg: &str, vp: &str, frames: &[f64]) -> Row {
     Row {
         algorithm: alg.into(),
-        settings: "k=2".into(),
+        settings: "k=2".parse().unwrap(),
         dataset: "box:1k".into(),
         viewpoint: vp.into(),
         tets: 1000,
