@@ -21,7 +21,7 @@ fn template(dir: &Path) -> PathBuf {
         for vp in ["+x", "+x+y+z", "-x+y-z"] {
             let mut row = Row {
                 algorithm: format!("alg{i}"),
-                settings: "k=2".into(),
+                settings: "k=2".parse().unwrap(),
                 dataset: "box:1k".into(),
                 viewpoint: vp.into(),
                 frames: 1,
