@@ -64,19 +64,18 @@ pub fn from_settings(s: &Settings) -> anyhow::Result<FragmentPtSettings> {
     })
 }
 
+/// Measured on the check scene (`tests/vs_reference.rs`, lavapipe): average shading 72.8 dB
+/// (bucket order) to 73.1 dB, the ψ table 69.4 to 69.5 dB; 3 dB below the lowest.
 fn tolerance(s: &Settings) -> Tolerance {
     if s.is("shading", "psi") {
         Tolerance {
-            min_psnr_db: PSI_MIN_PSNR_DB,
-            why: "psi table: measured on the check scene, 3 dB margin",
+            min_psnr_db: 66.0,
+            why: "psi table: 69.4-69.5 dB measured, 3 dB margin",
         }
     } else {
         Tolerance {
-            min_psnr_db: AVERAGE_MIN_PSNR_DB,
-            why: "average scalar: measured on the check scene, 3 dB margin",
+            min_psnr_db: 69.5,
+            why: "average scalar: 72.8-73.1 dB measured, 3 dB margin",
         }
     }
 }
-
-const PSI_MIN_PSNR_DB: f64 = 0.0;
-const AVERAGE_MIN_PSNR_DB: f64 = 0.0;

@@ -131,13 +131,12 @@ pub fn from_settings(s: &Settings) -> anyhow::Result<HavsSettings> {
     })
 }
 
-/// Measured on the check scene (a convex grid, where every k sorts exactly): see
-/// `tests/vs_reference.rs`; 3 dB margin.
+/// Measured on the check scene (`tests/vs_reference.rs`, lavapipe): 96.5 dB for k = 2 and 6
+/// with either sort (a convex grid sorts exactly with any k); 3 dB margin (×1.41 RMSE), far
+/// inside what a wrong order or table coordinate costs (tens of dB).
 fn tolerance(_: &Settings) -> Tolerance {
     Tolerance {
-        min_psnr_db: HAVS_MIN_PSNR_DB,
-        why: "pre-integrated segments on a convex grid: measured 0 dB below the exact integral minus the table error",
+        min_psnr_db: 93.0,
+        why: "pre-integrated segments on a convex grid: 96.5 dB measured, 3 dB margin",
     }
 }
-
-const HAVS_MIN_PSNR_DB: f64 = 0.0;

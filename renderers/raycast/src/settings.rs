@@ -217,19 +217,20 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     counters: &["ray_steps", "triangles"],
 };
 
+/// Measured on the check scene (`tests/vs_reference.rs`, lavapipe): the 3D table 96.5 dB, the
+/// 2D table 46.6 dB (one table length scaled to each segment, the paper's §2.2
+/// approximation); 3 dB margin each.
 fn tolerance(s: &Settings) -> Tolerance {
     if s.is("table", "3d") {
         Tolerance {
-            min_psnr_db: TABLE_3D_MIN_PSNR_DB,
-            why: "3D table: measured on the check scene, 3 dB margin",
+            min_psnr_db: 93.5,
+            why: "3D table: 96.5 dB measured, 3 dB margin",
         }
     } else {
         Tolerance {
-            min_psnr_db: TABLE_2D_MIN_PSNR_DB,
-            why: "2D table (length scaled, the paper's approximation): measured on the check scene, 3 dB margin",
+            min_psnr_db: 43.5,
+            why:
+                "2D table (length scaled, the paper's approximation): 46.6 dB measured, 3 dB margin",
         }
     }
 }
-
-const TABLE_3D_MIN_PSNR_DB: f64 = 0.0;
-const TABLE_2D_MIN_PSNR_DB: f64 = 0.0;
