@@ -193,12 +193,12 @@ pub fn from_settings(s: &Settings) -> anyhow::Result<SplatSettings> {
     })
 }
 
+/// Measured on the check scene (`tests/vs_reference.rs`, lavapipe): 40.4 dB with either bucket
+/// variant (the mesh resampled to a 32-point grid and splatted with a smooth kernel); 3 dB
+/// margin.
 fn tolerance(_: &Settings) -> Tolerance {
     Tolerance {
-        min_psnr_db: SPLAT_MIN_PSNR_DB,
-        why:
-            "a resampled grid and a Gaussian-like kernel: measured on the check scene, 3 dB margin",
+        min_psnr_db: 37.0,
+        why: "a resampled grid and a smooth kernel: 40.4 dB measured, 3 dB margin",
     }
 }
-
-const SPLAT_MIN_PSNR_DB: f64 = 0.0;
