@@ -231,9 +231,10 @@ pub fn adapter_of(f: &ResultsFile) -> String {
     }
 }
 
-type Key = (String, Settings, String, String, u32, u32);
+/// A row's place in the matrix: algorithm, settings, data set, viewpoint, viewport.
+pub(crate) type Key = (String, Settings, String, String, u32, u32);
 
-fn key(r: &Row) -> Key {
+pub(crate) fn key(r: &Row) -> Key {
     (
         r.algorithm.clone(),
         r.settings.clone(),

@@ -14,6 +14,7 @@
 //! run-wide factor divided out, Holm over the groups. Its outputs go to `OUT/compare`, the
 //! drift each pair saw to `OUT/ab.json` and the terminal.
 
+use crate::compare::{key, Key};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -169,19 +170,6 @@ fn invoke(bin: &Binary, dir: &Path, log: &Path, opt: &AbOptions) -> anyhow::Resu
             tail(log, 20)
         ),
     }
-}
-
-type Key = (String, render_core::Settings, String, String, u32, u32);
-
-fn key(r: &Row) -> Key {
-    (
-        r.algorithm.clone(),
-        r.settings.clone(),
-        r.dataset.clone(),
-        r.viewpoint.clone(),
-        r.width,
-        r.height,
-    )
 }
 
 /// A row's own median frame time (`None`: failed or no samples).
