@@ -20,6 +20,7 @@
 //! The CPU twin of a ray step is [`step`]; the pass-count map (the paper's Fig. 5) is
 //! [`passmap`].
 
+mod description;
 pub mod layout;
 pub mod passmap;
 mod render;
@@ -27,8 +28,9 @@ pub mod resources;
 pub mod settings;
 pub mod step;
 
+pub use description::DESCRIPTION;
 pub use render::{PassData, Raycast};
-pub use settings::{Mode, RaycastSettings, TableKind, DESCRIPTION};
+pub use settings::{Mode, RaycastSettings, TableKind};
 
 /// The default variants ([`settings::default_settings`]) as renderers.
 pub fn default_variants() -> Vec<Box<dyn render_core::Renderer>> {
