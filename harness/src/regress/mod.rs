@@ -16,6 +16,12 @@ use anyhow::Context;
 pub mod ab;
 pub mod bisect;
 pub mod build;
+pub mod compare;
+pub mod compare_plot;
+pub mod compare_report;
+pub mod compare_time;
+pub mod export;
+pub mod history;
 
 /// The run matrix of `ab` and `bisect`: the options of `tetbench run` that choose what is
 /// measured, handed on unchanged to every side's `run`. Only options given are passed, so an
