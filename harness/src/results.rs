@@ -115,6 +115,12 @@ pub struct Row {
     /// the mark cannot be reset (non-Linux) and in files written before it existed.
     #[serde(default)]
     pub host_peak_bytes: Option<u64>,
+    /// Wall time (ms) the harness spent on this row outside its frames, summed over rounds:
+    /// image readback, PNG and f32 image, hash, metrics and heatmap, bookkeeping between
+    /// frames. Neither the warm-up frames nor the reference renderer's work (once per view,
+    /// cached across runs) is in it. Empty in files written before it existed.
+    #[serde(default)]
+    pub harness_ms: Option<f64>,
     /// Empty on success; otherwise what went wrong (the metrics are then empty).
     pub error: String,
     /// Per-frame samples: in `results.json` only (`samples.csv` has them one per line).

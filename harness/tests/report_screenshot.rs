@@ -66,6 +66,7 @@ fn row(algorithm: &str, settings: &str, dataset: &str, viewpoint: &str, i: usize
         bound_by: String::new(),
         normalized_time: None,
         host_peak_bytes: None,
+        harness_ms: None,
         suspect: String::new(),
         error: String::new(),
         samples: Default::default(),

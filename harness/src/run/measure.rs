@@ -16,6 +16,9 @@ pub(super) struct DatasetContext<'a> {
     /// The reference renderer's per-mesh data (planes, boundary bins), built on the first
     /// cache miss and shared by every viewpoint (0.3 s per view saved on Blunt Fin).
     reference_mesh: Option<reference::Prepared<'a>>,
+    /// Wall time of the last [`Self::reference`] call (ms): taken out of the row's
+    /// `harness_ms`, since the reference is rendered once per view for every variant.
+    reference_ms: f64,
 }
 
 /// The row's fixed parts, before measuring (everything measured starts empty).
@@ -93,6 +96,7 @@ impl<'a> DatasetContext<'a> {
             label,
             references: HashMap::new(),
             reference_mesh: None,
+            reference_ms: 0.0,
         }
     }
 
@@ -175,6 +179,7 @@ impl<'a> DatasetContext<'a> {
                         frames: vec![Vec::<FrameStats>::new(); views],
                         failed: vec![None::<String>; views],
                         peaks,
+                        harness_ms: vec![0.0; views],
                     })
                 }
                 Err(e) => {
@@ -190,6 +195,9 @@ impl<'a> DatasetContext<'a> {
                 }
             }
         }
+        // `scripts/profile.sh` samples only from here on: the frames and the rows, not the
+        // loading and preparing.
+        let _profiled = super::perf_control::ProfiledSection::begin();
         for round in 0..rounds {
             let last = round + 1 == rounds;
             for v in live.iter_mut() {
@@ -205,12 +213,17 @@ impl<'a> DatasetContext<'a> {
                             what
                         });
                         match self.time_frames(v.renderer.as_mut(), vp) {
-                            Ok(f) => v.frames[i].extend(f),
+                            Ok((f, between_frames_ms)) => {
+                                v.frames[i].extend(f);
+                                v.harness_ms[i] += between_frames_ms;
+                            }
                             Err(e) => v.failed[i] = Some(format!("{e:#}")),
                         }
                     }
                     if last {
                         let f = std::mem::take(&mut v.frames[i]);
+                        let finishing = Instant::now();
+                        self.reference_ms = 0.0;
                         let mut row = self.finish_row(
                             v.renderer.as_mut(),
                             &v.prepared,
@@ -221,6 +234,9 @@ impl<'a> DatasetContext<'a> {
                             outcome,
                             &writer.file.rows,
                         );
+                        let finish_ms = finishing.elapsed().as_secs_f64() * 1e3;
+                        row.harness_ms =
+                            Some(v.harness_ms[i] + (finish_ms - self.reference_ms).max(0.0));
                         v.peaks[i] = v.peaks[i].max(host_peak_bytes(peak_reset));
                         row.host_peak_bytes = v.peaks[i];
                         writer.push(row)?;
@@ -242,22 +258,27 @@ impl<'a> DatasetContext<'a> {
         )
     }
 
-    /// The warm-up and timed frames of one viewpoint in one round.
+    /// The warm-up and timed frames of one viewpoint in one round, and the wall time (ms)
+    /// between and around the timed frames that none of them counts (the harness's own
+    /// overhead inside the timing loop, plus whatever a renderer does before its clock starts).
     fn time_frames(
         &mut self,
         renderer: &mut dyn Renderer,
         vp: &Viewpoint,
-    ) -> anyhow::Result<Vec<FrameStats>> {
+    ) -> anyhow::Result<(Vec<FrameStats>, f64)> {
         let c = self.config;
         let camera = Camera::fit(&self.mesh.bounds(), vp, c.projection, c.width, c.height);
         for _ in 0..c.warmup {
             guarded("render", || renderer.render(self.gpu, &camera))?;
         }
         let mut frames = Vec::with_capacity(c.frames as usize);
+        let timed = Instant::now();
         for _ in 0..c.frames {
             frames.push(guarded("render", || renderer.render(self.gpu, &camera))?);
         }
-        Ok(frames)
+        let loop_ms = timed.elapsed().as_secs_f64() * 1e3;
+        let inside_frames: f64 = frames.iter().map(|f| f.total_ms).sum();
+        Ok((frames, (loop_ms - inside_frames).max(0.0)))
     }
 
     /// The row of one viewpoint once all its rounds ran (`failure`: the first error of any).
@@ -384,7 +405,10 @@ impl<'a> DatasetContext<'a> {
         }
 
         if c.reference {
-            match self.reference(vp, &camera, progress) {
+            let referencing = Instant::now();
+            let reference = self.reference(vp, &camera, progress);
+            self.reference_ms = referencing.elapsed().as_secs_f64() * 1e3;
+            match reference {
                 Ok((reference, ref_path, lost_rays)) => {
                     // Rays the reference could not follow to their end (0 on sound meshes).
                     let lost = format!("reference_lost_rays={lost_rays}");
@@ -441,6 +465,8 @@ struct Variant {
     frames: Vec<Vec<FrameStats>>,
     failed: Vec<Option<String>>,
     peaks: Vec<Option<u64>>,
+    /// Per viewpoint: the harness's wall time outside the frames so far (ms).
+    harness_ms: Vec<f64>,
 }
 
 /// Resets the kernel's peak-resident-set mark (VmHWM) of this process to its current resident

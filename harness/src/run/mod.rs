@@ -28,6 +28,7 @@ use crate::metrics::{self, summarize};
 use crate::results::{ResultsWriter, Row, RunDescription};
 
 pub mod lock;
+mod perf_control;
 mod measure;
 pub mod resume;
 use measure::DatasetContext;
