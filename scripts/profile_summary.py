@@ -12,25 +12,35 @@ import pathlib
 import re
 import sys
 
-# (category, thread regex, dso regex, symbol regex); the first rule that matches wins.
+# (category, thread regex, dso regex, symbol regex); the first rule that matches wins. Debian
+# ships lavapipe stripped (no internal symbols, and no debug package reachable here), so its code
+# is split by thread: llvmpipe's worker threads (`llvmpipe-N`) rasterise binned triangles, run the
+# JIT-compiled fragment shaders and blend; compute dispatches and the vertex/setup half of a draw
+# (vertex fetch, JIT vertex shader, clipping, triangle setup, binning) run on the submitting
+# thread, whose name is the process's.
+WORKER = r"^llvmpipe"
+SUBMITTER = r"^(?!llvmpipe)"
+JIT = r"^\[JIT\]|^\[unknown\]|perf-\d+\.map"
 RULES = [
     ("LLVM shader compilation", r".*", r"libLLVM", r".*"),
+    ("llvmpipe workers: JIT fragment shaders and blending", WORKER, JIT, r".*"),
+    ("llvmpipe workers: rasterisation, tile load/store, clears", WORKER, r"libvulkan_lvp|libgallium", r".*"),
+    ("llvmpipe workers: other (kernel, libc)", WORKER, r".*", r".*"),
     ("harness per row (readback, PNG, f32 image, metrics)", r".*", r".*",
-     r"png::|fdeflate|miniz_oxide|zstd|lz4|blake3|harness::metrics|harness::samples|"
-     r"image::|crc32|adler|serde_json|csv::|harness::results|read_rgba32f|heatmap"),
-    ("llvmpipe rasteriser: JIT fragment shaders", r"^llvmpipe|^lp", r"\[unknown\]|\[JIT\]|perf-\d+\.map", r".*"),
-    ("llvmpipe rasteriser: tiles, blending, clears", r"^llvmpipe|^lp", r".*", r".*"),
-    ("llvmpipe vertex processing and triangle setup", r".*", r".*",
-     r"^(draw_|lp_setup|llvmpipe_|lp_rast_|lp_scene|vbuf|vsplit|vcache|fetch_|emit_|"
-     r"clip_|do_triangle|triangle|setup_)"),
-    ("llvmpipe JIT vertex/compute shaders (submitting thread)", r".*", r"\[unknown\]|\[JIT\]|perf-\d+\.map", r".*"),
-    ("lavapipe command execution (copies, compute dispatch, state)", r".*", r"libvulkan_lvp|libgallium|lvp", r".*"),
+     r"png::|fdeflate|miniz_oxide|zstd|lz4|blake3|harness::|image::|crc32|adler|serde_json|"
+     r"csv::|read_rgba32f|to_srgb8|image_error|ZSTD|heatmap"),
+    ("submitting thread: JIT vertex and compute shaders", SUBMITTER, JIT, r".*"),
+    ("submitting thread: lavapipe (command execution, vertex fetch, setup, binning, copies)",
+     SUBMITTER, r"libvulkan_lvp|libgallium", r".*"),
     ("wgpu (encoding, validation, submission)", r".*", r".*", r"wgpu|naga|ash::|gpu_alloc|gpu_descriptor"),
-    ("our host work (sorts, classification, packing)", r".*", r"tetbench", r"render_core|gator_pt|havs|fragment_pt|raycast|splat|datasets"),
-    ("memcpy/memset (libc)", r".*", r"libc", r"mem(cpy|set|move)"),
+    ("our host work (sorts, classification, packing, counters)", r".*", r"tetbench",
+     r"render_core|gator_pt|havs|fragment_pt|raycast|splat|datasets|radix|rayon"),
+    ("kernel (page faults, scheduling, futex)", r".*", r"kernel", r".*"),
+    ("libc and libm (memcpy, math)", r".*", r"libc|libm", r".*"),
 ]
 OTHER = "other"
-LINE = re.compile(r"^\s*([0-9.]+)%\s+(\S.*?)\s{2,}(\S+)\s+\[(.)\]\s+(.*)$")
+# `perf report -t '|' --sort comm,dso,sym`: " 3.21%  |tetbench  |tetbench  |[.] symbol".
+LINE = re.compile(r"^\s*([0-9.]+)%\s*\|([^|]*)\|([^|]*)\|\[(.)\]\s*(.*)$")
 
 
 def classify(comm, dso, sym):
@@ -46,7 +56,7 @@ def read_report(path):
         m = LINE.match(line)
         if m:
             pct, comm, dso, _, sym = m.groups()
-            samples.append((float(pct), comm.strip(), dso, sym.strip()))
+            samples.append((float(pct), comm.strip(), dso.strip(), sym.strip()))
     return samples
 
 
@@ -57,24 +67,31 @@ def median(v):
 
 
 def frame_figures(run_dir):
+    """One dict per successful row of the profiled run (every variant of the default grid)."""
     try:
         rows = json.loads((run_dir / "results.json").read_text())["rows"]
     except (OSError, KeyError, ValueError):
-        return None
-    rows = [r for r in rows if not r.get("error")]
-    if not rows:
-        return None
-    r = rows[0]
-    stages = dict(kv.split("=", 1) for kv in r.get("stages", "").split(";") if "=" in kv)
-    return {
-        "settings": r.get("settings"),
-        "tets": r.get("tets"),
-        "total_ms": r.get("total_ms"),
-        "cpu_ms": r.get("cpu_ms"),
-        "wait_ms": float(stages["wait"]) if "wait" in stages else None,
-        "frames": r.get("frames"),
-        "harness_ms": r.get("harness_ms"),
-    }
+        return []
+    figures = []
+    for r in rows:
+        if r.get("error"):
+            continue
+        stages = dict(kv.split("=", 1) for kv in (r.get("stages") or "").split(";") if "=" in kv)
+        counters = dict(kv.split("=", 1) for kv in (r.get("counters") or "").split(";") if "=" in kv)
+        settings = r.get("settings")
+        if isinstance(settings, dict):
+            settings = ";".join(f"{k}={v}" for k, v in settings.items())
+        figures.append({
+            "settings": settings,
+            "tets": r.get("tets"),
+            "total_ms": r.get("total_ms"),
+            "cpu_ms": r.get("cpu_ms"),
+            "wait_ms": float(stages["wait"]) if "wait" in stages else None,
+            "frames": r.get("frames"),
+            "harness_ms": r.get("harness_ms"),
+            "fragments": float(counters["fragments"]) if "fragments" in counters else None,
+        })
+    return figures
 
 
 def fmt(v, digits=1):
@@ -98,13 +115,17 @@ def main():
             k = classify(comm, dso, sym)
             shares[k] = shares.get(k, 0.0) + pct
         top = sorted(samples, reverse=True)[:8]
-        f = frame_figures(out / f"{name}.run") or {}
+        rows = frame_figures(out / f"{name}.run")
         lines += [f"## {algorithm} on {dataset} at {resolution}²", ""]
-        lines.append(
-            f"settings `{f.get('settings')}`, {f.get('tets')} tets: frame {fmt(f.get('total_ms'))} ms "
-            f"(host CPU {fmt(f.get('cpu_ms'))} ms, waiting for the GPU {fmt(f.get('wait_ms'))} ms); "
-            f"harness outside the frames {fmt(f.get('harness_ms'))} ms for the row's "
-            f"{f.get('frames')} frames")
+        if rows:
+            lines += ["| variant | tets | fragments | frame ms | ns per fragment | host CPU ms | GPU wait ms | harness ms per frame |",
+                      "|---|---:|---:|---:|---:|---:|---:|---:|"]
+            for f in rows:
+                per_frame = (f["harness_ms"] / f["frames"]) if f.get("harness_ms") is not None and f.get("frames") else None
+                ns = (f["total_ms"] * 1e6 / f["fragments"]) if f.get("fragments") and f.get("total_ms") else None
+                frags = f"{f['fragments']:,.0f}" if f.get("fragments") else "–"
+                lines.append(f"| `{f['settings']}` | {f['tets']} | {frags} | {fmt(f['total_ms'])} | {fmt(ns)} | {fmt(f['cpu_ms'])} | "
+                             f"{fmt(f['wait_ms'])} | {fmt(per_frame)} |")
         lines += ["", "| category | share of CPU samples |", "|---|---:|"]
         for k, v in sorted(shares.items(), key=lambda kv: -kv[1]):
             lines.append(f"| {k} | {v:.1f} % |")
