@@ -27,6 +27,7 @@ use crate::machine::MachineInfo;
 use crate::metrics::{self, summarize};
 use crate::results::{ResultsWriter, Row, RunDescription};
 
+pub mod allocator;
 pub mod lock;
 mod perf_control;
 mod measure;
