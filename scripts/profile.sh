@@ -74,7 +74,7 @@ for d in "${sets[@]}"; do
         --out "$out/$name.run" >"$out/$name.log" 2>&1 \
         || { echo "profile.sh: $name failed (see $out/$name.log)" >&2; continue; }
       perf report -q -i "$out/$name.perf.data" --stdio --no-children \
-        --sort comm,dso,sym -t '|' --percent-limit 0 >"$out/$name.report.txt" 2>/dev/null
+        -F sample,comm,dso,sym -t '|' >"$out/$name.report.txt" 2>/dev/null
       rm -f "$out/$name.perf.data"
     done
   done

@@ -15,11 +15,11 @@ import sys
 # (category, thread regex, dso regex, symbol regex); the first rule that matches wins. Debian
 # ships lavapipe stripped (no internal symbols, and no debug package reachable here), so its code
 # is split by thread: llvmpipe's worker threads (`llvmpipe-N`) rasterise binned triangles, run the
-# JIT-compiled fragment shaders and blend; compute dispatches and the vertex/setup half of a draw
-# (vertex fetch, JIT vertex shader, clipping, triangle setup, binning) run on the submitting
-# thread, whose name is the process's.
+# JIT-compiled fragment shaders and blend; the vertex/setup half of a draw (vertex fetch, JIT
+# vertex shader, clipping, triangle setup, binning) runs on lavapipe's queue thread, and compute
+# dispatches on its compute threads, all of which carry the process's name.
 WORKER = r"^llvmpipe"
-SUBMITTER = r"^(?!llvmpipe)"
+QUEUE_AND_COMPUTE = r"^(?!llvmpipe)"
 JIT = r"^\[JIT\]|^\[unknown\]|perf-\d+\.map"
 RULES = [
     ("LLVM shader compilation", r".*", r"libLLVM", r".*"),
@@ -29,9 +29,9 @@ RULES = [
     ("harness per row (readback, PNG, f32 image, metrics)", r".*", r".*",
      r"png::|fdeflate|miniz_oxide|zstd|lz4|blake3|harness::|image::|crc32|adler|serde_json|"
      r"csv::|read_rgba32f|to_srgb8|image_error|ZSTD|heatmap"),
-    ("submitting thread: JIT vertex and compute shaders", SUBMITTER, JIT, r".*"),
-    ("submitting thread: lavapipe (command execution, vertex fetch, setup, binning, copies)",
-     SUBMITTER, r"libvulkan_lvp|libgallium", r".*"),
+    ("queue and compute threads: JIT vertex and compute shaders", QUEUE_AND_COMPUTE, JIT, r".*"),
+    ("queue and compute threads: lavapipe (command execution, vertex fetch, setup, binning, copies)",
+     QUEUE_AND_COMPUTE, r"libvulkan_lvp|libgallium", r".*"),
     ("wgpu (encoding, validation, submission)", r".*", r".*", r"wgpu|naga|ash::|gpu_alloc|gpu_descriptor"),
     ("our host work (sorts, classification, packing, counters)", r".*", r"tetbench",
      r"render_core|gator_pt|havs|fragment_pt|raycast|splat|datasets|radix|rayon"),
@@ -39,8 +39,10 @@ RULES = [
     ("libc and libm (memcpy, math)", r".*", r"libc|libm", r".*"),
 ]
 OTHER = "other"
-# `perf report -t '|' --sort comm,dso,sym`: " 3.21%  |tetbench  |tetbench  |[.] symbol".
-LINE = re.compile(r"^\s*([0-9.]+)%\s*\|([^|]*)\|([^|]*)\|\[(.)\]\s*(.*)$")
+# `perf report -t '|' -F sample,comm,dso,sym`: " 234  |tetbench  |tetbench  |[.] symbol". Sample
+# counts, not percentages: JIT code spreads over thousands of addresses, each under the 0.01 %
+# that a percentage column can show, and would be lost.
+LINE = re.compile(r"^\s*([0-9]+)\s*\|([^|]*)\|([^|]*)\|\[(.)\]\s*(.*)$")
 
 
 def classify(comm, dso, sym):
@@ -55,9 +57,10 @@ def read_report(path):
     for line in path.read_text(errors="replace").splitlines():
         m = LINE.match(line)
         if m:
-            pct, comm, dso, _, sym = m.groups()
-            samples.append((float(pct), comm.strip(), dso.strip(), sym.strip()))
-    return samples
+            count, comm, dso, _, sym = m.groups()
+            samples.append((float(count), comm.strip(), dso.strip(), sym.strip()))
+    total = sum(s[0] for s in samples) or 1.0
+    return [(100.0 * c / total, comm, dso, sym) for c, comm, dso, sym in samples]
 
 
 def median(v):
