@@ -120,7 +120,7 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
     let mut points: Vec<SweepPoint> = vec![];
     let mut adapter = String::new();
     for &res in &args.resolutions {
-        let plan = crate::plan::RunPlan {
+        let plan = crate::run::plan::RunPlan {
             algorithms: args.algorithms.clone(),
             datasets: args.datasets.clone(),
             viewpoints: Some(args.viewpoints.clone()),
@@ -222,7 +222,7 @@ pub fn fig8_markdown(points: &[SweepPoint], adapter: &str) -> String {
 
 const FONT: &str = "DejaVu Sans";
 
-/// Registers the embedded DejaVu Sans with plotters (as `report.rs` does; registering the
+/// Registers the embedded DejaVu Sans with plotters (as `report/mod.rs` does; registering the
 /// same family twice is harmless).
 fn register_font() {
     static ONCE: Once = Once::new();

@@ -276,9 +276,10 @@ pub fn run_kbuffer(args: KbufferArgs, ctx: &super::Context) -> anyhow::Result<()
         }
         w.flush()?;
         if let Some(s) = worst {
-            let path = args
-                .out
-                .join(format!("havs_fig6_{}.png", crate::names::slug(spec)));
+            let path = args.out.join(format!(
+                "havs_fig6_{}.png",
+                crate::results::names::slug(spec)
+            ));
             s.k_map_image()
                 .save(&path)
                 .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;

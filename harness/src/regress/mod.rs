@@ -158,7 +158,7 @@ pub struct AbArgs {
     pub out: PathBuf,
     /// Exit with status 3 on a regression (default) or on any change; `never`: always 0.
     #[arg(long, value_enum, default_value = "regression")]
-    pub fail_on: crate::compare::FailOn,
+    pub fail_on: crate::regress::compare::FailOn,
     #[command(flatten)]
     pub judge: JudgeArgs,
     #[command(flatten)]
@@ -192,7 +192,7 @@ fn ab_options(
     out: PathBuf,
     pairs: u32,
     judge: &JudgeArgs,
-    fail_on: crate::compare::FailOn,
+    fail_on: crate::regress::compare::FailOn,
     matrix: &MatrixArgs,
     data_dir: Option<PathBuf>,
 ) -> anyhow::Result<ab::AbOptions> {
@@ -203,7 +203,7 @@ fn ab_options(
             .map(|d| vec!["--data-dir".to_string(), d.display().to_string()])
             .unwrap_or_default(),
         run_args: matrix.run_args(),
-        compare: crate::compare::CompareOptions {
+        compare: crate::regress::compare::CompareOptions {
             threshold: judge.threshold,
             alpha: judge.alpha,
             normalised: false,
@@ -237,7 +237,7 @@ pub fn run_bisect_command(args: BisectArgs, data_dir: Option<PathBuf>) -> anyhow
         args.out.clone(),
         args.pairs,
         &args.judge,
-        crate::compare::FailOn::Regression,
+        crate::regress::compare::FailOn::Regression,
         &args.matrix,
         data_dir,
     )?;

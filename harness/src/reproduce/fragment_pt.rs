@@ -84,7 +84,7 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
         let Some(alg) = alg else { continue };
         s.run(
             &RunSpec {
-                name: format!("table2-{}", crate::names::slug(label)),
+                name: format!("table2-{}", crate::results::names::slug(label)),
                 algorithms: vec![alg.to_string()],
                 datasets: vec!["bluntfin".into(), "post".into()],
                 viewpoints: "orbit:14".into(),

@@ -108,7 +108,7 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
     for (label, alg, settings) in TABLE5_ALGORITHMS.iter().skip(1) {
         s.run(
             &RunSpec {
-                name: format!("table5-{}", crate::names::slug(label)),
+                name: format!("table5-{}", crate::results::names::slug(label)),
                 algorithms: vec![alg.to_string()],
                 datasets: TABLE5_DATASETS.map(String::from).to_vec(),
                 viewpoints: "14".into(),

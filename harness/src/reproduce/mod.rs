@@ -17,8 +17,8 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 
-use crate::machine::MachineInfo;
 use crate::report::{aggregate, Aggregate};
+use crate::results::machine::MachineInfo;
 use crate::results::{ResultsFile, Row};
 
 pub mod evidence;
@@ -59,7 +59,7 @@ pub struct Args {
     /// External renderers measured in every run beside the paper's algorithms (as
     /// `tetbench run --external`).
     #[command(flatten)]
-    pub external: crate::external_cmd::ExternalArgs,
+    pub external: crate::run::matrix::ExternalArgs,
     /// Run although the working tree has uncommitted changes (the reports then say so; by
     /// default `reproduce` refuses, so every report names the one commit it came from).
     #[arg(long)]
@@ -145,8 +145,8 @@ pub const QUICK_FRAMES: u32 = 1;
 pub const QUICK_RESOLUTION_DIVISOR: u32 = 2;
 pub const QUICK_WARMUP: u32 = 1;
 /// The full mode's frames and warm-up (tetbench's standard).
-pub const FULL_FRAMES: u32 = crate::suite::STANDARD_FRAMES;
-pub const FULL_WARMUP: u32 = crate::suite::STANDARD_WARMUP;
+pub const FULL_FRAMES: u32 = crate::run::suite::STANDARD_FRAMES;
+pub const FULL_WARMUP: u32 = crate::run::suite::STANDARD_WARMUP;
 
 /// Measured rows of one paper plus what could not be measured.
 #[derive(Debug, Clone, Default)]
@@ -243,7 +243,7 @@ pub struct Session {
     /// The equivalent `tetbench run` command of every run, and its outcome.
     pub log: Vec<String>,
     /// External renderers added to every run (`--external`).
-    pub external: crate::external_cmd::ExternalArgs,
+    pub external: crate::run::matrix::ExternalArgs,
     /// The commit the binary was built from and whether the tree was clean.
     pub source: SourceState,
     /// Set by `tetbench analyze PAPER RUN_DIR`: the runs the tables come from.
@@ -295,7 +295,7 @@ impl Session {
         };
         let datasets: Vec<String> = spec.datasets.iter().map(|d| self.dataset(d)).collect();
         let out = self.dir.join("runs").join(&spec.name);
-        let args = crate::plan::RunPlan {
+        let args = crate::run::plan::RunPlan {
             algorithms: algorithms.clone(),
             datasets: datasets.clone(),
             viewpoints: Some(viewpoints.clone()),
@@ -362,7 +362,8 @@ impl Session {
         measured.errors.extend(outcome.errors.iter().cloned());
         for mut row in file.rows {
             if let Some((plan, _)) = self.substitutes.iter().find(|(_, s)| {
-                crate::names::slug(s) == crate::names::slug(&row.dataset) || *s == row.dataset
+                crate::results::names::slug(s) == crate::results::names::slug(&row.dataset)
+                    || *s == row.dataset
             }) {
                 row.dataset = plan.clone();
             }

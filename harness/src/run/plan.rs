@@ -10,8 +10,8 @@ use std::path::PathBuf;
 use render_core::{Projection, TransferFunction};
 
 use crate::algorithms::{self, SettingsFilter};
+use crate::run::suite::{self, DEFAULT_SUITE};
 use crate::run::RunConfig;
-use crate::suite::{self, DEFAULT_SUITE};
 
 /// A run as asked for: `None` and empty lists mean "the default" (the default suite's when no
 /// data set is named, the papers' standard otherwise).
@@ -46,7 +46,7 @@ pub struct RunPlan {
     /// Peer groups as `--peers`.
     pub peers: Vec<String>,
     /// External renderers as `--external` (docs/external-renderers.md).
-    pub external: crate::external_cmd::ExternalArgs,
+    pub external: crate::run::matrix::ExternalArgs,
 }
 
 impl RunPlan {

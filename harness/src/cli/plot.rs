@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use crate::plan::RunPlan;
 use crate::plot::data::Inputs;
 use crate::plot::Kind;
+use crate::run::plan::RunPlan;
 
 #[derive(Debug, clap::Args)]
 pub struct PlotArgs {
@@ -55,7 +55,7 @@ pub struct PlotArgs {
     pub tf: String,
     /// Sweep: external renderers (as `tetbench run --external`).
     #[command(flatten)]
-    pub external: crate::external_cmd::ExternalArgs,
+    pub external: crate::run::matrix::ExternalArgs,
 }
 
 /// `box:10k,100k,1m` → `box:10k`, `box:100k`, `box:1m`; names and paths are kept as given.
@@ -85,16 +85,19 @@ impl PlotArgs {
             viewpoints: Some(
                 self.viewpoints
                     .clone()
-                    .unwrap_or_else(|| crate::suite::DEFAULT_SUITE.viewpoints.to_string()),
+                    .unwrap_or_else(|| crate::run::suite::DEFAULT_SUITE.viewpoints.to_string()),
             ),
             resolution: Some(resolution),
             tf: self.tf.clone(),
             // The suite's number of samples, in one round: a sweep's large meshes should not
             // all stay prepared at once.
             frames: Some(self.frames.unwrap_or(
-                crate::suite::DEFAULT_SUITE.frames * crate::suite::DEFAULT_SUITE.rounds,
+                crate::run::suite::DEFAULT_SUITE.frames * crate::run::suite::DEFAULT_SUITE.rounds,
             )),
-            warmup: Some(self.warmup.unwrap_or(crate::suite::DEFAULT_SUITE.warmup)),
+            warmup: Some(
+                self.warmup
+                    .unwrap_or(crate::run::suite::DEFAULT_SUITE.warmup),
+            ),
             rounds: None,
             out,
             settings: self.settings.clone(),
@@ -156,7 +159,7 @@ fn sweep(
             }
             let res = args
                 .resolution
-                .unwrap_or(crate::suite::DEFAULT_SUITE.resolution);
+                .unwrap_or(crate::run::suite::DEFAULT_SUITE.resolution);
             Ok(vec![measure(
                 args.run_args(datasets, res, root.join("scaling")),
                 data_dir,

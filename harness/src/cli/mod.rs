@@ -2,16 +2,20 @@
 
 use std::path::PathBuf;
 
+pub mod datasets;
+pub mod external;
+pub mod plot;
+
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 
+use self::datasets::DatasetsCommand;
 use crate::algorithms;
 use crate::analyze::{self, AnalyzeCommand};
-use crate::datasets_cmd::{self, DatasetsCommand};
-pub use crate::plan::default_cache_dir;
-use crate::plan::RunPlan;
+pub use crate::run::plan::default_cache_dir;
+use crate::run::plan::RunPlan;
+use crate::run::shard::INCOMPLETE;
 use crate::run::{self, RunConfig};
-use crate::shard::INCOMPLETE;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -106,16 +110,16 @@ pub enum Command {
     /// github-action-benchmark's customSmallerIsBetter (docs/regression.md, "Exports").
     Export {
         #[arg(long, value_enum)]
-        format: crate::export::ExportFormat,
+        format: crate::regress::export::ExportFormat,
         /// The run's output directory (holding results.json).
         results: PathBuf,
     },
     /// Draw comparison charts (speed-error, scaling, resolution, bars, all) from any results,
     /// or run a sweep first (--sweep).
-    Plot(crate::plot_cli::PlotArgs),
+    Plot(crate::cli::plot::PlotArgs),
     /// Renderers in other processes and languages (docs/external-renderers.md): `check`.
     #[command(subcommand)]
-    External(crate::external_cmd::ExternalCommand),
+    External(crate::cli::external::ExternalCommand),
     /// Run two builds (binaries or git revisions) in turns, A B B A …, over one matrix and
     /// compare them with compare's test (docs/regression.md, "A/B").
     Ab(crate::regress::AbArgs),
@@ -138,7 +142,7 @@ pub struct CompareArgs {
     /// Exit with status 3 on a regression (or on any change); 1 means an error or a refused
     /// comparison, 0 neither (docs/regression.md, "Exit codes").
     #[arg(long, value_enum, default_value = "never")]
-    pub fail_on: crate::compare::FailOn,
+    pub fail_on: crate::regress::compare::FailOn,
     /// Compare runs from different adapters on calibration-normalised times.
     #[arg(long)]
     pub normalised: bool,
@@ -157,7 +161,7 @@ pub struct CompareArgs {
     /// What goes to stdout: the terminal table, compare.json, or compare.md (for a pull
     /// request comment). The files are written to --out in every case.
     #[arg(long, value_enum, default_value = "text")]
-    pub format: crate::compare_report::CompareFormat,
+    pub format: crate::regress::compare_report::CompareFormat,
 }
 
 #[derive(Debug, Clone, clap::Args)]
@@ -239,7 +243,7 @@ pub struct RunArgs {
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     pub peers: Vec<String>,
     #[command(flatten)]
-    pub external: crate::external_cmd::ExternalArgs,
+    pub external: crate::run::matrix::ExternalArgs,
 }
 
 impl RunArgs {
@@ -354,7 +358,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Datasets(cmd) => datasets_cmd::run(cmd, cli.data_dir),
+        Command::Datasets(cmd) => self::datasets::run(cmd, cli.data_dir),
         Command::Analyze(AnalyzeAny::Tool(cmd)) => analyze::run(
             cmd,
             &analyze::Context {
@@ -371,7 +375,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
         } => {
             if !merge.is_empty() {
                 let out = out.context("report --merge needs --out OUT")?;
-                let merged = crate::shard::merge(&merge, &out, allow_missing)?;
+                let merged = crate::run::shard::merge(&merge, &out, allow_missing)?;
                 for gap in merged.errors.iter().filter(|e| e.starts_with(INCOMPLETE)) {
                     eprintln!("tetbench: {gap}");
                 }
@@ -392,7 +396,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Compare(args) => {
-            let opt = crate::compare::CompareOptions {
+            let opt = crate::regress::compare::CompareOptions {
                 threshold: args.threshold,
                 alpha: args.alpha,
                 normalised: args.normalised,
@@ -403,9 +407,14 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             };
             anyhow::ensure!(args.threshold >= 1.0, "--threshold must be at least 1");
             anyhow::ensure!(args.drift_limit >= 1.0, "--drift-limit must be at least 1");
-            if crate::compare_report::run_command(&args.base, &args.new, &opt, args.format)? {
+            if crate::regress::compare_report::run_command(
+                &args.base,
+                &args.new,
+                &opt,
+                args.format,
+            )? {
                 // The documented CI gate: status 3 (1 is an error or a refusal).
-                std::process::exit(crate::compare::EXIT_REGRESSION);
+                std::process::exit(crate::regress::compare::EXIT_REGRESSION);
             }
             Ok(())
         }
@@ -421,16 +430,16 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             dirs,
             out,
             threshold,
-        } => crate::history::run_command(&dirs, &out, threshold, 0.05),
+        } => crate::regress::history::run_command(&dirs, &out, threshold, 0.05),
         Command::Export { format, results } => {
-            print!("{}", crate::export::run_command(&results, format)?);
+            print!("{}", crate::regress::export::run_command(&results, format)?);
             Ok(())
         }
-        Command::Plot(args) => crate::plot_cli::run(args, cli.data_dir, command_line),
-        Command::External(cmd) => crate::external_cmd::run(cmd),
+        Command::Plot(args) => crate::cli::plot::run(args, cli.data_dir, command_line),
+        Command::External(cmd) => crate::cli::external::run(cmd),
         Command::Ab(args) => {
             if crate::regress::run_ab_command(args, cli.data_dir)? {
-                std::process::exit(crate::compare::EXIT_REGRESSION);
+                std::process::exit(crate::regress::compare::EXIT_REGRESSION);
             }
             Ok(())
         }
