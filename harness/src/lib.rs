@@ -15,6 +15,5 @@ pub mod regress;
 // The regression wing's modules keep their crate-level paths (`crate::regress::compare`, …).
 pub use regress::{compare, compare_plot, compare_report, compare_time, export, history};
 pub mod report;
-pub mod reproduce;
 pub mod results;
 pub mod run;

@@ -39,7 +39,7 @@ pub enum AnalyzeAny {
     #[command(flatten)]
     Tool(AnalyzeCommand),
     #[command(flatten)]
-    Paper(crate::reproduce::from_run::PaperAnalysis),
+    Paper(crate::papers::from_run::PaperAnalysis),
 }
 
 #[derive(Debug, Subcommand)]
@@ -57,7 +57,7 @@ pub enum Command {
     Analyze(AnalyzeAny),
     /// Reproduce a paper's tables with one command: runs what they need, then writes
     /// OUT/<paper>/report.md and report.html with the paper's values beside ours.
-    Reproduce(crate::reproduce::Args),
+    Reproduce(crate::papers::reproduce::Args),
     /// Re-render the report (charts, index.html) of an earlier run from its results.json, or
     /// merge shards / runs of several machines: `report --merge DIR… --out OUT`.
     Report {
@@ -365,8 +365,8 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
                 data_dir: cli.data_dir,
             },
         ),
-        Command::Analyze(AnalyzeAny::Paper(cmd)) => crate::reproduce::from_run::run(cmd),
-        Command::Reproduce(args) => crate::reproduce::run(args, cli.data_dir),
+        Command::Analyze(AnalyzeAny::Paper(cmd)) => crate::papers::from_run::run(cmd),
+        Command::Reproduce(args) => crate::papers::reproduce::run(args, cli.data_dir),
         Command::Report {
             dir,
             merge,

@@ -8,7 +8,7 @@
 //! The paper's figures come from its transcribed tables (`reports/papers/fragment-pt_table*.csv`,
 //! provenance in `reports/papers/fragment-pt.md`); Fig. 8 is a plot whose numbers the text does
 //! not give. Tables 1–2 are `tetbench reproduce fragment-pt` (or `tetbench analyze fragment-pt
-//! RUN_DIR` for finished runs), written once, in `reproduce/fragment_pt.rs`.
+//! RUN_DIR` for finished runs), written once, in `papers/fragment_pt/mod.rs`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -111,7 +111,7 @@ pub fn sweep_points(rows: &[Row], resolution: u32) -> Vec<SweepPoint> {
     out
 }
 
-pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Result<()> {
+pub fn run_resolution(args: ResolutionArgs, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
     if args.resolutions.is_empty() {
         anyhow::bail!("--resolutions is empty");
     }
@@ -143,10 +143,8 @@ pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Res
             peers: vec![],
             external: Default::default(),
         };
-        let config = plan.to_config(
-            ctx.data_dir.clone(),
-            vec!["tetbench analyze resolution".into()],
-        )?;
+        let config =
+            plan.to_config(data_dir.clone(), vec!["tetbench analyze resolution".into()])?;
         eprintln!("resolution sweep: {res}×{res}");
         let filter = config.settings_filter.clone();
         let outcome = crate::run::run(&config, &|name: &str| {
