@@ -10,8 +10,8 @@ use anyhow::Context;
 use clap::{Parser, Subcommand};
 
 use self::datasets::DatasetsCommand;
-use crate::algorithms;
 use crate::analyze::{self, AnalyzeCommand};
+use crate::run::matrix::MatrixArgs;
 pub use crate::run::plan::default_cache_dir;
 use crate::run::plan::RunPlan;
 use crate::run::shard::INCOMPLETE;
@@ -166,34 +166,9 @@ pub struct CompareArgs {
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct RunArgs {
-    /// Comma-separated algorithms (default: all).
-    #[arg(long, value_delimiter = ',', value_name = "LIST")]
-    pub algorithms: Vec<String>,
-    /// Comma-separated data set names, generator specs (box:200k, shell:1m) or files
-    /// (default: the embedded suite, box:10k and shell:10k).
-    #[arg(long, value_delimiter = ',', value_name = "LIST")]
-    pub datasets: Vec<String>,
-    /// `14` (the HAVS tables' fixed viewpoints), `axes`, `diagonals`, `orbit:N`, or names
-    /// such as `+x,-y,+x+y-z` (default 14; the default suite uses 3).
-    #[arg(long, value_name = "SPEC")]
-    pub viewpoints: Option<String>,
-    /// Square viewport size in pixels (default 512; the default suite uses 128).
-    #[arg(long, value_name = "PIXELS")]
-    pub resolution: Option<u32>,
-    /// Transfer function: a preset (low-opacity, high-opacity) or a ParaView colormap JSON file.
-    #[arg(long, value_name = "NAME|FILE", default_value = "low-opacity")]
-    pub tf: String,
-    /// Timed frames per viewpoint in each round (default 10; the default suite uses 1).
-    #[arg(long, value_name = "N")]
-    pub frames: Option<u32>,
-    /// Untimed warm-up frames before them, in each round (default 2; the default suite uses 1).
-    #[arg(long, value_name = "N")]
-    pub warmup: Option<u32>,
-    /// Passes over each data set's variants, so that a row's samples come from separate
-    /// moments (default 1; the default suite uses 3). With more than 1, all variants of a
-    /// data set stay prepared at once.
-    #[arg(long, value_name = "N")]
-    pub rounds: Option<u32>,
+    /// What is measured (shared with `plot --sweep`, `analyze resolution`, `ab` and `bisect`).
+    #[command(flatten)]
+    pub matrix: MatrixArgs,
     /// Output directory (results, images, report). Earlier results there are replaced
     /// (unless --resume). One run at a time: a second run into a busy directory refuses.
     #[arg(long, value_name = "DIR", default_value = "out")]
@@ -202,28 +177,6 @@ pub struct RunArgs {
     /// the results already in --out and measure the rest; refused if the plan differs.
     #[arg(long)]
     pub resume: bool,
-    /// Keep only variants whose settings match, e.g. `variant=linear` or `k=2|6;sort=radix`
-    /// (keys an algorithm lacks are ignored for it).
-    #[arg(long, value_name = "FILTER")]
-    pub settings: Option<String>,
-    /// Run every variant each algorithm offers (what `--settings` selects from) instead of
-    /// the defaults; with `--settings`, every variant that matches it (settings the filter does
-    /// not name are not held to their defaults).
-    #[arg(long)]
-    pub all_variants: bool,
-    /// Skip the reference and the error metrics (timing only).
-    #[arg(long)]
-    pub no_reference: bool,
-    /// Where reference images are cached (default: $TETBENCH_CACHE, else
-    /// $XDG_CACHE_HOME/tetbench, else ~/.cache/tetbench).
-    #[arg(long, value_name = "DIR")]
-    pub cache_dir: Option<PathBuf>,
-    /// Orthographic instead of perspective (30° vertical field of view) projection.
-    #[arg(long)]
-    pub orthographic: bool,
-    /// Point array to use as the scalar (default: the file's first).
-    #[arg(long, value_name = "NAME")]
-    pub scalar: Option<String>,
     /// Do not write the HTML report and charts.
     #[arg(long)]
     pub no_report: bool,
@@ -235,41 +188,16 @@ pub struct RunArgs {
     /// job arrays; merge the parts with `report --merge`.
     #[arg(long, value_name = "i/N")]
     pub shard: Option<String>,
-    /// Skip the backend calibration (and the rows' roofline columns).
-    #[arg(long)]
-    pub no_calibrate: bool,
-    /// Add other packages' renderers as peers: `vtk` (vtk-pt, vtk-raycast, vtk-zsweep through
-    /// VTK's Python package; see scripts/setup-vtk.sh).
-    #[arg(long, value_delimiter = ',', value_name = "LIST")]
-    pub peers: Vec<String>,
-    #[command(flatten)]
-    pub external: crate::run::matrix::ExternalArgs,
 }
 
 impl RunArgs {
     /// The plain run request these arguments describe.
     pub fn to_plan(&self) -> RunPlan {
         RunPlan {
-            algorithms: self.algorithms.clone(),
-            datasets: self.datasets.clone(),
-            viewpoints: self.viewpoints.clone(),
-            resolution: self.resolution,
-            tf: self.tf.clone(),
-            frames: self.frames,
-            warmup: self.warmup,
-            rounds: self.rounds,
-            out: self.out.clone(),
-            settings: self.settings.clone(),
-            no_reference: self.no_reference,
-            cache_dir: self.cache_dir.clone(),
-            orthographic: self.orthographic,
-            scalar: self.scalar.clone(),
             no_report: self.no_report,
             strict: self.strict,
             shard: self.shard.clone(),
-            no_calibrate: self.no_calibrate,
-            peers: self.peers.clone(),
-            external: self.external.clone(),
+            ..self.matrix.plan(self.out.clone())
         }
     }
 
@@ -282,20 +210,6 @@ impl RunArgs {
         let mut config = self.to_plan().to_config(data_dir, command_line)?;
         config.resume = self.resume;
         Ok(config)
-    }
-}
-
-/// The variants `tetbench run` starts from for algorithm `name`: every one it offers with
-/// `--all-variants` (the run then keeps those `filter` accepts), else `--settings`' selection.
-fn run_variants(
-    name: &str,
-    all_variants: bool,
-    filter: &algorithms::SettingsFilter,
-) -> anyhow::Result<Vec<Box<dyn render_core::Renderer>>> {
-    if all_variants {
-        algorithms::all_variants(name)
-    } else {
-        algorithms::selected_variants(name, filter)
     }
 }
 
@@ -319,9 +233,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
         Command::Run(args) => {
             let config = args.to_config(cli.data_dir, command_line)?;
             let filter = config.settings_filter.clone();
-            let outcome = run::run(&config, &|name: &str| {
-                run_variants(name, args.all_variants, &filter)
-            })?;
+            let outcome = run::run(&config, &|name: &str| args.matrix.variants(name, &filter))?;
             println!(
                 "{} rows in {:.1} s; results in {} (open {})",
                 outcome.rows,
@@ -450,6 +362,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algorithms;
 
     #[test]
     fn cli_definition_is_consistent() {
@@ -477,19 +390,21 @@ mod tests {
         else {
             unreachable!()
         };
-        assert!(run.all_variants);
+        assert!(run.matrix.all_variants);
+        let every_variant = run.matrix;
+        let defaults = MatrixArgs::default();
         let none = algorithms::SettingsFilter::default();
         for name in algorithms::names() {
-            let every = run_variants(name, true, &none).unwrap().len();
+            let every = every_variant.variants(name, &none).unwrap().len();
             assert_eq!(every, algorithms::all_variants(name).unwrap().len());
             assert_eq!(
-                run_variants(name, false, &none).unwrap().len(),
+                defaults.variants(name, &none).unwrap().len(),
                 algorithms::variants(name).unwrap().len()
             );
         }
         assert!(
-            run_variants("havs", true, &none).unwrap().len()
-                > run_variants("havs", false, &none).unwrap().len()
+            every_variant.variants("havs", &none).unwrap().len()
+                > defaults.variants("havs", &none).unwrap().len()
         );
     }
 

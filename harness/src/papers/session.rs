@@ -10,6 +10,7 @@ use anyhow::Context as _;
 use crate::report::{aggregate, Aggregate};
 use crate::results::machine::MachineInfo;
 use crate::results::{ResultsFile, Row};
+use crate::run::matrix::{MatrixArgs, DEFAULT_TF};
 
 use super::claims::ClaimResult;
 use super::reproduce::SourceState;
@@ -212,12 +213,12 @@ impl Session {
         };
         let datasets: Vec<String> = spec.datasets.iter().map(|d| self.dataset(d)).collect();
         let out = self.dir.join("runs").join(&spec.name);
-        let args = crate::run::plan::RunPlan {
+        let matrix = MatrixArgs {
             algorithms: algorithms.clone(),
             datasets: datasets.clone(),
             viewpoints: Some(viewpoints.clone()),
             resolution: Some(self.resolution(spec.resolution)),
-            tf: spec.tf.unwrap_or("low-opacity").into(),
+            tf: Some(spec.tf.unwrap_or(DEFAULT_TF).into()),
             frames: Some(if self.quick {
                 QUICK_FRAMES
             } else {
@@ -228,20 +229,13 @@ impl Session {
             } else {
                 FULL_WARMUP
             }),
-            rounds: None,
-            out: out.clone(),
             settings: spec.settings.clone(),
             no_reference: self.quick,
             cache_dir: self.cache_dir.clone(),
-            orthographic: false,
-            scalar: None,
-            no_report: true,
-            strict: false,
-            shard: None,
-            no_calibrate: false,
-            peers: vec![],
             external: self.external.clone(),
+            ..MatrixArgs::default()
         };
+        let args = matrix.plan(out.clone());
         let command = format!(
             "tetbench run --algorithms {} --datasets {} --viewpoints {viewpoints} --resolution {}{}{}{}",
             algorithms.join(","),
@@ -261,10 +255,8 @@ impl Session {
         let config = args.to_config(self.data_dir.clone(), vec![command.clone()])?;
         let filter = config.settings_filter.clone();
         let t0 = Instant::now();
-        let outcome = crate::run::run(&config, &|name: &str| {
-            crate::algorithms::selected_variants(name, &filter)
-        })
-        .with_context(|| format!("run {}", spec.name))?;
+        let outcome = crate::run::run(&config, &|name: &str| matrix.variants(name, &filter))
+            .with_context(|| format!("run {}", spec.name))?;
         let file = ResultsFile::read(&out)?;
         if self.machine.is_none() {
             self.machine = Some(file.machine.clone());
