@@ -30,7 +30,7 @@ pub enum AnalyzeCommand {
     /// Table 1).
     Summary(summary::Args),
     /// Fragment PT Fig. 8: K tets/s against viewport size (one timing run per size), plotted.
-    Resolution(fig8::ResolutionArgs),
+    Resolution(Box<fig8::ResolutionArgs>),
     /// HAVS Table 1: sorting 1 M floats with shellsort, heapsort, quicksort, radix and std sort.
     Sort(analysis::SortArgs),
     /// HAVS Table 2 and Fig. 6: exact A-buffer analysis of how large the k-buffer must be.
@@ -40,7 +40,7 @@ pub enum AnalyzeCommand {
 pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
     match cmd {
         AnalyzeCommand::Summary(args) => summary::run(args, ctx),
-        AnalyzeCommand::Resolution(args) => fig8::run_resolution(args, ctx.data_dir.clone()),
+        AnalyzeCommand::Resolution(args) => fig8::run_resolution(*args, ctx.data_dir.clone()),
         AnalyzeCommand::Sort(args) => analysis::run_sort(args),
         AnalyzeCommand::Kbuffer(args) => analysis::run_kbuffer(args, ctx.data_dir.clone()),
     }
