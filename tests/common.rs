@@ -1,7 +1,7 @@
 //! Helpers shared by the cross-crate tests: the data directory, and the set-up every
 //! `*_vs_reference.rs` repeats (GPU, meshes, optics, cameras, the reference image, the image
 //! error). The image error is the harness's own ([`render_core::image_error`], re-exported as
-//! `harness::metrics`): a PSNR in a test means what it means in `results.csv`.
+//! `harness::results::metrics`): a PSNR in a test means what it means in `results.csv`.
 
 use std::path::PathBuf;
 

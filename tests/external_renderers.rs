@@ -140,7 +140,7 @@ fn examples_render_the_default_suite_meshes_in_a_run() {
     let (_dir, c) = c_example();
     let py = format!("py={}", python_example(""));
     let c = format!("c={c}");
-    let datasets = harness::suite::DEFAULT_SUITE.datasets.join(",");
+    let datasets = harness::run::suite::DEFAULT_SUITE.datasets.join(",");
     let outdir = out.path().to_str().unwrap();
     let args = [
         "--external",
@@ -170,7 +170,7 @@ fn examples_render_the_default_suite_meshes_in_a_run() {
     let file = harness::results::ResultsFile::read(out.path()).unwrap();
     assert_eq!(
         file.rows.len(),
-        2 * harness::suite::DEFAULT_SUITE.datasets.len()
+        2 * harness::run::suite::DEFAULT_SUITE.datasets.len()
     );
     for row in &file.rows {
         assert!(

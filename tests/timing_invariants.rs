@@ -173,7 +173,9 @@ fn run_violations(out: &std::path::Path) -> (Vec<Row>, Vec<String>) {
         }
     }
     bad.extend(non_finite_cells(&out.join("results.csv")));
-    bad.extend(non_finite_cells(&out.join(harness::samples::SAMPLES_CSV)));
+    bad.extend(non_finite_cells(
+        &out.join(harness::results::samples::SAMPLES_CSV),
+    ));
     (rows, bad)
 }
 

@@ -10,7 +10,7 @@
 //! (`scripts/setup-vtk.sh`; `scripts/test.sh` runs it): without it the tests fail and say so.
 
 use datasets::TetMesh;
-use harness::metrics::{compare, ImageError};
+use harness::results::metrics::{compare, ImageError};
 use render_core::{Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint};
 use vtk_peer::{Integrator, Readout, VtkMapper, VtkPeer};
 

@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use harness::machine::MachineInfo;
+use harness::results::machine::MachineInfo;
 use harness::results::{ResultsFile, Row, RunDescription, SCHEMA_VERSION};
 
 const GROUPS: usize = 8;

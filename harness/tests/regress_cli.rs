@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use harness::machine::MachineInfo;
+use harness::results::machine::MachineInfo;
 use harness::results::{ResultsFile, Row, RunDescription, SCHEMA_VERSION};
 
 /// A deterministic wobble of ±3 % (no RNG crate needed for a fixed pattern).

@@ -7,8 +7,8 @@
 use std::path::Path;
 use std::process::Command;
 
-use harness::machine::MachineInfo;
 use harness::plot::style::StyleBook;
+use harness::results::machine::MachineInfo;
 use harness::results::{ResultsFile, Row, RunDescription, SCHEMA_VERSION};
 
 fn row(algorithm: &str, settings: &str, dataset: &str, viewpoint: &str, i: usize) -> Row {

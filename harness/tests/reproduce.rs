@@ -79,9 +79,10 @@ fn quick_gator_reproduction_end_to_end() {
 fn a_paper_whose_algorithm_is_missing_fails_clearly() {
     // Whichever paper's algorithm this build lacks (from the algorithm table); none: nothing
     // to check.
-    let Some(paper) = harness::reproduce::papers()
-        .into_iter()
-        .find(|p| !harness::reproduce::built_in(p.algorithm))
+    let Some(paper) = harness::papers::PAPERS
+        .iter()
+        .map(|p| p.paper())
+        .find(|p| !harness::papers::session::built_in(p.algorithm))
     else {
         return;
     };

@@ -8,9 +8,9 @@ use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use harness::machine::MachineInfo;
+use harness::results::machine::MachineInfo;
 use harness::results::{self, ResultsFile, Row, RunDescription};
-use harness::shard::{select, units_of, Shard};
+use harness::run::shard::{select, units_of, Shard};
 
 const TETBENCH: &str = env!("CARGO_BIN_EXE_tetbench");
 

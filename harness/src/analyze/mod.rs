@@ -1,18 +1,19 @@
 //! `tetbench analyze …`: the CPU analyses behind the papers' tables (HAVS's sorts and k-buffer,
-//! fragment PT's Fig. 8) and the summary of any run. A paper's tables from finished runs are
-//! `tetbench analyze PAPER RUN_DIR` (`reproduce::from_run`), written by the same code as
+//! fragment PT's Fig. 8; they live in their paper's folder, `papers/havs/analysis.rs` and
+//! `papers/fragment_pt/fig8.rs`) and the summary of any run. A paper's tables from finished
+//! runs are `tetbench analyze PAPER RUN_DIR` (`papers::from_run`), written by the same code as
 //! `tetbench reproduce`.
 //!
-//! To add one: write `analyze/NAME.rs` with a `#[derive(clap::Args)] pub struct Args` and
-//! `pub fn run(args: Args, ctx: &Context) -> anyhow::Result<()>`, then add a `mod NAME;` line,
-//! a variant to [`AnalyzeCommand`] and an arm to [`run`].
+//! To add one: its `#[derive(clap::Args)]` struct and its `run` function, a variant of
+//! [`AnalyzeCommand`] and an arm of [`run`].
 
 use std::path::PathBuf;
 
 use clap::Subcommand;
 
-pub mod fragment_pt;
-pub mod havs;
+use crate::papers::fragment_pt::fig8;
+use crate::papers::havs::analysis;
+
 pub mod summary;
 
 /// What every analysis may need from the global options.
@@ -29,18 +30,18 @@ pub enum AnalyzeCommand {
     /// Table 1).
     Summary(summary::Args),
     /// Fragment PT Fig. 8: K tets/s against viewport size (one timing run per size), plotted.
-    Resolution(fragment_pt::ResolutionArgs),
+    Resolution(Box<fig8::ResolutionArgs>),
     /// HAVS Table 1: sorting 1 M floats with shellsort, heapsort, quicksort, radix and std sort.
-    Sort(havs::SortArgs),
+    Sort(analysis::SortArgs),
     /// HAVS Table 2 and Fig. 6: exact A-buffer analysis of how large the k-buffer must be.
-    Kbuffer(havs::KbufferArgs),
+    Kbuffer(analysis::KbufferArgs),
 }
 
 pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
     match cmd {
         AnalyzeCommand::Summary(args) => summary::run(args, ctx),
-        AnalyzeCommand::Resolution(args) => fragment_pt::run_resolution(args, ctx),
-        AnalyzeCommand::Sort(args) => havs::run_sort(args, ctx),
-        AnalyzeCommand::Kbuffer(args) => havs::run_kbuffer(args, ctx),
+        AnalyzeCommand::Resolution(args) => fig8::run_resolution(*args, ctx.data_dir.clone()),
+        AnalyzeCommand::Sort(args) => analysis::run_sort(args),
+        AnalyzeCommand::Kbuffer(args) => analysis::run_kbuffer(args, ctx.data_dir.clone()),
     }
 }

@@ -14,7 +14,7 @@ pub fn paper_markdown(aggs: &[crate::report::Aggregate]) -> String {
     let mut md = String::new();
     for a in aggs {
         let Some((source, paper)) =
-            crate::papers::paper_tets_per_sec(&a.algorithm, &a.settings, &a.dataset)
+            crate::papers::transcription::paper_tets_per_sec(&a.algorithm, &a.settings, &a.dataset)
         else {
             continue;
         };

@@ -373,8 +373,11 @@ fn evaluate_one(claim: &Claim, dataset: Option<&str>, inputs: &Inputs) -> Evalua
                     claim.paper, claim.id
                 ));
             };
-            let row = super::paper_name(&claim.paper, d).unwrap_or(d);
-            match super::table(table).ok().and_then(|t| t.value(row, column)) {
+            let row = super::transcription::paper_name(&claim.paper, d).unwrap_or(d);
+            match super::transcription::table(table)
+                .ok()
+                .and_then(|t| t.value(row, column))
+            {
                 Some(v) => Expect::Equals(v),
                 None => {
                     return Evaluation::not_checkable(format!(

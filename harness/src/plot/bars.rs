@@ -13,7 +13,7 @@ use super::draw::{self, err, Chart, LegendEntry, FONT, MAX_LEGEND_ROWS, PLOT_WID
 use super::speed_error::sort_by_style;
 use super::style::StyleBook;
 use super::{ChartFile, Kind};
-use crate::stats::Spread;
+use crate::results::stats::Spread;
 
 /// One CSV line: a bar.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
@@ -249,7 +249,7 @@ fn write_metric(
         let stem = if alg.is_empty() {
             stem.to_string()
         } else {
-            format!("{stem}_{}", crate::names::slug(&alg))
+            format!("{stem}_{}", crate::results::names::slug(&alg))
         };
         let title = if alg.is_empty() {
             title.to_string()

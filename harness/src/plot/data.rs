@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use serde::Serialize;
 
+use crate::results::stats::Spread;
 use crate::results::{ResultsFile, Row, JSON_FILE};
-use crate::stats::Spread;
 
 /// Rows of every input, with what the charts need from the runs' headers.
 #[derive(Debug, Clone, Default)]
@@ -106,7 +106,7 @@ impl Inputs {
             self.without_reference = true;
         }
         for d in &file.run.datasets {
-            let label = crate::names::dataset_label(d);
+            let label = crate::results::names::dataset_label(d);
             if !file.rows.iter().any(|r| r.dataset == label) {
                 let why = file
                     .errors
@@ -203,12 +203,12 @@ impl Point {
     }
 }
 
-/// Suspect rows ([`crate::suspect`]): the row's own `suspect` column, or — for results
+/// Suspect rows ([`crate::results::suspect`]): the row's own `suspect` column, or — for results
 /// written before the column existed, or rows merged from several runs — the same rule applied
 /// to these rows. One flag per row.
 pub fn suspect_flags(rows: &[Row]) -> Vec<bool> {
     rows.iter()
-        .map(|r| !r.suspect.is_empty() || crate::suspect::reason(r, rows).is_some())
+        .map(|r| !r.suspect.is_empty() || crate::results::suspect::reason(r, rows).is_some())
         .collect()
 }
 
@@ -258,8 +258,8 @@ pub fn points(rows: &[Row]) -> Vec<Point> {
             .find(|r| !r.ok())
             .map(|r| r.error.clone())
             .unwrap_or_default();
-        p.tets_per_sec = crate::stats::spread(g.iter().filter_map(|r| r.tets_per_sec));
-        p.psnr_db = crate::stats::spread(g.iter().filter_map(|r| r.psnr_db));
+        p.tets_per_sec = crate::results::stats::spread(g.iter().filter_map(|r| r.tets_per_sec));
+        p.psnr_db = crate::results::stats::spread(g.iter().filter_map(|r| r.psnr_db));
         p.gpu_bytes = g.iter().filter_map(|r| r.gpu_bytes).max();
         p.bytes_per_tet = g.iter().find_map(|r| r.bytes_per_tet);
         p.suspect = m.iter().any(|&i| suspect[i]);

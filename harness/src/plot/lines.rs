@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use super::data::Bound;
 use super::draw::{self, err, Chart, LegendEntry, FONT, PLOT_WIDTH};
 use super::style::{Marker, Style, StyleBook};
-use crate::stats::Spread;
+use crate::results::stats::Spread;
 
 /// One measured (or failed) point of a line.
 #[derive(Debug, Clone)]

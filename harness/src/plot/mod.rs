@@ -310,10 +310,10 @@ mod tests {
 
         let mut n = 0;
         for d in ["box:10k", "box:100k"] {
-            let recs: Vec<speed_error::Record> = read_csv(
-                &dir.path()
-                    .join(format!("speed_error_{}.csv", crate::names::slug(d))),
-            );
+            let recs: Vec<speed_error::Record> = read_csv(&dir.path().join(format!(
+                "speed_error_{}.csv",
+                crate::results::names::slug(d)
+            )));
             for r in &recs {
                 let t = direct(&rows, &r.algorithm, &r.settings, d, |r| r.tets_per_sec);
                 let p = direct(&rows, &r.algorithm, &r.settings, d, |r| r.psnr_db);

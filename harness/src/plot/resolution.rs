@@ -110,9 +110,9 @@ pub fn write(
             vec![(String::new(), lines)]
         };
         for (alg, part) in parts {
-            let mut stem = format!("resolution_{}", crate::names::slug(&dataset));
+            let mut stem = format!("resolution_{}", crate::results::names::slug(&dataset));
             if !alg.is_empty() {
-                stem.push_str(&format!("_{}", crate::names::slug(&alg)));
+                stem.push_str(&format!("_{}", crate::results::names::slug(&alg)));
             }
             let title = format!(
                 "Throughput vs viewport size — {dataset}{}",

@@ -13,7 +13,7 @@ use super::lines::{Line, LineChart, LinePoint};
 use super::speed_error::sort_by_style;
 use super::style::StyleBook;
 use super::{ChartFile, Kind};
-use crate::stats::Spread;
+use crate::results::stats::Spread;
 
 /// A data set's family: a generator's name (`box:1m` → `box`), or `data sets` for files and
 /// registry names, whose sizes differ too.
@@ -132,7 +132,10 @@ pub fn write(
         }
         sort_by_style(&mut pts, book);
         pts.sort_by_key(|p| p.tets);
-        let mut stem = format!("scaling_{}", crate::names::slug(&fam.replace(' ', "_")));
+        let mut stem = format!(
+            "scaling_{}",
+            crate::results::names::slug(&fam.replace(' ', "_"))
+        );
         if many_sizes {
             stem.push_str(&format!("_{width}x{height}"));
         }
@@ -281,7 +284,7 @@ pub fn write(
                 let stem = if alg.is_empty() {
                     format!("{stem}_{what}")
                 } else {
-                    format!("{stem}_{what}_{}", crate::names::slug(&alg))
+                    format!("{stem}_{what}_{}", crate::results::names::slug(&alg))
                 };
                 let title = format!(
                     "Scaling with mesh size — {fam}{}: {}",

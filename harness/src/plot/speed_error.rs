@@ -12,7 +12,7 @@ use super::data::{distinct, write_csv, Point};
 use super::draw::{self, err, Chart, LegendEntry, FONT, MAX_LEGEND_ROWS, PLOT_WIDTH};
 use super::style::{Marker, Style, StyleBook};
 use super::ChartFile;
-use crate::metrics::PSNR_CAP_DB;
+use crate::results::metrics::PSNR_CAP_DB;
 
 /// One CSV line: a variant's point on one data set's chart.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
@@ -361,7 +361,7 @@ pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<V
         } else {
             vec![(String::new(), pts.clone())]
         };
-        let mut stem_base = format!("speed_error_{}", crate::names::slug(&dataset));
+        let mut stem_base = format!("speed_error_{}", crate::results::names::slug(&dataset));
         if many_sizes {
             stem_base.push_str(&format!("_{width}x{height}"));
         }
@@ -397,7 +397,7 @@ pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<V
             let viewpoints = part.iter().map(|p| p.rows).max().unwrap_or(0);
             let mut stem = stem_base.clone();
             if !alg.is_empty() {
-                stem.push_str(&format!("_{}", crate::names::slug(&alg)));
+                stem.push_str(&format!("_{}", crate::results::names::slug(&alg)));
             }
             let title = format!(
                 "Speed vs error — {dataset}{} ({} tets, {width}×{height})",
@@ -445,7 +445,7 @@ mod tests {
     }
 
     fn point(algorithm: &str, settings: &str, speed: f64, psnr: f64) -> Point {
-        let spread = |v: f64| crate::stats::Spread {
+        let spread = |v: f64| crate::results::stats::Spread {
             mean: v,
             min: v,
             max: v,

@@ -333,7 +333,7 @@ impl StyleBook {
                 color: RGBColor(0, 0, 0),
                 marker: Marker::Circle,
                 hollow: false,
-                label: crate::names::series_label(algorithm, settings),
+                label: crate::results::names::series_label(algorithm, settings),
                 slot: 0,
             })
     }

@@ -10,11 +10,11 @@
 //! failed invocation leaves is that round alone. The rounds of a side are then merged into
 //! `OUT/base/results.json` and `OUT/new/results.json` — a row's samples are its rounds' frames
 //! one round after the other, `run.rounds` the number of rounds, exactly the layout of one run
-//! with `--rounds N` — and [`crate::compare::compare`] judges them: one value per round, the
+//! with `--rounds N` — and [`crate::regress::compare::compare`] judges them: one value per round, the
 //! run-wide factor divided out, Holm over the groups. Its outputs go to `OUT/compare`, the
 //! drift each pair saw to `OUT/ab.json` and the terminal.
 
-use crate::compare::{key, Key};
+use crate::regress::compare::{key, Key};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -24,10 +24,10 @@ use anyhow::Context;
 use serde::Serialize;
 
 use super::build::Binary;
-use crate::compare::{adapter_of, CompareOptions, Comparison, FailOn};
-use crate::metrics::summarize;
+use crate::regress::compare::{adapter_of, CompareOptions, Comparison, FailOn};
+use crate::results::metrics::summarize;
+use crate::results::stats::median;
 use crate::results::{MergedRun, ResultsFile, Row};
-use crate::stats::median;
 
 /// Which build an invocation ran.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -369,11 +369,11 @@ fn summarise_samples(row: &mut Row, samples: crate::results::FrameSamples) {
 /// `OUT/compare/` and `OUT/ab.json`.
 pub fn run_ab(base: &Binary, new: &Binary, opt: &AbOptions) -> anyhow::Result<AbOutcome> {
     anyhow::ensure!(
-        opt.pairs >= crate::compare::MIN_ROUNDS,
+        opt.pairs >= crate::regress::compare::MIN_ROUNDS,
         "--pairs {} gives each side {} rounds; compare judges time from {} rounds on",
         opt.pairs,
         opt.pairs,
-        crate::compare::MIN_ROUNDS
+        crate::regress::compare::MIN_ROUNDS
     );
     let started = Instant::now();
     let logs = opt.out.join("logs");
@@ -411,11 +411,14 @@ pub fn run_ab(base: &Binary, new: &Binary, opt: &AbOptions) -> anyhow::Result<Ab
         );
     }
     let drift = pair_drift(&rounds[0], &rounds[1]);
-    let comparison =
-        crate::compare::compare(&opt.out.join("base"), &opt.out.join("new"), &opt.compare)?;
+    let comparison = crate::regress::compare::compare(
+        &opt.out.join("base"),
+        &opt.out.join("new"),
+        &opt.compare,
+    )?;
     std::fs::create_dir_all(&opt.compare.out)
         .with_context(|| format!("cannot create {}", opt.compare.out.display()))?;
-    crate::compare_report::write_outputs(&comparison, &opt.compare.out)?;
+    crate::regress::compare_report::write_outputs(&comparison, &opt.compare.out)?;
     let fail = match opt.compare.fail_on {
         FailOn::Never => false,
         FailOn::Regression => !comparison.regressions.is_empty(),
@@ -482,7 +485,10 @@ pub fn run_command(base: &Binary, new: &Binary, opt: &AbOptions) -> anyhow::Resu
     );
     print!("{}", drift_text(&outcome.report.drift));
     println!();
-    print!("{}", crate::compare_report::terminal(&outcome.comparison));
+    print!(
+        "{}",
+        crate::regress::compare_report::terminal(&outcome.comparison)
+    );
     for r in &outcome.comparison.regressions {
         println!("regression: {r}");
     }

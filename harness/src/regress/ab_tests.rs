@@ -33,7 +33,7 @@ fn row(alg: &str, vp: &str, frames: &[f64]) -> Row {
 fn round(dir: &Path, rows: Vec<Row>) -> ResultsFile {
     let file = ResultsFile {
         schema_version: crate::results::SCHEMA_VERSION,
-        machine: crate::machine::MachineInfo::collect(),
+        machine: crate::results::machine::MachineInfo::collect(),
         run: RunDescription {
             rounds: 1,
             frames: 2,
@@ -79,7 +79,7 @@ fn rounds_merge_into_one_run_of_n_rounds() {
         (Some(10.0), Some(31.0))
     );
     assert_eq!(havs.image_f32, "round-01/images/havs+x.f32.zz");
-    let values = crate::compare::round_values(havs, "total_ms", 3, false).unwrap();
+    let values = crate::regress::compare::round_values(havs, "total_ms", 3, false).unwrap();
     assert_eq!(values, [10.5, 20.5, 30.5]);
     assert!(merged.errors.is_empty(), "{:?}", merged.errors);
 }

@@ -119,7 +119,7 @@ pub fn run_command(opt: &BisectOptions) -> anyhow::Result<BisectReport> {
             global_args: opt.ab.global_args.clone(),
             run_args: opt.ab.run_args.clone(),
             pairs: opt.ab.pairs,
-            compare: crate::compare::CompareOptions {
+            compare: crate::regress::compare::CompareOptions {
                 out: dir.join("compare"),
                 ..opt.ab.compare.clone()
             },

@@ -36,9 +36,9 @@ pub struct BuildArgs {
 
 impl BuildArgs {
     pub fn cache(&self) -> PathBuf {
-        self.build_cache
-            .clone()
-            .unwrap_or_else(|| crate::plan::default_cache_dir(Path::new(".")).join("ab-builds"))
+        self.build_cache.clone().unwrap_or_else(|| {
+            crate::run::plan::default_cache_dir(Path::new(".")).join("ab-builds")
+        })
     }
 }
 

@@ -2,7 +2,7 @@
 //!
 //! Rows are matched by (algorithm, settings, data set, viewpoint, size). Per row:
 //! - **time** (`total_ms`, `cpu_ms`, `gpu_ms`): the Mann–Whitney U test plus asv's factor
-//!   threshold ([`crate::stats`] says why): "slower" needs the ratio of medians ≥ threshold
+//!   threshold ([`crate::results::stats`] says why): "slower" needs the ratio of medians ≥ threshold
 //!   *and* p < α. The unit of replication is the **round** (`run --rounds`), not the frame:
 //!   frames rendered back to back share the machine's state of that moment, so they are one
 //!   sample, and testing them as many is pseudo-replication (any drift during one round
@@ -31,13 +31,13 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
-pub use crate::compare_time::{
+pub use crate::regress::compare_time::{
     adjust_family, fmt_p, run_wide_factor, scaled, time_test, TimeTest, Verdict,
     MIN_GROUPS_FOR_DRIFT,
 };
+use crate::results::samples;
+use crate::results::stats::{holm_adjust, mann_whitney_p, median};
 use crate::results::{ResultsFile, Row};
-use crate::samples;
-use crate::stats::{holm_adjust, mann_whitney_p, median};
 
 /// A PSNR change larger than this is reported (and a drop this large is a regression).
 pub const PSNR_TOLERANCE_DB: f64 = 0.1;
@@ -647,10 +647,10 @@ fn image_change(
                     .with_context(|| format!("cannot create {}", heat_dir.display()))?;
                 let name = format!(
                     "{}__{}__{}__{}.png",
-                    crate::names::slug(&b.dataset),
-                    crate::names::viewpoint_slug(&b.viewpoint),
-                    crate::names::slug(&b.algorithm),
-                    crate::names::slug(&b.settings.to_string())
+                    crate::results::names::slug(&b.dataset),
+                    crate::results::names::viewpoint_slug(&b.viewpoint),
+                    crate::results::names::slug(&b.algorithm),
+                    crate::results::names::slug(&b.settings.to_string())
                 );
                 let path = heat_dir.join(&name);
                 d.heatmap
@@ -771,7 +771,7 @@ pub fn image_difference(
         heat.put_pixel(
             i as u32 % base.width,
             i as u32 / base.width,
-            image::Rgb(crate::metrics::ramp(t)),
+            image::Rgb(crate::results::metrics::ramp(t)),
         );
     }
     Ok(ImageDifference {

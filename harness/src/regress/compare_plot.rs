@@ -8,10 +8,10 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::compare::Verdict;
 use crate::plot::draw::{register_font, FONT};
+use crate::regress::compare::Verdict;
 
-pub use crate::compare::{image_difference, ImageDifference};
+pub use crate::regress::compare::{image_difference, ImageDifference};
 
 /// One strip of a ratio plot.
 pub struct Strip {

@@ -7,8 +7,8 @@ use std::path::Path;
 use anyhow::Context;
 use serde::Serialize;
 
-use crate::compare::{CompareOptions, Comparison, FailOn, RowComparison, TimeTest};
-use crate::compare_plot::{ratio_plot, Strip};
+use crate::regress::compare::{CompareOptions, Comparison, FailOn, RowComparison, TimeTest};
+use crate::regress::compare_plot::{ratio_plot, Strip};
 
 fn header(c: &Comparison) -> Vec<String> {
     let commit = |c: &Option<String>| {
@@ -219,7 +219,7 @@ struct ComparePage<'a> {
     rows: Vec<HtmlRow>,
 }
 
-/// compare.html, from `templates/compare.html` (every value escaped, crate::html).
+/// compare.html, from `templates/compare.html` (every value escaped, crate::report::html).
 fn html(c: &Comparison) -> anyhow::Result<String> {
     let rows = c
         .rows
@@ -254,7 +254,7 @@ fn html(c: &Comparison) -> anyhow::Result<String> {
             }
         })
         .collect();
-    crate::html::render(
+    crate::report::html::render(
         "compare.html",
         ComparePage {
             header: header(c),
@@ -350,7 +350,7 @@ pub fn run_command(
     opt: &CompareOptions,
     format: CompareFormat,
 ) -> anyhow::Result<bool> {
-    let cmp = crate::compare::compare(base, new, opt)?;
+    let cmp = crate::regress::compare::compare(base, new, opt)?;
     std::fs::create_dir_all(&opt.out)
         .with_context(|| format!("cannot create {}", opt.out.display()))?;
     write_outputs(&cmp, &opt.out)?;
@@ -372,9 +372,9 @@ pub fn run_command(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::compare::compare;
+    use crate::regress::compare::compare;
+    use crate::results::samples;
     use crate::results::ResultsFile;
-    use crate::samples;
 
     /// Writes a one-row results set whose f32 image is `img`, with 5 frames around `ms`.
     fn results_dir(dir: &Path, img: &render_core::Image, ms: f64) {
@@ -399,7 +399,7 @@ mod tests {
         row.image_hash = samples::image_hash(img);
         let file = ResultsFile {
             schema_version: crate::results::SCHEMA_VERSION,
-            machine: crate::machine::MachineInfo::collect(),
+            machine: crate::results::machine::MachineInfo::collect(),
             run: Default::default(),
             finished_utc: None,
             rows: vec![row],
@@ -424,7 +424,7 @@ mod tests {
     /// Issue 23: a data set named with markup lands in compare.html as text.
     #[test]
     fn markup_in_names_is_escaped() {
-        use crate::html::{assert_no_live_markup, HOSTILE_NAME};
+        use crate::report::html::{assert_no_live_markup, HOSTILE_NAME};
         let tmp = tempfile::tempdir().unwrap();
         let img = render_core::Image::new(8, 8);
         let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));

@@ -1,4 +1,4 @@
-//! Tests of [`crate::compare`]: drift correction, rounds as the unit of replication,
+//! Tests of [`crate::regress::compare`]: drift correction, rounds as the unit of replication,
 //! provenance warnings (kept apart so compare.rs stays readable).
 use super::*;
 
@@ -7,7 +7,7 @@ use super::*;
 /// of a round is further multiplied by `1 + drift·j` (the machine drifting during a round).
 fn run_dir(dir: &Path, factors: &[f64], rounds: u32, frames: u32, drift: f64, seed: u64) {
     std::fs::create_dir_all(dir).unwrap();
-    let mut rng = crate::stats::TestRng::new(seed);
+    let mut rng = crate::results::stats::TestRng::new(seed);
     let mut rows = vec![];
     for (i, f) in factors.iter().enumerate() {
         for vp in ["+x", "+x+y+z", "-x+y-z"] {
@@ -31,7 +31,7 @@ fn run_dir(dir: &Path, factors: &[f64], rounds: u32, frames: u32, drift: f64, se
     }
     let file = ResultsFile {
         schema_version: crate::results::SCHEMA_VERSION,
-        machine: crate::machine::MachineInfo::collect(),
+        machine: crate::results::machine::MachineInfo::collect(),
         run: crate::results::RunDescription {
             rounds,
             frames,
@@ -182,7 +182,7 @@ fn one_round_never_gates_on_time_and_five_rounds_find_a_slowdown() {
 fn dirty_or_debug_sides_are_warned() {
     let mut f = ResultsFile {
         schema_version: crate::results::SCHEMA_VERSION,
-        machine: crate::machine::MachineInfo::collect(),
+        machine: crate::results::machine::MachineInfo::collect(),
         run: Default::default(),
         finished_utc: None,
         rows: vec![],

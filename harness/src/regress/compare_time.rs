@@ -1,10 +1,10 @@
-//! The time verdicts of `tetbench compare` ([`crate::compare`]): asv's rule (Mann–Whitney U
+//! The time verdicts of `tetbench compare` ([`crate::regress::compare`]): asv's rule (Mann–Whitney U
 //! plus a factor threshold) on one metric's samples, Holm's adjustment over a family of such
 //! tests, and the run-wide factor that is divided out of a run that drifted as a whole.
 
 use serde::{Deserialize, Serialize};
 
-use crate::stats::{holm_adjust, mann_whitney_p, median};
+use crate::results::stats::{holm_adjust, mann_whitney_p, median};
 
 /// Fewer groups than this give no run-wide factor: a median of one or two groups would be
 /// the change being looked for, not the machine's.
@@ -160,7 +160,7 @@ pub fn fmt_p(p: Option<f64>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stats::TestRng;
+    use crate::results::stats::TestRng;
 
     /// Frame times with 8 % multiplicative noise and occasional 30 % spikes, as on a busy
     /// machine.

@@ -132,7 +132,7 @@ mod tests {
         };
         ResultsFile {
             schema_version: crate::results::SCHEMA_VERSION,
-            machine: crate::machine::MachineInfo::collect(),
+            machine: crate::results::machine::MachineInfo::collect(),
             run: crate::results::RunDescription {
                 rounds: 3,
                 ..Default::default()

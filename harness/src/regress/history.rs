@@ -4,7 +4,7 @@
 //! - Per run and group the time is the median over viewpoints of the rows' median `total_ms`;
 //!   the band is the 10–90 % range of all the group's frames, each divided by its row's median
 //!   and multiplied by that time (the frame-to-frame noise, comparable across groups).
-//! - Each adjacent pair of runs is judged by **compare's own test** ([`crate::compare`]: one
+//! - Each adjacent pair of runs is judged by **compare's own test** ([`crate::regress::compare`]: one
 //!   value per round, the run-wide factor divided out, Holm over the groups, PSNR and memory
 //!   exact), so history and compare never disagree about a pair.
 //! - Over the whole series, **steps** are found by a piecewise-constant fit with a penalty per
@@ -22,10 +22,10 @@ use anyhow::{anyhow, Context};
 use plotters::prelude::*;
 use serde::Serialize;
 
-use crate::compare::{adapter_of, CompareOptions, FailOn, Verdict};
 use crate::plot::draw::{register_font, FONT};
+use crate::regress::compare::{adapter_of, CompareOptions, FailOn, Verdict};
+use crate::results::stats::{median, quantile};
 use crate::results::{ResultsFile, Row};
-use crate::stats::{median, quantile};
 
 #[derive(Debug, Clone, Serialize)]
 pub struct Point {
@@ -209,7 +209,9 @@ pub fn history(
             fail_on: FailOn::Never,
             out: out.join("pairs").join(format!("{}-{}", k, k + 1)),
         };
-        pairs.push(Some(crate::compare::compare(&w[0].0, &w[1].0, &opt)?));
+        pairs.push(Some(crate::regress::compare::compare(
+            &w[0].0, &w[1].0, &opt,
+        )?));
     }
     let mut groups: Vec<(String, Settings, String)> = vec![];
     for (_, f) in &files {
@@ -470,8 +472,8 @@ pub fn page(h: &History, charts: &[(String, String)]) -> anyhow::Result<String> 
         series,
         charts,
     };
-    // templates/history.html: every value HTML-escaped (crate::html).
-    crate::html::render("history.html", &page)
+    // templates/history.html: every value HTML-escaped (crate::report::html).
+    crate::report::html::render("history.html", &page)
 }
 
 /// `tetbench history`: history.json, history.md, history.html and one chart per algorithm ×
@@ -526,8 +528,8 @@ pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> 
     for (alg, ds) in &pairs {
         let name = format!(
             "history_{}_{}.png",
-            crate::names::slug(alg),
-            crate::names::slug(ds)
+            crate::results::names::slug(alg),
+            crate::results::names::slug(ds)
         );
         chart(&charts_dir.join(&name), &h, alg, ds)?;
         charts.push((format!("{alg} on {ds}"), name));
@@ -651,7 +653,7 @@ mod tests {
                     rows.push(row);
                 }
             }
-            let mut machine = crate::machine::MachineInfo::collect();
+            let mut machine = crate::results::machine::MachineInfo::collect();
             machine.git_commit = Some(commit.into());
             machine.date_utc = format!("2026-01-0{}T00:00:00Z", k + 1);
             let file = ResultsFile {

@@ -23,96 +23,10 @@ pub mod compare_time;
 pub mod export;
 pub mod history;
 
-/// The run matrix of `ab` and `bisect`: the options of `tetbench run` that choose what is
-/// measured, handed on unchanged to every side's `run`. Only options given are passed, so an
-/// older build that lacks a newer option still runs a matrix that does not use it. Each side's
-/// invocation adds `--rounds 1 --no-report --out DIR` itself.
-#[derive(Debug, Clone, Default, clap::Args)]
-pub struct MatrixArgs {
-    /// Comma-separated algorithms (as for run; default: all).
-    #[arg(long, value_name = "LIST")]
-    pub algorithms: Option<String>,
-    /// Comma-separated data sets (as for run; default: the embedded suite).
-    #[arg(long, value_name = "LIST")]
-    pub datasets: Option<String>,
-    /// Viewpoints (as for run).
-    #[arg(long, value_name = "SPEC")]
-    pub viewpoints: Option<String>,
-    /// Square viewport size in pixels (as for run).
-    #[arg(long, value_name = "PIXELS")]
-    pub resolution: Option<u32>,
-    /// Transfer function (as for run).
-    #[arg(long, value_name = "NAME|FILE")]
-    pub tf: Option<String>,
-    /// Timed frames per viewpoint in each round (as for run).
-    #[arg(long, value_name = "N")]
-    pub frames: Option<u32>,
-    /// Untimed warm-up frames per viewpoint in each round (as for run).
-    #[arg(long, value_name = "N")]
-    pub warmup: Option<u32>,
-    /// Settings filter (as for run).
-    #[arg(long, value_name = "FILTER")]
-    pub settings: Option<String>,
-    /// Every variant of each algorithm (as for run).
-    #[arg(long)]
-    pub all_variants: bool,
-    /// Skip the reference and the error metrics (as for run).
-    #[arg(long)]
-    pub no_reference: bool,
-    /// Reference image cache (as for run).
-    #[arg(long, value_name = "DIR")]
-    pub cache_dir: Option<PathBuf>,
-    /// Orthographic projection (as for run).
-    #[arg(long)]
-    pub orthographic: bool,
-    /// Point array to use as the scalar (as for run).
-    #[arg(long, value_name = "NAME")]
-    pub scalar: Option<String>,
-    /// Skip the backend calibration (as for run).
-    #[arg(long)]
-    pub no_calibrate: bool,
-    /// Other packages' renderers as peers (as for run).
-    #[arg(long, value_name = "LIST")]
-    pub peers: Option<String>,
-}
-
-impl MatrixArgs {
-    /// The `tetbench run` options these stand for (only those given).
-    pub fn run_args(&self) -> Vec<String> {
-        let mut out = vec![];
-        let mut value = |flag: &str, v: Option<String>| {
-            if let Some(v) = v {
-                out.push(format!("--{flag}"));
-                out.push(v);
-            }
-        };
-        value("algorithms", self.algorithms.clone());
-        value("datasets", self.datasets.clone());
-        value("viewpoints", self.viewpoints.clone());
-        value("resolution", self.resolution.map(|v| v.to_string()));
-        value("tf", self.tf.clone());
-        value("frames", self.frames.map(|v| v.to_string()));
-        value("warmup", self.warmup.map(|v| v.to_string()));
-        value("settings", self.settings.clone());
-        value(
-            "cache-dir",
-            self.cache_dir.as_ref().map(|p| p.display().to_string()),
-        );
-        value("scalar", self.scalar.clone());
-        value("peers", self.peers.clone());
-        for (flag, on) in [
-            ("--all-variants", self.all_variants),
-            ("--no-reference", self.no_reference),
-            ("--orthographic", self.orthographic),
-            ("--no-calibrate", self.no_calibrate),
-        ] {
-            if on {
-                out.push(flag.to_string());
-            }
-        }
-        out
-    }
-}
+// The run matrix of `ab` and `bisect` is `tetbench run`'s, handed on to every side's `run` as
+// `MatrixArgs::run_args` (only the options given, so an older build that lacks a newer option
+// still runs a matrix that does not use it); each side adds `--rounds 1 --no-report --out DIR`.
+use crate::run::matrix::MatrixArgs;
 
 /// compare's options as `ab` and `bisect` take them.
 #[derive(Debug, Clone, clap::Args)]
@@ -158,7 +72,7 @@ pub struct AbArgs {
     pub out: PathBuf,
     /// Exit with status 3 on a regression (default) or on any change; `never`: always 0.
     #[arg(long, value_enum, default_value = "regression")]
-    pub fail_on: crate::compare::FailOn,
+    pub fail_on: crate::regress::compare::FailOn,
     #[command(flatten)]
     pub judge: JudgeArgs,
     #[command(flatten)]
@@ -192,18 +106,22 @@ fn ab_options(
     out: PathBuf,
     pairs: u32,
     judge: &JudgeArgs,
-    fail_on: crate::compare::FailOn,
+    fail_on: crate::regress::compare::FailOn,
     matrix: &MatrixArgs,
     data_dir: Option<PathBuf>,
 ) -> anyhow::Result<ab::AbOptions> {
     judge.check()?;
+    anyhow::ensure!(
+        matrix.rounds.is_none(),
+        "--rounds: each side runs one round per invocation; --pairs sets how many"
+    );
     Ok(ab::AbOptions {
         pairs,
         global_args: data_dir
             .map(|d| vec!["--data-dir".to_string(), d.display().to_string()])
             .unwrap_or_default(),
         run_args: matrix.run_args(),
-        compare: crate::compare::CompareOptions {
+        compare: crate::regress::compare::CompareOptions {
             threshold: judge.threshold,
             alpha: judge.alpha,
             normalised: false,
@@ -237,7 +155,7 @@ pub fn run_bisect_command(args: BisectArgs, data_dir: Option<PathBuf>) -> anyhow
         args.out.clone(),
         args.pairs,
         &args.judge,
-        crate::compare::FailOn::Regression,
+        crate::regress::compare::FailOn::Regression,
         &args.matrix,
         data_dir,
     )?;
@@ -260,7 +178,7 @@ mod tests {
     fn matrix_args_pass_only_what_was_given() {
         assert!(MatrixArgs::default().run_args().is_empty());
         let m = MatrixArgs {
-            algorithms: Some("gator-pt,havs".into()),
+            algorithms: vec!["gator-pt".into(), "havs".into()],
             resolution: Some(64),
             no_reference: true,
             ..Default::default()

@@ -76,8 +76,8 @@ pub fn acquire(dir: &Path, command_line: &[String]) -> anyhow::Result<OutputLock
     }
     let holder = Holder {
         pid: std::process::id(),
-        host: crate::machine::host_name(),
-        started_utc: crate::machine::iso8601_utc(std::time::SystemTime::now()),
+        host: crate::results::machine::host_name(),
+        started_utc: crate::results::machine::iso8601_utc(std::time::SystemTime::now()),
         command_line: command_line.to_vec(),
     };
     file.set_len(0)?;
@@ -102,7 +102,7 @@ mod tests {
         let e = acquire(&dir, &[]).unwrap_err().to_string();
         let pid = format!("pid {}", std::process::id());
         assert!(e.contains(&pid), "{e}");
-        assert!(e.contains(&crate::machine::host_name()), "{e}");
+        assert!(e.contains(&crate::results::machine::host_name()), "{e}");
         assert!(e.contains("tetbench run"), "{e}");
         drop(first);
         let again = acquire(&dir, &[]).unwrap();
@@ -110,7 +110,7 @@ mod tests {
         // What a crashed run leaves: its record, but no lock.
         let stale = Holder {
             pid: u32::MAX - 1,
-            host: crate::machine::host_name(),
+            host: crate::results::machine::host_name(),
             started_utc: "2000-01-01T00:00:00Z".into(),
             command_line: vec!["tetbench".into()],
         };

@@ -316,7 +316,7 @@ impl<'a> DatasetContext<'a> {
             ));
         } else {
             // Against the rows so far; the final flags are set once every row is in.
-            row.suspect = crate::suspect::reason(&row, rows_so_far).unwrap_or_default();
+            row.suspect = crate::results::suspect::reason(&row, rows_so_far).unwrap_or_default();
             progress.row(&format!(
                 "{what} {}: {:.2} ms, {:.3} M tets/s, PSNR {}{}",
                 vp.name,
@@ -383,7 +383,7 @@ impl<'a> DatasetContext<'a> {
         }
         row.stages = median_named(&frames, |f| &f.stages);
         row.counters = median_named(&frames, |f| &f.counters);
-        row.samples = crate::samples::FrameSamples::from_frames(&frames);
+        row.samples = crate::results::samples::FrameSamples::from_frames(&frames);
 
         let (dir, rel) = self.images_dir(vp);
         std::fs::create_dir_all(&dir)
@@ -395,10 +395,10 @@ impl<'a> DatasetContext<'a> {
         );
         image.save_png(&dir.join(format!("{stem}.png")))?;
         row.image = format!("{rel}/{stem}.png");
-        let exact = format!("{stem}.{}", crate::samples::IMAGE_EXTENSION);
-        crate::samples::write_f32_image(&dir.join(&exact), &image)?;
+        let exact = format!("{stem}.{}", crate::results::samples::IMAGE_EXTENSION);
+        crate::results::samples::write_f32_image(&dir.join(&exact), &image)?;
         row.image_f32 = format!("{rel}/{exact}");
-        row.image_hash = crate::samples::image_hash(&image);
+        row.image_hash = crate::results::samples::image_hash(&image);
         // A renderer's second picture (the ray caster's pass-count map) goes beside it.
         if let Some((suffix, extra)) = guarded("extra_image", || renderer.extra_image(self.gpu))? {
             extra.save_png(&dir.join(format!("{stem}.{suffix}.png")))?;

@@ -20,18 +20,22 @@ use render_core::{
     Camera, FrameStats, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint,
 };
 
-pub use crate::names::{dataset_label, slug, viewpoint_slug};
+pub use crate::results::names::{dataset_label, slug, viewpoint_slug};
 
 use crate::algorithms::SettingsFilter;
-use crate::machine::MachineInfo;
-use crate::metrics::{self, summarize};
+use crate::results::machine::MachineInfo;
+use crate::results::metrics::{self, summarize};
 use crate::results::{ResultsWriter, Row, RunDescription};
 
 pub mod allocator;
 pub mod lock;
-mod perf_control;
+pub mod matrix;
 mod measure;
+mod perf_control;
+pub mod plan;
 pub mod resume;
+pub mod shard;
+pub mod suite;
 use measure::DatasetContext;
 
 /// Everything a run needs, already parsed and checked.
@@ -63,10 +67,10 @@ pub struct RunConfig {
     pub command_line: Vec<String>,
     /// Write the HTML report and charts at the end.
     pub report: bool,
-    /// Make suspect rows ([`crate::suspect`]) an error (non-zero exit), for CI.
+    /// Make suspect rows ([`crate::results::suspect`]) an error (non-zero exit), for CI.
     pub strict: bool,
-    /// Run only this part of the matrix (`--shard i/N`, see [`crate::shard`]).
-    pub shard: Option<crate::shard::Shard>,
+    /// Run only this part of the matrix (`--shard i/N`, see [`crate::run::shard`]).
+    pub shard: Option<crate::run::shard::Shard>,
     /// Calibrate the backend (or reuse the cached figures) and add the roofline columns.
     pub calibrate: bool,
     /// Keep the finished units of an earlier run of the same plan in `out` and measure only
@@ -86,7 +90,7 @@ pub struct RunOutcome {
     pub rows: usize,
     pub failed_rows: usize,
     /// Rows whose image error is out of line with the others on the same image
-    /// ([`crate::suspect`]): measured, but probably a renderer defect.
+    /// ([`crate::results::suspect`]): measured, but probably a renderer defect.
     pub suspect_rows: Vec<String>,
     /// Failures that are not one row (a data set that did not load, a missing reference).
     pub errors: Vec<String>,
@@ -338,7 +342,10 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     }
     // The (data set, algorithm, settings) units this shard runs; `None`: all.
     let shard_units = match config.shard {
-        Some(shard) => Some(crate::shard::select(shard, &matrix_units(config, factory)?)),
+        Some(shard) => Some(crate::run::shard::select(
+            shard,
+            &matrix_units(config, factory)?,
+        )),
         None => None,
     };
     let in_shard = |label: &str, alg: &str, settings: &render_core::Settings| {
@@ -468,7 +475,7 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         }
     }
     progress.finish();
-    crate::suspect::mark_all(&mut writer.file.rows);
+    crate::results::suspect::mark_all(&mut writer.file.rows);
     outcome.suspect_rows = writer
         .file
         .rows
@@ -486,7 +493,7 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     }
     // Columns only known once every row is in (suspect flags, roofline): both files again.
     writer.rewrite_all()?;
-    writer.file.machine.load_average_end = crate::machine::load_average();
+    writer.file.machine.load_average_end = crate::results::machine::load_average();
     writer.finish()?;
     outcome.rows = writer.file.rows.len();
     if config.report {
@@ -512,7 +519,7 @@ fn external_variants(config: &RunConfig, name: &str) -> Option<Vec<Box<dyn Rende
 fn matrix_units(
     config: &RunConfig,
     factory: VariantFactory,
-) -> anyhow::Result<Vec<crate::shard::Unit>> {
+) -> anyhow::Result<Vec<crate::run::shard::Unit>> {
     let mut units = vec![];
     for spec in &config.datasets {
         for name in &config.algorithms {

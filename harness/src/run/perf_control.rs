@@ -25,7 +25,9 @@ struct Control {
 impl Control {
     fn open(spec: &str) -> std::io::Result<Control> {
         let (ctl, ack) = spec.split_once(',').ok_or_else(|| {
-            std::io::Error::other(format!("{VARIABLE} must be CTL_FIFO,ACK_FIFO, not {spec:?}"))
+            std::io::Error::other(format!(
+                "{VARIABLE} must be CTL_FIFO,ACK_FIFO, not {spec:?}"
+            ))
         })?;
         Ok(Control {
             ctl: OpenOptions::new().write(true).open(ctl)?,

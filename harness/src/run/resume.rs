@@ -1,6 +1,6 @@
 //! `run --resume`: an interrupted run continues where it stopped.
 //!
-//! Rows are on disk the moment they finish (`results.rs`), so an interrupted run leaves every
+//! Rows are on disk the moment they finish (`results/mod.rs`), so an interrupted run leaves every
 //! finished row in `OUT/results.json`. With `--resume` the new run keeps the rows of every
 //! (data set, algorithm, settings) unit whose viewpoints all finished and measures only the
 //! rest; a unit cut off halfway is measured again whole (its rounds must come from one
@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use crate::machine::MachineInfo;
+use crate::results::machine::MachineInfo;
 use crate::results::{ResultsFile, Row, RunDescription, JSON_FILE};
 
 /// A unit of the run matrix: (data set label, algorithm, settings).

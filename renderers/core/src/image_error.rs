@@ -1,6 +1,6 @@
 //! The one image error of tetbench: RMSE and PSNR of a rendering against a reference, plus the
 //! maximum absolute error and the share of visibly wrong pixels. The harness's result rows
-//! (`harness::metrics`, which re-exports this module) and every test that compares two images
+//! (`harness::results::metrics`, which re-exports this module) and every test that compares two images
 //! (`tests/*_vs_reference.rs`, `renderers/*/tests/`) call [`compare`] / [`psnr`], so a PSNR
 //! in a test means the same as a PSNR in `results.csv`.
 //!

@@ -6,11 +6,21 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use crate::plan::RunPlan;
 use crate::plot::data::Inputs;
 use crate::plot::Kind;
+use crate::run::matrix::MatrixArgs;
+use crate::run::plan::RunPlan;
 
+/// The matrix options' help names the sweep's defaults, not `run`'s.
 #[derive(Debug, clap::Args)]
+#[command(
+    mut_arg("algorithms", |a| a.help("Sweep: comma-separated algorithms (default: all)")),
+    mut_arg("datasets", |a| a.help("Sweep (resolution): data sets (default box:100k)")),
+    mut_arg("viewpoints", |a| a.help("Sweep: viewpoints, as `tetbench run --viewpoints` (default +x,+x+y+z,-x+y-z)")),
+    mut_arg("resolution", |a| a.help("Sweep (scaling): square viewport in pixels (default 128)")),
+    mut_arg("frames", |a| a.help("Sweep: timed frames per viewpoint (default 3)")),
+    mut_arg("warmup", |a| a.help("Sweep: warm-up frames (default 1)")),
+)]
 pub struct PlotArgs {
     /// Which charts: speed-error, scaling, resolution, bars or all.
     #[arg(value_enum)]
@@ -23,39 +33,13 @@ pub struct PlotArgs {
     pub out: PathBuf,
     /// Measure first, then plot: for `scaling` the mesh sizes (`box:10k,100k,1m,5m`: sizes
     /// after the first keep its generator; names and files also allowed), for `resolution`
-    /// the square viewport sizes (`128,256,512`). Runs go to OUT/sweep/.
+    /// the square viewport sizes (`128,256,512`). Runs go to OUT/sweep/; the matrix options
+    /// apply to the sweep.
     #[arg(long, value_name = "SPEC")]
     pub sweep: Option<String>,
-    /// Sweep: comma-separated algorithms (default: all).
-    #[arg(long, value_delimiter = ',', value_name = "LIST")]
-    pub algorithms: Vec<String>,
-    /// Sweep (resolution): data sets (default box:100k).
-    #[arg(long, value_delimiter = ',', value_name = "LIST")]
-    pub datasets: Vec<String>,
-    /// Sweep: viewpoints, as `tetbench run --viewpoints` (default +x,+x+y+z,-x+y-z).
-    #[arg(long, value_name = "SPEC")]
-    pub viewpoints: Option<String>,
-    /// Sweep (scaling): square viewport in pixels (default 128).
-    #[arg(long, value_name = "PIXELS")]
-    pub resolution: Option<u32>,
-    /// Sweep: timed frames per viewpoint (default 3).
-    #[arg(long, value_name = "N")]
-    pub frames: Option<u32>,
-    /// Sweep: warm-up frames (default 1).
-    #[arg(long, value_name = "N")]
-    pub warmup: Option<u32>,
-    /// Sweep: keep only variants whose settings match (as `tetbench run --settings`).
-    #[arg(long, value_name = "FILTER")]
-    pub settings: Option<String>,
-    /// Sweep: timing only, no reference images or error metrics (the charts say so).
-    #[arg(long)]
-    pub no_reference: bool,
-    /// Sweep: transfer function preset or file.
-    #[arg(long, value_name = "NAME|FILE", default_value = "low-opacity")]
-    pub tf: String,
-    /// Sweep: external renderers (as `tetbench run --external`).
+    /// The sweep's matrix (as `tetbench run`'s).
     #[command(flatten)]
-    pub external: crate::external_cmd::ExternalArgs,
+    pub matrix: MatrixArgs,
 }
 
 /// `box:10k,100k,1m` → `box:10k`, `box:100k`, `box:1m`; names and paths are kept as given.
@@ -78,37 +62,20 @@ pub fn expand_sizes(spec: &str) -> Vec<String> {
 }
 
 impl PlotArgs {
+    /// One sweep step: the given matrix options, the sweep's defaults for those left out
+    /// (the suite's number of samples, in one round: a sweep's large meshes should not all
+    /// stay prepared at once), and the step's data sets and viewport.
     fn run_args(&self, datasets: Vec<String>, resolution: u32, out: PathBuf) -> RunPlan {
-        RunPlan {
-            algorithms: self.algorithms.clone(),
-            datasets,
-            viewpoints: Some(
-                self.viewpoints
-                    .clone()
-                    .unwrap_or_else(|| crate::suite::DEFAULT_SUITE.viewpoints.to_string()),
-            ),
-            resolution: Some(resolution),
-            tf: self.tf.clone(),
-            // The suite's number of samples, in one round: a sweep's large meshes should not
-            // all stay prepared at once.
-            frames: Some(self.frames.unwrap_or(
-                crate::suite::DEFAULT_SUITE.frames * crate::suite::DEFAULT_SUITE.rounds,
-            )),
-            warmup: Some(self.warmup.unwrap_or(crate::suite::DEFAULT_SUITE.warmup)),
-            rounds: None,
-            out,
-            settings: self.settings.clone(),
-            no_reference: self.no_reference,
-            cache_dir: None,
-            orthographic: false,
-            scalar: None,
-            no_report: true,
-            strict: false,
-            shard: None,
-            no_calibrate: false,
-            peers: vec![],
-            external: self.external.clone(),
-        }
+        let suite = &crate::run::suite::DEFAULT_SUITE;
+        let mut matrix = self.matrix.or(MatrixArgs {
+            viewpoints: Some(suite.viewpoints.to_string()),
+            frames: Some(suite.frames * suite.rounds),
+            warmup: Some(suite.warmup),
+            ..MatrixArgs::default()
+        });
+        matrix.datasets = datasets;
+        matrix.resolution = Some(resolution);
+        matrix.plan(out)
     }
 }
 
@@ -121,9 +88,7 @@ fn measure(
     let out = args.out.clone();
     let config = args.to_config(data_dir, command_line.to_vec())?;
     let filter = config.settings_filter.clone();
-    let outcome = crate::run::run(&config, &|name: &str| {
-        crate::algorithms::selected_variants(name, &filter)
-    })?;
+    let outcome = crate::run::run(&config, &|name: &str| args.matrix.variants(name, &filter))?;
     if !outcome.all_ok() {
         eprintln!(
             "tetbench plot: {} of {} rows failed in {} (plotted as missing){}",
@@ -155,8 +120,9 @@ fn sweep(
                 anyhow::bail!("--sweep {spec:?}: a scaling sweep needs at least two mesh sizes");
             }
             let res = args
+                .matrix
                 .resolution
-                .unwrap_or(crate::suite::DEFAULT_SUITE.resolution);
+                .unwrap_or(crate::run::suite::DEFAULT_SUITE.resolution);
             Ok(vec![measure(
                 args.run_args(datasets, res, root.join("scaling")),
                 data_dir,
@@ -177,10 +143,10 @@ fn sweep(
             if sizes.len() < 2 {
                 anyhow::bail!("--sweep {spec:?}: a resolution sweep needs at least two sizes");
             }
-            let datasets = if args.datasets.is_empty() {
+            let datasets = if args.matrix.datasets.is_empty() {
                 vec!["box:100k".to_string()]
             } else {
-                args.datasets.clone()
+                args.matrix.datasets.clone()
             };
             sizes
                 .iter()
@@ -210,7 +176,10 @@ pub fn run(
     let mut sources = args.results.clone();
     if let Some(spec) = &args.sweep {
         sources.extend(sweep(&args, spec, data_dir, &command_line)?);
-    } else if !args.datasets.is_empty() || args.resolution.is_some() || args.no_reference {
+    } else if !args.matrix.datasets.is_empty()
+        || args.matrix.resolution.is_some()
+        || args.matrix.no_reference
+    {
         anyhow::bail!("--datasets, --resolution and --no-reference only apply with --sweep");
     }
     let inputs = Inputs::read(&sources)?;

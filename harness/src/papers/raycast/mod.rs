@@ -9,9 +9,10 @@
 //! and our other data sets as extra rows. Settings `tiles` (`NxN`), `table` (`2d|3d`); counter
 //! `passes_max` (the most passes any tile of a frame ran).
 
-use super::papers;
-use super::table::{Cell, CompRow, Comparison, Metric};
-use super::{is_standin, Extra, Measured, Paper, Report, RunSpec, Session};
+use crate::papers::session::{is_standin, Extra, Measured, Report, RunSpec};
+use crate::papers::table::{Cell, CompRow, Comparison, Metric};
+use crate::papers::transcription;
+use crate::papers::{Paper, PaperModule};
 
 pub const PAPER: Paper = Paper {
     id: "raycast",
@@ -21,8 +22,7 @@ pub const PAPER: Paper = Paper {
     algorithm: "raycast",
     datasets: &["spx1", "bluntfin", "f117"],
     sections: &["Abstract", "§1", "§2", "§2.1", "§2.2", "§2.3", "§2.4", "§3", "§3.1", "§3.1 (its Table 1)", "§3.2", "§4", "§5", "Table 1", "Table 2", "Table 3", "Table 4", "Table 5", "Table 6", "Tables 5–6"],
-    reproduce,
-    tables,
+    analyze_about: "Tiled ray casting (Bernardon et al.) Tables 3–6, bytes per tet and claims from finished runs.",
 };
 
 const DATASETS: [(&str, &str); 3] = [("spx1", "spx1"), ("blunt", "bluntfin"), ("f117", "f117")];
@@ -30,10 +30,16 @@ const TILINGS: [&str; 6] = ["1x1", "2x2", "3x3", "4x4", "5x5", "6x6"];
 /// §3.1: 9 RGBA32F texels per tet.
 const PAPER_BYTES_PER_TET: f64 = 144.0;
 
-fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
-    let mut m = Measured::default();
-    s.run(
-        &RunSpec {
+/// The tiled ray casting paper.
+pub struct Raycast;
+
+impl PaperModule for Raycast {
+    fn paper(&self) -> &'static Paper {
+        &PAPER
+    }
+
+    fn plan(&self) -> Vec<RunSpec> {
+        vec![RunSpec {
             name: "raycast".into(),
             algorithms: vec!["raycast".into()],
             datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
@@ -46,10 +52,12 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
                 "tiles={};table=2d|3d;mode=passes;et=on",
                 TILINGS.join("|")
             )),
-        },
-        &mut m,
-    )?;
-    Ok(tables(&m, &Extra::default()))
+        }]
+    }
+
+    fn tables(&self, m: &Measured, x: &Extra) -> Report {
+        tables(m, x)
+    }
 }
 
 fn rows_of<'a>(
@@ -76,7 +84,7 @@ fn min_max(v: impl Iterator<Item = f64>) -> (Option<f64>, Option<f64>) {
 
 pub fn tables(m: &Measured, x: &Extra) -> Report {
     let mut report = Report::default();
-    let load = |n: &str| papers::table(n).expect("embedded paper CSV parses (tested)");
+    let load = |n: &str| transcription::table(n).expect("embedded paper CSV parses (tested)");
     let t3 = load("raycast_table3");
     let gpus: Vec<String> = {
         let mut g: Vec<String> = t3
@@ -239,6 +247,6 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         rows,
         notes: vec![],
     });
-    report.claims = super::evaluate_claims(PAPER.id, m, x);
+    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x);
     report
 }

@@ -162,7 +162,7 @@ pub fn units_of(run: &RunDescription) -> Vec<Unit> {
     let filter = crate::algorithms::SettingsFilter::parse(&run.settings_filter).unwrap_or_default();
     let mut units = vec![];
     for spec in &run.datasets {
-        let label = crate::names::dataset_label(spec);
+        let label = crate::results::names::dataset_label(spec);
         for a in &run.algorithms {
             for settings in crate::algorithms::selected_settings(a, &filter).unwrap_or_default() {
                 units.push((label.clone(), a.clone(), settings));
@@ -365,7 +365,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path, allow_missing: bool) -> anyhow::Resul
     };
     results::write_csv(out, &merged.rows)?;
     results::write_json(out, &merged)?;
-    crate::samples::write_samples_csv(out, &merged.rows)?;
+    crate::results::samples::write_samples_csv(out, &merged.rows)?;
     Ok(merged)
 }
 
@@ -392,9 +392,9 @@ pub fn sort_like_a_run(rows: &mut [Row], run: &RunDescription) {
     let labels: Vec<String> = run
         .datasets
         .iter()
-        .map(|d| crate::names::dataset_label(d))
+        .map(|d| crate::results::names::dataset_label(d))
         .collect();
-    let viewpoints: Vec<String> = crate::suite::parse_viewpoints(&run.viewpoints)
+    let viewpoints: Vec<String> = crate::run::suite::parse_viewpoints(&run.viewpoints)
         .map(|v| v.into_iter().map(|v| v.name).collect())
         .unwrap_or_default();
     let filter = crate::algorithms::SettingsFilter::parse(&run.settings_filter).ok();
@@ -504,7 +504,7 @@ mod tests {
             .collect();
         ResultsFile {
             schema_version: results::SCHEMA_VERSION,
-            machine: crate::machine::MachineInfo::collect(),
+            machine: crate::results::machine::MachineInfo::collect(),
             run,
             finished_utc: Some("2026-01-01T00:00:00Z".into()),
             rows,

@@ -8,7 +8,7 @@
 //! The paper's figures come from its transcribed tables (`reports/papers/fragment-pt_table*.csv`,
 //! provenance in `reports/papers/fragment-pt.md`); Fig. 8 is a plot whose numbers the text does
 //! not give. Tables 1–2 are `tetbench reproduce fragment-pt` (or `tetbench analyze fragment-pt
-//! RUN_DIR` for finished runs), written once, in `reproduce/fragment_pt.rs`.
+//! RUN_DIR` for finished runs), written once, in `papers/fragment_pt/mod.rs`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -20,6 +20,7 @@ use plotters::style::FontStyle;
 
 use crate::report::aggregate;
 use crate::results::{ResultsFile, Row};
+use crate::run::matrix::MatrixArgs;
 
 fn fmt_opt(v: Option<f64>, digits: usize) -> String {
     match v {
@@ -28,25 +29,19 @@ fn fmt_opt(v: Option<f64>, digits: usize) -> String {
     }
 }
 
-/// `tetbench analyze resolution`: Fig. 8, performance against viewport size.
+/// `tetbench analyze resolution`: Fig. 8, performance against viewport size. The matrix
+/// options' help names Fig. 8's defaults, not `run`'s.
 #[derive(Debug, clap::Args)]
+#[command(
+    mut_arg("algorithms", |a| a.help("Comma-separated algorithms (default: fragment-pt)")),
+    mut_arg("datasets", |a| a.help("Comma-separated data sets (default: the paper's spx, bluntfin, comb, post)")),
+    mut_arg("viewpoints", |a| a.help("Viewpoints per size, as `tetbench run --viewpoints` (default 14)")),
+    mut_arg("frames", |a| a.help("Timed frames per viewpoint (default 5)")),
+    mut_arg("warmup", |a| a.help("Untimed warm-up frames (default 1)")),
+    mut_arg("resolution", |a| a.hide(true)),
+    mut_arg("no_reference", |a| a.hide(true)),
+)]
 pub struct ResolutionArgs {
-    /// Comma-separated algorithms (default: fragment-pt).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        value_name = "LIST",
-        default_value = "fragment-pt"
-    )]
-    pub algorithms: Vec<String>,
-    /// Comma-separated data sets (default: the paper's spx, bluntfin, comb, post).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        value_name = "LIST",
-        default_value = "spx,bluntfin,comb,post"
-    )]
-    pub datasets: Vec<String>,
     /// Square viewport sizes in pixels (the paper's Fig. 8: 256, 512, 768, 1024).
     #[arg(
         long,
@@ -55,24 +50,32 @@ pub struct ResolutionArgs {
         default_value = "256,512,768,1024"
     )]
     pub resolutions: Vec<u32>,
-    /// Viewpoints per size (as `tetbench run --viewpoints`).
-    #[arg(long, value_name = "SPEC", default_value = "14")]
-    pub viewpoints: String,
-    /// Timed frames per viewpoint.
-    #[arg(long, value_name = "N", default_value_t = 5)]
-    pub frames: u32,
-    /// Untimed warm-up frames.
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub warmup: u32,
-    /// Keep only variants whose settings match (as `tetbench run --settings`).
-    #[arg(long, value_name = "FILTER")]
-    pub settings: Option<String>,
-    /// Transfer function preset or file.
-    #[arg(long, value_name = "NAME|FILE", default_value = "low-opacity")]
-    pub tf: String,
+    /// The sweep's matrix (as `tetbench run`'s; left out: fragment-pt on the paper's spx,
+    /// bluntfin, comb and post, 14 viewpoints, 5 timed frames after 1 warm-up; always timing
+    /// only, and the viewport is --resolutions').
+    #[command(flatten)]
+    pub matrix: MatrixArgs,
     /// Output directory: one sub-directory per size, and the figure.
     #[arg(long, value_name = "DIR", default_value = "out-resolution")]
     pub out: PathBuf,
+}
+
+impl ResolutionArgs {
+    /// The matrix of every size: the options given, Fig. 8's defaults for the others.
+    fn matrix(&self) -> MatrixArgs {
+        self.matrix.or(MatrixArgs {
+            algorithms: vec!["fragment-pt".into()],
+            datasets: ["spx", "bluntfin", "comb", "post"]
+                .map(String::from)
+                .to_vec(),
+            viewpoints: Some("14".into()),
+            frames: Some(5),
+            warmup: Some(1),
+            // Fig. 8 is about speed: no reference images (they dominate at 1024²).
+            no_reference: true,
+            ..MatrixArgs::default()
+        })
+    }
 }
 
 /// One point of Fig. 8: a series at one viewport size.
@@ -111,47 +114,26 @@ pub fn sweep_points(rows: &[Row], resolution: u32) -> Vec<SweepPoint> {
     out
 }
 
-pub fn run_resolution(args: ResolutionArgs, ctx: &super::Context) -> anyhow::Result<()> {
+pub fn run_resolution(args: ResolutionArgs, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
     if args.resolutions.is_empty() {
         anyhow::bail!("--resolutions is empty");
+    }
+    if args.matrix.resolution.is_some() {
+        anyhow::bail!("--resolution: analyze resolution sweeps the viewport; give --resolutions");
     }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let mut points: Vec<SweepPoint> = vec![];
     let mut adapter = String::new();
     for &res in &args.resolutions {
-        let plan = crate::plan::RunPlan {
-            algorithms: args.algorithms.clone(),
-            datasets: args.datasets.clone(),
-            viewpoints: Some(args.viewpoints.clone()),
-            resolution: Some(res),
-            tf: args.tf.clone(),
-            frames: Some(args.frames),
-            warmup: Some(args.warmup),
-            rounds: None,
-            out: args.out.join(format!("res-{res}")),
-            settings: args.settings.clone(),
-            // Fig. 8 is about speed: no reference images (they dominate at 1024²).
-            no_reference: true,
-            cache_dir: None,
-            orthographic: false,
-            scalar: None,
-            no_report: true,
-            strict: false,
-            shard: None,
-            no_calibrate: false,
-            peers: vec![],
-            external: Default::default(),
-        };
-        let config = plan.to_config(
-            ctx.data_dir.clone(),
-            vec!["tetbench analyze resolution".into()],
-        )?;
+        let mut matrix = args.matrix();
+        matrix.resolution = Some(res);
+        let plan = matrix.plan(args.out.join(format!("res-{res}")));
+        let config =
+            plan.to_config(data_dir.clone(), vec!["tetbench analyze resolution".into()])?;
         eprintln!("resolution sweep: {res}×{res}");
         let filter = config.settings_filter.clone();
-        let outcome = crate::run::run(&config, &|name: &str| {
-            crate::algorithms::selected_variants(name, &filter)
-        })?;
+        let outcome = crate::run::run(&config, &|name: &str| plan.matrix.variants(name, &filter))?;
         if !outcome.all_ok() {
             eprintln!(
                 "WARNING: {} of {} rows failed at {res}²: {:?}",
@@ -222,7 +204,7 @@ pub fn fig8_markdown(points: &[SweepPoint], adapter: &str) -> String {
 
 const FONT: &str = "DejaVu Sans";
 
-/// Registers the embedded DejaVu Sans with plotters (as `report.rs` does; registering the
+/// Registers the embedded DejaVu Sans with plotters (as `report/mod.rs` does; registering the
 /// same family twice is harmless).
 fn register_font() {
     static ONCE: Once = Once::new();

@@ -11,11 +11,13 @@ use anyhow::Context;
 use serde::Serialize;
 
 use crate::algorithms::is_peer;
-use crate::metrics::{HEATMAP_MAX_ERROR, ONE_STEP, PSNR_CAP_DB};
+use crate::results::metrics::{HEATMAP_MAX_ERROR, ONE_STEP, PSNR_CAP_DB};
 use crate::results::{ResultsFile, Row};
 
-pub use crate::names::series_label;
-pub use crate::stats::{spread, Spread};
+pub mod html;
+
+pub use crate::results::names::series_label;
+pub use crate::results::stats::{spread, Spread};
 
 /// One algorithm × settings × data set, over its viewpoints (the papers average over the 14
 /// fixed viewpoints, HAVS §6).
@@ -27,7 +29,7 @@ pub struct Aggregate {
     pub tets: u64,
     pub rows: usize,
     pub failed: usize,
-    /// Rows flagged by [`crate::suspect`].
+    /// Rows flagged by [`crate::results::suspect`].
     pub suspect: usize,
     pub total_ms: Option<Spread>,
     pub cpu_ms: Option<Spread>,
@@ -322,7 +324,7 @@ fn summary_lines(file: &ResultsFile, aggs: &[Aggregate], suspect: &[bool]) -> Ve
         .collect()
 }
 
-/// Rows flagged by [`crate::suspect`], each with its heatmap first, then the rendering and the
+/// Rows flagged by [`crate::results::suspect`], each with its heatmap first, then the rendering and the
 /// reference, so a broken renderer is the first picture a reader sees after the charts.
 fn suspect_figures(file: &ResultsFile) -> Vec<SuspectFigure> {
     file.rows
@@ -429,7 +431,7 @@ fn html(
     charts: &crate::plot::ChartsPage,
 ) -> anyhow::Result<String> {
     let suspect = crate::plot::data::suspect_flags(&file.rows);
-    crate::html::render(
+    crate::report::html::render(
         "report.html",
         ReportPage {
             machine: machine_lines(file),
@@ -494,7 +496,7 @@ pub fn markdown_summary(aggs: &[Aggregate]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::machine::MachineInfo;
+    use crate::results::machine::MachineInfo;
     use crate::results::{test_row, RunDescription, SCHEMA_VERSION};
 
     fn file() -> ResultsFile {
@@ -537,7 +539,7 @@ mod tests {
     /// the page as text.
     #[test]
     fn markup_in_names_is_escaped() {
-        use crate::html::{assert_no_live_markup, HOSTILE_NAME};
+        use crate::report::html::{assert_no_live_markup, HOSTILE_NAME};
         let mut f = file();
         for r in &mut f.rows {
             r.dataset = HOSTILE_NAME.into();

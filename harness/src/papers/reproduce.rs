@@ -5,11 +5,11 @@
 //! conditions of both, bar charts, and the paper's claims (`reports/papers/claims.csv`), each
 //! with a verdict of [`crate::papers::verdict`] and the numbers and variants it rests on.
 //!
-//! Each paper is one module with (a) its run plan (`measure`, built on the run loop
-//! [`crate::run`] and the analyses of [`crate::analyze`]) and (b) its table writer (`tables`,
-//! a pure function of what was measured, so tests can check it without a GPU). Algorithms a
-//! plan names that this build lacks (derived from [`crate::algorithms::names`]) leave their
-//! cells empty with the reason.
+//! Each paper is one folder implementing [`PaperModule`]: its CPU analyses and run plan
+//! (measured here, on the run loop [`crate::run`]) and its table writer (`tables`, a pure
+//! function of what was measured, so tests can check it without a GPU). Algorithms a plan
+//! names that this build lacks (derived from [`crate::algorithms::names`]) leave their cells
+//! empty with the reason.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -17,23 +17,13 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 
-use crate::machine::MachineInfo;
-use crate::report::{aggregate, Aggregate};
-use crate::results::{ResultsFile, Row};
-
-pub mod evidence;
-pub mod fragment_pt;
-pub mod from_run;
-pub mod gator;
-pub mod havs;
-pub use crate::papers;
-pub mod raycast;
-pub mod splat;
-pub mod table;
-
-use crate::papers::claims::{self, ClaimResult};
-pub use evidence::evaluate_claims;
-use table::Comparison;
+use super::claims::{self, ClaimResult};
+use super::session::{
+    not_built_reason, Measured, Report, Session, FULL_FRAMES, FULL_WARMUP, QUICK_FRAMES,
+    QUICK_RESOLUTION_DIVISOR, QUICK_VIEWPOINTS, QUICK_WARMUP,
+};
+use super::{table, Paper, PaperModule, PAPERS};
+use crate::results::machine::MachineInfo;
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
@@ -59,337 +49,28 @@ pub struct Args {
     /// External renderers measured in every run beside the paper's algorithms (as
     /// `tetbench run --external`).
     #[command(flatten)]
-    pub external: crate::external_cmd::ExternalArgs,
+    pub external: crate::run::matrix::ExternalArgs,
     /// Run although the working tree has uncommitted changes (the reports then say so; by
     /// default `reproduce` refuses, so every report names the one commit it came from).
     #[arg(long)]
     pub allow_dirty: bool,
 }
 
-/// One paper: what it is, on what it was measured, and how to reproduce it.
-pub struct Paper {
-    /// Name on the command line and output folder.
-    pub id: &'static str,
-    pub title: &'static str,
-    pub citation: &'static str,
-    /// The paper's test machine, from the transcription.
-    pub hardware: &'static str,
-    /// The tetbench algorithm the paper describes (must be built in to reproduce it alone).
-    pub algorithm: &'static str,
-    /// Every data set the plan loads (registry names): the rows a claim may name.
-    pub datasets: &'static [&'static str],
-    /// The places of the paper a claim may cite (its numbered sections, tables, abstract,
-    /// captions), from its source text.
-    pub sections: &'static [&'static str],
-    pub reproduce: fn(&mut Session) -> anyhow::Result<Report>,
-    /// Its tables and claims from what was measured: the one writer, shared by `reproduce` and
-    /// `analyze PAPER RUN_DIR`.
-    pub tables: fn(&Measured, &Extra) -> Report,
-}
-
-/// Every paper, in the order `all` runs them.
-pub fn papers() -> [&'static Paper; 5] {
-    [
-        &havs::PAPER,
-        &gator::PAPER,
-        &fragment_pt::PAPER,
-        &raycast::PAPER,
-        &splat::PAPER,
-    ]
-}
-
-/// What a paper module's table writer returns.
-#[derive(Debug, Clone, Default)]
-pub struct Report {
-    pub comparisons: Vec<Comparison>,
-    /// The paper's claims (`reports/papers/claims.csv`), one verdict per data set.
-    pub claims: Vec<ClaimResult>,
-    pub notes: Vec<String>,
-}
-
-/// Whether this build has an algorithm (from the algorithm table).
-pub fn built_in(algorithm: &str) -> bool {
-    crate::algorithms::names().contains(&algorithm)
-}
-
-/// Why an algorithm has no rows: not built in (which issue adds it), or `None` if built.
-pub fn not_built_reason(algorithm: &str) -> Option<String> {
-    (!built_in(algorithm)).then(|| {
-        format!(
-            "algorithm {algorithm} is not built in (this build has: {})",
-            crate::algorithms::names().join(", ")
-        )
-    })
-}
-
-/// One `tetbench run` of a plan.
-#[derive(Debug, Clone)]
-pub struct RunSpec {
-    /// Sub-folder of OUT/<paper>/runs/.
-    pub name: String,
-    pub algorithms: Vec<String>,
-    pub datasets: Vec<String>,
-    /// Viewpoints in the full run (the quick run uses [`QUICK_VIEWPOINTS`]).
-    pub viewpoints: String,
-    pub resolution: u32,
-    /// The transfer function (a preset name); `None` is the suite's `low-opacity`.
-    pub tf: Option<&'static str>,
-    pub settings: Option<String>,
-}
-
-/// The quick mode's viewpoint (one diagonal of the 14), frames and warm-up.
-pub const QUICK_VIEWPOINTS: &str = "+x+y+z";
-pub const QUICK_FRAMES: u32 = 1;
-/// The quick mode divides the paper's viewport side by this (fragments, and so the time of
-/// every rasterising algorithm on a CPU adapter, scale with the pixels).
-pub const QUICK_RESOLUTION_DIVISOR: u32 = 2;
-pub const QUICK_WARMUP: u32 = 1;
-/// The full mode's frames and warm-up (tetbench's standard).
-pub const FULL_FRAMES: u32 = crate::suite::STANDARD_FRAMES;
-pub const FULL_WARMUP: u32 = crate::suite::STANDARD_WARMUP;
-
-/// Measured rows of one paper plus what could not be measured.
-#[derive(Debug, Clone, Default)]
-pub struct Measured {
-    pub rows: Vec<Row>,
-    /// Per run, the failures that are not one row (a data set that did not load).
-    pub errors: Vec<String>,
-}
-
-impl Measured {
-    pub fn aggregates(&self) -> Vec<Aggregate> {
-        aggregate(&self.rows)
-    }
-
-    /// A counter of the first row of `algorithm` on `dataset` that has it.
-    pub fn counter(&self, algorithm: &str, dataset: &str, name: &str) -> Option<f64> {
-        self.rows
-            .iter()
-            .filter(|r| r.algorithm == algorithm && r.dataset == dataset)
-            .find_map(|r| r.counter(name))
-    }
-
-    /// Why `algorithm` has no value on `dataset`: not built, a failed row's error, a data set
-    /// that did not load, or not measured.
-    pub fn why(&self, algorithm: &str, dataset: &str) -> String {
-        if let Some(r) = not_built_reason(algorithm) {
-            return r;
-        }
-        if let Some(r) = self
-            .rows
-            .iter()
-            .find(|r| r.algorithm == algorithm && r.dataset == dataset && !r.error.is_empty())
-        {
-            return format!("failed: {}", r.error);
-        }
-        if let Some(e) = self
-            .errors
-            .iter()
-            .find(|e| e.contains(&format!("\"{dataset}\"")))
-        {
-            return e.clone();
-        }
-        "not measured in this run".into()
-    }
-}
-
-pub use crate::results::value_of;
-
-/// The aggregate of `algorithm` on `dataset` whose settings include every `want` pair, if
-/// exactly one does: where several variants match, none is taken (the first one found must
-/// never stand for the algorithm silently; the table's plan names the variant).
-pub fn find<'a>(
-    aggs: &'a [Aggregate],
-    algorithm: &str,
-    dataset: &str,
-    pins: &[(&str, &str)],
-) -> Option<&'a Aggregate> {
-    let want = pins
-        .iter()
-        .fold(render_core::Settings::new(), |s, (k, v)| s.with(k, *v));
-    find_including(
-        aggs,
-        algorithm,
-        dataset,
-        &want.retyped(|k| crate::algorithms::describe(algorithm).and_then(|d| d.kind_of(k))),
-    )
-}
-
-/// The one aggregate of `algorithm` on `dataset` whose settings include `want` (`None` when
-/// none or several do).
-pub fn find_including<'a>(
-    aggs: &'a [Aggregate],
-    algorithm: &str,
-    dataset: &str,
-    want: &render_core::Settings,
-) -> Option<&'a Aggregate> {
-    let mut hits = aggs
-        .iter()
-        .filter(|a| a.algorithm == algorithm && a.dataset == dataset && a.settings.includes(want));
-    let first = hits.next()?;
-    hits.next().is_none().then_some(first)
-}
-
-/// The state of one paper's reproduction: where it writes, the mode, and what it ran.
-pub struct Session {
-    pub dir: PathBuf,
-    pub quick: bool,
-    pub data_dir: Option<PathBuf>,
-    pub cache_dir: Option<PathBuf>,
-    pub substitutes: Vec<(String, String)>,
-    pub resolution: Option<u32>,
-    /// The machine of the first run (adapter included), for the conditions.
-    pub machine: Option<MachineInfo>,
-    /// The equivalent `tetbench run` command of every run, and its outcome.
-    pub log: Vec<String>,
-    /// External renderers added to every run (`--external`).
-    pub external: crate::external_cmd::ExternalArgs,
-    /// The commit the binary was built from and whether the tree was clean.
-    pub source: SourceState,
-    /// Set by `tetbench analyze PAPER RUN_DIR`: the runs the tables come from.
-    pub from_run: Option<PathBuf>,
-}
-
-impl Session {
-    /// The data set the plan calls `name` (or its substitute).
-    pub fn dataset(&self, name: &str) -> String {
-        self.substitutes
-            .iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, s)| s.clone())
-            .unwrap_or_else(|| name.to_string())
-    }
-
-    /// The viewport of a run: `--resolution`, else the paper's (halved in quick mode).
-    pub fn resolution(&self, paper: u32) -> u32 {
-        self.resolution.unwrap_or(if self.quick {
-            paper / QUICK_RESOLUTION_DIVISOR
-        } else {
-            paper
-        })
-    }
-
-    /// Runs one plan entry with the built-in algorithms it names; rows keep the plan's data
-    /// set names (substitutes are renamed back so the tables find them).
-    pub fn run(&mut self, spec: &RunSpec, measured: &mut Measured) -> anyhow::Result<()> {
-        let algorithms: Vec<String> = spec
-            .algorithms
-            .iter()
-            .filter(|a| built_in(a))
-            .cloned()
-            .collect();
-        for a in spec.algorithms.iter().filter(|a| !built_in(a)) {
-            self.log.push(format!(
-                "run {}: {a} skipped ({})",
-                spec.name,
-                not_built_reason(a).unwrap_or_default()
-            ));
-        }
-        if algorithms.is_empty() {
-            return Ok(());
-        }
-        let viewpoints = if self.quick {
-            QUICK_VIEWPOINTS.to_string()
-        } else {
-            spec.viewpoints.clone()
-        };
-        let datasets: Vec<String> = spec.datasets.iter().map(|d| self.dataset(d)).collect();
-        let out = self.dir.join("runs").join(&spec.name);
-        let args = crate::plan::RunPlan {
-            algorithms: algorithms.clone(),
-            datasets: datasets.clone(),
-            viewpoints: Some(viewpoints.clone()),
-            resolution: Some(self.resolution(spec.resolution)),
-            tf: spec.tf.unwrap_or("low-opacity").into(),
-            frames: Some(if self.quick {
-                QUICK_FRAMES
-            } else {
-                FULL_FRAMES
-            }),
-            warmup: Some(if self.quick {
-                QUICK_WARMUP
-            } else {
-                FULL_WARMUP
-            }),
-            rounds: None,
-            out: out.clone(),
-            settings: spec.settings.clone(),
-            no_reference: self.quick,
-            cache_dir: self.cache_dir.clone(),
-            orthographic: false,
-            scalar: None,
-            no_report: true,
-            strict: false,
-            shard: None,
-            no_calibrate: false,
-            peers: vec![],
-            external: self.external.clone(),
-        };
-        let command = format!(
-            "tetbench run --algorithms {} --datasets {} --viewpoints {viewpoints} --resolution {}{}{}{}",
-            algorithms.join(","),
-            datasets.join(","),
-            self.resolution(spec.resolution),
-            spec.tf.map(|t| format!(" --tf {t}")).unwrap_or_default(),
-            spec.settings
-                .as_ref()
-                .map(|s| format!(" --settings '{s}'"))
-                .unwrap_or_default(),
-            if self.quick {
-                format!(" --frames {QUICK_FRAMES} --warmup {QUICK_WARMUP} --no-reference")
-            } else {
-                String::new()
-            }
-        );
-        let config = args.to_config(self.data_dir.clone(), vec![command.clone()])?;
-        let filter = config.settings_filter.clone();
-        let t0 = Instant::now();
-        let outcome = crate::run::run(&config, &|name: &str| {
-            crate::algorithms::selected_variants(name, &filter)
-        })
-        .with_context(|| format!("run {}", spec.name))?;
-        let file = ResultsFile::read(&out)?;
-        if self.machine.is_none() {
-            self.machine = Some(file.machine.clone());
-        }
-        self.log.push(format!(
-            "run {}: `{command}` — {} rows, {} failed, {:.0} s",
-            spec.name,
-            outcome.rows,
-            outcome.failed_rows,
-            t0.elapsed().as_secs_f64()
-        ));
-        measured.errors.extend(outcome.errors.iter().cloned());
-        for mut row in file.rows {
-            if let Some((plan, _)) = self.substitutes.iter().find(|(_, s)| {
-                crate::names::slug(s) == crate::names::slug(&row.dataset) || *s == row.dataset
-            }) {
-                row.dataset = plan.clone();
-            }
-            measured.rows.push(row);
-        }
-        Ok(())
-    }
-}
-
 /// `tetbench reproduce …`.
 pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
     let all = args.paper == "all";
-    let chosen: Vec<&Paper> = if all {
-        papers().to_vec()
+    let chosen: Vec<&dyn PaperModule> = if all {
+        PAPERS.to_vec()
     } else {
-        let p = papers()
-            .into_iter()
-            .find(|p| p.id == args.paper)
-            .ok_or_else(|| {
-                anyhow::anyhow!(
-                    "unknown paper {:?}; known: {}, all",
-                    args.paper,
-                    papers().map(|p| p.id).join(", ")
-                )
-            })?;
-        if let Some(why) = not_built_reason(p.algorithm) {
-            anyhow::bail!("cannot reproduce {}: {why}", p.id);
+        let p = super::find(&args.paper).ok_or_else(|| {
+            anyhow::anyhow!(
+                "unknown paper {:?}; known: {}, all",
+                args.paper,
+                super::ids().join(", ")
+            )
+        })?;
+        if let Some(why) = not_built_reason(p.paper().algorithm) {
+            anyhow::bail!("cannot reproduce {}: {why}", p.paper().id);
         }
         vec![p]
     };
@@ -403,7 +84,8 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
     let mut source = SourceState::read();
     source.check(args.allow_dirty)?;
     let started = Instant::now();
-    for p in chosen {
+    for module in chosen {
+        let p = module.paper();
         let t0 = Instant::now();
         let dir = args.out.join(p.id);
         if dir.exists() {
@@ -426,7 +108,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             from_run: None,
         };
         eprintln!("tetbench reproduce: {} ({})", p.id, p.title);
-        let report = (p.reproduce)(&mut session)?;
+        let report = measure_and_tabulate(module, &mut session)?;
         let seconds = t0.elapsed().as_secs_f64();
         write_report(p, &session, &report, seconds)?;
         let exact: Vec<String> = report
@@ -472,6 +154,16 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// A paper's CPU analyses, then its plan's runs, then its tables from what they measured.
+fn measure_and_tabulate(paper: &dyn PaperModule, session: &mut Session) -> anyhow::Result<Report> {
+    let mut measured = Measured::default();
+    let extra = paper.analyses(session, &mut measured)?;
+    for spec in paper.plan() {
+        session.run(&spec, &mut measured)?;
+    }
+    Ok(paper.tables(&measured, &extra))
+}
+
 /// What the index says of one paper's report (`OUT/<paper>/summary.json`).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct PaperSummary {
@@ -491,7 +183,7 @@ pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
     let mut md = String::from("# Papers reproduced\n\nWritten by `tetbench reproduce` from each paper's `summary.json`; nothing here is edited by hand.\n\n| paper | mode | seconds | commit | exact tables | claims (verdicts per data set) | report |\n|---|---|---:|---|---|---|---|\n");
     let mut total = 0.0;
     let mut sources = vec![];
-    for p in papers() {
+    for p in PAPERS.iter().map(|p| p.paper()) {
         let path = out.join(p.id).join(SUMMARY_FILE);
         if !path.exists() {
             continue;
@@ -615,7 +307,7 @@ impl SourceState {
     }
 }
 
-fn write_report(
+pub(crate) fn write_report(
     paper: &Paper,
     session: &Session,
     report: &Report,
@@ -708,11 +400,6 @@ fn write_file(path: &Path, text: &str) -> anyhow::Result<()> {
     std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// Whether a data set name is a generated stand-in (its rows are marked).
-pub fn is_standin(name: &str) -> bool {
-    datasets::standins::is_generated(name)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -722,15 +409,12 @@ mod tests {
     /// a value).
     #[test]
     fn every_paper_value_is_printed() {
-        let prefixes = [
-            ("havs", havs::tables as fn(&Measured, &Extra) -> Report),
-            ("gator", gator::tables),
-            ("fragment-pt", fragment_pt::tables),
-            ("raycast", raycast::tables),
-            ("splat", splat::tables),
-        ];
-        for (prefix, tables) in prefixes {
-            let report = tables(&Measured::default(), &Extra::default());
+        use crate::papers::session::Extra;
+        use crate::papers::transcription;
+        for paper in PAPERS {
+            // A paper's transcribed tables are named after its id (`fragment-pt_table1`).
+            let prefix = paper.paper().id;
+            let report = paper.tables(&Measured::default(), &Extra::default());
             let printed: Vec<f64> = report
                 .comparisons
                 .iter()
@@ -740,13 +424,13 @@ mod tests {
                         .flat_map(|r| r.cells.iter().filter_map(|c| c.paper))
                 })
                 .collect();
-            for (name, _) in papers::CSVS
+            for (name, _) in transcription::CSVS
                 .iter()
                 .filter(|(n, _)| n.starts_with(&format!("{prefix}_")))
             {
-                let t = papers::table(name).unwrap();
+                let t = transcription::table(name).unwrap();
                 for key in t.keys() {
-                    for col in t.header.iter().filter(|c| !papers::is_key_column(c)) {
+                    for col in t.header.iter().filter(|c| !transcription::is_key_column(c)) {
                         if let Some(v) = t.value(&key, col) {
                             assert!(
                                 printed.contains(&v),
@@ -773,25 +457,3 @@ mod tests {
         );
     }
 }
-
-/// What a paper measured besides run rows (CPU analyses), shared shape so the tests can call
-/// every table writer alike.
-#[derive(Debug, Clone, Default)]
-pub struct Extra {
-    /// HAVS Table 1: each sort's median, fastest and slowest run.
-    pub sorts: Vec<crate::analyze::havs::SortRow>,
-    /// HAVS Table 2 rows.
-    pub kbuffer: Vec<crate::analyze::havs::KbufferRow>,
-    /// GATOR Table 1: the classifier's distinct outcomes (`None`: not run).
-    pub truth_table: Option<Vec<gator::ObservedCase>>,
-    /// Data set sizes: (plan name, points, tets).
-    pub sizes: Vec<(String, u64, u64)>,
-    /// Zero-volume tets the loader dropped, per data set (plan name, count).
-    pub dropped: Vec<(String, u64)>,
-    /// How many viewpoints and what viewport the k analysis used.
-    pub kbuffer_views: usize,
-    pub kbuffer_resolution: u32,
-}
-
-#[cfg(test)]
-mod claims_tests;

@@ -11,7 +11,7 @@
 
 /// Median of a non-empty slice (mean of the middle two for an even count); NaN when empty.
 pub fn median(v: &[f64]) -> f64 {
-    crate::metrics::summarize(v).map_or(f64::NAN, |s| s.median)
+    crate::results::metrics::summarize(v).map_or(f64::NAN, |s| s.median)
 }
 
 /// Share `q` ∈ [0, 1] quantile by linear interpolation; NaN when empty.

@@ -1,31 +1,68 @@
 //! `tetbench analyze havs|gator|fragment-pt|raycast|splat RUN_DIR`: a paper's tables and
 //! claims from runs already made, written by the same table code as `tetbench reproduce`
-//! (one writer per table). `RUN_DIR` is a `tetbench run` output (it holds `results.json`), or
+//! (one writer per table: the paper's [`super::PaperModule::tables`]). `RUN_DIR` is a `tetbench run` output (it holds `results.json`), or
 //! a folder of such outputs (e.g. a reproduce folder's `runs/`), read whole.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 
-use super::{write_report, Extra, Measured, Session, SourceState};
+use super::reproduce::{write_report, SourceState};
+use super::session::{Extra, Measured, Session};
 use crate::results::ResultsFile;
 
-/// The paper analyses, one subcommand per paper (flattened into `tetbench analyze`).
-#[derive(Debug, clap::Subcommand)]
-pub enum PaperAnalysis {
-    /// HAVS (Callahan et al. 2005) Tables 1–5 and claims from finished runs (Tables 1–2 and the
-    /// claims on them need `tetbench reproduce havs`: they are CPU analyses, not runs).
-    Havs(FromRunArgs),
-    /// GATOR (Wylie et al. 2002) Tables 1–3 and claims from finished runs.
-    Gator(FromRunArgs),
-    /// Fragment PT (Marroquim et al. 2006) Tables 1–2, bytes per tet and claims from finished
-    /// runs.
-    FragmentPt(FromRunArgs),
-    /// Tiled ray casting (Bernardon et al.) Tables 3–6, bytes per tet and claims from finished
-    /// runs.
-    Raycast(FromRunArgs),
-    /// Splatting (Grau & Tost 2007) Table 1 and claims from finished runs.
-    Splat(FromRunArgs),
+/// `tetbench analyze PAPER RUN_DIR`: one subcommand per paper of [`super::PAPERS`] (flattened
+/// into `tetbench analyze`), built from the registry so that a new paper needs no line here.
+#[derive(Debug, Clone)]
+pub struct PaperAnalysis {
+    /// The paper's id (its subcommand's name).
+    pub paper: &'static str,
+    pub args: FromRunArgs,
+}
+
+impl clap::FromArgMatches for PaperAnalysis {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let (name, sub) = matches.subcommand().ok_or_else(|| {
+            clap::Error::raw(
+                clap::error::ErrorKind::MissingSubcommand,
+                "name a paper or an analysis",
+            )
+        })?;
+        let paper = super::find(name).ok_or_else(|| {
+            clap::Error::raw(
+                clap::error::ErrorKind::InvalidSubcommand,
+                format!("{name} is not a paper; known: {}", super::ids().join(", ")),
+            )
+        })?;
+        Ok(PaperAnalysis {
+            paper: paper.paper().id,
+            args: FromRunArgs::from_arg_matches(sub)?,
+        })
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(matches)?;
+        Ok(())
+    }
+}
+
+impl clap::Subcommand for PaperAnalysis {
+    fn augment_subcommands(mut cmd: clap::Command) -> clap::Command {
+        for p in super::PAPERS {
+            let paper = p.paper();
+            let sub = clap::Command::new(paper.id).about(paper.analyze_about.trim_end_matches('.'));
+            cmd = cmd.subcommand(<FromRunArgs as clap::Args>::augment_args(sub));
+        }
+        cmd
+    }
+
+    fn augment_subcommands_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_subcommands(cmd)
+    }
+
+    fn has_subcommand(name: &str) -> bool {
+        super::find(name).is_some()
+    }
 }
 
 #[derive(Debug, Clone, clap::Args)]
@@ -58,23 +95,14 @@ fn results_files(dir: &Path) -> anyhow::Result<Vec<ResultsFile>> {
 }
 
 pub fn run(cmd: PaperAnalysis) -> anyhow::Result<()> {
-    let (id, args) = match cmd {
-        PaperAnalysis::Havs(a) => ("havs", a),
-        PaperAnalysis::Gator(a) => ("gator", a),
-        PaperAnalysis::FragmentPt(a) => ("fragment-pt", a),
-        PaperAnalysis::Raycast(a) => ("raycast", a),
-        PaperAnalysis::Splat(a) => ("splat", a),
-    };
-    let paper = super::papers()
-        .into_iter()
-        .find(|p| p.id == id)
-        .expect("every subcommand is a paper");
+    let PaperAnalysis { paper: id, args } = cmd;
+    let paper = super::find(id).expect("every subcommand is a paper");
     let files = results_files(&args.run_dir)?;
     let mut measured = Measured::default();
     for f in &files {
         measured.rows.extend(f.rows.iter().cloned());
     }
-    let report = (paper.tables)(&measured, &Extra::default());
+    let report = paper.tables(&measured, &Extra::default());
     let out = args
         .out
         .unwrap_or_else(|| args.run_dir.join(format!("analysis-{id}")));
@@ -113,7 +141,7 @@ pub fn run(cmd: PaperAnalysis) -> anyhow::Result<()> {
         source: SourceState::read(),
         from_run: Some(args.run_dir.clone()),
     };
-    write_report(paper, &session, &report, 0.0)?;
+    write_report(paper.paper(), &session, &report, 0.0)?;
     let md = std::fs::read_to_string(out.join("report.md"))?;
     print!("{md}");
     eprintln!("wrote {}", out.join("report.md").display());

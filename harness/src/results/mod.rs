@@ -17,7 +17,14 @@ use serde::{Deserialize, Serialize};
 
 use render_core::Settings;
 
-use crate::machine::MachineInfo;
+use crate::results::machine::MachineInfo;
+
+pub mod machine;
+pub mod metrics;
+pub mod names;
+pub mod samples;
+pub mod stats;
+pub mod suspect;
 
 /// Bumped whenever a field changes meaning or is removed (adding a field does not bump it).
 /// Version 2 adds per-frame `samples`, the exact f32 image (`image_f32`, `image_hash`), the
@@ -32,7 +39,7 @@ pub const CSV_FILE: &str = "results.csv";
 pub const JSON_FILE: &str = "results.json";
 
 /// One (algorithm, settings, data set, viewpoint) measurement. Times in ms, rates per second,
-/// error metrics as defined in [`crate::metrics`]. `None` is an empty CSV cell / JSON null: no
+/// error metrics as defined in [`crate::results::metrics`]. `None` is an empty CSV cell / JSON null: no
 /// timestamp queries (gpu_ms), no reference (error metrics), or a failed row (`error` set).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Row {
@@ -89,10 +96,10 @@ pub struct Row {
     pub reference_image: String,
     pub heatmap: String,
     /// Empty, or why the row's image error is out of line with the other algorithms on the
-    /// same image ([`crate::suspect`]). Absent in files written before it existed.
+    /// same image ([`crate::results::suspect`]). Absent in files written before it existed.
     #[serde(default)]
     pub suspect: String,
-    /// The exact rendering (premultiplied linear RGBA f32, compressed, see [`crate::samples`]),
+    /// The exact rendering (premultiplied linear RGBA f32, compressed, see [`crate::results::samples`]),
     /// relative to the output directory, and the blake3 hash of its pixels.
     #[serde(default)]
     pub image_f32: String,
@@ -357,7 +364,9 @@ impl ResultsWriter {
     }
 
     pub fn finish(&mut self) -> anyhow::Result<()> {
-        self.file.finished_utc = Some(crate::machine::iso8601_utc(std::time::SystemTime::now()));
+        self.file.finished_utc = Some(crate::results::machine::iso8601_utc(
+            std::time::SystemTime::now(),
+        ));
         self.write_json()
     }
 

@@ -9,9 +9,10 @@
 
 use datasets::standins::{self, Recipe};
 
-use super::papers;
-use super::table::{Cell, CompRow, Comparison, Metric};
-use super::{find, Extra, Measured, Paper, Report, RunSpec, Session};
+use crate::papers::session::{find, Extra, Measured, Report, RunSpec};
+use crate::papers::table::{Cell, CompRow, Comparison, Metric};
+use crate::papers::transcription;
+use crate::papers::{Paper, PaperModule};
 
 pub const PAPER: Paper = Paper {
     id: "splat",
@@ -21,8 +22,7 @@ pub const PAPER: Paper = Paper {
     algorithm: "splat",
     datasets: &["lobster", "engine", "teapot", "aneurism", "bonsai", "stagbeetle"],
     sections: &["Abstract", "§1", "§2", "§3", "§3.1", "§3.2", "§3.3", "§3.4", "§3.5", "§3.6", "§4", "§5", "§6", "Table 1"],
-    reproduce,
-    tables,
+    analyze_about: "Splatting (Grau & Tost 2007) Table 1 and claims from finished runs.",
 };
 
 /// The transfer function of the Table 1 runs: κ(0) = 0, so the effective voxels are exactly
@@ -44,10 +44,16 @@ const VOLUMES: [(&str, &str); 6] = [
     ("StagBeetle", "stagbeetle"),
 ];
 
-fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
-    let mut m = Measured::default();
-    s.run(
-        &RunSpec {
+/// The splatting paper.
+pub struct Splat;
+
+impl PaperModule for Splat {
+    fn paper(&self) -> &'static Paper {
+        &PAPER
+    }
+
+    fn plan(&self) -> Vec<RunSpec> {
+        vec![RunSpec {
             name: "splat".into(),
             algorithms: vec!["splat".into()],
             datasets: VOLUMES.map(|(_, d)| d.to_string()).to_vec(),
@@ -55,15 +61,17 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
             resolution: 512,
             tf: Some(TABLE1_TF),
             settings: Some(TABLE1_SETTINGS.into()),
-        },
-        &mut m,
-    )?;
-    Ok(tables(&m, &Extra::default()))
+        }]
+    }
+
+    fn tables(&self, m: &Measured, x: &Extra) -> Report {
+        tables(m, x)
+    }
 }
 
 pub fn tables(m: &Measured, x: &Extra) -> Report {
     let mut report = Report::default();
-    let t = papers::table("splat_table1").expect("embedded paper CSV parses (tested)");
+    let t = transcription::table("splat_table1").expect("embedded paper CSV parses (tested)");
     let aggs = m.aggregates();
     let mut rows = vec![];
     let mut radix_notes = vec![];
@@ -140,6 +148,6 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         rows,
         notes: radix_notes,
     });
-    report.claims = super::evaluate_claims(PAPER.id, m, x);
+    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x);
     report
 }

@@ -282,7 +282,7 @@ pub fn markdown(c: &Comparison) -> String {
 /// A report page from its Markdown: pulldown-cmark (tables on) renders the body, and raw HTML
 /// in the Markdown — a data set or file name such as `<img src=x onerror=alert(1)>` quoted in a
 /// table — is turned into text before rendering, so only the Markdown's own structure becomes
-/// markup. The page around it comes from `templates/markdown.html` (crate::html).
+/// markup. The page around it comes from `templates/markdown.html` (crate::report::html).
 pub fn markdown_to_html(md: &str, title: &str) -> anyhow::Result<String> {
     use pulldown_cmark::{Event, Options, Parser};
     let events = Parser::new_ext(md, Options::ENABLE_TABLES).map(|e| match e {
@@ -296,7 +296,7 @@ pub fn markdown_to_html(md: &str, title: &str) -> anyhow::Result<String> {
         title: &'a str,
         body: minijinja::Value,
     }
-    crate::html::render(
+    crate::report::html::render(
         "markdown.html",
         Page {
             title,
@@ -348,7 +348,7 @@ pub fn write_charts(dir: &Path, c: &Comparison) -> anyhow::Result<Vec<String>> {
         if !bars.iter().any(|(_, p, _)| p.is_some()) || !bars.iter().any(|(_, _, o)| o.is_some()) {
             continue;
         }
-        let name = format!("{}_{}.png", c.key, crate::names::slug(&m.name));
+        let name = format!("{}_{}.png", c.key, crate::results::names::slug(&m.name));
         let path = dir.join(&name);
         let title = format!("{} — {}", c.title, m.name);
         draw_bars(&path, &title, &m.name, &bars)
@@ -527,7 +527,7 @@ mod tests {
     /// Issue 23: markup in a data set's name, in an image's alt text or path, lands as text.
     #[test]
     fn markup_in_a_report_lands_as_text() {
-        use crate::html::{assert_no_live_markup, HOSTILE_NAME};
+        use crate::report::html::{assert_no_live_markup, HOSTILE_NAME};
         let md = format!(
             "# Report\n\n| data set | tets |\n|---|---:|\n| {HOSTILE_NAME} | 3 |\n\n{HOSTILE_NAME}\n\n\
              ![x\" onerror=\"alert(1)](charts/a.png)\n"

@@ -8,12 +8,12 @@
 //!   per-pixel list, largest k needed, pixels needing k > 2 and k > 6, maxima over the 14
 //!   viewpoints; and Fig. 6's maps of where k > 2 and k > 6 are needed.
 //!
-//! Tables 3–5 are written once, by `reproduce/havs.rs` (`tetbench reproduce havs`, or
-//! `tetbench analyze havs RUN_DIR` for finished runs).
-//!
-//! The paper's figures come from its transcribed tables (`reports/papers/havs_table*.csv`,
+//! Each writes what it measured; the comparison with the paper beside it is written by the one
+//! writer of that table, [`super::table1`] and [`super::table2`], which `tetbench reproduce havs`
+//! uses too (Tables 3–5 are `reproduce havs`, or `tetbench analyze havs RUN_DIR` for finished
+//! runs). The paper's figures come from its transcribed tables (`reports/papers/havs_table*.csv`,
 //! provenance in `reports/papers/havs.md`); `tetbench reproduce havs` runs the paper's own data
-//! sets and prints the full comparison.
+//! sets.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -23,21 +23,11 @@ use anyhow::Context as _;
 use rayon::prelude::*;
 use render_core::{fixed_viewpoints, Camera, Optics, Projection, TransferFunction};
 
+use crate::papers::session::{Extra, Measured};
+use crate::papers::table::markdown;
+
 /// What the paper reports that we could verify: its abstract's range of rates.
 pub const PAPER_RATE_RANGE_TETS_PER_SEC: (f64, f64) = (1.0e6, 6.0e6);
-
-/// A cell of a HAVS paper table (`havs_tableN.csv`), `None` where the paper has none.
-fn paper_value(table: &str, row: &str, column: &str) -> Option<f64> {
-    crate::papers::table(table).ok()?.value(row, column)
-}
-
-/// The paper's Table 1 name of one of our sorts.
-fn paper_sort_name(ours: &str) -> Option<&'static str> {
-    ["shellsort", "heapsort", "quicksort"]
-        .into_iter()
-        .find(|n| ours == *n)
-        .or_else(|| ours.contains("one core").then_some("radixsort"))
-}
 
 #[derive(Debug, clap::Args)]
 pub struct SortArgs {
@@ -80,7 +70,7 @@ fn random_keys(n: usize, seed: u64) -> Vec<f32> {
 }
 
 /// Table 1: each sort orders the indices of `n` random keys, `repeats` times; median ms.
-pub fn table1(n: usize, repeats: usize) -> anyhow::Result<Vec<SortRow>> {
+pub fn sort_times(n: usize, repeats: usize) -> anyhow::Result<Vec<SortRow>> {
     use render_core::sort::*;
     let keys = random_keys(n, 0x5eed);
     let mut expect: Vec<u32> = (0..n as u32).collect();
@@ -128,30 +118,26 @@ pub fn table1(n: usize, repeats: usize) -> anyhow::Result<Vec<SortRow>> {
     Ok(rows)
 }
 
-pub fn run_sort(args: SortArgs, _ctx: &super::Context) -> anyhow::Result<()> {
-    let rows = table1(args.keys, args.repeats)?;
+pub fn run_sort(args: SortArgs) -> anyhow::Result<()> {
+    let rows = sort_times(args.keys, args.repeats)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let csv_path = args.out.join("havs_table1.csv");
     let mut w = csv::Writer::from_path(&csv_path)
         .with_context(|| format!("cannot create {}", csv_path.display()))?;
-    w.write_record(["sort", "keys", "ms", "keys_per_sec", "paper_ms"])?;
-    let paper_ms = |name: &str| {
-        paper_sort_name(name).and_then(|p| paper_value("havs_table1", p, "time_ms_sort_1M_floats"))
-    };
+    w.write_record(["sort", "keys", "ms", "keys_per_sec"])?;
     for r in &rows {
         w.write_record([
             r.name.to_string(),
             args.keys.to_string(),
             r.ms.to_string(),
             r.keys_per_sec.to_string(),
-            paper_ms(r.name).map(|v| v.to_string()).unwrap_or_default(),
         ])?;
     }
     w.flush()?;
     let mut md = format!(
         "HAVS Table 1: sorting {} random floats (indices by key), median of {} runs, {} ({} cores).\n\n\
-         | sort | ms (ours) | M keys/s (ours) | ms (paper) |\n|---|---:|---:|---:|\n",
+         | sort | ms (ours) | M keys/s (ours) |\n|---|---:|---:|\n",
         args.keys,
         args.repeats,
         cpu_name(),
@@ -160,18 +146,18 @@ pub fn run_sort(args: SortArgs, _ctx: &super::Context) -> anyhow::Result<()> {
     for r in &rows {
         writeln!(
             md,
-            "| {} | {:.1} | {:.1} | {} |",
+            "| {} | {:.1} | {:.1} |",
             r.name,
             r.ms,
-            r.keys_per_sec / 1e6,
-            paper_ms(r.name)
-                .map(|v| format!("{v:.0}"))
-                .unwrap_or_else(|| "–".into())
+            r.keys_per_sec / 1e6
         )?;
     }
-    md.push_str(
-        "\nPaper: Pentium 4 at 3.2 GHz (reports/papers/havs_table1.csv); it timed shellsort, heapsort, quicksort and the radix sort only.\n",
-    );
+    md.push('\n');
+    let extra = Extra {
+        sorts: rows,
+        ..Extra::default()
+    };
+    md.push_str(&markdown(&super::table1(&extra)));
     let md_path = args.out.join("havs_table1.md");
     std::fs::write(&md_path, &md).with_context(|| format!("cannot write {}", md_path.display()))?;
     println!("{md}");
@@ -222,10 +208,10 @@ pub struct KbufferRow {
     pub worst_viewpoint: String,
 }
 
-pub fn run_kbuffer(args: KbufferArgs, ctx: &super::Context) -> anyhow::Result<()> {
+pub fn run_kbuffer(args: KbufferArgs, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let registry = datasets::registry::Registry::new(ctx.data_dir.clone());
+    let registry = datasets::registry::Registry::new(data_dir);
     let tf = TransferFunction::preset("low-opacity").context("low-opacity preset")?;
     let csv_path = args.out.join("havs_table2.csv");
     let mut w = csv::Writer::from_path(&csv_path)
@@ -276,9 +262,10 @@ pub fn run_kbuffer(args: KbufferArgs, ctx: &super::Context) -> anyhow::Result<()
         }
         w.flush()?;
         if let Some(s) = worst {
-            let path = args
-                .out
-                .join(format!("havs_fig6_{}.png", crate::names::slug(spec)));
+            let path = args.out.join(format!(
+                "havs_fig6_{}.png",
+                crate::results::names::slug(spec)
+            ));
             s.k_map_image()
                 .save(&path)
                 .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
@@ -289,7 +276,7 @@ pub fn run_kbuffer(args: KbufferArgs, ctx: &super::Context) -> anyhow::Result<()
         );
         table.push(row);
     }
-    let md = table2_markdown(&table, args.resolution);
+    let md = table2_markdown(&table, args.resolution, fixed_viewpoints().len());
     let md_path = args.out.join("havs_table2.md");
     std::fs::write(&md_path, &md).with_context(|| format!("cannot write {}", md_path.display()))?;
     println!("{md}");
@@ -343,37 +330,21 @@ pub fn kbuffer_row(
     (row, all, worst.map(|(_, s)| s))
 }
 
-/// Table 2 in the paper's shape (one row per data set, maxima over the 14 viewpoints).
-pub fn table2_markdown(rows: &[KbufferRow], resolution: u32) -> String {
+/// What `analyze kbuffer` measured (one row per data set, maxima over the viewpoints), then,
+/// where any of its data sets is one of the paper's, Table 2 as [`super::table2`] writes it.
+pub fn table2_markdown(rows: &[KbufferRow], resolution: u32, viewpoints: usize) -> String {
     let mut md = format!(
         "HAVS Table 2: k-buffer analysis, faces sorted by centroid distance and rasterised at \
-         {resolution}² into an exact A-buffer; maxima over the 14 viewpoints (6 axes, 8 diagonals). \
+         {resolution}² into an exact A-buffer; maxima over the {viewpoints} viewpoints. \
          \"k needed\": smallest number of k-buffer entries that completes every pixel's sort \
-         exactly. Paper: its data sets are f117, kew, spx2, torso and fighter \
-         (reports/papers/havs_table2.csv; `tetbench reproduce havs` runs them); its values are given \
-         where the data set is one of them, as fragments / max A / max k / k > 2 / k > 6.\n\n\
-         | data set | tets | faces | fragments | max A-buffer list | max k needed | pixels k > 2 | pixels k > 6 | worst view (Fig. 6 map) | paper |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|---|---|\n"
+         exactly.\n\n\
+         | data set | tets | faces | fragments | max A-buffer list | max k needed | pixels k > 2 | pixels k > 6 | worst view (Fig. 6 map) |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---|\n"
     );
     for r in rows {
-        let paper = [
-            "fragments_count",
-            "max_abuffer_list_length",
-            "max_k",
-            "pixels_needing_k_gt_2",
-            "pixels_needing_k_gt_6",
-        ]
-        .map(|c| paper_value("havs_table2", &r.dataset, c));
-        let paper = if paper.iter().all(Option::is_some) {
-            paper
-                .map(|v| format!("{:.0}", v.unwrap_or_default()))
-                .join(" / ")
-        } else {
-            "–".into()
-        };
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {paper} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.dataset,
             r.tets,
             r.faces,
@@ -383,6 +354,28 @@ pub fn table2_markdown(rows: &[KbufferRow], resolution: u32) -> String {
             r.pixels_k_gt2,
             r.pixels_k_gt6,
             r.worst_viewpoint
+        );
+    }
+    md.push('\n');
+    let extra = Extra {
+        kbuffer: rows.to_vec(),
+        kbuffer_views: viewpoints,
+        kbuffer_resolution: resolution,
+        ..Extra::default()
+    };
+    let table = super::table2(&Measured::default(), &extra);
+    let papers_own: Vec<&str> = table.rows.iter().map(|r| r.label.as_str()).collect();
+    if rows
+        .iter()
+        .any(|r| papers_own.contains(&r.dataset.as_str()))
+    {
+        md.push_str(&markdown(&table));
+    } else {
+        let _ = writeln!(
+            md,
+            "None of these is one of the paper's data sets ({}): `tetbench reproduce havs` \
+             measures those and compares them with the paper.",
+            papers_own.join(", ")
         );
     }
     md
@@ -406,7 +399,7 @@ mod tests {
     #[test]
     fn table1_sorts_correctly_and_reports_rates() {
         // Above the parallel threshold, so both radix sorts take their own path.
-        let rows = table1(100_000, 1).unwrap();
+        let rows = sort_times(100_000, 1).unwrap();
         assert_eq!(rows.len(), 6);
         assert!(rows.iter().all(|r| r.keys_per_sec > 0.0 && r.ms >= 0.0));
     }

@@ -2,16 +2,20 @@
 
 use std::path::PathBuf;
 
+pub mod datasets;
+pub mod external;
+pub mod plot;
+
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 
-use crate::algorithms;
+use self::datasets::DatasetsCommand;
 use crate::analyze::{self, AnalyzeCommand};
-use crate::datasets_cmd::{self, DatasetsCommand};
-pub use crate::plan::default_cache_dir;
-use crate::plan::RunPlan;
+use crate::run::matrix::MatrixArgs;
+pub use crate::run::plan::default_cache_dir;
+use crate::run::plan::RunPlan;
+use crate::run::shard::INCOMPLETE;
 use crate::run::{self, RunConfig};
-use crate::shard::INCOMPLETE;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -35,7 +39,7 @@ pub enum AnalyzeAny {
     #[command(flatten)]
     Tool(AnalyzeCommand),
     #[command(flatten)]
-    Paper(crate::reproduce::from_run::PaperAnalysis),
+    Paper(crate::papers::from_run::PaperAnalysis),
 }
 
 #[derive(Debug, Subcommand)]
@@ -53,7 +57,7 @@ pub enum Command {
     Analyze(AnalyzeAny),
     /// Reproduce a paper's tables with one command: runs what they need, then writes
     /// OUT/<paper>/report.md and report.html with the paper's values beside ours.
-    Reproduce(crate::reproduce::Args),
+    Reproduce(crate::papers::reproduce::Args),
     /// Re-render the report (charts, index.html) of an earlier run from its results.json, or
     /// merge shards / runs of several machines: `report --merge DIR… --out OUT`.
     Report {
@@ -106,16 +110,16 @@ pub enum Command {
     /// github-action-benchmark's customSmallerIsBetter (docs/regression.md, "Exports").
     Export {
         #[arg(long, value_enum)]
-        format: crate::export::ExportFormat,
+        format: crate::regress::export::ExportFormat,
         /// The run's output directory (holding results.json).
         results: PathBuf,
     },
     /// Draw comparison charts (speed-error, scaling, resolution, bars, all) from any results,
     /// or run a sweep first (--sweep).
-    Plot(crate::plot_cli::PlotArgs),
+    Plot(crate::cli::plot::PlotArgs),
     /// Renderers in other processes and languages (docs/external-renderers.md): `check`.
     #[command(subcommand)]
-    External(crate::external_cmd::ExternalCommand),
+    External(crate::cli::external::ExternalCommand),
     /// Run two builds (binaries or git revisions) in turns, A B B A …, over one matrix and
     /// compare them with compare's test (docs/regression.md, "A/B").
     Ab(crate::regress::AbArgs),
@@ -138,7 +142,7 @@ pub struct CompareArgs {
     /// Exit with status 3 on a regression (or on any change); 1 means an error or a refused
     /// comparison, 0 neither (docs/regression.md, "Exit codes").
     #[arg(long, value_enum, default_value = "never")]
-    pub fail_on: crate::compare::FailOn,
+    pub fail_on: crate::regress::compare::FailOn,
     /// Compare runs from different adapters on calibration-normalised times.
     #[arg(long)]
     pub normalised: bool,
@@ -157,39 +161,14 @@ pub struct CompareArgs {
     /// What goes to stdout: the terminal table, compare.json, or compare.md (for a pull
     /// request comment). The files are written to --out in every case.
     #[arg(long, value_enum, default_value = "text")]
-    pub format: crate::compare_report::CompareFormat,
+    pub format: crate::regress::compare_report::CompareFormat,
 }
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct RunArgs {
-    /// Comma-separated algorithms (default: all).
-    #[arg(long, value_delimiter = ',', value_name = "LIST")]
-    pub algorithms: Vec<String>,
-    /// Comma-separated data set names, generator specs (box:200k, shell:1m) or files
-    /// (default: the embedded suite, box:10k and shell:10k).
-    #[arg(long, value_delimiter = ',', value_name = "LIST")]
-    pub datasets: Vec<String>,
-    /// `14` (the HAVS tables' fixed viewpoints), `axes`, `diagonals`, `orbit:N`, or names
-    /// such as `+x,-y,+x+y-z` (default 14; the default suite uses 3).
-    #[arg(long, value_name = "SPEC")]
-    pub viewpoints: Option<String>,
-    /// Square viewport size in pixels (default 512; the default suite uses 128).
-    #[arg(long, value_name = "PIXELS")]
-    pub resolution: Option<u32>,
-    /// Transfer function: a preset (low-opacity, high-opacity) or a ParaView colormap JSON file.
-    #[arg(long, value_name = "NAME|FILE", default_value = "low-opacity")]
-    pub tf: String,
-    /// Timed frames per viewpoint in each round (default 10; the default suite uses 1).
-    #[arg(long, value_name = "N")]
-    pub frames: Option<u32>,
-    /// Untimed warm-up frames before them, in each round (default 2; the default suite uses 1).
-    #[arg(long, value_name = "N")]
-    pub warmup: Option<u32>,
-    /// Passes over each data set's variants, so that a row's samples come from separate
-    /// moments (default 1; the default suite uses 3). With more than 1, all variants of a
-    /// data set stay prepared at once.
-    #[arg(long, value_name = "N")]
-    pub rounds: Option<u32>,
+    /// What is measured (shared with `plot --sweep`, `analyze resolution`, `ab` and `bisect`).
+    #[command(flatten)]
+    pub matrix: MatrixArgs,
     /// Output directory (results, images, report). Earlier results there are replaced
     /// (unless --resume). One run at a time: a second run into a busy directory refuses.
     #[arg(long, value_name = "DIR", default_value = "out")]
@@ -198,28 +177,6 @@ pub struct RunArgs {
     /// the results already in --out and measure the rest; refused if the plan differs.
     #[arg(long)]
     pub resume: bool,
-    /// Keep only variants whose settings match, e.g. `variant=linear` or `k=2|6;sort=radix`
-    /// (keys an algorithm lacks are ignored for it).
-    #[arg(long, value_name = "FILTER")]
-    pub settings: Option<String>,
-    /// Run every variant each algorithm offers (what `--settings` selects from) instead of
-    /// the defaults; with `--settings`, every variant that matches it (settings the filter does
-    /// not name are not held to their defaults).
-    #[arg(long)]
-    pub all_variants: bool,
-    /// Skip the reference and the error metrics (timing only).
-    #[arg(long)]
-    pub no_reference: bool,
-    /// Where reference images are cached (default: $TETBENCH_CACHE, else
-    /// $XDG_CACHE_HOME/tetbench, else ~/.cache/tetbench).
-    #[arg(long, value_name = "DIR")]
-    pub cache_dir: Option<PathBuf>,
-    /// Orthographic instead of perspective (30° vertical field of view) projection.
-    #[arg(long)]
-    pub orthographic: bool,
-    /// Point array to use as the scalar (default: the file's first).
-    #[arg(long, value_name = "NAME")]
-    pub scalar: Option<String>,
     /// Do not write the HTML report and charts.
     #[arg(long)]
     pub no_report: bool,
@@ -231,41 +188,16 @@ pub struct RunArgs {
     /// job arrays; merge the parts with `report --merge`.
     #[arg(long, value_name = "i/N")]
     pub shard: Option<String>,
-    /// Skip the backend calibration (and the rows' roofline columns).
-    #[arg(long)]
-    pub no_calibrate: bool,
-    /// Add other packages' renderers as peers: `vtk` (vtk-pt, vtk-raycast, vtk-zsweep through
-    /// VTK's Python package; see scripts/setup-vtk.sh).
-    #[arg(long, value_delimiter = ',', value_name = "LIST")]
-    pub peers: Vec<String>,
-    #[command(flatten)]
-    pub external: crate::external_cmd::ExternalArgs,
 }
 
 impl RunArgs {
     /// The plain run request these arguments describe.
     pub fn to_plan(&self) -> RunPlan {
         RunPlan {
-            algorithms: self.algorithms.clone(),
-            datasets: self.datasets.clone(),
-            viewpoints: self.viewpoints.clone(),
-            resolution: self.resolution,
-            tf: self.tf.clone(),
-            frames: self.frames,
-            warmup: self.warmup,
-            rounds: self.rounds,
-            out: self.out.clone(),
-            settings: self.settings.clone(),
-            no_reference: self.no_reference,
-            cache_dir: self.cache_dir.clone(),
-            orthographic: self.orthographic,
-            scalar: self.scalar.clone(),
             no_report: self.no_report,
             strict: self.strict,
             shard: self.shard.clone(),
-            no_calibrate: self.no_calibrate,
-            peers: self.peers.clone(),
-            external: self.external.clone(),
+            ..self.matrix.plan(self.out.clone())
         }
     }
 
@@ -278,20 +210,6 @@ impl RunArgs {
         let mut config = self.to_plan().to_config(data_dir, command_line)?;
         config.resume = self.resume;
         Ok(config)
-    }
-}
-
-/// The variants `tetbench run` starts from for algorithm `name`: every one it offers with
-/// `--all-variants` (the run then keeps those `filter` accepts), else `--settings`' selection.
-fn run_variants(
-    name: &str,
-    all_variants: bool,
-    filter: &algorithms::SettingsFilter,
-) -> anyhow::Result<Vec<Box<dyn render_core::Renderer>>> {
-    if all_variants {
-        algorithms::all_variants(name)
-    } else {
-        algorithms::selected_variants(name, filter)
     }
 }
 
@@ -315,9 +233,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
         Command::Run(args) => {
             let config = args.to_config(cli.data_dir, command_line)?;
             let filter = config.settings_filter.clone();
-            let outcome = run::run(&config, &|name: &str| {
-                run_variants(name, args.all_variants, &filter)
-            })?;
+            let outcome = run::run(&config, &|name: &str| args.matrix.variants(name, &filter))?;
             println!(
                 "{} rows in {:.1} s; results in {} (open {})",
                 outcome.rows,
@@ -354,15 +270,15 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Datasets(cmd) => datasets_cmd::run(cmd, cli.data_dir),
+        Command::Datasets(cmd) => self::datasets::run(cmd, cli.data_dir),
         Command::Analyze(AnalyzeAny::Tool(cmd)) => analyze::run(
             cmd,
             &analyze::Context {
                 data_dir: cli.data_dir,
             },
         ),
-        Command::Analyze(AnalyzeAny::Paper(cmd)) => crate::reproduce::from_run::run(cmd),
-        Command::Reproduce(args) => crate::reproduce::run(args, cli.data_dir),
+        Command::Analyze(AnalyzeAny::Paper(cmd)) => crate::papers::from_run::run(cmd),
+        Command::Reproduce(args) => crate::papers::reproduce::run(args, cli.data_dir),
         Command::Report {
             dir,
             merge,
@@ -371,7 +287,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
         } => {
             if !merge.is_empty() {
                 let out = out.context("report --merge needs --out OUT")?;
-                let merged = crate::shard::merge(&merge, &out, allow_missing)?;
+                let merged = crate::run::shard::merge(&merge, &out, allow_missing)?;
                 for gap in merged.errors.iter().filter(|e| e.starts_with(INCOMPLETE)) {
                     eprintln!("tetbench: {gap}");
                 }
@@ -392,7 +308,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Compare(args) => {
-            let opt = crate::compare::CompareOptions {
+            let opt = crate::regress::compare::CompareOptions {
                 threshold: args.threshold,
                 alpha: args.alpha,
                 normalised: args.normalised,
@@ -403,9 +319,14 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             };
             anyhow::ensure!(args.threshold >= 1.0, "--threshold must be at least 1");
             anyhow::ensure!(args.drift_limit >= 1.0, "--drift-limit must be at least 1");
-            if crate::compare_report::run_command(&args.base, &args.new, &opt, args.format)? {
+            if crate::regress::compare_report::run_command(
+                &args.base,
+                &args.new,
+                &opt,
+                args.format,
+            )? {
                 // The documented CI gate: status 3 (1 is an error or a refusal).
-                std::process::exit(crate::compare::EXIT_REGRESSION);
+                std::process::exit(crate::regress::compare::EXIT_REGRESSION);
             }
             Ok(())
         }
@@ -421,16 +342,16 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             dirs,
             out,
             threshold,
-        } => crate::history::run_command(&dirs, &out, threshold, 0.05),
+        } => crate::regress::history::run_command(&dirs, &out, threshold, 0.05),
         Command::Export { format, results } => {
-            print!("{}", crate::export::run_command(&results, format)?);
+            print!("{}", crate::regress::export::run_command(&results, format)?);
             Ok(())
         }
-        Command::Plot(args) => crate::plot_cli::run(args, cli.data_dir, command_line),
-        Command::External(cmd) => crate::external_cmd::run(cmd),
+        Command::Plot(args) => crate::cli::plot::run(args, cli.data_dir, command_line),
+        Command::External(cmd) => crate::cli::external::run(cmd),
         Command::Ab(args) => {
             if crate::regress::run_ab_command(args, cli.data_dir)? {
-                std::process::exit(crate::compare::EXIT_REGRESSION);
+                std::process::exit(crate::regress::compare::EXIT_REGRESSION);
             }
             Ok(())
         }
@@ -441,6 +362,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algorithms;
 
     #[test]
     fn cli_definition_is_consistent() {
@@ -468,19 +390,21 @@ mod tests {
         else {
             unreachable!()
         };
-        assert!(run.all_variants);
+        assert!(run.matrix.all_variants);
+        let every_variant = run.matrix;
+        let defaults = MatrixArgs::default();
         let none = algorithms::SettingsFilter::default();
         for name in algorithms::names() {
-            let every = run_variants(name, true, &none).unwrap().len();
+            let every = every_variant.variants(name, &none).unwrap().len();
             assert_eq!(every, algorithms::all_variants(name).unwrap().len());
             assert_eq!(
-                run_variants(name, false, &none).unwrap().len(),
+                defaults.variants(name, &none).unwrap().len(),
                 algorithms::variants(name).unwrap().len()
             );
         }
         assert!(
-            run_variants("havs", true, &none).unwrap().len()
-                > run_variants("havs", false, &none).unwrap().len()
+            every_variant.variants("havs", &none).unwrap().len()
+                > defaults.variants("havs", &none).unwrap().len()
         );
     }
 

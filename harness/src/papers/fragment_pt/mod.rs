@@ -6,11 +6,17 @@
 //! viewpoints; the bucket sort of §3.2, which the method uses while the view changes; shading
 //! not stated, we use the average-scalar mode); Table 2, fps on Blunt and Post beside GATOR and
 //! the ray casters (HARC: `raycast` where built in; HARC PPI and VICP have no tetbench
-//! algorithm).
+//! algorithm). Fig. 8 (performance against viewport size) is `tetbench analyze resolution`
+//! ([`fig8`]).
 
-use super::papers;
-use super::table::{Cell, CompRow, Comparison, Metric};
-use super::{find_including, is_standin, Extra, Measured, Paper, Report, RunSpec, Session};
+use crate::papers::session::{
+    find_including, is_standin, Extra, Measured, Report, RunSpec, Session,
+};
+use crate::papers::table::{Cell, CompRow, Comparison, Metric};
+use crate::papers::transcription;
+use crate::papers::{Paper, PaperModule};
+
+pub mod fig8;
 
 pub const PAPER: Paper = Paper {
     id: "fragment-pt",
@@ -20,8 +26,7 @@ pub const PAPER: Paper = Paper {
     algorithm: "fragment-pt",
     datasets: &["spx", "bluntfin", "comb", "post", "spx2", "fuel", "brain"],
     sections: &["Abstract", "§1", "§2", "§3", "§3.1", "§3.2", "§3.3", "§3.4", "§4", "§5", "Table 1", "Table 1 caption", "Table 2"],
-    reproduce,
-    tables,
+    analyze_about: "Fragment PT (Marroquim et al. 2006) Tables 1–2, bytes per tet and claims from finished runs.",
 };
 
 /// Table 1 rows: paper name → registry name.
@@ -52,24 +57,16 @@ const TABLE2: [(&str, Option<&str>, &str); 5] = [
 /// §4: 16 B per tet texel + 16 B per vertex texel, quoted as about 20 B per tet.
 const PAPER_BYTES_PER_TET: f64 = 20.0;
 
-fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
-    let mut m = Measured::default();
-    let mut x = Extra::default();
-    let registry = datasets::registry::Registry::new(s.data_dir.clone());
-    for (_, d) in DATASETS {
-        match registry.resolve(&s.dataset(d), &datasets::LoadOptions::default()) {
-            Ok(ds) => x.sizes.push((
-                d.to_string(),
-                ds.mesh.num_points() as u64,
-                ds.mesh.num_tets() as u64,
-            )),
-            Err(e) => m
-                .errors
-                .push(format!("data set \"{d}\" could not be loaded: {e}")),
-        }
+/// The fragment PT paper.
+pub struct FragmentPt;
+
+impl PaperModule for FragmentPt {
+    fn paper(&self) -> &'static Paper {
+        &PAPER
     }
-    s.run(
-        &RunSpec {
+
+    fn plan(&self) -> Vec<RunSpec> {
+        let mut plan = vec![RunSpec {
             name: "fragment-pt".into(),
             algorithms: vec!["fragment-pt".into()],
             datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
@@ -77,25 +74,43 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
             resolution: 512,
             tf: None,
             settings: Some(FRAGMENT_SETTINGS.into()),
-        },
-        &mut m,
-    )?;
-    for (label, alg, settings) in TABLE2.iter().skip(1) {
-        let Some(alg) = alg else { continue };
-        s.run(
-            &RunSpec {
-                name: format!("table2-{}", crate::names::slug(label)),
+        }];
+        for (label, alg, settings) in TABLE2.iter().skip(1) {
+            let Some(alg) = alg else { continue };
+            plan.push(RunSpec {
+                name: format!("table2-{}", crate::results::names::slug(label)),
                 algorithms: vec![alg.to_string()],
                 datasets: vec!["bluntfin".into(), "post".into()],
                 viewpoints: "orbit:14".into(),
                 resolution: 512,
                 tf: None,
                 settings: (!settings.is_empty()).then(|| settings.to_string()),
-            },
-            &mut m,
-        )?;
+            });
+        }
+        plan
     }
-    Ok(tables(&m, &x))
+
+    fn analyses(&self, s: &mut Session, m: &mut Measured) -> anyhow::Result<Extra> {
+        let mut x = Extra::default();
+        let registry = datasets::registry::Registry::new(s.data_dir.clone());
+        for (_, d) in DATASETS {
+            match registry.resolve(&s.dataset(d), &datasets::LoadOptions::default()) {
+                Ok(ds) => x.sizes.push((
+                    d.to_string(),
+                    ds.mesh.num_points() as u64,
+                    ds.mesh.num_tets() as u64,
+                )),
+                Err(e) => m
+                    .errors
+                    .push(format!("data set \"{d}\" could not be loaded: {e}")),
+            }
+        }
+        Ok(x)
+    }
+
+    fn tables(&self, m: &Measured, x: &Extra) -> Report {
+        tables(m, x)
+    }
 }
 
 fn want(settings: &str) -> render_core::Settings {
@@ -105,7 +120,7 @@ fn want(settings: &str) -> render_core::Settings {
 pub fn tables(m: &Measured, x: &Extra) -> Report {
     let mut report = Report::default();
     let aggs = m.aggregates();
-    let load = |n: &str| papers::table(n).expect("embedded paper CSV parses (tested)");
+    let load = |n: &str| transcription::table(n).expect("embedded paper CSV parses (tested)");
 
     // Table 1.
     let t = load("fragment-pt_table1");
@@ -207,6 +222,6 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         rows,
         notes: vec![],
     });
-    report.claims = super::evaluate_claims(PAPER.id, m, x);
+    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x);
     report
 }

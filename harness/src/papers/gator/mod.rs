@@ -6,9 +6,10 @@
 //! Fin, Oxygen Post and Delta Wing, sort excluded, averaged over many viewpoints (we use the 14;
 //! the paper's viewport is not stated, we use 512²).
 
-use super::papers;
-use super::table::{Cell, CompRow, Comparison, Metric};
-use super::{find, is_standin, Extra, Measured, Paper, Report, RunSpec, Session};
+use crate::papers::session::{find, is_standin, Extra, Measured, Report, RunSpec, Session};
+use crate::papers::table::{Cell, CompRow, Comparison, Metric};
+use crate::papers::transcription;
+use crate::papers::{Paper, PaperModule};
 
 pub const PAPER: Paper = Paper {
     id: "gator",
@@ -18,8 +19,7 @@ pub const PAPER: Paper = Paper {
     algorithm: "gator-pt",
     datasets: &["bluntfin", "post", "deltawing"],
     sections: &["Abstract", "§1", "§2", "§3", "§3.1", "§3.2", "§3.3", "§3.4", "§3.5", "§4", "§5", "Table 1", "Table 2", "Table 3"],
-    reproduce,
-    tables,
+    analyze_about: "GATOR (Wylie et al. 2002) Tables 1–3 and claims from finished runs.",
 };
 
 /// The paper's data set names → registry names.
@@ -76,7 +76,7 @@ pub fn observed_truth_table(samples: usize) -> Vec<ObservedCase> {
 
 /// The paper's Table 1 rows: test outcomes (None = X, either).
 pub fn paper_rows() -> Vec<[Option<bool>; 4]> {
-    let t = papers::table("gator_table1").expect("embedded paper CSV parses (tested)");
+    let t = transcription::table("gator_table1").expect("embedded paper CSV parses (tested)");
     let cols = ["test1_bool", "test2_bool", "test3_bool", "test4_bool"];
     t.keys()
         .iter()
@@ -140,33 +140,16 @@ pub fn table1_mismatches(observed: &[ObservedCase], rows: &[[Option<bool>; 4]]) 
     out
 }
 
-fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
-    let mut m = Measured::default();
-    let mut x = Extra {
-        truth_table: Some(observed_truth_table(200_000)),
-        ..Default::default()
-    };
-    s.log
-        .push("Table 1: 200,000 random projected tets through the classifier's CPU twin".into());
-    let registry = datasets::registry::Registry::new(s.data_dir.clone());
-    for (_, d) in DATASETS {
-        match registry.resolve(&s.dataset(d), &datasets::LoadOptions::default()) {
-            Ok(ds) => {
-                x.sizes.push((
-                    d.to_string(),
-                    ds.mesh.num_points() as u64,
-                    ds.mesh.num_tets() as u64,
-                ));
-                x.dropped
-                    .push((d.to_string(), ds.mesh.repair.degenerate_dropped as u64));
-            }
-            Err(e) => m
-                .errors
-                .push(format!("data set \"{d}\" could not be loaded: {e}")),
-        }
+/// The GATOR paper.
+pub struct Gator;
+
+impl PaperModule for Gator {
+    fn paper(&self) -> &'static Paper {
+        &PAPER
     }
-    s.run(
-        &RunSpec {
+
+    fn plan(&self) -> Vec<RunSpec> {
+        vec![RunSpec {
             name: "gator".into(),
             algorithms: vec!["gator-pt".into()],
             datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
@@ -174,15 +157,45 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
             resolution: 512,
             tf: None,
             settings: Some("variant=constant|linear".into()),
-        },
-        &mut m,
-    )?;
-    Ok(tables(&m, &x))
+        }]
+    }
+
+    fn analyses(&self, s: &mut Session, m: &mut Measured) -> anyhow::Result<Extra> {
+        let mut x = Extra {
+            truth_table: Some(observed_truth_table(200_000)),
+            ..Default::default()
+        };
+        s.log.push(
+            "Table 1: 200,000 random projected tets through the classifier's CPU twin".into(),
+        );
+        let registry = datasets::registry::Registry::new(s.data_dir.clone());
+        for (_, d) in DATASETS {
+            match registry.resolve(&s.dataset(d), &datasets::LoadOptions::default()) {
+                Ok(ds) => {
+                    x.sizes.push((
+                        d.to_string(),
+                        ds.mesh.num_points() as u64,
+                        ds.mesh.num_tets() as u64,
+                    ));
+                    x.dropped
+                        .push((d.to_string(), ds.mesh.repair.degenerate_dropped as u64));
+                }
+                Err(e) => m
+                    .errors
+                    .push(format!("data set \"{d}\" could not be loaded: {e}")),
+            }
+        }
+        Ok(x)
+    }
+
+    fn tables(&self, m: &Measured, x: &Extra) -> Report {
+        tables(m, x)
+    }
 }
 
 pub fn tables(m: &Measured, x: &Extra) -> Report {
     let mut report = Report::default();
-    let load = |n: &str| papers::table(n).expect("embedded paper CSV parses (tested)");
+    let load = |n: &str| transcription::table(n).expect("embedded paper CSV parses (tested)");
 
     // Table 1: per paper row, the outcomes of the case our classifier numbers as that row,
     // and the triangle counts.
@@ -348,6 +361,6 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         rows,
         notes: vec![],
     });
-    report.claims = super::evaluate_claims(PAPER.id, m, x);
+    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x);
     report
 }

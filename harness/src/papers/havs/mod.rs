@@ -9,9 +9,14 @@
 
 use render_core::TransferFunction;
 
-use super::papers::{self, PaperTable};
-use super::table::{Cell, CompRow, Comparison, Metric};
-use super::{find, find_including, is_standin, Extra, Measured, Paper, Report, RunSpec, Session};
+pub mod analysis;
+
+use crate::papers::session::{
+    find, find_including, is_standin, Extra, Measured, Report, RunSpec, Session,
+};
+use crate::papers::table::{Cell, CompRow, Comparison, Metric};
+use crate::papers::transcription::{self, PaperTable};
+use crate::papers::{Paper, PaperModule};
 
 pub const PAPER: Paper = Paper {
     id: "havs",
@@ -21,8 +26,7 @@ pub const PAPER: Paper = Paper {
     algorithm: "havs",
     datasets: &["f117", "kew", "spx2", "torso", "fighter"],
     sections: &["Abstract", "§1", "§2", "§3", "§3.1", "§3.2", "§3.3", "§4", "§5", "§5.1", "§5.2", "§5.3", "§5.4", "§6", "§7", "Table 1", "Table 2", "Table 3", "Table 4", "Table 5"],
-    reproduce,
-    tables,
+    analyze_about: "HAVS (Callahan et al. 2005) Tables 1–5 and claims from finished runs (Tables 1–2 and the claims on them need `tetbench reproduce havs`: they are CPU analyses, not runs).",
 };
 
 /// Table 2–4 data sets, in the paper's order.
@@ -48,52 +52,17 @@ const TABLE5_ALGORITHMS: [(&str, &str, Option<&str>); 5] = [
 const TABLE2_RESOLUTION: u32 = 512;
 const HAVS_SETTINGS: &str = "k=2|6;sort=cpu-radix;et=off";
 
-fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
-    let mut m = Measured::default();
-    // Table 1: CPU sorts of 1 M floats, median of 5 runs. Not shrunk in quick mode: five sorts
-    // of 1 M floats take seconds, and one run per sort would leave the orderings of Table 1
-    // without a spread.
-    let mut x = Extra {
-        sorts: crate::analyze::havs::table1(1_000_000, 5)?,
-        ..Extra::default()
-    };
-    s.log
-        .push("Table 1: `tetbench analyze sort` (1 M floats)".into());
+/// The HAVS paper.
+pub struct Havs;
 
-    // Table 2: exact A-buffer k analysis. It does not depend on the GPU, so it runs at the
-    // paper's size in every mode (512², the 14 viewpoints): `--quick` and `--resolution`
-    // shrink timed work only.
-    let registry = datasets::registry::Registry::new(s.data_dir.clone());
-    let tf = TransferFunction::preset("low-opacity")
-        .ok_or_else(|| anyhow::anyhow!("the low-opacity preset is missing"))?;
-    let views = render_core::fixed_viewpoints();
-    x.kbuffer_views = views.len();
-    x.kbuffer_resolution = TABLE2_RESOLUTION;
-    for d in DATASETS {
-        match registry.resolve(&s.dataset(d), &datasets::LoadOptions::default()) {
-            Ok(ds) => {
-                let t0 = std::time::Instant::now();
-                let (mut row, _, _) =
-                    crate::analyze::havs::kbuffer_row(d, &ds.mesh, &tf, TABLE2_RESOLUTION, &views);
-                row.dataset = d.to_string();
-                s.log.push(format!(
-                    "Table 2: k analysis of {d} ({} tets), {} viewpoints at {}², {:.0} s",
-                    row.tets,
-                    views.len(),
-                    TABLE2_RESOLUTION,
-                    t0.elapsed().as_secs_f64()
-                ));
-                x.kbuffer.push(row);
-            }
-            Err(e) => m
-                .errors
-                .push(format!("data set \"{d}\" could not be loaded: {e}")),
-        }
+impl PaperModule for Havs {
+    fn paper(&self) -> &'static Paper {
+        &PAPER
     }
 
-    // Tables 3-4 (and the HAVS row of Table 5).
-    s.run(
-        &RunSpec {
+    fn plan(&self) -> Vec<RunSpec> {
+        // Tables 3-4 (and the HAVS row of Table 5).
+        let mut plan = vec![RunSpec {
             name: "havs".into(),
             algorithms: vec!["havs".into()],
             datasets: DATASETS.map(String::from).to_vec(),
@@ -101,25 +70,69 @@ fn reproduce(s: &mut Session) -> anyhow::Result<Report> {
             resolution: 512,
             tf: None,
             settings: Some(HAVS_SETTINGS.into()),
-        },
-        &mut m,
-    )?;
-    // Table 5's other rows.
-    for (label, alg, settings) in TABLE5_ALGORITHMS.iter().skip(1) {
-        s.run(
-            &RunSpec {
-                name: format!("table5-{}", crate::names::slug(label)),
+        }];
+        // Table 5's other rows.
+        for (label, alg, settings) in TABLE5_ALGORITHMS.iter().skip(1) {
+            plan.push(RunSpec {
+                name: format!("table5-{}", crate::results::names::slug(label)),
                 algorithms: vec![alg.to_string()],
                 datasets: TABLE5_DATASETS.map(String::from).to_vec(),
                 viewpoints: "14".into(),
                 resolution: 512,
                 tf: None,
                 settings: settings.map(String::from),
-            },
-            &mut m,
-        )?;
+            });
+        }
+        plan
     }
-    Ok(tables(&m, &x))
+
+    fn analyses(&self, s: &mut Session, m: &mut Measured) -> anyhow::Result<Extra> {
+        // Table 1: CPU sorts of 1 M floats, median of 5 runs. Not shrunk in quick mode: five
+        // sorts of 1 M floats take seconds, and one run per sort would leave the orderings of
+        // Table 1 without a spread.
+        let mut x = Extra {
+            sorts: analysis::sort_times(1_000_000, 5)?,
+            ..Extra::default()
+        };
+        s.log
+            .push("Table 1: `tetbench analyze sort` (1 M floats)".into());
+
+        // Table 2: exact A-buffer k analysis. It does not depend on the GPU, so it runs at the
+        // paper's size in every mode (512², the 14 viewpoints): `--quick` and `--resolution`
+        // shrink timed work only.
+        let registry = datasets::registry::Registry::new(s.data_dir.clone());
+        let tf = TransferFunction::preset("low-opacity")
+            .ok_or_else(|| anyhow::anyhow!("the low-opacity preset is missing"))?;
+        let views = render_core::fixed_viewpoints();
+        x.kbuffer_views = views.len();
+        x.kbuffer_resolution = TABLE2_RESOLUTION;
+        for d in DATASETS {
+            match registry.resolve(&s.dataset(d), &datasets::LoadOptions::default()) {
+                Ok(ds) => {
+                    let t0 = std::time::Instant::now();
+                    let (mut row, _, _) =
+                        analysis::kbuffer_row(d, &ds.mesh, &tf, TABLE2_RESOLUTION, &views);
+                    row.dataset = d.to_string();
+                    s.log.push(format!(
+                        "Table 2: k analysis of {d} ({} tets), {} viewpoints at {}², {:.0} s",
+                        row.tets,
+                        views.len(),
+                        TABLE2_RESOLUTION,
+                        t0.elapsed().as_secs_f64()
+                    ));
+                    x.kbuffer.push(row);
+                }
+                Err(e) => m
+                    .errors
+                    .push(format!("data set \"{d}\" could not be loaded: {e}")),
+            }
+        }
+        Ok(x)
+    }
+
+    fn tables(&self, m: &Measured, x: &Extra) -> Report {
+        tables(m, x)
+    }
 }
 
 fn uncertain(t: &PaperTable, key: &str, col: &str) -> Option<String> {
@@ -130,92 +143,10 @@ fn uncertain(t: &PaperTable, key: &str, col: &str) -> Option<String> {
 pub fn tables(m: &Measured, x: &Extra) -> Report {
     let mut report = Report::default();
     let aggs = m.aggregates();
-    let load = |n: &str| papers::table(n).expect("embedded paper CSV parses (tested)");
+    let load = |n: &str| transcription::table(n).expect("embedded paper CSV parses (tested)");
 
-    // Table 1.
-    let t = load("havs_table1");
-    let our_sort = |paper_name: &str| -> Option<f64> {
-        let prefix = match paper_name {
-            "radixsort" => "radix sort (HAVS §5.1, one core)",
-            other => other,
-        };
-        x.sorts
-            .iter()
-            .find(|r| r.name.starts_with(prefix))
-            .map(|r| r.ms)
-    };
-    let rows: Vec<CompRow> = t
-        .keys()
-        .iter()
-        .map(|k| CompRow {
-            label: k.clone(),
-            standin: false,
-            cells: vec![Cell {
-                paper: t.value(k, "time_ms_sort_1M_floats"),
-                ours: our_sort(k),
-                why_no_ours: our_sort(k).is_none().then(|| "not measured".into()),
-                uncertain: uncertain(&t, k, "time_ms_sort_1M_floats"),
-            }],
-        })
-        .collect();
-    report.comparisons.push(Comparison {
-        key: "table1".into(),
-        title: "Table 1 — CPU time to sort 10⁶ floats (ms)".into(),
-        conditions: "Paper: Pentium 4 3.2 GHz. Ours: the same routines on our CPU, one core for radix sort (§5.1's five-pass LSD sort), median of the runs.".into(),
-        metrics: vec![Metric::new("ms", 1)],
-        rows,
-        notes: vec![],
-    });
-
-    // Table 2.
-    let t = load("havs_table2");
-    let cols = [
-        ("fragments_count", "fragments"),
-        ("max_abuffer_list_length", "max A"),
-        ("max_k", "max k"),
-        ("pixels_needing_k_gt_2", "pixels k>2"),
-        ("pixels_needing_k_gt_6", "pixels k>6"),
-    ];
-    let rows = t
-        .keys()
-        .iter()
-        .map(|k| {
-            let ours = x.kbuffer.iter().find(|r| r.dataset == *k);
-            let val = |c: &str| {
-                ours.map(|r| match c {
-                    "fragments_count" => r.fragments as f64,
-                    "max_abuffer_list_length" => r.max_list as f64,
-                    "max_k" => r.max_k as f64,
-                    "pixels_needing_k_gt_2" => r.pixels_k_gt2 as f64,
-                    _ => r.pixels_k_gt6 as f64,
-                })
-            };
-            CompRow {
-                label: k.clone(),
-                standin: is_standin(k),
-                cells: cols
-                    .iter()
-                    .map(|(c, _)| Cell {
-                        paper: t.value(k, c),
-                        ours: val(c),
-                        why_no_ours: val(c).is_none().then(|| m.why("havs", k)),
-                        uncertain: uncertain(&t, k, c),
-                    })
-                    .collect(),
-            }
-        })
-        .collect();
-    report.comparisons.push(Comparison {
-        key: "table2".into(),
-        title: "Table 2 — k-buffer analysis (exact A-buffer, maxima over the viewpoints)".into(),
-        conditions: format!(
-            "Paper: software A-buffer, 512², maximum over 14 viewpoints. Ours: the CPU model of `tetbench analyze kbuffer`, {}², over {} viewpoint(s). Counts are geometric (no GPU); they can equal the paper's only on the same mesh, camera, viewport, rasterisation rule and face order, so the cells are compared exactly here and claims H3–H5 compare spx2 (the paper's own mesh) within a stated tolerance.",
-            x.kbuffer_resolution, x.kbuffer_views
-        ),
-        metrics: cols.iter().map(|(_, n)| Metric::exact(*n, 0)).collect(),
-        rows,
-        notes: vec![],
-    });
+    report.comparisons.push(table1(x));
+    report.comparisons.push(table2(m, x));
 
     // Table 3: GPU time only (timestamp queries), k = 2 and 6.
     let t = load("havs_table3");
@@ -394,6 +325,99 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     report.notes.push(
         "Rows on f117, kew, torso and fighter are measured on generated stand-ins with the papers' tet counts (non-convex cavities where the originals are; `tetbench datasets list`); spx2 is spx split 1:8 twice, the paper's own mesh. Timings on stand-ins compare sizes, not images.".into(),
     );
-    report.claims = super::evaluate_claims(PAPER.id, m, x);
+    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x);
     report
+}
+
+/// Table 1 from the CPU sorts: the one writer of it, for `reproduce havs` and
+/// `analyze sort` alike.
+pub fn table1(x: &Extra) -> Comparison {
+    let load = |n: &str| transcription::table(n).expect("embedded paper CSV parses (tested)");
+    let t = load("havs_table1");
+    let our_sort = |paper_name: &str| -> Option<f64> {
+        let prefix = match paper_name {
+            "radixsort" => "radix sort (HAVS §5.1, one core)",
+            other => other,
+        };
+        x.sorts
+            .iter()
+            .find(|r| r.name.starts_with(prefix))
+            .map(|r| r.ms)
+    };
+    let rows: Vec<CompRow> = t
+        .keys()
+        .iter()
+        .map(|k| CompRow {
+            label: k.clone(),
+            standin: false,
+            cells: vec![Cell {
+                paper: t.value(k, "time_ms_sort_1M_floats"),
+                ours: our_sort(k),
+                why_no_ours: our_sort(k).is_none().then(|| "not measured".into()),
+                uncertain: uncertain(&t, k, "time_ms_sort_1M_floats"),
+            }],
+        })
+        .collect();
+    Comparison {
+        key: "table1".into(),
+        title: "Table 1 — CPU time to sort 10⁶ floats (ms)".into(),
+        conditions: "Paper: Pentium 4 3.2 GHz. Ours: the same routines on our CPU, one core for radix sort (§5.1's five-pass LSD sort), median of the runs.".into(),
+        metrics: vec![Metric::new("ms", 1)],
+        rows,
+        notes: vec![],
+    }
+}
+
+/// Table 2 from the k-buffer model: the one writer of it, for `reproduce havs` and
+/// `analyze kbuffer` alike.
+pub fn table2(m: &Measured, x: &Extra) -> Comparison {
+    let load = |n: &str| transcription::table(n).expect("embedded paper CSV parses (tested)");
+    let t = load("havs_table2");
+    let cols = [
+        ("fragments_count", "fragments"),
+        ("max_abuffer_list_length", "max A"),
+        ("max_k", "max k"),
+        ("pixels_needing_k_gt_2", "pixels k>2"),
+        ("pixels_needing_k_gt_6", "pixels k>6"),
+    ];
+    let rows = t
+        .keys()
+        .iter()
+        .map(|k| {
+            let ours = x.kbuffer.iter().find(|r| r.dataset == *k);
+            let val = |c: &str| {
+                ours.map(|r| match c {
+                    "fragments_count" => r.fragments as f64,
+                    "max_abuffer_list_length" => r.max_list as f64,
+                    "max_k" => r.max_k as f64,
+                    "pixels_needing_k_gt_2" => r.pixels_k_gt2 as f64,
+                    _ => r.pixels_k_gt6 as f64,
+                })
+            };
+            CompRow {
+                label: k.clone(),
+                standin: is_standin(k),
+                cells: cols
+                    .iter()
+                    .map(|(c, _)| Cell {
+                        paper: t.value(k, c),
+                        ours: val(c),
+                        why_no_ours: val(c).is_none().then(|| m.why("havs", k)),
+                        uncertain: uncertain(&t, k, c),
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    Comparison {
+        key: "table2".into(),
+        title: "Table 2 — k-buffer analysis (exact A-buffer, maxima over the viewpoints)".into(),
+        conditions: format!(
+            "Paper: software A-buffer, 512², maximum over 14 viewpoints. Ours: the CPU model of `tetbench analyze kbuffer`, {}², over {} viewpoint(s). Counts are geometric (no GPU); they can equal the paper's only on the same mesh, camera, viewport, rasterisation rule and face order, so the cells are compared exactly here and claims H3–H5 compare spx2 (the paper's own mesh) within a stated tolerance.",
+            x.kbuffer_resolution, x.kbuffer_views
+        ),
+        metrics: cols.iter().map(|(_, n)| Metric::exact(*n, 0)).collect(),
+        rows,
+        notes: vec![],
+    }
 }

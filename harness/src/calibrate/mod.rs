@@ -6,7 +6,7 @@
 //! triangle blended additively into the target format the algorithms use), compute throughput
 //! (vec4 FMA chains), storage-copy bandwidth (a compute copy between two storage buffers), the
 //! CPU radix sort of `render_core::sort` (HAVS §5.1) in keys/s, and the work-specific ones of
-//! `calibrate_work.rs`: ray steps (a walk through 144-byte cells), splat fragments (a
+//! `work.rs`: ray steps (a walk through 144-byte cells), splat fragments (a
 //! footprint lookup blended into a two-channel float sheet) and render-core's GPU radix sort.
 //! Each figure is the best of five timed repetitions after one warm-up (a roofline wants the
 //! backend's peak, and on a busy machine the best repetition is the one least disturbed), by
@@ -32,9 +32,11 @@ use std::time::Instant;
 use anyhow::Context;
 use render_core::Gpu;
 
-use crate::calibrate_work::best_seconds;
-use crate::machine::MachineInfo;
+use crate::calibrate::work::best_seconds;
+use crate::results::machine::MachineInfo;
 use crate::results::Row;
+
+pub mod work;
 
 /// Bumped whenever a kernel or its size changes (old cache files are then re-measured).
 pub const CALIBRATION_VERSION: u32 = 3;
@@ -48,7 +50,7 @@ const FMA_INVOCATIONS: u64 = 64 * 1024;
 const COPY_BYTES: u64 = 32 << 20;
 const SORT_KEYS: usize = 1 << 20;
 
-pub use crate::machine::Calibration;
+pub use crate::results::machine::Calibration;
 
 fn driver_of(gpu: &Gpu) -> String {
     let a = &gpu.adapter;
@@ -68,7 +70,7 @@ pub fn cache_path(cache_dir: &Path, gpu: &Gpu, machine: &MachineInfo) -> PathBuf
     let hex = blake3::hash(key.as_bytes()).to_hex();
     cache_dir.join("calibration").join(format!(
         "{}-{}.json",
-        crate::names::slug(&gpu.adapter.name),
+        crate::results::names::slug(&gpu.adapter.name),
         &hex[..16]
     ))
 }
@@ -289,10 +291,10 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         "the calibration's radix sort did not sort"
     );
 
-    // 6–8. The work of the counters no generic figure prices (calibrate_work.rs).
-    let ray_steps_per_sec = crate::calibrate_work::ray_steps_per_sec(gpu, &module)?;
-    let splat_fragments_per_sec = crate::calibrate_work::splat_fragments_per_sec(gpu, &module)?;
-    let gpu_sort_keys_per_sec = crate::calibrate_work::gpu_sort_keys_per_sec(gpu)?;
+    // 6–8. The work of the counters no generic figure prices (work.rs).
+    let ray_steps_per_sec = crate::calibrate::work::ray_steps_per_sec(gpu, &module)?;
+    let splat_fragments_per_sec = crate::calibrate::work::splat_fragments_per_sec(gpu, &module)?;
+    let gpu_sort_keys_per_sec = crate::calibrate::work::gpu_sort_keys_per_sec(gpu)?;
 
     Ok(Calibration {
         version: CALIBRATION_VERSION,
@@ -300,7 +302,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         driver: driver_of(gpu),
         cpu_model: machine.cpu_model.clone(),
         cpu_cores: machine.cpu_cores,
-        date_utc: crate::machine::iso8601_utc(std::time::SystemTime::now()),
+        date_utc: crate::results::machine::iso8601_utc(std::time::SystemTime::now()),
         seconds: started.elapsed().as_secs_f64(),
         triangles_per_sec: TRIANGLES as f64 / tri_s,
         fill_fragments_per_sec: (FILL_SIZE as u64 * FILL_SIZE as u64 * FILL_LAYERS) as f64 / fill_s,
@@ -537,10 +539,10 @@ mod tests {
     /// setting (counter names such as `ray_steps` are the only vocabulary).
     #[test]
     fn calibrate_names_no_algorithm() {
-        let source = include_str!("calibrate.rs");
+        let source = include_str!("mod.rs");
         for name in crate::algorithms::names() {
             let quoted = format!("\"{name}\"");
-            assert!(!source.contains(&quoted), "calibrate.rs names {quoted}");
+            assert!(!source.contains(&quoted), "calibrate/mod.rs names {quoted}");
         }
         assert!(!source.contains(concat!(".algo", "rithm")));
         assert!(!source.contains(concat!(".set", "ting")));

@@ -1,7 +1,8 @@
 //! The numbers behind a paper's claims: the run's rows, and for the metrics that are not in
 //! rows, the paper's own CPU analyses (sorts, k-buffer, classifier, data set sizes).
 
-use super::{gator, Extra, Measured};
+use super::gator;
+use super::session::{Extra, Measured};
 use crate::papers::claims::{self, ClaimResult, VariantSpec};
 use crate::papers::verdict::{Sample, Side};
 

@@ -1,4 +1,4 @@
-// Micro-benchmarks of `tetbench calibrate` (see calibrate.rs). Each entry point stresses one
+// Micro-benchmarks of `tetbench calibrate` (see mod.rs). Each entry point stresses one
 // resource and does as little else as possible.
 
 // Small triangles: triangle t lies inside one pixel of a GRID×GRID target without covering its

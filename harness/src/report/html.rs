@@ -11,12 +11,15 @@ use serde::Serialize;
 
 /// The templates, by name, as `{% extends %}` and `{% include %}` find them.
 const TEMPLATES: &[(&str, &str)] = &[
-    ("base.html", include_str!("../templates/base.html")),
-    ("charts.html", include_str!("../templates/charts.html")),
-    ("report.html", include_str!("../templates/report.html")),
-    ("history.html", include_str!("../templates/history.html")),
-    ("compare.html", include_str!("../templates/compare.html")),
-    ("markdown.html", include_str!("../templates/markdown.html")),
+    ("base.html", include_str!("../../templates/base.html")),
+    ("charts.html", include_str!("../../templates/charts.html")),
+    ("report.html", include_str!("../../templates/report.html")),
+    ("history.html", include_str!("../../templates/history.html")),
+    ("compare.html", include_str!("../../templates/compare.html")),
+    (
+        "markdown.html",
+        include_str!("../../templates/markdown.html"),
+    ),
 ];
 
 fn environment() -> &'static minijinja::Environment<'static> {

@@ -1,6 +1,6 @@
-//! What to run, before checking: the plain form of a `tetbench run`, built by the command
-//! line ([`crate::cli::RunArgs`]), the analyses' sweeps, `tetbench reproduce` and
-//! `tetbench plot --sweep`, and turned into a checked [`RunConfig`] by [`RunPlan::to_config`].
+//! What to run, before checking: the matrix ([`MatrixArgs`], built by every command that runs
+//! one) plus where and how to write it, turned into a checked [`RunConfig`] by
+//! [`RunPlan::to_config`]. [`MatrixArgs::plan`] is the one place a plan is built.
 //!
 //! It lives outside `cli` so that the analyses and the paper runs do not depend on the command
 //! line's argument struct (which depends on them to dispatch).
@@ -10,55 +10,21 @@ use std::path::PathBuf;
 use render_core::{Projection, TransferFunction};
 
 use crate::algorithms::{self, SettingsFilter};
+use crate::run::matrix::{MatrixArgs, DEFAULT_TF};
+use crate::run::suite::{self, DEFAULT_SUITE};
 use crate::run::RunConfig;
-use crate::suite::{self, DEFAULT_SUITE};
 
-/// A run as asked for: `None` and empty lists mean "the default" (the default suite's when no
-/// data set is named, the papers' standard otherwise).
-#[derive(Debug, Clone, Default)]
+/// A run as asked for: in the matrix, `None` and empty lists mean "the default" (the default
+/// suite's when no data set is named, the papers' standard otherwise).
+#[derive(Debug, Clone, PartialEq)]
 pub struct RunPlan {
-    /// Algorithms (empty: all of tetbench's own).
-    pub algorithms: Vec<String>,
-    /// Data set names, generator specs or files (empty: the default suite).
-    pub datasets: Vec<String>,
-    /// Viewpoint spec as `--viewpoints`.
-    pub viewpoints: Option<String>,
-    /// Square viewport size in pixels.
-    pub resolution: Option<u32>,
-    /// Transfer function preset or ParaView JSON file.
-    pub tf: String,
-    pub frames: Option<u32>,
-    pub warmup: Option<u32>,
-    /// Passes over each data set's variants (`run --rounds`); `None`: 1, the suite 3.
-    pub rounds: Option<u32>,
+    /// What is measured.
+    pub matrix: MatrixArgs,
     pub out: PathBuf,
-    /// Settings filter as `--settings`.
-    pub settings: Option<String>,
-    pub no_reference: bool,
-    pub cache_dir: Option<PathBuf>,
-    pub orthographic: bool,
-    pub scalar: Option<String>,
     pub no_report: bool,
     pub strict: bool,
     /// `i/N` as `--shard`.
     pub shard: Option<String>,
-    pub no_calibrate: bool,
-    /// Peer groups as `--peers`.
-    pub peers: Vec<String>,
-    /// External renderers as `--external` (docs/external-renderers.md).
-    pub external: crate::external_cmd::ExternalArgs,
-}
-
-impl RunPlan {
-    /// A plan with every default: the low-opacity transfer function, output in `out`, no report.
-    pub fn new(out: PathBuf) -> Self {
-        Self {
-            tf: "low-opacity".into(),
-            out,
-            no_report: true,
-            ..Self::default()
-        }
-    }
 }
 
 /// The reference cache: `--cache-dir`, `$TETBENCH_CACHE`, `$XDG_CACHE_HOME/tetbench`,
@@ -83,7 +49,8 @@ impl RunPlan {
         data_dir: Option<PathBuf>,
         command_line: Vec<String>,
     ) -> anyhow::Result<RunConfig> {
-        let suite_mode = self.datasets.is_empty();
+        let m = &self.matrix;
+        let suite_mode = m.datasets.is_empty();
         let datasets: Vec<String> = if suite_mode {
             DEFAULT_SUITE
                 .datasets
@@ -91,7 +58,7 @@ impl RunPlan {
                 .map(|s| s.to_string())
                 .collect()
         } else {
-            self.datasets
+            m.datasets
                 .iter()
                 .map(|s| s.trim().to_string())
                 .filter(|s| !s.is_empty())
@@ -103,7 +70,7 @@ impl RunPlan {
         let pick = |given: Option<u32>, suite: u32, standard: u32| {
             given.unwrap_or(if suite_mode { suite } else { standard })
         };
-        let viewpoint_spec = self.viewpoints.clone().unwrap_or_else(|| {
+        let viewpoint_spec = m.viewpoints.clone().unwrap_or_else(|| {
             if suite_mode {
                 DEFAULT_SUITE.viewpoints
             } else {
@@ -113,26 +80,26 @@ impl RunPlan {
         });
         let viewpoints = suite::parse_viewpoints(&viewpoint_spec)?;
         let resolution = pick(
-            self.resolution,
+            m.resolution,
             DEFAULT_SUITE.resolution,
             suite::STANDARD_RESOLUTION,
         );
         if !(1..=16384).contains(&resolution) {
             anyhow::bail!("--resolution {resolution}: must be between 1 and 16384 pixels");
         }
-        let frames = pick(self.frames, DEFAULT_SUITE.frames, suite::STANDARD_FRAMES);
+        let frames = pick(m.frames, DEFAULT_SUITE.frames, suite::STANDARD_FRAMES);
         if frames == 0 {
             anyhow::bail!("--frames must be at least 1");
         }
-        let warmup = pick(self.warmup, DEFAULT_SUITE.warmup, suite::STANDARD_WARMUP);
-        let rounds = pick(self.rounds, DEFAULT_SUITE.rounds, suite::STANDARD_ROUNDS);
+        let warmup = pick(m.warmup, DEFAULT_SUITE.warmup, suite::STANDARD_WARMUP);
+        let rounds = pick(m.rounds, DEFAULT_SUITE.rounds, suite::STANDARD_ROUNDS);
         if rounds == 0 {
             anyhow::bail!("--rounds must be at least 1");
         }
 
         let known = algorithms::names();
-        let externals = self.external.specs()?;
-        let mut algorithms: Vec<String> = if self.algorithms.is_empty() {
+        let externals = m.external.specs()?;
+        let mut algorithms: Vec<String> = if m.algorithms.is_empty() {
             // "All" means tetbench's own; peers come with --peers or by name.
             known
                 .iter()
@@ -140,7 +107,7 @@ impl RunPlan {
                 .map(|s| s.to_string())
                 .collect()
         } else {
-            self.algorithms
+            m.algorithms
                 .iter()
                 .map(|s| s.trim().to_string())
                 .filter(|s| !s.is_empty())
@@ -154,12 +121,7 @@ impl RunPlan {
                 );
             }
         }
-        for group in self
-            .peers
-            .iter()
-            .map(|s| s.trim())
-            .filter(|s| !s.is_empty())
-        {
+        for group in m.peers.iter().map(|s| s.trim()).filter(|s| !s.is_empty()) {
             for name in
                 algorithms::peer_group(group).map_err(|e| anyhow::anyhow!("--peers: {e}"))?
             {
@@ -177,9 +139,10 @@ impl RunPlan {
             anyhow::bail!("--algorithms is empty; known: {}", known.join(", "));
         }
 
-        let tf = TransferFunction::load(&self.tf)
-            .map_err(|e| anyhow::anyhow!("--tf {:?}: {e:#}", self.tf))?;
-        let settings_filter = SettingsFilter::parse(self.settings.as_deref().unwrap_or(""))?;
+        let tf_spec = m.tf.clone().unwrap_or_else(|| DEFAULT_TF.to_string());
+        let tf = TransferFunction::load(&tf_spec)
+            .map_err(|e| anyhow::anyhow!("--tf {tf_spec:?}: {e:#}"))?;
+        let settings_filter = SettingsFilter::parse(m.settings.as_deref().unwrap_or(""))?;
         Ok(RunConfig {
             algorithms,
             datasets,
@@ -190,27 +153,27 @@ impl RunPlan {
             frames,
             warmup,
             rounds,
-            tf_spec: self.tf.clone(),
+            tf_spec,
             tf,
-            projection: if self.orthographic {
+            projection: if m.orthographic {
                 Projection::Orthographic
             } else {
                 Projection::default()
             },
-            cache_dir: self
+            cache_dir: m
                 .cache_dir
                 .clone()
                 .unwrap_or_else(|| default_cache_dir(&self.out)),
             out: self.out.clone(),
             data_dir,
-            reference: !self.no_reference,
+            reference: !m.no_reference,
             settings_filter,
-            scalar: self.scalar.clone(),
+            scalar: m.scalar.clone(),
             command_line,
             report: !self.no_report,
             strict: self.strict,
             shard: self.shard.as_deref().map(str::parse).transpose()?,
-            calibrate: !self.no_calibrate,
+            calibrate: !m.no_calibrate,
             resume: false,
             externals,
         })

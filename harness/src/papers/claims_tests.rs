@@ -4,7 +4,11 @@
 
 use super::*;
 use crate::papers::claims::{self, ClaimResult};
+use crate::papers::evidence::evaluate_claims;
+use crate::papers::session::{Extra, Measured};
+use crate::papers::transcription;
 use crate::papers::verdict::Verdict;
+use crate::results::Row;
 
 const ANALYSES: [&str; 4] = [
     "sort-analysis",
@@ -16,7 +20,7 @@ const ANALYSES: [&str; 4] = [
 #[test]
 fn every_claim_names_a_paper_section_data_sets_and_variants_that_exist() {
     let all = claims::all().unwrap();
-    for p in papers() {
+    for p in PAPERS.iter().map(|p| p.paper()) {
         let n = all
             .iter()
             .filter(|c| c.paper == p.id && c.source == claims::Source::Paper)
@@ -24,9 +28,8 @@ fn every_claim_names_a_paper_section_data_sets_and_variants_that_exist() {
         assert!(n >= 3, "{}: {n} claims of the paper's own", p.id);
     }
     for c in &all {
-        let p = papers()
-            .into_iter()
-            .find(|p| p.id == c.paper)
+        let p = find(&c.paper)
+            .map(|p| p.paper())
             .unwrap_or_else(|| panic!("{} {}: unknown paper", c.paper, c.id));
         for part in c.cites.split(" and ") {
             assert!(
@@ -73,9 +76,9 @@ fn every_claim_names_a_paper_section_data_sets_and_variants_that_exist() {
         }
         // Every paper cell a claim compares with exists.
         if let claims::ExpectSpec::PaperCell { table, column } = &c.expect {
-            let t = papers::table(table).unwrap();
+            let t = transcription::table(table).unwrap();
             for d in &c.datasets {
-                let row = papers::paper_name(&c.paper, d).unwrap_or(d);
+                let row = transcription::paper_name(&c.paper, d).unwrap_or(d);
                 assert!(
                     t.value(row, column).is_some(),
                     "{} {}: {table} {row} {column}",
@@ -231,7 +234,7 @@ fn havs_table2_fails_when_a_fragment_is_dropped_past_the_tolerance() {
     // The last count inside the claim's 2 %, then one fragment fewer.
     let edge = (paper as f64 * 0.98).ceil() as u64;
     let x = |fragments: u64| Extra {
-        kbuffer: vec![crate::analyze::havs::KbufferRow {
+        kbuffer: vec![crate::papers::havs::analysis::KbufferRow {
             dataset: "spx2".into(),
             fragments,
             pixels_k_gt2: 10_626,

@@ -1,0 +1,307 @@
+//! What one paper's reproduction works with: the [`Session`] (where it writes, the mode, the
+//! runs it made), a plan's [`RunSpec`], what was [`Measured`] and the CPU analyses' [`Extra`],
+//! the [`Report`] a paper's table writer returns, and the lookups the writers share.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Context as _;
+
+use crate::report::{aggregate, Aggregate};
+use crate::results::machine::MachineInfo;
+use crate::results::{ResultsFile, Row};
+use crate::run::matrix::{MatrixArgs, DEFAULT_TF};
+
+use super::claims::ClaimResult;
+use super::reproduce::SourceState;
+use super::table::Comparison;
+
+/// What a paper module's table writer returns.
+#[derive(Debug, Clone, Default)]
+pub struct Report {
+    pub comparisons: Vec<Comparison>,
+    /// The paper's claims (`reports/papers/claims.csv`), one verdict per data set.
+    pub claims: Vec<ClaimResult>,
+    pub notes: Vec<String>,
+}
+
+/// Whether this build has an algorithm (from the algorithm table).
+pub fn built_in(algorithm: &str) -> bool {
+    crate::algorithms::names().contains(&algorithm)
+}
+
+/// Why an algorithm has no rows: not built in (which issue adds it), or `None` if built.
+pub fn not_built_reason(algorithm: &str) -> Option<String> {
+    (!built_in(algorithm)).then(|| {
+        format!(
+            "algorithm {algorithm} is not built in (this build has: {})",
+            crate::algorithms::names().join(", ")
+        )
+    })
+}
+
+/// One `tetbench run` of a plan.
+#[derive(Debug, Clone)]
+pub struct RunSpec {
+    /// Sub-folder of OUT/<paper>/runs/.
+    pub name: String,
+    pub algorithms: Vec<String>,
+    pub datasets: Vec<String>,
+    /// Viewpoints in the full run (the quick run uses [`QUICK_VIEWPOINTS`]).
+    pub viewpoints: String,
+    pub resolution: u32,
+    /// The transfer function (a preset name); `None` is the suite's `low-opacity`.
+    pub tf: Option<&'static str>,
+    pub settings: Option<String>,
+}
+
+/// The quick mode's viewpoint (one diagonal of the 14), frames and warm-up.
+pub const QUICK_VIEWPOINTS: &str = "+x+y+z";
+pub const QUICK_FRAMES: u32 = 1;
+/// The quick mode divides the paper's viewport side by this (fragments, and so the time of
+/// every rasterising algorithm on a CPU adapter, scale with the pixels).
+pub const QUICK_RESOLUTION_DIVISOR: u32 = 2;
+pub const QUICK_WARMUP: u32 = 1;
+/// The full mode's frames and warm-up (tetbench's standard).
+pub const FULL_FRAMES: u32 = crate::run::suite::STANDARD_FRAMES;
+pub const FULL_WARMUP: u32 = crate::run::suite::STANDARD_WARMUP;
+
+/// Measured rows of one paper plus what could not be measured.
+#[derive(Debug, Clone, Default)]
+pub struct Measured {
+    pub rows: Vec<Row>,
+    /// Per run, the failures that are not one row (a data set that did not load).
+    pub errors: Vec<String>,
+}
+
+impl Measured {
+    pub fn aggregates(&self) -> Vec<Aggregate> {
+        aggregate(&self.rows)
+    }
+
+    /// A counter of the first row of `algorithm` on `dataset` that has it.
+    pub fn counter(&self, algorithm: &str, dataset: &str, name: &str) -> Option<f64> {
+        self.rows
+            .iter()
+            .filter(|r| r.algorithm == algorithm && r.dataset == dataset)
+            .find_map(|r| r.counter(name))
+    }
+
+    /// Why `algorithm` has no value on `dataset`: not built, a failed row's error, a data set
+    /// that did not load, or not measured.
+    pub fn why(&self, algorithm: &str, dataset: &str) -> String {
+        if let Some(r) = not_built_reason(algorithm) {
+            return r;
+        }
+        if let Some(r) = self
+            .rows
+            .iter()
+            .find(|r| r.algorithm == algorithm && r.dataset == dataset && !r.error.is_empty())
+        {
+            return format!("failed: {}", r.error);
+        }
+        if let Some(e) = self
+            .errors
+            .iter()
+            .find(|e| e.contains(&format!("\"{dataset}\"")))
+        {
+            return e.clone();
+        }
+        "not measured in this run".into()
+    }
+}
+
+pub use crate::results::value_of;
+
+/// The aggregate of `algorithm` on `dataset` whose settings include every `want` pair, if
+/// exactly one does: where several variants match, none is taken (the first one found must
+/// never stand for the algorithm silently; the table's plan names the variant).
+pub fn find<'a>(
+    aggs: &'a [Aggregate],
+    algorithm: &str,
+    dataset: &str,
+    pins: &[(&str, &str)],
+) -> Option<&'a Aggregate> {
+    let want = pins
+        .iter()
+        .fold(render_core::Settings::new(), |s, (k, v)| s.with(k, *v));
+    find_including(
+        aggs,
+        algorithm,
+        dataset,
+        &want.retyped(|k| crate::algorithms::describe(algorithm).and_then(|d| d.kind_of(k))),
+    )
+}
+
+/// The one aggregate of `algorithm` on `dataset` whose settings include `want` (`None` when
+/// none or several do).
+pub fn find_including<'a>(
+    aggs: &'a [Aggregate],
+    algorithm: &str,
+    dataset: &str,
+    want: &render_core::Settings,
+) -> Option<&'a Aggregate> {
+    let mut hits = aggs
+        .iter()
+        .filter(|a| a.algorithm == algorithm && a.dataset == dataset && a.settings.includes(want));
+    let first = hits.next()?;
+    hits.next().is_none().then_some(first)
+}
+
+/// The state of one paper's reproduction: where it writes, the mode, and what it ran.
+pub struct Session {
+    pub dir: PathBuf,
+    pub quick: bool,
+    pub data_dir: Option<PathBuf>,
+    pub cache_dir: Option<PathBuf>,
+    pub substitutes: Vec<(String, String)>,
+    pub resolution: Option<u32>,
+    /// The machine of the first run (adapter included), for the conditions.
+    pub machine: Option<MachineInfo>,
+    /// The equivalent `tetbench run` command of every run, and its outcome.
+    pub log: Vec<String>,
+    /// External renderers added to every run (`--external`).
+    pub external: crate::run::matrix::ExternalArgs,
+    /// The commit the binary was built from and whether the tree was clean.
+    pub source: SourceState,
+    /// Set by `tetbench analyze PAPER RUN_DIR`: the runs the tables come from.
+    pub from_run: Option<PathBuf>,
+}
+
+impl Session {
+    /// The data set the plan calls `name` (or its substitute).
+    pub fn dataset(&self, name: &str) -> String {
+        self.substitutes
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, s)| s.clone())
+            .unwrap_or_else(|| name.to_string())
+    }
+
+    /// The viewport of a run: `--resolution`, else the paper's (halved in quick mode).
+    pub fn resolution(&self, paper: u32) -> u32 {
+        self.resolution.unwrap_or(if self.quick {
+            paper / QUICK_RESOLUTION_DIVISOR
+        } else {
+            paper
+        })
+    }
+
+    /// Runs one plan entry with the built-in algorithms it names; rows keep the plan's data
+    /// set names (substitutes are renamed back so the tables find them).
+    pub fn run(&mut self, spec: &RunSpec, measured: &mut Measured) -> anyhow::Result<()> {
+        let algorithms: Vec<String> = spec
+            .algorithms
+            .iter()
+            .filter(|a| built_in(a))
+            .cloned()
+            .collect();
+        for a in spec.algorithms.iter().filter(|a| !built_in(a)) {
+            self.log.push(format!(
+                "run {}: {a} skipped ({})",
+                spec.name,
+                not_built_reason(a).unwrap_or_default()
+            ));
+        }
+        if algorithms.is_empty() {
+            return Ok(());
+        }
+        let viewpoints = if self.quick {
+            QUICK_VIEWPOINTS.to_string()
+        } else {
+            spec.viewpoints.clone()
+        };
+        let datasets: Vec<String> = spec.datasets.iter().map(|d| self.dataset(d)).collect();
+        let out = self.dir.join("runs").join(&spec.name);
+        let matrix = MatrixArgs {
+            algorithms: algorithms.clone(),
+            datasets: datasets.clone(),
+            viewpoints: Some(viewpoints.clone()),
+            resolution: Some(self.resolution(spec.resolution)),
+            tf: Some(spec.tf.unwrap_or(DEFAULT_TF).into()),
+            frames: Some(if self.quick {
+                QUICK_FRAMES
+            } else {
+                FULL_FRAMES
+            }),
+            warmup: Some(if self.quick {
+                QUICK_WARMUP
+            } else {
+                FULL_WARMUP
+            }),
+            settings: spec.settings.clone(),
+            no_reference: self.quick,
+            cache_dir: self.cache_dir.clone(),
+            external: self.external.clone(),
+            ..MatrixArgs::default()
+        };
+        let args = matrix.plan(out.clone());
+        let command = format!(
+            "tetbench run --algorithms {} --datasets {} --viewpoints {viewpoints} --resolution {}{}{}{}",
+            algorithms.join(","),
+            datasets.join(","),
+            self.resolution(spec.resolution),
+            spec.tf.map(|t| format!(" --tf {t}")).unwrap_or_default(),
+            spec.settings
+                .as_ref()
+                .map(|s| format!(" --settings '{s}'"))
+                .unwrap_or_default(),
+            if self.quick {
+                format!(" --frames {QUICK_FRAMES} --warmup {QUICK_WARMUP} --no-reference")
+            } else {
+                String::new()
+            }
+        );
+        let config = args.to_config(self.data_dir.clone(), vec![command.clone()])?;
+        let filter = config.settings_filter.clone();
+        let t0 = Instant::now();
+        let outcome = crate::run::run(&config, &|name: &str| matrix.variants(name, &filter))
+            .with_context(|| format!("run {}", spec.name))?;
+        let file = ResultsFile::read(&out)?;
+        if self.machine.is_none() {
+            self.machine = Some(file.machine.clone());
+        }
+        self.log.push(format!(
+            "run {}: `{command}` — {} rows, {} failed, {:.0} s",
+            spec.name,
+            outcome.rows,
+            outcome.failed_rows,
+            t0.elapsed().as_secs_f64()
+        ));
+        measured.errors.extend(outcome.errors.iter().cloned());
+        for mut row in file.rows {
+            if let Some((plan, _)) = self.substitutes.iter().find(|(_, s)| {
+                crate::results::names::slug(s) == crate::results::names::slug(&row.dataset)
+                    || *s == row.dataset
+            }) {
+                row.dataset = plan.clone();
+            }
+            measured.rows.push(row);
+        }
+        Ok(())
+    }
+}
+
+/// Whether a data set name is a generated stand-in (its rows are marked).
+pub fn is_standin(name: &str) -> bool {
+    datasets::standins::is_generated(name)
+}
+
+/// What a paper measured besides run rows (CPU analyses), shared shape so the tests can call
+/// every table writer alike.
+#[derive(Debug, Clone, Default)]
+pub struct Extra {
+    /// HAVS Table 1: each sort's median, fastest and slowest run.
+    pub sorts: Vec<super::havs::analysis::SortRow>,
+    /// HAVS Table 2 rows.
+    pub kbuffer: Vec<super::havs::analysis::KbufferRow>,
+    /// GATOR Table 1: the classifier's distinct outcomes (`None`: not run).
+    pub truth_table: Option<Vec<super::gator::ObservedCase>>,
+    /// Data set sizes: (plan name, points, tets).
+    pub sizes: Vec<(String, u64, u64)>,
+    /// Zero-volume tets the loader dropped, per data set (plan name, count).
+    pub dropped: Vec<(String, u64)>,
+    /// How many viewpoints and what viewport the k analysis used.
+    pub kbuffer_views: usize,
+    pub kbuffer_resolution: u32,
+}
