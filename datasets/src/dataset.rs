@@ -97,7 +97,7 @@ pub struct LazyDataset {
 #[derive(Debug)]
 enum Content {
     Mesh(Box<Dataset>),
-    Voxels(VoxelVolume),
+    Voxels(Box<VoxelVolume>),
 }
 
 impl From<Dataset> for LazyDataset {
@@ -113,7 +113,7 @@ impl LazyDataset {
     pub fn from_voxels(volume: VoxelVolume, source: impl Into<String>) -> LazyDataset {
         LazyDataset {
             source: source.into(),
-            content: Content::Voxels(volume),
+            content: Content::Voxels(Box::new(volume)),
         }
     }
 

@@ -28,8 +28,8 @@ pub mod write_vtu;
 pub use dataset::{Dataset, LazyDataset, LoadOptions, Plot3dField};
 pub use error::{ErrorKind, LoadError, Location};
 pub use grid::VoxelGrid;
-pub use volume::CellSplit;
-pub use voxel_volume::{CellCover, VoxelVolume};
 pub use mesh::{
     Aabb, BoundaryFace, QualityStats, RepairReport, TetMesh, UniqueFaces, NO_NEIGHBOUR, TET_FACES,
 };
+pub use volume::CellSplit;
+pub use voxel_volume::{CellCover, VoxelVolume};
