@@ -3,8 +3,12 @@
 //! format dispatcher that depends on them.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
+use crate::error::LoadError;
 use crate::grid::VoxelGrid;
+use crate::mesh::Aabb;
+use crate::voxel_volume::VoxelVolume;
 use crate::TetMesh;
 
 /// Which PLOT3D Q quantity becomes the point scalar.
@@ -57,11 +61,12 @@ pub struct LoadOptions {
     pub plot3d_field: Option<Plot3dField>,
 }
 
-/// A loaded data set: always a tet mesh; regular volumes keep their voxel grid too.
+/// A loaded data set: always a tet mesh; regular volumes keep their voxel grid too (shared
+/// with the mesh's [`TetMesh::source_grid`] once [`Dataset::attach_grid`] ran).
 #[derive(Debug, Clone)]
 pub struct Dataset {
     pub mesh: TetMesh,
-    pub volume: Option<VoxelGrid>,
+    pub volume: Option<Arc<VoxelGrid>>,
     /// Where it came from (file path or generator spec).
     pub source: String,
 }
@@ -73,7 +78,116 @@ impl Dataset {
     pub fn attach_grid(&mut self) {
         if let Some(grid) = &self.volume {
             if self.mesh.source_grid.is_none() && grid.num_voxels() == self.mesh.num_points() {
-                self.mesh.source_grid = Some(std::sync::Arc::new(grid.clone()));
+                self.mesh.source_grid = Some(Arc::clone(grid));
+            }
+        }
+    }
+}
+
+/// A data set as a run holds it: a tet mesh, or a voxel volume whose tets are split only when
+/// something asks for them ([`LazyDataset::mesh`]); a voxel renderer takes the volume itself
+/// ([`LazyDataset::voxels`]).
+#[derive(Debug)]
+pub struct LazyDataset {
+    /// Where it came from (file path or generator spec).
+    pub source: String,
+    content: Content,
+}
+
+#[derive(Debug)]
+enum Content {
+    Mesh(Box<Dataset>),
+    Voxels(Box<VoxelVolume>),
+}
+
+impl From<Dataset> for LazyDataset {
+    fn from(ds: Dataset) -> LazyDataset {
+        LazyDataset {
+            source: ds.source.clone(),
+            content: Content::Mesh(Box::new(ds)),
+        }
+    }
+}
+
+impl LazyDataset {
+    pub fn from_voxels(volume: VoxelVolume, source: impl Into<String>) -> LazyDataset {
+        LazyDataset {
+            source: source.into(),
+            content: Content::Voxels(Box::new(volume)),
+        }
+    }
+
+    /// The voxel volume, for a data set that is one (none for a mesh, even one split from a
+    /// grid: its grid is the mesh's [`TetMesh::source_grid`]).
+    pub fn voxels(&self) -> Option<&VoxelVolume> {
+        match &self.content {
+            Content::Voxels(v) => Some(v),
+            Content::Mesh(_) => None,
+        }
+    }
+
+    /// The tet mesh, split from the voxels on first use.
+    pub fn mesh(&self) -> Result<&TetMesh, LoadError> {
+        match &self.content {
+            Content::Mesh(ds) => Ok(&ds.mesh),
+            Content::Voxels(v) => v.mesh().map_err(|k| LoadError::new(&self.source, k)),
+        }
+    }
+
+    /// Whether the tet mesh exists (always for a mesh; for voxels, once [`Self::mesh`] ran).
+    pub fn tets_built(&self) -> bool {
+        match &self.content {
+            Content::Mesh(_) => true,
+            Content::Voxels(v) => v.tets_built(),
+        }
+    }
+
+    pub fn num_points(&self) -> usize {
+        match &self.content {
+            Content::Mesh(ds) => ds.mesh.num_points(),
+            Content::Voxels(v) => v.num_points(),
+        }
+    }
+
+    /// Tets of the mesh, counted without splitting the voxels.
+    pub fn num_tets(&self) -> usize {
+        match &self.content {
+            Content::Mesh(ds) => ds.mesh.num_tets(),
+            Content::Voxels(v) => v.num_tets(),
+        }
+    }
+
+    /// The mesh's [`TetMesh::bounds`], without splitting the voxels.
+    pub fn bounds(&self) -> Aabb {
+        match &self.content {
+            Content::Mesh(ds) => ds.mesh.bounds(),
+            Content::Voxels(v) => v.bounds(),
+        }
+    }
+
+    /// The mesh's [`TetMesh::scalar_range`], without splitting the voxels.
+    pub fn scalar_range(&self) -> (f32, f32) {
+        match &self.content {
+            Content::Mesh(ds) => ds.mesh.scalar_range(),
+            Content::Voxels(v) => v.scalar_range(),
+        }
+    }
+
+    /// The data set with its mesh (split now if it was voxels), sharing the grid.
+    pub fn into_dataset(self) -> Result<Dataset, LoadError> {
+        match self.content {
+            Content::Mesh(ds) => Ok(Dataset {
+                source: self.source,
+                ..*ds
+            }),
+            Content::Voxels(v) => {
+                let volume = Some(Arc::clone(v.grid()));
+                let mesh = v.into_mesh().map_err(|k| LoadError::new(&self.source, k))?;
+                Ok(Dataset {
+                    mesh,
+                    volume,
+                    source: self.source,
+                })
             }
         }
     }

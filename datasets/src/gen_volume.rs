@@ -26,7 +26,8 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use crate::error::{ErrorKind, LoadError};
-use crate::volume::{hex_cell_tets, VoxelGrid};
+use crate::volume::{CellSplit, VoxelGrid};
+use crate::voxel_volume::{CellCover, VoxelVolume};
 use crate::TetMesh;
 
 /// The largest tet split a generated volume may have (16 bytes per tet, plus the checks).
@@ -219,55 +220,38 @@ pub fn volume_grid(spec: &VolumeSpec) -> Result<VoxelGrid, ErrorKind> {
     ))
 }
 
-/// The grid as a tet mesh of its support cells (see the module documentation).
-pub fn volume_mesh(name: &str, grid: VoxelGrid) -> Result<TetMesh, ErrorKind> {
-    let d = grid.dims;
-    let cells = [d[0] - 1, d[1] - 1, d[2] - 1];
-    let support: Vec<[usize; 3]> = (0..cells[2])
-        .into_par_iter()
-        .flat_map_iter(|k| {
-            let grid = &grid;
-            (0..cells[1]).flat_map(move |j| {
-                (0..cells[0])
-                    .filter_map(move |i| grid.cube_has_nonzero_corner(i, j, k).then_some([i, j, k]))
-            })
-        })
-        .collect();
-    if support.len() * 5 > MAX_VOLUME_TETS {
+/// The grid as a voxel data set whose tets split its support cells 5 each (see the module
+/// documentation), refused when that split would exceed [`MAX_VOLUME_TETS`].
+pub fn volume_voxels(name: &str, grid: VoxelGrid) -> Result<VoxelVolume, ErrorKind> {
+    let volume = VoxelVolume::new(name, Arc::new(grid), CellSplit::Five, CellCover::Support)?;
+    if volume.num_tets() > MAX_VOLUME_TETS {
         return Err(ErrorKind::Io(format!(
             "the tet split of this volume would have {} tets, above the {} a generated volume may \
              have; use a smaller grid or a smaller eff",
-            support.len() * 5,
+            volume.num_tets(),
             MAX_VOLUME_TETS
         )));
     }
-    let tets: Vec<[u32; 4]> = support
-        .par_iter()
-        .flat_map_iter(|&[i, j, k]| hex_cell_tets(d, i, j, k))
-        .collect();
-    let points: Vec<[f32; 3]> = (0..grid.num_voxels())
-        .into_par_iter()
-        .map(|g| {
-            grid.point(g % d[0], (g / d[0]) % d[1], g / (d[0] * d[1]))
-                .map(|c| c as f32)
-        })
-        .collect();
-    let mut mesh = TetMesh::new(
-        name,
-        points,
-        grid.values.clone(),
-        grid.scalar_name.clone(),
-        tets,
-    )?;
-    mesh.source_grid = Some(Arc::new(grid));
-    Ok(mesh)
+    Ok(volume)
+}
+
+/// The grid as a tet mesh of its support cells (see the module documentation).
+pub fn volume_mesh(name: &str, grid: VoxelGrid) -> Result<TetMesh, ErrorKind> {
+    volume_voxels(name, grid)?.into_mesh()
+}
+
+/// The voxel data set a volume spec names (its tets not split yet).
+pub fn voxels_from_volume_spec(spec: &str) -> Result<VoxelVolume, LoadError> {
+    let s = parse_volume_spec(spec).map_err(|k| LoadError::new(spec, k))?;
+    let grid = volume_grid(&s).map_err(|k| LoadError::new(spec, k))?;
+    volume_voxels(spec, grid).map_err(|k| LoadError::new(spec, k))
 }
 
 /// Builds the mesh a volume spec names.
 pub fn from_volume_spec(spec: &str) -> Result<TetMesh, LoadError> {
-    let s = parse_volume_spec(spec).map_err(|k| LoadError::new(spec, k))?;
-    let grid = volume_grid(&s).map_err(|k| LoadError::new(spec, k))?;
-    volume_mesh(spec, grid).map_err(|k| LoadError::new(spec, k))
+    voxels_from_volume_spec(spec)?
+        .into_mesh()
+        .map_err(|k| LoadError::new(spec, k))
 }
 
 #[cfg(test)]

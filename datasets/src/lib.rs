@@ -20,13 +20,16 @@ pub mod split;
 pub mod standins;
 pub mod toff;
 pub mod volume;
+pub mod voxel_volume;
 pub mod vtk_legacy;
 pub mod vtk_xml;
 pub mod write_vtu;
 
-pub use dataset::{Dataset, LoadOptions, Plot3dField};
+pub use dataset::{Dataset, LazyDataset, LoadOptions, Plot3dField};
 pub use error::{ErrorKind, LoadError, Location};
 pub use grid::VoxelGrid;
 pub use mesh::{
     Aabb, BoundaryFace, QualityStats, RepairReport, TetMesh, UniqueFaces, NO_NEIGHBOUR, TET_FACES,
 };
+pub use volume::CellSplit;
+pub use voxel_volume::{CellCover, VoxelVolume};

@@ -443,7 +443,7 @@ fn decode(
     mesh.repair.warnings.extend(h.warnings);
     Ok(Dataset {
         mesh,
-        volume: Some(volume),
+        volume: Some(std::sync::Arc::new(volume)),
         source: path.display().to_string(),
     })
 }

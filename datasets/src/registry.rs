@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::dataset::{Dataset, LoadOptions, Plot3dField};
+use crate::dataset::{Dataset, LazyDataset, LoadOptions, Plot3dField};
 use crate::error::{ErrorKind, LoadError};
 
 /// Where public copies of the files live (shown when one is missing).
@@ -213,7 +213,7 @@ impl Registry {
             Source::File(p) => crate::load::load(&p, options),
             Source::Volume => {
                 let mesh = crate::gen_volume::from_volume_spec(key)?;
-                let volume = mesh.source_grid.as_deref().cloned();
+                let volume = mesh.source_grid.clone();
                 Ok(Dataset {
                     mesh,
                     volume,
@@ -227,6 +227,33 @@ impl Registry {
                         ErrorKind::Io("not a stand-in or split modifier".into()),
                     ))
                 }),
+        }
+    }
+
+    /// [`Self::resolve`], leaving generated volumes (`vol:N`, `fuel`, `brain`, the splatting
+    /// stand-ins) as voxels whose tets are split only when something asks for them: what a run
+    /// holds, so that one measuring only voxel renderers never splits them.
+    pub fn resolve_lazy(
+        &self,
+        name_or_path: &str,
+        options: &LoadOptions,
+    ) -> Result<LazyDataset, LoadError> {
+        let key = name_or_path.trim();
+        match self.locate(key)? {
+            Source::Volume => {
+                let volume = crate::gen_volume::voxels_from_volume_spec(key)?;
+                Ok(LazyDataset::from_voxels(volume, key))
+            }
+            Source::StandIn => {
+                crate::standins::resolve_lazy(&|k, o| self.resolve(k, o), key, options)
+                    .unwrap_or_else(|| {
+                        Err(LoadError::new(
+                            key,
+                            ErrorKind::Io("not a stand-in or split modifier".into()),
+                        ))
+                    })
+            }
+            _ => self.resolve(key, options).map(Into::into),
         }
     }
 
@@ -370,5 +397,32 @@ mod tests {
             .resolve("box:lots", &LoadOptions::default())
             .unwrap_err();
         assert!(matches!(err.kind, ErrorKind::Syntax { .. }));
+    }
+
+    #[test]
+    fn volumes_resolve_lazily_and_hold_their_values_once() {
+        let reg = Registry::new(None);
+        let options = LoadOptions::default();
+        for spec in ["vol:12x10x9:eff=200", "fuel"] {
+            let lazy = reg.resolve_lazy(spec, &options).unwrap();
+            let volume = lazy.voxels().expect("a generated volume stays voxels");
+            // Only the volume holds the grid: no split mesh, no second copy.
+            assert_eq!(std::sync::Arc::strong_count(volume.grid()), 1, "{spec}");
+            assert!(!lazy.tets_built(), "{spec}");
+            let eager = reg.resolve(spec, &options).unwrap();
+            assert_eq!(lazy.num_tets(), eager.mesh.num_tets(), "{spec}");
+            assert_eq!(lazy.num_points(), eager.mesh.num_points(), "{spec}");
+            assert_eq!(lazy.bounds(), eager.mesh.bounds(), "{spec}");
+            assert_eq!(lazy.scalar_range(), eager.mesh.scalar_range(), "{spec}");
+            assert_eq!(lazy.mesh().unwrap().tets, eager.mesh.tets, "{spec}");
+            // The eager data set's grid and its mesh's source grid are one allocation.
+            let (grid, source) = (eager.volume.as_ref(), eager.mesh.source_grid.as_ref());
+            assert!(
+                std::sync::Arc::ptr_eq(grid.unwrap(), source.unwrap()),
+                "{spec}"
+            );
+        }
+        let mesh = reg.resolve_lazy("box:1k", &options).unwrap();
+        assert!(mesh.voxels().is_none() && mesh.tets_built());
     }
 }

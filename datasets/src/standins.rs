@@ -13,11 +13,15 @@
 
 use rayon::prelude::*;
 
-use crate::dataset::{Dataset, LoadOptions};
+use std::sync::Arc;
+
+use crate::dataset::{Dataset, LazyDataset, LoadOptions};
 use crate::entry::Entry;
 use crate::error::{ErrorKind, LoadError};
 use crate::generate::{Field, FieldEval};
-use crate::volume::{hex_cell_tets, VoxelGrid};
+pub use crate::volume::kuhn_cell_tets;
+use crate::volume::{hex_cell_tets, split_cells, CellSplit, VoxelGrid};
+use crate::voxel_volume::{CellCover, VoxelVolume};
 use crate::TetMesh;
 
 /// How a data set of this module is made.
@@ -279,15 +283,28 @@ pub fn resolve(
     key: &str,
     options: &LoadOptions,
 ) -> Option<Result<Dataset, LoadError>> {
+    let lazy = resolve_lazy(resolve_base, key, options)?;
+    Some(lazy.and_then(|ds| {
+        let mut ds = ds.into_dataset()?;
+        ds.attach_grid();
+        Ok(ds)
+    }))
+}
+
+/// [`resolve`], leaving the volumes (`fuel`, `brain`, the splatting stand-ins) as voxels whose
+/// tets are split on first use.
+pub fn resolve_lazy(
+    resolve_base: ResolveBase,
+    key: &str,
+    options: &LoadOptions,
+) -> Option<Result<LazyDataset, LoadError>> {
     if let Some((base, modifier)) = key.rsplit_once('@') {
         let levels = crate::split::parse_modifier(modifier)?;
-        return Some(split_dataset(resolve_base, key, base, levels, options));
+        return Some(split_dataset(resolve_base, key, base, levels, options).map(Into::into));
     }
     let s = find(key)?;
     Some(build(resolve_base, s, options).map(|mut ds| {
-        ds.mesh.name = s.name.to_string();
         ds.source = format!("{} ({})", s.name, s.description);
-        ds.attach_grid();
         ds
     }))
 }
@@ -332,7 +349,7 @@ fn build(
     resolve_base: ResolveBase,
     s: &StandIn,
     options: &LoadOptions,
-) -> Result<Dataset, LoadError> {
+) -> Result<LazyDataset, LoadError> {
     let err = |k: ErrorKind| LoadError::new(s.name, k);
     if let Some(want) = &options.scalar {
         if matches!(
@@ -345,19 +362,18 @@ fn build(
             }));
         }
     }
+    let every_cube = |grid: VoxelGrid| {
+        VoxelVolume::new(s.name, Arc::new(grid), CellSplit::Six, CellCover::All)
+            .map(|v| LazyDataset::from_voxels(v, s.name))
+            .map_err(err)
+    };
     match s.recipe {
         Recipe::Split { base, levels } => {
-            split_dataset(resolve_base, s.name, base, levels, options)
+            let mut ds = split_dataset(resolve_base, s.name, base, levels, options)?;
+            ds.mesh.name = s.name.to_string();
+            Ok(ds.into())
         }
-        Recipe::Fuel => {
-            let grid = fuel_volume();
-            let mesh = six_tet_mesh(&grid).map_err(err)?;
-            Ok(Dataset {
-                mesh,
-                volume: Some(grid),
-                source: String::new(),
-            })
-        }
+        Recipe::Fuel => every_cube(fuel_volume()),
         Recipe::Resampled { base, n } => {
             let ds = resolve_base(base, options).map_err(|e| derived_error(s.name, e))?;
             let Some(vol) = ds.volume else {
@@ -365,27 +381,22 @@ fn build(
                     "{base} is not a voxel volume, cannot resample it"
                 ))));
             };
-            let grid = resample_trilinear(&vol, [n; 3]);
-            let mesh = six_tet_mesh(&grid).map_err(err)?;
+            every_cube(resample_trilinear(&vol, [n; 3]))
+        }
+        Recipe::Domain { shape, tets } => {
+            let mut mesh = domain_mesh(shape, tets, seed_of(s.name)).map_err(err)?;
+            mesh.name = s.name.to_string();
             Ok(Dataset {
                 mesh,
-                volume: Some(grid),
+                volume: None,
                 source: String::new(),
-            })
+            }
+            .into())
         }
-        Recipe::Domain { shape, tets } => Ok(Dataset {
-            mesh: domain_mesh(shape, tets, seed_of(s.name)).map_err(err)?,
-            volume: None,
-            source: String::new(),
-        }),
         Recipe::Volume { dims, effective } => {
             let grid = splat_volume(dims, effective, seed_of(s.name));
-            let mesh = volume_tet_mesh(&grid).map_err(err)?;
-            Ok(Dataset {
-                mesh,
-                volume: Some(grid),
-                source: String::new(),
-            })
+            let volume = volume_voxels(s.name, Arc::new(grid)).map_err(err)?;
+            Ok(LazyDataset::from_voxels(volume, s.name))
         }
     }
 }
@@ -394,36 +405,6 @@ fn build(
 fn seed_of(name: &str) -> u64 {
     name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
         (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
-    })
-}
-
-/// The 6 tets of cube (i, j, k) of a grid with `dims` points: Kuhn's split along the diagonal
-/// from the cube's lowest to its highest corner. Every face is cut along the diagonal through
-/// its lowest corner, the same in both cubes that share it, so the mesh conforms. Tets are
-/// emitted positively oriented (the permutation's parity decides the vertex order).
-pub fn kuhn_cell_tets(dims: [usize; 3], i: usize, j: usize, k: usize) -> [[u32; 4]; 6] {
-    let idx = |d: [usize; 3]| (i + d[0] + dims[0] * ((j + d[1]) + dims[1] * (k + d[2]))) as u32;
-    const PERMS: [([usize; 3], bool); 6] = [
-        ([0, 1, 2], true),
-        ([1, 2, 0], true),
-        ([2, 0, 1], true),
-        ([0, 2, 1], false),
-        ([2, 1, 0], false),
-        ([1, 0, 2], false),
-    ];
-    PERMS.map(|(p, even)| {
-        let mut d = [0usize; 3];
-        let c0 = idx(d);
-        d[p[0]] = 1;
-        let c1 = idx(d);
-        d[p[1]] = 1;
-        let c2 = idx(d);
-        let c3 = idx([1, 1, 1]);
-        if even {
-            [c0, c1, c2, c3]
-        } else {
-            [c0, c2, c1, c3]
-        }
     })
 }
 
@@ -447,32 +428,37 @@ pub fn volume_tet_mesh(grid: &VoxelGrid) -> Result<TetMesh, ErrorKind> {
 
 /// [`volume_tet_mesh`] with the full split's limit as a parameter (0: always the support).
 pub fn volume_tet_mesh_within(grid: &VoxelGrid, full_limit: usize) -> Result<TetMesh, ErrorKind> {
+    volume_voxels_within("volume", Arc::new(grid.clone()), full_limit)?.into_mesh()
+}
+
+/// The voxel data set of a generated volume, its tets ([`volume_tet_mesh`]) not split yet.
+pub fn volume_voxels(name: &str, grid: Arc<VoxelGrid>) -> Result<VoxelVolume, ErrorKind> {
+    volume_voxels_within(name, grid, MAX_VOLUME_MESH_TETS)
+}
+
+/// [`volume_voxels`] with the full split's limit as a parameter (0: always the support).
+pub fn volume_voxels_within(
+    name: &str,
+    grid: Arc<VoxelGrid>,
+    full_limit: usize,
+) -> Result<VoxelVolume, ErrorKind> {
     let d = grid.dims;
     let cubes: usize = d.iter().map(|x| x.saturating_sub(1)).product();
     if cubes * 6 <= full_limit {
-        return six_tet_mesh(grid);
+        return VoxelVolume::new(name, grid, CellSplit::Six, CellCover::All);
     }
-    let nonzero = |i, j, k| grid.cube_has_nonzero_corner(i, j, k);
-    let support: usize = (0..d[2] - 1)
-        .into_par_iter()
-        .map(|k| {
-            (0..d[1] - 1)
-                .flat_map(|j| (0..d[0] - 1).map(move |i| (i, j)))
-                .filter(|&(i, j)| nonzero(i, j, k))
-                .count()
-        })
-        .sum();
-    if support * 6 > MAX_SUPPORT_MESH_TETS {
+    let volume = VoxelVolume::new(name, grid, CellSplit::Six, CellCover::Support)?;
+    if volume.num_tets() > MAX_SUPPORT_MESH_TETS {
         return Err(ErrorKind::Invalid(format!(
             "the {}×{}×{} volume's support split would have {} tets (more than \
              {MAX_SUPPORT_MESH_TETS})",
             d[0],
             d[1],
             d[2],
-            support * 6
+            volume.num_tets()
         )));
     }
-    kuhn_mesh(grid, nonzero)
+    Ok(volume)
 }
 
 /// The 6-tet split of the cubes `keep` accepts, with every grid point a mesh point.
@@ -480,37 +466,7 @@ fn kuhn_mesh(
     grid: &VoxelGrid,
     keep: impl Fn(usize, usize, usize) -> bool + Sync,
 ) -> Result<TetMesh, ErrorKind> {
-    let d = grid.dims;
-    let (nx, ny) = (d[0], d[1]);
-    let points: Vec<[f32; 3]> = (0..grid.num_voxels())
-        .into_par_iter()
-        .map(|g| {
-            grid.point(g % nx, (g / nx) % ny, g / (nx * ny))
-                .map(|c| c as f32)
-        })
-        .collect();
-    let c = d.map(|x| x.saturating_sub(1));
-    let tets: Vec<[u32; 4]> = (0..c[2])
-        .into_par_iter()
-        .flat_map_iter(|k| {
-            let mut out = Vec::new();
-            for j in 0..c[1] {
-                for i in 0..c[0] {
-                    if keep(i, j, k) {
-                        out.extend_from_slice(&kuhn_cell_tets(d, i, j, k));
-                    }
-                }
-            }
-            out
-        })
-        .collect();
-    TetMesh::new(
-        "volume",
-        points,
-        grid.values.clone(),
-        grid.scalar_name.clone(),
-        tets,
-    )
+    split_cells(grid, CellSplit::Six, keep)
 }
 
 /// The fuel stand-in: a 64³ grid on [-1,1]³ holding a synthetic jet — fuel entering at the

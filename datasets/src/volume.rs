@@ -220,6 +220,98 @@ pub fn structured_tets(dims: [usize; 3]) -> Vec<[u32; 4]> {
     tets
 }
 
+/// The 6 tets of cube (i, j, k) of a grid with `dims` points: Kuhn's split along the diagonal
+/// from the cube's lowest to its highest corner. Every face is cut along the diagonal through
+/// its lowest corner, the same in both cubes that share it, so the mesh conforms. Tets are
+/// emitted positively oriented (the permutation's parity decides the vertex order).
+pub fn kuhn_cell_tets(dims: [usize; 3], i: usize, j: usize, k: usize) -> [[u32; 4]; 6] {
+    let idx = |d: [usize; 3]| (i + d[0] + dims[0] * ((j + d[1]) + dims[1] * (k + d[2]))) as u32;
+    const PERMS: [([usize; 3], bool); 6] = [
+        ([0, 1, 2], true),
+        ([1, 2, 0], true),
+        ([2, 0, 1], true),
+        ([0, 2, 1], false),
+        ([2, 1, 0], false),
+        ([1, 0, 2], false),
+    ];
+    PERMS.map(|(p, even)| {
+        let mut d = [0usize; 3];
+        let c0 = idx(d);
+        d[p[0]] = 1;
+        let c1 = idx(d);
+        d[p[1]] = 1;
+        let c2 = idx(d);
+        let c3 = idx([1, 1, 1]);
+        if even {
+            [c0, c1, c2, c3]
+        } else {
+            [c0, c2, c1, c3]
+        }
+    })
+}
+
+/// How a grid's cells become tets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CellSplit {
+    /// Five per cell, the two mirror splits alternating ([`hex_cell_tets`]).
+    Five,
+    /// Six per cell around its main diagonal ([`kuhn_cell_tets`]).
+    Six,
+}
+
+impl CellSplit {
+    pub fn tets_per_cell(self) -> usize {
+        match self {
+            CellSplit::Five => 5,
+            CellSplit::Six => 6,
+        }
+    }
+}
+
+/// The tet mesh of the cells (i, j, k) that `keep` accepts, split by `split`, in cell order
+/// (x fastest): every grid point is a mesh point (same order and value, unused ones included),
+/// which is what lets [`TetMesh::source_grid`] stand for them.
+pub fn split_cells(
+    grid: &VoxelGrid,
+    split: CellSplit,
+    keep: impl Fn(usize, usize, usize) -> bool + Sync,
+) -> Result<TetMesh, ErrorKind> {
+    let d = grid.dims;
+    let (nx, ny) = (d[0], d[1]);
+    let points: Vec<[f32; 3]> = (0..grid.num_voxels())
+        .into_par_iter()
+        .map(|g| {
+            grid.point(g % nx, (g / nx) % ny, g / (nx * ny))
+                .map(|c| c as f32)
+        })
+        .collect();
+    let c = d.map(|x| x.saturating_sub(1));
+    let tets: Vec<[u32; 4]> = (0..c[2])
+        .into_par_iter()
+        .flat_map_iter(|k| {
+            let mut out = Vec::new();
+            for j in 0..c[1] {
+                for i in 0..c[0] {
+                    if keep(i, j, k) {
+                        match split {
+                            CellSplit::Five => out.extend_from_slice(&hex_cell_tets(d, i, j, k)),
+                            CellSplit::Six => out.extend_from_slice(&kuhn_cell_tets(d, i, j, k)),
+                        }
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    TetMesh::new(
+        "volume",
+        points,
+        grid.values.clone(),
+        grid.scalar_name.clone(),
+        tets,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

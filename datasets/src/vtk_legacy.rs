@@ -1319,12 +1319,14 @@ impl VtkFile {
             }
         };
 
-        let volume = regular.map(|(dims, origin, spacing)| VoxelGrid {
-            dims,
-            spacing,
-            origin,
-            values: scalars.clone(),
-            scalar_name: scalar_name.clone(),
+        let volume = regular.map(|(dims, origin, spacing)| {
+            std::sync::Arc::new(VoxelGrid {
+                dims,
+                spacing,
+                origin,
+                values: scalars.clone(),
+                scalar_name: scalar_name.clone(),
+            })
         });
         let mut mesh = TetMesh::new(util::stem_name(path), points, scalars, scalar_name, tets)
             .map_err(|k| LoadError::new(path, k))?;

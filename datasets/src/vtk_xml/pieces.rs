@@ -503,7 +503,7 @@ impl<'a> XmlFile<'a> {
             };
             let mut mesh = vg.to_tets().map_err(|k| LoadError::new(self.path, k))?;
             mesh.name = name;
-            (mesh, Some(vg))
+            (mesh, Some(std::sync::Arc::new(vg)))
         } else {
             if image {
                 warnings.push("ImageData with a non-identity Direction: converted to tets only (no voxel grid)".into());

@@ -7,7 +7,9 @@ use super::*;
 pub(super) struct DatasetContext<'a> {
     config: &'a RunConfig,
     gpu: &'a Gpu,
-    mesh: &'a TetMesh,
+    /// A mesh, or voxels split into tets on first need (a variant that draws tets, the
+    /// reference).
+    data: &'a LazyDataset,
     optics: &'a Optics,
     label: String,
     /// Reference image per viewpoint with its PNG path and lost-ray count (or why there is
@@ -29,7 +31,7 @@ fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Ro
         algorithm: renderer.algorithm().to_string(),
         settings: renderer.settings(),
         dataset: ctx.label.clone(),
-        tets: ctx.mesh.num_tets() as u64,
+        tets: ctx.data.num_tets() as u64,
         viewpoint: vp.name.clone(),
         width: c.width,
         height: c.height,
@@ -84,14 +86,14 @@ impl<'a> DatasetContext<'a> {
     pub(super) fn new(
         config: &'a RunConfig,
         gpu: &'a Gpu,
-        mesh: &'a TetMesh,
+        data: &'a LazyDataset,
         optics: &'a Optics,
         label: String,
     ) -> Self {
         DatasetContext {
             config,
             gpu,
-            mesh,
+            data,
             optics,
             label,
             references: HashMap::new(),
@@ -120,9 +122,10 @@ impl<'a> DatasetContext<'a> {
         progress.status(&format!("reference {} {}", self.label, vp.name));
         let (dir, rel) = self.images_dir(vp);
         let cache = &self.config.cache_dir;
-        let (mesh, optics) = (self.mesh, self.optics);
+        let (data, optics) = (self.data, self.optics);
         let prepared = &mut self.reference_mesh;
         let r = guarded("the reference renderer", || {
+            let mesh = data.mesh()?;
             let r = match reference::read_cached_reference(mesh, optics, camera, cache) {
                 Some(r) => r,
                 None => prepared
@@ -163,10 +166,17 @@ impl<'a> DatasetContext<'a> {
         for mut renderer in renderers {
             let what = self.describe(renderer.as_ref());
             progress.activity(&format!("preparing {what}"));
+            // A voxel renderer takes a voxel volume as it is; any other renderer needs the
+            // tets, split on first need outside the prepare's peak (as loading is).
+            let voxels = self.data.voxels().filter(|_| renderer.draws_voxels());
+            if voxels.is_none() {
+                let _ = guarded("splitting the volume into tets", || Ok(self.data.mesh()?));
+            }
             // The first viewpoint's row carries the prepare's peak (host copies of the mesh).
             let peak_reset = reset_host_peak();
-            let prepared = guarded("prepare", || {
-                renderer.prepare(self.gpu, self.mesh, self.optics)
+            let prepared = guarded("prepare", || match voxels {
+                Some(volume) => renderer.prepare_voxels(self.gpu, volume, self.optics),
+                None => renderer.prepare(self.gpu, self.data.mesh()?, self.optics),
             });
             let prepare_peak = host_peak_bytes(peak_reset);
             match prepared {
@@ -267,7 +277,7 @@ impl<'a> DatasetContext<'a> {
         vp: &Viewpoint,
     ) -> anyhow::Result<(Vec<FrameStats>, f64)> {
         let c = self.config;
-        let camera = Camera::fit(&self.mesh.bounds(), vp, c.projection, c.width, c.height);
+        let camera = Camera::fit(&self.data.bounds(), vp, c.projection, c.width, c.height);
         for _ in 0..c.warmup {
             guarded("render", || renderer.render(self.gpu, &camera))?;
         }
@@ -352,7 +362,7 @@ impl<'a> DatasetContext<'a> {
             // A NaN would also make results.json unreadable (JSON has no NaN).
             anyhow::bail!("the renderer reported an impossible frame time: {problem}");
         }
-        let camera = Camera::fit(&self.mesh.bounds(), vp, c.projection, c.width, c.height);
+        let camera = Camera::fit(&self.data.bounds(), vp, c.projection, c.width, c.height);
         let image = guarded("read_image", || renderer.read_image(self.gpu))?;
 
         let total = summarize(&frames.iter().map(|f| f.total_ms).collect::<Vec<_>>())

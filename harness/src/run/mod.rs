@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{anyhow, Context};
-use datasets::TetMesh;
+use datasets::LazyDataset;
 use indicatif::{ProgressBar, ProgressStyle};
 use render_core::{
     Camera, FrameStats, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint,
@@ -430,7 +430,7 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         let t0 = Instant::now();
         let dataset = match guarded("loading", || {
             registry
-                .resolve(spec, &load_options)
+                .resolve_lazy(spec, &load_options)
                 .map_err(|e| anyhow!("{e}"))
         }) {
             Ok(d) => d,
@@ -447,15 +447,22 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
                 continue;
             }
         };
-        let mesh = dataset.mesh;
+        // A voxel volume's tets are counted, not split: only a variant that draws tets (or the
+        // reference) splits them (measure.rs).
         progress.log(&format!(
-            "{label}: {} points, {} tets (loaded in {:.2} s)",
-            mesh.num_points(),
-            mesh.num_tets(),
+            "{label}: {} points, {} tets{} (loaded in {:.2} s)",
+            dataset.num_points(),
+            dataset.num_tets(),
+            if dataset.tets_built() {
+                ""
+            } else {
+                ", not split yet"
+            },
             t0.elapsed().as_secs_f64()
         ));
-        let optics = Optics::for_mesh(config.tf.clone(), &mesh);
-        let mut ctx = DatasetContext::new(config, &gpu, &mesh, &optics, label.clone());
+        let optics =
+            Optics::for_extent(config.tf.clone(), &dataset.bounds(), dataset.scalar_range());
+        let mut ctx = DatasetContext::new(config, &gpu, &dataset, &optics, label.clone());
         let mut renderers = vec![];
         for (name, _) in &plan {
             renderers.extend(factory(name)?.into_iter().filter(|r| {

@@ -4,7 +4,7 @@
 //! [`Renderer::render`] per camera (timings) → [`Renderer::read_image`] (only when the harness
 //! wants the picture, so readback never pollutes the timings).
 
-use datasets::TetMesh;
+use datasets::{TetMesh, VoxelVolume};
 
 use crate::gpu::Gpu;
 use crate::image::Image;
@@ -49,6 +49,24 @@ pub trait Renderer {
 
     /// Uploads the mesh and every view-independent table.
     fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared>;
+
+    /// Whether [`Renderer::prepare_voxels`] draws a voxel data set from its grid alone (the
+    /// splatter): a run then never splits such a data set into tets for this renderer.
+    fn draws_voxels(&self) -> bool {
+        false
+    }
+
+    /// [`Renderer::prepare`] for a voxel data set, without its tets; the same [`Prepared`] and
+    /// the same frames as `prepare` with the volume's split mesh. Only called when
+    /// [`Renderer::draws_voxels`] says so.
+    fn prepare_voxels(
+        &mut self,
+        _gpu: &Gpu,
+        _volume: &VoxelVolume,
+        _optics: &Optics,
+    ) -> anyhow::Result<Prepared> {
+        anyhow::bail!("{} draws tets, not voxels", self.algorithm())
+    }
 
     /// Renders one view into the renderer's own target and waits for the GPU.
     fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats>;

@@ -505,12 +505,17 @@ pub struct Optics {
 
 impl Optics {
     pub fn for_mesh(tf: TransferFunction, mesh: &datasets::TetMesh) -> Optics {
-        let (lo, hi) = mesh.scalar_range();
+        Optics::for_extent(tf, &mesh.bounds(), mesh.scalar_range())
+    }
+
+    /// [`Optics::for_mesh`] from the mesh's bounds and scalar range alone (what a voxel data
+    /// set knows without splitting its tets, `datasets::LazyDataset`).
+    pub fn for_extent(tf: TransferFunction, bounds: &datasets::Aabb, range: (f32, f32)) -> Optics {
         Optics {
             tf,
-            scalar_min: lo as f64,
-            scalar_max: hi as f64,
-            length_unit: mesh.bounds().diagonal(),
+            scalar_min: range.0 as f64,
+            scalar_max: range.1 as f64,
+            length_unit: bounds.diagonal(),
         }
     }
 

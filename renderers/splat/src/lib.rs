@@ -34,7 +34,7 @@ pub mod voxels;
 use std::time::Instant;
 
 use anyhow::{bail, Context};
-use datasets::TetMesh;
+use datasets::{TetMesh, VoxelVolume};
 use render_core::bind::{color_pass, render_target, whole as entry};
 use render_core::gpu_sort::GpuRadixSort;
 use render_core::{
@@ -566,16 +566,16 @@ fn depth_row(camera: &Camera) -> [f32; 4] {
     [v[0][2], v[1][2], v[2][2], v[3][2]]
 }
 
-impl Renderer for Splat {
-    fn algorithm(&self) -> &'static str {
-        "splat"
-    }
-
-    fn settings(&self) -> render_core::Settings {
-        description::settings_of(&self.settings)
-    }
-
-    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+impl Splat {
+    /// Everything `prepare` does once the voxels are chosen: `voxels` makes the set from the
+    /// largest brick's voxel count; `tets` is the data set's tet count (for the row).
+    fn prepare_set(
+        &mut self,
+        gpu: &Gpu,
+        optics: &Optics,
+        tets: usize,
+        voxels: impl FnOnce(usize) -> VoxelSet,
+    ) -> anyhow::Result<Prepared> {
         if !gpu.features.contains(wgpu::Features::FLOAT32_BLENDABLE) {
             bail!(
                 "splat: adapter {} cannot blend into 32-bit float targets (FLOAT32_BLENDABLE)",
@@ -590,7 +590,7 @@ impl Renderer for Splat {
         let binding = gpu.max_storage_binding();
         let cap = (binding / 16) as usize;
         let cap = s.brick.map_or(cap, |b| b.min(cap));
-        let mut set = VoxelSet::new(mesh, optics, s.grid, cap);
+        let mut set = voxels(cap);
         set.border_voxels = set.count_border_voxels(s.radius);
         let table = FootprintTable::new(
             Kernel::new(s.radius, SIGMA),
@@ -737,7 +737,39 @@ impl Renderer for Splat {
         });
         Ok(Prepared {
             persistent_bytes: persistent,
-            tets: mesh.num_tets() as u64,
+            tets: tets as u64,
+        })
+    }
+}
+
+impl Renderer for Splat {
+    fn algorithm(&self) -> &'static str {
+        "splat"
+    }
+
+    fn settings(&self) -> render_core::Settings {
+        description::settings_of(&self.settings)
+    }
+
+    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+        let grid = self.settings.grid;
+        self.prepare_set(gpu, optics, mesh.num_tets(), |cap| {
+            VoxelSet::new(mesh, optics, grid, cap)
+        })
+    }
+
+    fn draws_voxels(&self) -> bool {
+        true
+    }
+
+    fn prepare_voxels(
+        &mut self,
+        gpu: &Gpu,
+        volume: &VoxelVolume,
+        optics: &Optics,
+    ) -> anyhow::Result<Prepared> {
+        self.prepare_set(gpu, optics, volume.num_tets(), |cap| {
+            VoxelSet::from_volume(volume, optics, cap)
         })
     }
 

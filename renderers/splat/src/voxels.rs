@@ -5,7 +5,7 @@
 //! storage binding — the volume is split into octants, each brick drawn on its own in
 //! camera order).
 
-use datasets::{TetMesh, VoxelGrid};
+use datasets::{TetMesh, VoxelGrid, VoxelVolume};
 use rayon::prelude::*;
 use render_core::Optics;
 
@@ -69,9 +69,10 @@ impl VoxelSet {
     /// it). A voxel is effective when κ of its normalised value is > 0. Bricks hold at most
     /// `brick_cap` voxels.
     pub fn new(mesh: &TetMesh, optics: &Optics, grid: usize, brick_cap: usize) -> VoxelSet {
-        let (owned, inside, resampled);
-        let g: &VoxelGrid = match &mesh.source_grid {
-            Some(g) => {
+        let owned;
+        let (g, inside, resampled);
+        match &mesh.source_grid {
+            Some(source) => {
                 let mut used = vec![false; mesh.num_points()];
                 for t in &mesh.tets {
                     for &v in t {
@@ -80,28 +81,55 @@ impl VoxelSet {
                 }
                 inside = used;
                 resampled = false;
-                g
+                g = &**source;
             }
             None => {
                 let (gr, ins) = VoxelGrid::resample_with_inside(mesh, resample_dims(mesh, grid));
                 owned = gr;
                 inside = ins;
                 resampled = true;
-                &owned
+                g = &owned;
             }
         };
+        let grid_points = inside.iter().filter(|&&b| b).count() as u64;
+        VoxelSet::select(g, |i| inside[i], grid_points, resampled, optics, brick_cap)
+    }
+
+    /// The voxels of a voxel data set: the grid points its tets would use
+    /// ([`VoxelVolume::point_is_used`]), without splitting it; the same set as
+    /// [`VoxelSet::new`] with the volume's split mesh.
+    pub fn from_volume(volume: &VoxelVolume, optics: &Optics, brick_cap: usize) -> VoxelSet {
+        let grid_points = volume.footprint().used_points as u64;
+        VoxelSet::select(
+            volume.grid(),
+            |i| volume.point_is_used(i),
+            grid_points,
+            false,
+            optics,
+            brick_cap,
+        )
+    }
+
+    /// The effective voxels of `g` among the points `inside` accepts (`grid_points` of them).
+    fn select(
+        g: &VoxelGrid,
+        inside: impl Fn(usize) -> bool + Sync,
+        grid_points: u64,
+        resampled: bool,
+        optics: &Optics,
+        brick_cap: usize,
+    ) -> VoxelSet {
         let tf = &optics.tf;
+        // κ first: on a large volume most points are empty, and `inside` may cost more.
         let mut chosen: Vec<(f32, u32)> = (0..g.num_voxels())
             .into_par_iter()
-            .filter(|&i| inside[i])
             .filter_map(|i| {
                 let s = optics.normalise(g.values[i] as f64);
-                (tf.kappa_at(s) > 0.0).then_some((s as f32, i as u32))
+                (tf.kappa_at(s) > 0.0 && inside(i)).then_some((s as f32, i as u32))
             })
             .collect();
         // The paper's list of relevant voxels sorted by value (ties by grid index).
         chosen.par_sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let grid_points = inside.iter().filter(|&&b| b).count() as u64;
         let kernel_unit = g.spacing.iter().copied().fold(0.0, f64::max).max(1e-30);
         let density_scale = g.spacing.iter().product::<f64>() / kernel_unit.powi(3);
 
@@ -110,6 +138,7 @@ impl VoxelSet {
         let mut bricks = vec![];
         let mut ordered: Vec<(f32, u32)> = Vec::with_capacity(chosen.len());
         let tree = build(&chosen, [0; 3], dims, cap, dims, &mut bricks, &mut ordered);
+        drop(chosen);
         let voxels: Vec<[f32; 4]> = ordered
             .par_iter()
             .map(|&(s, i)| {
