@@ -188,9 +188,18 @@ fn drain(@builtin(global_invocation_id) g: vec3<u32>) {
     }
     pixels[p].color = st.color;
     let info = pixels[p].info;
-    atomicAdd(&counters[0], info.y);
-    atomicAdd(&counters[1], info.z + st.errors);
-    atomicAdd(&counters[4], info.w);
+    // Only pixels with something to count touch the shared counters: on a small mesh most
+    // pixels are empty, and three contended atomics per pixel of the screen were a fixed cost
+    // of every frame (docs/profile.md).
+    if info.y != 0u {
+        atomicAdd(&counters[0], info.y);
+    }
+    if info.z + st.errors != 0u {
+        atomicAdd(&counters[1], info.z + st.errors);
+    }
+    if info.w != 0u {
+        atomicAdd(&counters[4], info.w);
+    }
 }
 
 fn node_entry(n: vec4<u32>) -> vec2<f32> {
