@@ -256,6 +256,40 @@ impl Camera {
         }
     }
 
+    /// The pixel rectangle `[x0, x1) × [y0, y1)` that holds every pixel centre the box can
+    /// cover (its eight corners projected, widened by a pixel); the whole viewport when a corner
+    /// lies at or behind the eye plane, where the projection of the box is unbounded. Renderers
+    /// with per-pixel passes use it to leave alone the pixels no fragment can reach.
+    pub fn covered_rect(&self, bounds: &Aabb) -> [u32; 4] {
+        let full = [0, 0, self.width, self.height];
+        let vp = self.view_proj();
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for corner in 0..8 {
+            let pick = |axis: usize| {
+                if corner >> axis & 1 == 1 {
+                    bounds.max[axis]
+                } else {
+                    bounds.min[axis]
+                }
+            };
+            let c = vp * DVec4::new(pick(0), pick(1), pick(2), 1.0);
+            if c.w <= 1e-9 * c.truncate().length().max(1.0) {
+                return full;
+            }
+            let x = (c.x / c.w + 1.0) * 0.5 * self.width as f64;
+            let y = (1.0 - c.y / c.w) * 0.5 * self.height as f64;
+            lo = [lo[0].min(x), lo[1].min(y)];
+            hi = [hi[0].max(x), hi[1].max(y)];
+        }
+        let clamp = |v: f64, n: u32| v.clamp(0.0, n as f64) as u32;
+        [
+            clamp(lo[0].floor() - 1.0, self.width),
+            clamp(lo[1].floor() - 1.0, self.height),
+            clamp(hi[0].ceil() + 1.0, self.width),
+            clamp(hi[1].ceil() + 1.0, self.height),
+        ]
+    }
+
     /// Projects a world point to pixel coordinates (x right, y down) and view depth.
     pub fn project_to_pixel(&self, p: [f64; 3]) -> [f64; 3] {
         let c = self.view_proj() * DVec4::new(p[0], p[1], p[2], 1.0);
@@ -271,6 +305,35 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn covered_rect_holds_every_projected_point_and_falls_back_behind_the_eye() {
+        let b = Aabb {
+            min: [-1.0, -0.5, -0.25],
+            max: [1.0, 0.5, 0.25],
+        };
+        for vp in fixed_viewpoints() {
+            let cam = Camera::fit(&b, &vp, Projection::default(), 200, 120);
+            let [x0, y0, x1, y1] = cam.covered_rect(&b);
+            assert!(x0 < x1 && y0 < y1 && x1 <= 200 && y1 <= 120, "{vp:?}");
+            // Points inside the box land inside the rectangle.
+            for i in 0..=4 {
+                for j in 0..=4 {
+                    for k in 0..=4 {
+                        let f =
+                            |t: usize, a: usize| b.min[a] + (b.max[a] - b.min[a]) * t as f64 / 4.0;
+                        let [x, y, _] = cam.project_to_pixel([f(i, 0), f(j, 1), f(k, 2)]);
+                        assert!(x >= x0 as f64 && x <= x1 as f64, "{vp:?} x {x}");
+                        assert!(y >= y0 as f64 && y <= y1 as f64, "{vp:?} y {y}");
+                    }
+                }
+            }
+        }
+        // An eye inside the box: the whole viewport.
+        let mut cam = Camera::fit(&b, &fixed_viewpoints()[0], Projection::default(), 64, 48);
+        cam.eye = [0.5, 0.1, 0.05];
+        assert_eq!(cam.covered_rect(&b), [0, 0, 64, 48]);
+    }
 
     #[test]
     fn fourteen_distinct_viewpoints() {

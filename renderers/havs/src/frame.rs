@@ -278,6 +278,16 @@ impl State {
         }
         let t = self.target.as_ref().expect("target ensured");
         let flags = (s.tags == TagScheme::Two) as u32 | ((s.early_termination as u32) << 1);
+        // The per-pixel passes (k-buffer clear, drain) cover the rows and columns the mesh can
+        // reach, rounded up to whole 8×8 workgroups; no fragment lands outside, and `pixels`
+        // (the image) is still cleared whole. Rows left out keep stale k-buffer entries, which
+        // no pass of this frame reads, and a later frame clears the rows it uses.
+        let [x0, y0, x1, y1] = camera.covered_rect(&self.bounds);
+        let groups = (
+            x1.saturating_sub(x0).div_ceil(8),
+            y1.saturating_sub(y0).div_ceil(8),
+        );
+        let rows = y0..(y0 + 8 * groups.1).min(t.height);
         for (range, ub) in self.chunks.iter().zip(&self.uniforms) {
             let u = Uniforms {
                 view_proj: camera.view_proj_f32(),
@@ -292,7 +302,9 @@ impl State {
                 n_l: self.n_l as f32,
                 node_capacity: t.node_capacity.min(u32::MAX as u64) as u32,
                 et_alpha: kbuffer::EARLY_TERMINATION_ALPHA,
-                _pad: [0; 3],
+                rect_x0: x0,
+                rect_y0: y0,
+                _pad: 0,
             };
             gpu.queue.write_buffer(ub, 0, bytemuck::bytes_of(&u));
         }
@@ -329,9 +341,18 @@ impl State {
         }
         enc.clear_buffer(&t.pixels, 0, None);
         enc.clear_buffer(&self.counters, 0, None);
-        match s.mode {
-            Mode::FragmentRace => enc.clear_buffer(&t.kentries, 0, None),
-            Mode::RaceFree => enc.clear_buffer(&t.heads, 0, None),
+        // Bytes per pixel: k entries of 8 bytes (fragment race), one list head of 4 (race free).
+        let (per_pixel, rows_buffer) = match s.mode {
+            Mode::FragmentRace => (s.k as u64 * 8, &t.kentries),
+            Mode::RaceFree => (4, &t.heads),
+        };
+        let row_bytes = t.width as u64 * per_pixel;
+        if !rows.is_empty() {
+            enc.clear_buffer(
+                rows_buffer,
+                rows.start as u64 * row_bytes,
+                Some(rows.len() as u64 * row_bytes),
+            );
         }
         {
             let mut pass = render_core::bind::color_pass(
@@ -356,7 +377,9 @@ impl State {
             });
             pass.set_pipeline(&self.drain_pipeline);
             pass.set_bind_group(0, &t.bind_groups[0], &[]);
-            pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
+            if groups.0 > 0 && groups.1 > 0 {
+                pass.dispatch_workgroups(groups.0, groups.1, 1);
+            }
         }
         self.timer.end(&mut enc);
         clock.submit(gpu, [enc.finish()]);

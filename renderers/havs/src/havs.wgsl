@@ -28,8 +28,10 @@ struct Uniforms {
     node_capacity: u32,
     // Opacity at which early ray termination stops a pixel.
     et_alpha: f32,
-    _pad0: u32,
-    _pad1: u32,
+    // First column and row of the per-pixel passes: the drain (or list resolve) covers only
+    // the rectangle of the screen the mesh can reach, from here (`Camera::covered_rect`).
+    rect_x0: u32,
+    rect_y0: u32,
     _pad2: u32,
 }
 
@@ -178,10 +180,12 @@ fn fs_append(in: VOut, @builtin(front_facing) front_facing: bool) -> @location(0
 // Faithful mode, screen pass after the last face: drain what each k-buffer still holds.
 @compute @workgroup_size(8, 8)
 fn drain(@builtin(global_invocation_id) g: vec3<u32>) {
-    if g.x >= u.width || g.y >= u.height {
+    let x = g.x + u.rect_x0;
+    let y = g.y + u.rect_y0;
+    if x >= u.width || y >= u.height {
         return;
     }
-    let p = g.y * u.width + g.x;
+    let p = y * u.width + x;
     var st = load_state(p);
     if !(early_termination() && st.color.a >= u.et_alpha) {
         kb_drain(&st, two_tags());
@@ -209,10 +213,12 @@ fn node_entry(n: vec4<u32>) -> vec2<f32> {
 // Race-free mode, pass 2: each pixel's fragments in submission order through the k-buffer.
 @compute @workgroup_size(8, 8)
 fn resolve_lists(@builtin(global_invocation_id) g: vec3<u32>) {
-    if g.x >= u.width || g.y >= u.height {
+    let x = g.x + u.rect_x0;
+    let y = g.y + u.rect_y0;
+    if x >= u.width || y >= u.height {
         return;
     }
-    let p = g.y * u.width + g.x;
+    let p = y * u.width + x;
     var st: KState;
     st.color = vec4<f32>(0.0);
     st.last_back = 0.0;

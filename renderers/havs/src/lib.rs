@@ -227,7 +227,9 @@ struct Uniforms {
     n_l: f32,
     node_capacity: u32,
     et_alpha: f32,
-    _pad: [u32; 3],
+    rect_x0: u32,
+    rect_y0: u32,
+    _pad: u32,
 }
 
 #[repr(C)]
@@ -246,7 +248,7 @@ pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
     vec![
         render_core::rust_layout!(Uniforms => "havs.wgsl::Uniforms" {
             view_proj, eye, forward, width, height, flags, base_face, max_len, n_s, n_l,
-            node_capacity, et_alpha, _pad
+            node_capacity, et_alpha, rect_x0, rect_y0, _pad
         }),
         render_core::rust_layout!(KeyUniforms => "keys.wgsl::KeyUniforms" { eye, forward, faces, _pad }),
     ]
@@ -281,6 +283,8 @@ struct State {
     num_faces: u64,
     /// Face centroids for the CPU sort.
     centroids: Vec<[f32; 3]>,
+    /// The mesh's bounding box: the per-pixel passes cover only its screen rectangle.
+    bounds: datasets::Aabb,
     order: wgpu::Buffer,
     /// Face ranges of the order buffer that fit one storage binding each.
     chunks: Vec<std::ops::Range<u64>>,
@@ -598,6 +602,7 @@ impl Renderer for Havs {
             faces: faces_buf,
             num_faces,
             centroids,
+            bounds: mesh.bounds(),
             order,
             chunks,
             uniforms,
