@@ -14,7 +14,6 @@
 //!   than the threshold factor is not one.
 //! - Runs of different adapters are refused: a step between two machines is not a change.
 
-use render_core::Settings;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -22,6 +21,7 @@ use anyhow::Context;
 use serde::Serialize;
 
 use crate::regress::compare::{adapter_of, CompareOptions, FailOn, Verdict};
+use crate::results::aggregate::GroupKey;
 use crate::results::stats::{median, quantile};
 use crate::results::{ResultsFile, Row};
 
@@ -64,11 +64,8 @@ pub struct History {
     pub series: Vec<Series>,
 }
 
-fn group_rows<'a>(f: &'a ResultsFile, g: &(String, Settings, String)) -> Vec<&'a Row> {
-    f.rows
-        .iter()
-        .filter(|r| (&r.algorithm, &r.settings, &r.dataset) == (&g.0, &g.1, &g.2) && r.ok())
-        .collect()
+fn group_rows<'a>(f: &'a ResultsFile, g: &GroupKey) -> Vec<&'a Row> {
+    f.rows.iter().filter(|r| g.matches(r) && r.ok()).collect()
 }
 
 /// Pooled frames of a group, each divided by `scale(row)`.
@@ -211,12 +208,12 @@ pub fn history(
             &w[0].0, &w[1].0, &opt,
         )?));
     }
-    let mut groups: Vec<(String, Settings, String)> = vec![];
+    // The reports' groups (variant × data set × viewport), matched across the runs.
+    let mut groups: Vec<GroupKey> = vec![];
     for (_, f) in &files {
         for r in &f.rows {
-            let g = (r.algorithm.clone(), r.settings.clone(), r.dataset.clone());
-            if !groups.contains(&g) {
-                groups.push(g);
+            if !groups.iter().any(|g| g.matches(r)) {
+                groups.push(GroupKey::of(r));
             }
         }
     }
@@ -244,7 +241,8 @@ pub fn history(
                 .filter(|_| points.last().is_some_and(|p| p.run + 1 == i))
             {
                 if let Some(gc) = cmp.groups.iter().find(|c| {
-                    (&c.algorithm, &c.settings, &c.dataset) == (&g.0, &g.1.to_string(), &g.2)
+                    (&c.algorithm, &c.settings, &c.dataset)
+                        == (&g.algorithm, &g.settings.to_string(), &g.dataset)
                 }) {
                     match gc.total.verdict {
                         Verdict::Slower => changes.push(format!("slower ×{:.3}", gc.total.ratio)),
@@ -254,7 +252,8 @@ pub fn history(
                     }
                 }
                 let rows_here = cmp.rows.iter().filter(|r| {
-                    (&r.algorithm, &r.settings, &r.dataset) == (&g.0, &g.1.to_string(), &g.2)
+                    (&r.algorithm, &r.settings, &r.dataset)
+                        == (&g.algorithm, &g.settings.to_string(), &g.dataset)
                 });
                 let mut psnr_moved = false;
                 let mut memory = false;
@@ -304,9 +303,9 @@ pub fn history(
             points[s].step = Some(median(&values[s..end]) / median(&values[prev_start..s]));
         }
         series.push(Series {
-            algorithm: g.0,
-            settings: g.1.to_string(),
-            dataset: g.2,
+            algorithm: g.algorithm.clone(),
+            settings: g.settings.to_string(),
+            dataset: g.dataset.clone(),
             points,
         });
     }
