@@ -373,6 +373,15 @@ pub fn run_command(
     })
 }
 
+/// The colour a verdict's strip gets in the ratio plots.
+fn direction(verdict: Verdict) -> Direction {
+    match verdict {
+        Verdict::Slower => Direction::Slower,
+        Verdict::Faster => Direction::Faster,
+        _ => Direction::Neither,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -483,14 +492,5 @@ mod tests {
         ] {
             assert!(tmp.path().join("ac").join(f).is_file(), "{f}");
         }
-    }
-}
-
-/// The colour a verdict's strip gets in the ratio plots.
-fn direction(verdict: Verdict) -> Direction {
-    match verdict {
-        Verdict::Slower => Direction::Slower,
-        Verdict::Faster => Direction::Faster,
-        _ => Direction::Neither,
     }
 }
