@@ -5,9 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::{anyhow, Context};
-use plotters::prelude::*;
-use plotters::style::FontStyle;
+use anyhow::Context;
 
 /// How a metric is compared with the paper's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -306,20 +304,10 @@ pub fn markdown_to_html(md: &str, title: &str) -> anyhow::Result<String> {
     )
 }
 
-const FONT: &str = "DejaVu Sans";
-
-fn register_font() {
-    static ONCE: std::sync::Once = std::sync::Once::new();
-    ONCE.call_once(|| {
-        let _ = plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
-    });
-}
-
 /// Bar charts paper vs ours, one PNG per metric of `c` that has values on both sides, on a
 /// log scale (papers' GPUs and ours differ by orders of magnitude). Returns the file names
 /// written (relative to `dir`).
 pub fn write_charts(dir: &Path, c: &Comparison) -> anyhow::Result<Vec<String>> {
-    register_font();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut written = vec![];
     for (mi, m) in c.metrics.iter().enumerate() {
@@ -351,125 +339,11 @@ pub fn write_charts(dir: &Path, c: &Comparison) -> anyhow::Result<Vec<String>> {
         let name = format!("{}_{}.png", c.key, crate::results::names::slug(&m.name));
         let path = dir.join(&name);
         let title = format!("{} — {}", c.title, m.name);
-        draw_bars(&path, &title, &m.name, &bars)
+        crate::plot::paper_bars::draw(&path, &title, &m.name, &bars)
             .with_context(|| format!("writing {}", path.display()))?;
         written.push(name);
     }
     Ok(written)
-}
-
-/// An axis value in few characters: 1.5M, 230k, 12, 0.05.
-fn compact(v: f64) -> String {
-    let a = v.abs();
-    if a >= 1e6 {
-        format!("{}M", trim(v / 1e6))
-    } else if a >= 1e3 {
-        format!("{}k", trim(v / 1e3))
-    } else {
-        trim(v)
-    }
-}
-
-fn trim(v: f64) -> String {
-    let s = format!("{v:.3}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    s.to_string()
-}
-
-fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("drawing a chart: {e:?}")
-}
-
-fn draw_bars(
-    path: &Path,
-    title: &str,
-    y_desc: &str,
-    bars: &[(String, Option<f64>, Option<f64>)],
-) -> anyhow::Result<()> {
-    let values = bars.iter().flat_map(|(_, p, o)| [*p, *o]).flatten();
-    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
-    let (lo, hi) = (lo / 2.0, hi * 2.0);
-    let width = (160 + 90 * bars.len()).clamp(500, 1400) as u32;
-    let root = BitMapBackend::new(path, (width, 420)).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    let short: String = title.chars().take(90).collect();
-    let n = bars.len() as f64;
-    // Group i is centred on x = i, so the axis' integer ticks carry the row labels.
-    let mut chart = ChartBuilder::on(&root)
-        .caption(short, (FONT, 16).into_font())
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(-0.5..n - 0.5, (lo..hi).log_scale())
-        .map_err(err)?;
-    let labels: Vec<String> = bars.iter().map(|b| b.0.clone()).collect();
-    chart
-        .configure_mesh()
-        .disable_x_mesh()
-        .light_line_style(WHITE)
-        .x_labels(bars.len() + 1)
-        .x_label_formatter(&|x| {
-            let i = x.round();
-            if (x - i).abs() < 1e-6 && i >= 0.0 {
-                labels.get(i as usize).cloned().unwrap_or_default()
-            } else {
-                String::new()
-            }
-        })
-        .y_labels(8)
-        .y_label_formatter(&|y| compact(*y))
-        .y_desc(y_desc)
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 13))
-        .draw()
-        .map_err(err)?;
-    let paper_color = RGBColor(127, 127, 127);
-    let ours_color = RGBColor(31, 119, 180);
-    for (i, (_, p, o)) in bars.iter().enumerate() {
-        let x = i as f64;
-        if let Some(p) = p {
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(x - 0.4, lo), (x - 0.02, *p)],
-                    paper_color.filled(),
-                )))
-                .map_err(err)?;
-        }
-        if let Some(o) = o {
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(x + 0.02, lo), (x + 0.4, *o)],
-                    ours_color.filled(),
-                )))
-                .map_err(err)?;
-        }
-    }
-    chart
-        .draw_series(std::iter::once(Rectangle::new(
-            [(0.0, lo), (0.0, lo)],
-            paper_color.filled(),
-        )))
-        .map_err(err)?
-        .label("paper")
-        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], paper_color.filled()));
-    chart
-        .draw_series(std::iter::once(Rectangle::new(
-            [(0.0, lo), (0.0, lo)],
-            ours_color.filled(),
-        )))
-        .map_err(err)?
-        .label("ours")
-        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], ours_color.filled()));
-    chart
-        .configure_series_labels()
-        .label_font((FONT, 12))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(err)?;
-    root.present().map_err(err)?;
-    Ok(())
 }
 
 #[cfg(test)]
@@ -549,9 +423,6 @@ mod tests {
         assert!(write_charts(dir.path(), &comparison(true, 4.0))
             .unwrap()
             .is_empty());
-        assert_eq!(compact(1_500_000.0), "1.5M");
-        assert_eq!(compact(230_000.0), "230k");
-        assert_eq!(compact(0.05), "0.05");
         assert!(
             std::fs::metadata(dir.path().join("t_ms.png"))
                 .unwrap()

@@ -1,12 +1,13 @@
 //! What the charts are drawn from: rows read from any number of results (one run, shards,
-//! several runs), grouped into points — one per algorithm × settings × data set × viewport,
-//! over its viewpoints — and the flags the charts show (peers, suspect rows).
+//! several runs), as points — [`crate::results::aggregate`]'s groups, one per algorithm ×
+//! settings × data set × viewport, over its viewpoints — and the flags the charts show (peers, suspect rows).
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use serde::Serialize;
 
+use crate::results::aggregate::{aggregate, Aggregate};
 use crate::results::stats::Spread;
 use crate::results::{ResultsFile, Row, JSON_FILE};
 
@@ -203,68 +204,34 @@ impl Point {
     }
 }
 
-/// Suspect rows ([`crate::results::suspect`]): the row's own `suspect` column, or — for results
-/// written before the column existed, or rows merged from several runs — the same rule applied
-/// to these rows. One flag per row.
-pub fn suspect_flags(rows: &[Row]) -> Vec<bool> {
-    rows.iter()
-        .map(|r| !r.suspect.is_empty() || crate::results::suspect::reason(r, rows).is_some())
-        .collect()
-}
+/// Suspect rows, one flag per row: [`crate::results::suspect::flags`].
+pub use crate::results::suspect::flags as suspect_flags;
 
-/// Groups rows into points, in order of first appearance (charts order their series by style,
-/// not by this order).
-pub fn points(rows: &[Row]) -> Vec<Point> {
-    let suspect = suspect_flags(rows);
-    let mut out: Vec<Point> = vec![];
-    let mut members: Vec<Vec<usize>> = vec![];
-    for (i, r) in rows.iter().enumerate() {
-        let pos = out.iter().position(|p| {
-            p.algorithm == r.algorithm
-                && p.settings == r.settings.to_string()
-                && p.dataset == r.dataset
-                && p.width == r.width
-                && p.height == r.height
-        });
-        match pos {
-            Some(j) => members[j].push(i),
-            None => {
-                members.push(vec![i]);
-                out.push(Point {
-                    algorithm: r.algorithm.clone(),
-                    settings: r.settings.to_string(),
-                    dataset: r.dataset.clone(),
-                    tets: r.tets,
-                    width: r.width,
-                    height: r.height,
-                    rows: 0,
-                    failed: 0,
-                    error: String::new(),
-                    tets_per_sec: None,
-                    psnr_db: None,
-                    gpu_bytes: None,
-                    bytes_per_tet: None,
-                    suspect: false,
-                });
-            }
+impl From<&Aggregate> for Point {
+    fn from(a: &Aggregate) -> Point {
+        Point {
+            algorithm: a.algorithm.clone(),
+            settings: a.settings.to_string(),
+            dataset: a.dataset.clone(),
+            tets: a.tets,
+            width: a.width,
+            height: a.height,
+            rows: a.rows,
+            failed: a.failed,
+            error: a.error.clone(),
+            tets_per_sec: a.tets_per_sec,
+            psnr_db: a.psnr_db,
+            gpu_bytes: a.gpu_bytes,
+            bytes_per_tet: a.bytes_per_tet,
+            suspect: a.suspect > 0,
         }
     }
-    for (p, m) in out.iter_mut().zip(&members) {
-        let g: Vec<&Row> = m.iter().map(|&i| &rows[i]).collect();
-        p.rows = g.len();
-        p.failed = g.iter().filter(|r| !r.ok()).count();
-        p.error = g
-            .iter()
-            .find(|r| !r.ok())
-            .map(|r| r.error.clone())
-            .unwrap_or_default();
-        p.tets_per_sec = crate::results::stats::spread(g.iter().filter_map(|r| r.tets_per_sec));
-        p.psnr_db = crate::results::stats::spread(g.iter().filter_map(|r| r.psnr_db));
-        p.gpu_bytes = g.iter().filter_map(|r| r.gpu_bytes).max();
-        p.bytes_per_tet = g.iter().find_map(|r| r.bytes_per_tet);
-        p.suspect = m.iter().any(|&i| suspect[i]);
-    }
-    out
+}
+
+/// The points of [`crate::results::aggregate`] (one per variant × data set × viewport), in
+/// order of first appearance (charts order their series by style, not by this order).
+pub fn points(rows: &[Row]) -> Vec<Point> {
+    aggregate(rows).iter().map(Point::from).collect()
 }
 
 /// Distinct values in order of first appearance.

@@ -16,7 +16,11 @@ pub mod bars;
 
 pub mod data;
 pub mod draw;
+pub mod fig8;
+pub mod history;
 pub mod lines;
+pub mod paper_bars;
+pub mod ratio;
 pub mod resolution;
 pub mod scaling;
 pub mod speed_error;

@@ -58,6 +58,36 @@ impl Marker {
     }
 }
 
+/// The categorical colours of charts whose series are not algorithm variants (a history
+/// chart's series, a paper figure's resolutions): matplotlib's "tab10", in its order.
+pub const CATEGORICAL: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// A categorical colour by index, cycling.
+pub fn categorical(i: usize) -> RGBColor {
+    CATEGORICAL[i % CATEGORICAL.len()]
+}
+
+/// Verdict colours of the comparison charts: slower red, faster green, no change blue.
+pub const SLOWER: RGBColor = CATEGORICAL[3];
+pub const FASTER: RGBColor = CATEGORICAL[2];
+pub const NO_CHANGE: RGBColor = CATEGORICAL[0];
+/// BASE's samples in a ratio plot.
+pub const BASELINE_GREY: RGBColor = RGBColor(140, 140, 140);
+/// The papers' numbers beside ours in a paper's bar charts (grey), and ours (blue).
+pub const PAPER_VALUE: RGBColor = CATEGORICAL[7];
+pub const OUR_VALUE: RGBColor = CATEGORICAL[0];
+
 /// A colour family: four shades of one hue, dark to light, all readable on white.
 type Family = [RGBColor; SHADES];
 

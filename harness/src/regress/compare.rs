@@ -35,6 +35,7 @@ pub use crate::regress::compare_time::{
     adjust_family, fmt_p, run_wide_factor, scaled, time_test, TimeTest, Verdict,
     MIN_GROUPS_FOR_DRIFT,
 };
+use crate::results::aggregate::GroupKey;
 use crate::results::samples;
 use crate::results::stats::{holm_adjust, mann_whitney_p, median};
 use crate::results::{ResultsFile, Row};
@@ -670,7 +671,8 @@ fn image_change(
     Ok(c)
 }
 
-/// The pooled `total_ms` test per algorithm × settings × data set.
+/// The pooled `total_ms` test per group of [`GroupKey`] (variant × data set × viewport, the
+/// reports' groups); the samples are compare's own, per round.
 fn group_tests(
     base: &[Row],
     new: &[Row],
@@ -678,19 +680,16 @@ fn group_tests(
     scale: f64,
     rounds: Rounds,
 ) -> anyhow::Result<Vec<GroupComparison>> {
-    let mut groups: Vec<(String, Settings, String)> = vec![];
+    let mut groups: Vec<GroupKey> = vec![];
     for r in base {
-        let g = (r.algorithm.clone(), r.settings.clone(), r.dataset.clone());
-        if !groups.contains(&g) {
-            groups.push(g);
+        if !groups.iter().any(|g| g.matches(r)) {
+            groups.push(GroupKey::of(r));
         }
     }
     let mut out = vec![];
-    for (algorithm, settings, dataset) in groups {
+    for group in groups {
         let (mut bs, mut ns, mut views) = (vec![], vec![], 0);
-        for b in base.iter().filter(|r| {
-            (&r.algorithm, &r.settings, &r.dataset) == (&algorithm, &settings, &dataset)
-        }) {
+        for b in base.iter().filter(|r| group.matches(r)) {
             let Some(n) = new.iter().find(|n| key(n) == key(b)) else {
                 continue;
             };
@@ -714,9 +713,9 @@ fn group_tests(
         }
         out.push(GroupComparison {
             total: round_test("total_ms", &bs, &ns, opt, rounds),
-            algorithm,
-            settings: settings.to_string(),
-            dataset,
+            algorithm: group.algorithm,
+            settings: group.settings.to_string(),
+            dataset: group.dataset,
             viewpoints: views,
         });
     }

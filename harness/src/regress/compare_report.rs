@@ -7,8 +7,10 @@ use std::path::Path;
 use anyhow::Context;
 use serde::Serialize;
 
-use crate::regress::compare::{CompareOptions, Comparison, FailOn, RowComparison, TimeTest};
-use crate::regress::compare_plot::{ratio_plot, Strip};
+use crate::plot::ratio::{ratio_plot, Direction, Strip};
+use crate::regress::compare::{
+    CompareOptions, Comparison, FailOn, RowComparison, TimeTest, Verdict,
+};
 
 fn header(c: &Comparison) -> Vec<String> {
     let commit = |c: &Option<String>| {
@@ -295,7 +297,8 @@ pub fn write_outputs(c: &Comparison, out: &Path) -> anyhow::Result<()> {
             label: format!("{} {} @ {}", g.algorithm, g.settings, g.dataset),
             base: g.total.base_ratios.clone(),
             new: g.total.new_ratios.clone(),
-            verdict: g.total.verdict,
+            verdict: g.total.verdict.label().to_string(),
+            direction: direction(g.total.verdict),
         })
         .collect();
     ratio_plot(
@@ -317,7 +320,8 @@ pub fn write_outputs(c: &Comparison, out: &Path) -> anyhow::Result<()> {
                 ),
                 base: t.base_ratios.clone(),
                 new: t.new_ratios.clone(),
-                verdict: t.verdict,
+                verdict: t.verdict.label().to_string(),
+                direction: direction(t.verdict),
             })
         })
         .collect();
@@ -367,6 +371,15 @@ pub fn run_command(
         FailOn::Regression => !cmp.regressions.is_empty(),
         FailOn::Change => cmp.outcome() != "no change",
     })
+}
+
+/// The colour a verdict's strip gets in the ratio plots.
+fn direction(verdict: Verdict) -> Direction {
+    match verdict {
+        Verdict::Slower => Direction::Slower,
+        Verdict::Faster => Direction::Faster,
+        _ => Direction::Neither,
+    }
 }
 
 #[cfg(test)]

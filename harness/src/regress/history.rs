@@ -14,16 +14,14 @@
 //!   than the threshold factor is not one.
 //! - Runs of different adapters are refused: a step between two machines is not a change.
 
-use render_core::Settings;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, Context};
-use plotters::prelude::*;
+use anyhow::Context;
 use serde::Serialize;
 
-use crate::plot::draw::{register_font, FONT};
 use crate::regress::compare::{adapter_of, CompareOptions, FailOn, Verdict};
+use crate::results::aggregate::GroupKey;
 use crate::results::stats::{median, quantile};
 use crate::results::{ResultsFile, Row};
 
@@ -66,11 +64,8 @@ pub struct History {
     pub series: Vec<Series>,
 }
 
-fn group_rows<'a>(f: &'a ResultsFile, g: &(String, Settings, String)) -> Vec<&'a Row> {
-    f.rows
-        .iter()
-        .filter(|r| (&r.algorithm, &r.settings, &r.dataset) == (&g.0, &g.1, &g.2) && r.ok())
-        .collect()
+fn group_rows<'a>(f: &'a ResultsFile, g: &GroupKey) -> Vec<&'a Row> {
+    f.rows.iter().filter(|r| g.matches(r) && r.ok()).collect()
 }
 
 /// Pooled frames of a group, each divided by `scale(row)`.
@@ -213,12 +208,12 @@ pub fn history(
             &w[0].0, &w[1].0, &opt,
         )?));
     }
-    let mut groups: Vec<(String, Settings, String)> = vec![];
+    // The reports' groups (variant × data set × viewport), matched across the runs.
+    let mut groups: Vec<GroupKey> = vec![];
     for (_, f) in &files {
         for r in &f.rows {
-            let g = (r.algorithm.clone(), r.settings.clone(), r.dataset.clone());
-            if !groups.contains(&g) {
-                groups.push(g);
+            if !groups.iter().any(|g| g.matches(r)) {
+                groups.push(GroupKey::of(r));
             }
         }
     }
@@ -246,7 +241,8 @@ pub fn history(
                 .filter(|_| points.last().is_some_and(|p| p.run + 1 == i))
             {
                 if let Some(gc) = cmp.groups.iter().find(|c| {
-                    (&c.algorithm, &c.settings, &c.dataset) == (&g.0, &g.1.to_string(), &g.2)
+                    (&c.algorithm, &c.settings, &c.dataset)
+                        == (&g.algorithm, &g.settings.to_string(), &g.dataset)
                 }) {
                     match gc.total.verdict {
                         Verdict::Slower => changes.push(format!("slower ×{:.3}", gc.total.ratio)),
@@ -256,7 +252,8 @@ pub fn history(
                     }
                 }
                 let rows_here = cmp.rows.iter().filter(|r| {
-                    (&r.algorithm, &r.settings, &r.dataset) == (&g.0, &g.1.to_string(), &g.2)
+                    (&r.algorithm, &r.settings, &r.dataset)
+                        == (&g.algorithm, &g.settings.to_string(), &g.dataset)
                 });
                 let mut psnr_moved = false;
                 let mut memory = false;
@@ -306,9 +303,9 @@ pub fn history(
             points[s].step = Some(median(&values[s..end]) / median(&values[prev_start..s]));
         }
         series.push(Series {
-            algorithm: g.0,
-            settings: g.1.to_string(),
-            dataset: g.2,
+            algorithm: g.algorithm.clone(),
+            settings: g.settings.to_string(),
+            dataset: g.dataset.clone(),
             points,
         });
     }
@@ -323,95 +320,45 @@ fn psnr_mean(v: &[f64]) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
-/// One chart per algorithm × data set: a line per settings variant, its noise band, and a
-/// marker where a change was found (red ▲ slower, green ▼ faster, black ● other).
+/// One chart per algorithm × data set (drawn by [`crate::plot::history`]): a line per
+/// settings variant of `h`'s series on that pair.
 fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<()> {
-    register_font();
-    let series: Vec<&Series> = h
+    use crate::plot::history::{Change, Line, LinePoint};
+    let lines: Vec<Line> = h
         .series
         .iter()
         .filter(|s| s.algorithm == alg && s.dataset == dataset)
-        .collect();
-    let ymax = series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.band_hi.max(p.total_ms)))
-        .fold(0.0, f64::max)
-        * 1.15;
-    let root = BitMapBackend::new(path, (1100, 460)).into_drawing_area();
-    let err = |e| anyhow!("drawing {}: {e:?}", path.display());
-    root.fill(&WHITE).map_err(err)?;
-    let n = h.runs.len().max(2);
-    let mut c = ChartBuilder::on(&root)
-        .caption(
-            format!("{alg} on {dataset}: total ms per run"),
-            (FONT, 18).into_font(),
-        )
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(-0.3f64..(n - 1) as f64 + 0.3, 0f64..ymax.max(1e-3))
-        .map_err(err)?;
-    let labels: Vec<String> = h.runs.iter().map(|r| r.label.clone()).collect();
-    c.configure_mesh()
-        .x_labels(n)
-        .x_label_formatter(&|x| {
-            let i = x.round() as usize;
-            if (x - i as f64).abs() < 1e-6 {
-                labels.get(i).cloned().unwrap_or_default()
-            } else {
-                String::new()
-            }
+        .map(|s| Line {
+            label: s.settings.clone(),
+            points: s
+                .points
+                .iter()
+                .map(|p| LinePoint {
+                    run: p.run,
+                    total_ms: p.total_ms,
+                    band_lo: p.band_lo,
+                    band_hi: p.band_hi,
+                    step: p.step.is_some(),
+                    change: if p.changes.is_empty() {
+                        None
+                    } else if p.changes.iter().any(|c| c.starts_with("slower")) {
+                        Some(Change::Slower)
+                    } else if p.changes.iter().any(|c| c.starts_with("faster")) {
+                        Some(Change::Faster)
+                    } else {
+                        Some(Change::Other)
+                    },
+                })
+                .collect(),
         })
-        .y_desc("total ms (median over viewpoints)")
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 13))
-        .draw()
-        .map_err(err)?;
-    for (k, s) in series.iter().enumerate() {
-        let col = palette(k);
-        let mut band: Vec<(f64, f64)> =
-            s.points.iter().map(|p| (p.run as f64, p.band_hi)).collect();
-        band.extend(s.points.iter().rev().map(|p| (p.run as f64, p.band_lo)));
-        c.draw_series(std::iter::once(Polygon::new(band, col.mix(0.15))))
-            .map_err(err)?;
-        c.draw_series(LineSeries::new(
-            s.points.iter().map(|p| (p.run as f64, p.total_ms)),
-            col.stroke_width(2),
-        ))
-        .map_err(err)?
-        .label(s.settings.clone())
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2)));
-        // A step of the fit: a vertical bar at the run where the new level starts.
-        for p in s.points.iter().filter(|p| p.step.is_some()) {
-            let x = p.run as f64 - 0.5;
-            c.draw_series(std::iter::once(PathElement::new(
-                vec![(x, 0.0), (x, ymax)],
-                col.mix(0.6).stroke_width(2),
-            )))
-            .map_err(err)?;
-        }
-        for p in s.points.iter().filter(|p| !p.changes.is_empty()) {
-            let at = (p.run as f64, p.total_ms);
-            if p.changes.iter().any(|c| c.starts_with("slower")) {
-                c.draw_series(std::iter::once(TriangleMarker::new(at, 8, RED.filled())))
-                    .map_err(err)?;
-            } else if p.changes.iter().any(|c| c.starts_with("faster")) {
-                c.draw_series(std::iter::once(Cross::new(at, 7, GREEN.stroke_width(3))))
-                    .map_err(err)?;
-            } else {
-                c.draw_series(std::iter::once(Circle::new(at, 5, BLACK.filled())))
-                    .map_err(err)?;
-            }
-        }
-    }
-    c.configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.3))
-        .label_font((FONT, 11))
-        .draw()
-        .map_err(err)?;
-    root.present().map_err(err)?;
-    Ok(())
+        .collect();
+    let runs: Vec<String> = h.runs.iter().map(|r| r.label.clone()).collect();
+    crate::plot::history::chart(
+        path,
+        &format!("{alg} on {dataset}: total ms per run"),
+        &runs,
+        &lines,
+    )
 }
 
 #[derive(Serialize)]
@@ -541,24 +488,6 @@ pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> 
     print!("{md}");
     println!("wrote {}/history.{{md,html,json}}", out.display());
     Ok(())
-}
-
-/// Line colours of the history charts (one per group; the comparison charts' per-variant styles
-/// live in `crate::plot::style`).
-fn palette(i: usize) -> RGBColor {
-    const PALETTE: [RGBColor; 10] = [
-        RGBColor(31, 119, 180),
-        RGBColor(255, 127, 14),
-        RGBColor(44, 160, 44),
-        RGBColor(214, 39, 40),
-        RGBColor(148, 103, 189),
-        RGBColor(140, 86, 75),
-        RGBColor(227, 119, 194),
-        RGBColor(127, 127, 127),
-        RGBColor(188, 189, 34),
-        RGBColor(23, 190, 207),
-    ];
-    PALETTE[i % PALETTE.len()]
 }
 
 #[cfg(test)]

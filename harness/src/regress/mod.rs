@@ -17,7 +17,6 @@ pub mod ab;
 pub mod bisect;
 pub mod build;
 pub mod compare;
-pub mod compare_plot;
 pub mod compare_report;
 pub mod compare_time;
 pub mod export;

@@ -19,76 +19,7 @@ pub mod html;
 pub use crate::results::names::series_label;
 pub use crate::results::stats::{spread, Spread};
 
-/// One algorithm × settings × data set, over its viewpoints (the papers average over the 14
-/// fixed viewpoints, HAVS §6).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Aggregate {
-    pub algorithm: String,
-    pub settings: render_core::Settings,
-    pub dataset: String,
-    pub tets: u64,
-    pub rows: usize,
-    pub failed: usize,
-    /// Rows flagged by [`crate::results::suspect`].
-    pub suspect: usize,
-    pub total_ms: Option<Spread>,
-    pub cpu_ms: Option<Spread>,
-    pub gpu_ms: Option<Spread>,
-    pub fps: Option<Spread>,
-    pub tets_per_sec: Option<Spread>,
-    pub psnr_db: Option<Spread>,
-    pub rmse: Option<Spread>,
-    pub bad_pixel_share: Option<Spread>,
-    pub bytes_per_tet: Option<f64>,
-    pub gpu_bytes: Option<u64>,
-}
-
-impl Aggregate {
-    /// `algorithm settings` as one label.
-    pub fn series(&self) -> String {
-        series_label(&self.algorithm, &self.settings.to_string())
-    }
-}
-
-/// Groups rows by (algorithm, settings, data set), in order of first appearance.
-pub fn aggregate(rows: &[Row]) -> Vec<Aggregate> {
-    let mut keys: Vec<(String, render_core::Settings, String)> = vec![];
-    for r in rows {
-        let k = (r.algorithm.clone(), r.settings.clone(), r.dataset.clone());
-        if !keys.contains(&k) {
-            keys.push(k);
-        }
-    }
-    keys.into_iter()
-        .map(|(algorithm, settings, dataset)| {
-            let g: Vec<&Row> = rows
-                .iter()
-                .filter(|r| {
-                    r.algorithm == algorithm && r.settings == settings && r.dataset == dataset
-                })
-                .collect();
-            Aggregate {
-                tets: g[0].tets,
-                rows: g.len(),
-                failed: g.iter().filter(|r| !r.ok()).count(),
-                suspect: g.iter().filter(|r| !r.suspect.is_empty()).count(),
-                total_ms: spread(g.iter().filter_map(|r| r.total_ms)),
-                cpu_ms: spread(g.iter().filter_map(|r| r.cpu_ms)),
-                gpu_ms: spread(g.iter().filter_map(|r| r.gpu_ms)),
-                fps: spread(g.iter().filter_map(|r| r.fps)),
-                tets_per_sec: spread(g.iter().filter_map(|r| r.tets_per_sec)),
-                psnr_db: spread(g.iter().filter_map(|r| r.psnr_db)),
-                rmse: spread(g.iter().filter_map(|r| r.rmse)),
-                bad_pixel_share: spread(g.iter().filter_map(|r| r.bad_pixel_share)),
-                bytes_per_tet: g.iter().find_map(|r| r.bytes_per_tet),
-                gpu_bytes: g.iter().filter_map(|r| r.gpu_bytes).max(),
-                algorithm,
-                settings,
-                dataset,
-            }
-        })
-        .collect()
-}
+pub use crate::results::aggregate::{aggregate, Aggregate};
 
 /// Writes the charts (see [`crate::plot`]) and `index.html` into `out` for the results in
 /// `file`.
@@ -289,21 +220,17 @@ fn machine_lines(file: &ResultsFile) -> Vec<(&'static str, String)> {
     ]
 }
 
-fn summary_lines(file: &ResultsFile, aggs: &[Aggregate], suspect: &[bool]) -> Vec<SummaryLine> {
+fn summary_lines(aggs: &[Aggregate]) -> Vec<SummaryLine> {
     aggs.iter()
         .map(|a| {
-            let any_suspect = file.rows.iter().zip(suspect).any(|(r, s)| {
-                *s && r.algorithm == a.algorithm
-                    && r.settings == a.settings
-                    && r.dataset == a.dataset
-            });
+            let any_suspect = a.suspect > 0;
             let peer = is_peer(&a.algorithm);
             SummaryLine {
                 classes: row_classes(a.failed > 0, any_suspect, &a.algorithm),
                 algorithm: a.algorithm.clone(),
                 peer,
                 settings: a.settings.to_string(),
-                dataset: a.dataset.clone(),
+                dataset: a.place(aggs),
                 tets: a.tets,
                 rows: a.rows,
                 failed: a.failed,
@@ -430,7 +357,7 @@ fn html(
     aggs: &[Aggregate],
     charts: &crate::plot::ChartsPage,
 ) -> anyhow::Result<String> {
-    let suspect = crate::plot::data::suspect_flags(&file.rows);
+    let suspect = crate::results::suspect::flags(&file.rows);
     crate::report::html::render(
         "report.html",
         ReportPage {
@@ -439,7 +366,7 @@ fn html(
             charts,
             suspects: suspect_figures(file),
             any_peer: file.rows.iter().any(|r| is_peer(&r.algorithm)),
-            summary: summary_lines(file, aggs, &suspect),
+            summary: summary_lines(aggs),
             heatmap_max_error: HEATMAP_MAX_ERROR,
             psnr_cap_db: PSNR_CAP_DB,
             one_step: format!("{ONE_STEP:.4}"),
@@ -465,7 +392,7 @@ pub fn markdown_summary(aggs: &[Aggregate]) -> String {
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} ({}) | {} |",
             a.algorithm,
             a.settings,
-            a.dataset,
+            a.place(aggs),
             a.tets,
             m(a.total_ms, 1.0, 2),
             m(a.cpu_ms, 1.0, 2),
@@ -486,7 +413,11 @@ pub fn markdown_summary(aggs: &[Aggregate]) -> String {
             let _ = writeln!(
                 s,
                 "- {} {} on {}: {} of {} views",
-                a.algorithm, a.settings, a.dataset, a.suspect, a.rows
+                a.algorithm,
+                a.settings,
+                a.place(aggs),
+                a.suspect,
+                a.rows
             );
         }
     }

@@ -19,6 +19,7 @@ use render_core::Settings;
 
 use crate::results::machine::MachineInfo;
 
+pub mod aggregate;
 pub mod machine;
 pub mod metrics;
 pub mod names;

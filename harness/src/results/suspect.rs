@@ -54,6 +54,15 @@ pub fn reason(row: &Row, others: &[Row]) -> Option<String> {
     }
 }
 
+/// Suspect rows: the row's own `suspect` column, or — for results written before the column
+/// existed, or rows merged from several runs — the same rule applied to these rows. One flag
+/// per row.
+pub fn flags(rows: &[Row]) -> Vec<bool> {
+    rows.iter()
+        .map(|r| !r.suspect.is_empty() || reason(r, rows).is_some())
+        .collect()
+}
+
 /// Sets every row's `suspect` column from all rows of the run; returns how many are suspect.
 pub fn mark_all(rows: &mut [Row]) -> usize {
     let reasons: Vec<String> = rows

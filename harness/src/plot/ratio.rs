@@ -1,5 +1,5 @@
-//! Pictures of a comparison: the exact difference of two f32 images as a heatmap, and the ratio
-//! plots (each row's or group's frame samples divided by BASE's median, on a log axis).
+//! The ratio plots of `tetbench compare` (each row's or group's frame samples divided by BASE's
+//! median, on a log axis); `regress::compare_report` passes the strips, already judged.
 
 use std::path::Path;
 
@@ -9,16 +9,24 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::plot::draw::{register_font, FONT};
-use crate::regress::compare::Verdict;
+use crate::plot::style::{BASELINE_GREY, FASTER, NO_CHANGE, SLOWER};
 
-pub use crate::regress::compare::{image_difference, ImageDifference};
+/// Which way a strip's verdict went, for its colour (the verdicts themselves are compare's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Direction {
+    Slower,
+    Faster,
+    Neither,
+}
 
 /// One strip of a ratio plot.
 pub struct Strip {
     pub label: String,
     pub base: Vec<f64>,
     pub new: Vec<f64>,
-    pub verdict: Verdict,
+    /// The verdict's words, shown after the label.
+    pub verdict: String,
+    pub direction: Direction,
 }
 
 const LABEL_WIDTH: u32 = 560;
@@ -69,26 +77,23 @@ where
     chart
         .draw_series([
             line(1.0, BLACK.stroke_width(1)),
-            line(threshold, RGBColor(214, 39, 40).mix(0.5).stroke_width(1)),
-            line(
-                1.0 / threshold,
-                RGBColor(44, 160, 44).mix(0.5).stroke_width(1),
-            ),
+            line(threshold, SLOWER.mix(0.5).stroke_width(1)),
+            line(1.0 / threshold, FASTER.mix(0.5).stroke_width(1)),
         ])
         .map_err(err)?;
     let text = TextStyle::from((FONT, 12).into_font()).pos(Pos::new(HPos::Right, VPos::Center));
     for (i, s) in strips.iter().enumerate() {
         let y = (n - 1 - i) as f64 + 0.5;
-        let colour = match s.verdict {
-            Verdict::Slower => RGBColor(214, 39, 40),
-            Verdict::Faster => RGBColor(44, 160, 44),
-            _ => RGBColor(31, 119, 180),
+        let colour = match s.direction {
+            Direction::Slower => SLOWER,
+            Direction::Faster => FASTER,
+            Direction::Neither => NO_CHANGE,
         };
         chart
             .draw_series(
                 s.base
                     .iter()
-                    .map(|&x| Circle::new((x, y + 0.18), 3, RGBColor(140, 140, 140).filled())),
+                    .map(|&x| Circle::new((x, y + 0.18), 3, BASELINE_GREY.filled())),
             )
             .map_err(err)?;
         chart
@@ -101,7 +106,7 @@ where
         let (_, py) = chart.backend_coord(&(1.0, y));
         labels
             .draw(&Text::new(
-                format!("{} [{}]", s.label, s.verdict.label()),
+                format!("{} [{}]", s.label, s.verdict),
                 (LABEL_WIDTH as i32 - 8, py),
                 text.clone(),
             ))
