@@ -11,9 +11,9 @@ use crate::mesh::{cross, dot, sub, TetMesh};
 pub use crate::grid::VoxelGrid;
 
 impl VoxelGrid {
-    /// The volume as a tet mesh: grid points become mesh points (same order, same values) and
-    /// each cell 5 tets ([`structured_tets`]); a 68³ volume gives 67³·5 = 1,503,815 tets.
-    pub fn to_tets(&self) -> Result<TetMesh, ErrorKind> {
+    /// The voxel count, once the values match it and every voxel fits a `u32` index (what the
+    /// tet split and the voxel-only volume both need).
+    pub fn checked_num_voxels(&self) -> Result<usize, ErrorKind> {
         let n = self.num_voxels();
         if self.values.len() != n {
             return Err(ErrorKind::CountMismatch {
@@ -28,6 +28,13 @@ impl VoxelGrid {
                 count: n as u64,
             });
         }
+        Ok(n)
+    }
+
+    /// The volume as a tet mesh: grid points become mesh points (same order, same values) and
+    /// each cell 5 tets ([`structured_tets`]); a 68³ volume gives 67³·5 = 1,503,815 tets.
+    pub fn to_tets(&self) -> Result<TetMesh, ErrorKind> {
+        let n = self.checked_num_voxels()?;
         let [nx, ny, _] = self.dims;
         let points: Vec<[f32; 3]> = (0..n)
             .into_par_iter()

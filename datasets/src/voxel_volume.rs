@@ -89,20 +89,7 @@ impl VoxelVolume {
         split: CellSplit,
         cover: CellCover,
     ) -> Result<VoxelVolume, ErrorKind> {
-        let n = grid.num_voxels();
-        if grid.values.len() != n {
-            return Err(ErrorKind::CountMismatch {
-                what: "voxel values".into(),
-                expected: n as u64,
-                found: grid.values.len() as u64,
-            });
-        }
-        if n > u32::MAX as usize {
-            return Err(ErrorKind::IndexOverflow {
-                what: "voxels".into(),
-                count: n as u64,
-            });
-        }
+        let n = grid.checked_num_voxels()?;
         let geometry = grid.origin.iter().chain(&grid.spacing);
         if let Some(v) = geometry.copied().find(|v| !v.is_finite()) {
             return Err(ErrorKind::NonFinite {
