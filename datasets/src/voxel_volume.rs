@@ -89,7 +89,7 @@ impl VoxelVolume {
         split: CellSplit,
         cover: CellCover,
     ) -> Result<VoxelVolume, ErrorKind> {
-        let n = grid.checked_num_voxels()?;
+        grid.checked_num_voxels()?;
         let geometry = grid.origin.iter().chain(&grid.spacing);
         if let Some(v) = geometry.copied().find(|v| !v.is_finite()) {
             return Err(ErrorKind::NonFinite {
