@@ -157,6 +157,61 @@ fn gator_sizes_fail_when_a_tet_is_lost() {
     );
 }
 
+#[test]
+fn gator_table2_counts_the_split_and_says_what_the_loader_dropped() {
+    let m = Measured::default();
+    let x = |loaded: u64, dropped: u64| Extra {
+        sizes: vec![
+            ("bluntfin".into(), 40_960, loaded),
+            ("post".into(), 109_744, 513_375),
+        ],
+        dropped: vec![("bluntfin".into(), dropped), ("post".into(), 0)],
+        ..Default::default()
+    };
+    let table2 = |x: &Extra| {
+        gator::tables(&m, x)
+            .comparisons
+            .into_iter()
+            .find(|c| c.key == "table2")
+            .unwrap()
+    };
+    // Blunt Fin as measured: 187,318 loaded + 77 of zero volume = the paper's 187,395.
+    let ok = table2(&x(187_318, 77));
+    assert_eq!(ok.verdict(), Some(true));
+    assert!(
+        ok.notes.iter().any(|n| n.contains("187395 tets; 77")),
+        "{:?}",
+        ok.notes
+    );
+    // One tet lost by the split (not by the drop) flips the table.
+    assert_eq!(table2(&x(187_317, 77)).verdict(), Some(false));
+    // Without the dropped ones counted back, the cell would not match either.
+    assert_eq!(table2(&x(187_318, 0)).verdict(), Some(false));
+}
+
+#[test]
+fn havs_k_gt2_pixels_fail_past_two_percent() {
+    let paper = 10_626u64;
+    let edge = (paper as f64 * 0.98).ceil() as u64;
+    let x = |pixels: u64| Extra {
+        kbuffer: vec![crate::papers::havs::analysis::KbufferRow {
+            dataset: "spx2".into(),
+            fragments: 6_615_778,
+            pixels_k_gt2: pixels,
+            pixels_k_gt6: 512,
+            ..Default::default()
+        }],
+        kbuffer_views: 14,
+        kbuffer_resolution: 512,
+        ..Default::default()
+    };
+    let m = Measured::default();
+    let at = evaluate_claims("havs", &m, &x(edge));
+    assert_eq!(verdict_of(&at, "H5", Some("spx2")), Verdict::Holds);
+    let below = evaluate_claims("havs", &m, &x(edge - 1));
+    assert_eq!(verdict_of(&below, "H5", Some("spx2")), Verdict::DoesNotHold);
+}
+
 fn counter_row(algorithm: &str, settings: &str, dataset: &str, counters: &str) -> Row {
     Row {
         algorithm: algorithm.into(),

@@ -124,11 +124,7 @@ fn analysis_side(
                 "dataset_tets" => exact(format!("{d} as loaded, tets"), &d, *tets as f64),
                 // The split's own count: what we load plus the zero-volume tets we drop.
                 "dataset_tets_split" => {
-                    let dropped = x
-                        .dropped
-                        .iter()
-                        .find(|(n, _)| *n == d)
-                        .map_or(0, |(_, n)| *n);
+                    let dropped = x.dropped_by_loader(&d);
                     exact(
                         format!("{d}: {tets} tets loaded + {dropped} of zero volume dropped"),
                         &d,

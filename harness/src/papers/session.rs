@@ -305,3 +305,13 @@ pub struct Extra {
     pub kbuffer_views: usize,
     pub kbuffer_resolution: u32,
 }
+
+impl Extra {
+    /// Tets of zero volume the loader dropped from data set `d` (0 when none or not loaded).
+    pub fn dropped_by_loader(&self, d: &str) -> u64 {
+        self.dropped
+            .iter()
+            .find(|(n, _)| n == d)
+            .map_or(0, |(_, n)| *n)
+    }
+}

@@ -297,19 +297,28 @@ pub struct KStats {
     pub fragments: u64,
     /// Longest per-pixel list (the A-buffer depth).
     pub max_list: u32,
-    /// Largest k any pixel needs for an exact result.
+    /// Largest k any pixel needs, as the paper measures it: the deepest insertion into an
+    /// ordered A-buffer, plus one ([`crate::kbuffer::insertion_k`], §5.2).
     pub max_k: u32,
+    /// Pixels whose k (the paper's measure) exceeds 2 and 6, the hardware's k values.
     pub pixels_k_gt2: u64,
     pub pixels_k_gt6: u64,
+    /// The same with the exact minimum k of our k-buffer twin ([`crate::kbuffer::k_needed`]),
+    /// never above the paper's measure: what the race-free renderer actually needs.
+    pub exact_max_k: u32,
+    pub exact_pixels_k_gt2: u64,
+    pub exact_pixels_k_gt6: u64,
     pub covered_pixels: u64,
-    /// Per pixel (row 0 at the top): the k it needs (0 where no fragment), saturated at 255.
+    /// Per pixel (row 0 at the top): its k, the paper's measure (0 where no fragment),
+    /// saturated at 255.
     pub k_map: Vec<u8>,
     pub width: u32,
     pub height: u32,
 }
 
 /// Rasterises the sorted faces at the camera's resolution and measures, per pixel, how far out
-/// of order its fragments arrive ([`crate::kbuffer::k_needed`]).
+/// of order its fragments arrive, by the paper's insertion depth ([`crate::kbuffer::insertion_k`])
+/// and by the exact minimum of our k-buffer ([`crate::kbuffer::k_needed`]).
 pub fn kbuffer_stats(geom: &Geometry, camera: &Camera) -> KStats {
     let order = geom.face_order(camera);
     let bands = for_each_band(geom, &order, camera, 16, |band| {
@@ -323,7 +332,11 @@ pub fn kbuffer_stats(geom: &Geometry, camera: &Camera) -> KStats {
             }
             depths.clear();
             depths.extend(list.iter().map(|f| f.depth));
-            let k = crate::kbuffer::k_needed(&depths) as u32;
+            let k = crate::kbuffer::insertion_k(&depths) as u32;
+            let exact = crate::kbuffer::k_needed(&depths) as u32;
+            s.exact_max_k = s.exact_max_k.max(exact);
+            s.exact_pixels_k_gt2 += (exact > 2) as u64;
+            s.exact_pixels_k_gt6 += (exact > 6) as u64;
             s.fragments += list.len() as u64;
             s.max_list = s.max_list.max(list.len() as u32);
             s.max_k = s.max_k.max(k);
@@ -343,6 +356,9 @@ pub fn kbuffer_stats(geom: &Geometry, camera: &Camera) -> KStats {
         total.fragments += s.fragments;
         total.max_list = total.max_list.max(s.max_list);
         total.max_k = total.max_k.max(s.max_k);
+        total.exact_max_k = total.exact_max_k.max(s.exact_max_k);
+        total.exact_pixels_k_gt2 += s.exact_pixels_k_gt2;
+        total.exact_pixels_k_gt6 += s.exact_pixels_k_gt6;
         total.pixels_k_gt2 += s.pixels_k_gt2;
         total.pixels_k_gt6 += s.pixels_k_gt6;
         total.covered_pixels += s.covered_pixels;

@@ -226,6 +226,23 @@ pub fn k_needed(depths: &[f32]) -> usize {
     k
 }
 
+/// The k of HAVS Table 2 as the paper measures it (§5.2): each fragment, in arrival order, is
+/// inserted into an ordered A-buffer and the depth of the insertion (how many fragments already
+/// there lie behind it) is recorded; the pixel's k is the deepest insertion plus one, the one
+/// more entry that compositing needs (§3.2: a k-nearly sorted stream needs k + 1 entries).
+/// Ties insert after equal depths. Never below [`k_needed`]: a fragment of sorted rank r that
+/// arrives at position p passes at least p − r fragments, so a k-buffer of this size is exact too.
+pub fn insertion_k(depths: &[f32]) -> usize {
+    let mut sorted: Vec<f32> = Vec::with_capacity(depths.len());
+    let mut deepest = 0;
+    for &d in depths {
+        let at = sorted.partition_point(|&x| x <= d);
+        deepest = deepest.max(sorted.len() - at);
+        sorted.insert(at, d);
+    }
+    deepest + 1
+}
+
 /// Front-to-back compositing of premultiplied RGBA (the "over" operator seen from the front).
 #[inline]
 pub fn composite_front_to_back(acc: &mut [f32; 4], seg: [f32; 4]) {
@@ -296,6 +313,30 @@ mod tests {
                 prop_assert_eq!(errors == 0, ok, "k={} errors={}", k, errors);
             }
         }
+    }
+
+    proptest! {
+        /// The paper's insertion-depth k never asks for fewer entries than the exact minimum.
+        #[test]
+        fn insertion_k_bounds_k_needed(depths in proptest::collection::vec(0u32..50, 0..40)) {
+            let depths: Vec<f32> = depths.into_iter().map(|d| d as f32).collect();
+            prop_assert!(insertion_k(&depths) >= k_needed(&depths));
+        }
+    }
+
+    #[test]
+    fn insertion_k_counts_the_fragments_passed() {
+        // 0 1 2 3 then 0.5 passes three fragments (1, 2, 3): k = 4, which is also the exact
+        // minimum (0.5 has rank 1 and arrives three places late).
+        assert_eq!(insertion_k(&[0.0, 1.0, 2.0, 3.0, 0.5]), 4);
+        assert_eq!(k_needed(&[0.0, 1.0, 2.0, 3.0, 0.5]), 4);
+        // Where they differ: 2 3 1 0. The 0 passes all three (k = 4), but a k-buffer of 3
+        // entries already holds 2 3 1 when 0 arrives, pops 0 and then 1: exact with k = 3.
+        assert_eq!(insertion_k(&[2.0, 3.0, 1.0, 0.0]), 4);
+        assert_eq!(k_needed(&[2.0, 3.0, 1.0, 0.0]), 3);
+        assert_eq!(insertion_k(&[5.0]), 1);
+        assert_eq!(insertion_k(&[]), 1);
+        assert_eq!(insertion_k(&[1.0, 1.0, 1.0]), 1);
     }
 
     #[test]
