@@ -11,9 +11,9 @@
 #   scripts/ab-power.sh [TRIALS]          # default 10 trials per row
 #
 # Environment: AB_POWER_WORK (default target/ab-power: worktree, target, binaries, trials),
-# AB_POWER_FACTORS (default "1.05 1.10 1.25"), AB_POWER_ALGORITHM (gator-pt),
+# AB_POWER_FACTORS (default "1.05 1.10 1.25 1.5"), AB_POWER_ALGORITHM (gator-pt),
 # AB_POWER_PAIRS (5), AB_POWER_THRESHOLDS ("1.10 1.05": `ab` runs with the first, compare
-# judges the same rounds again with the others), AB_POWER_MATRIX (the run options; default the
+# --paired judges the same rounds again with the others), AB_POWER_MATRIX (the run options; default the
 # default suite's box:10k, 3 viewpoints, 128 px, without splat — a second per frame on
 # lavapipe, half of each round — 2 frames after 1 warm-up, without the reference and the
 # calibration), AB_POWER_TARGET_DIR, AB_POWER_SRC,
@@ -28,7 +28,7 @@ root=$PWD
 work=$(realpath -m "${AB_POWER_WORK:-target/ab-power}")
 src=$(realpath -m "${AB_POWER_SRC:-$work/src}")
 target=$(realpath -m "${AB_POWER_TARGET_DIR:-$work/target}")
-factors=${AB_POWER_FACTORS:-1.05 1.10 1.25}
+factors=${AB_POWER_FACTORS:-1.05 1.10 1.25 1.5}
 algorithm=${AB_POWER_ALGORITHM:-gator-pt}
 pairs=${AB_POWER_PAIRS:-5}
 thresholds=${AB_POWER_THRESHOLDS:-1.10 1.05}
@@ -135,8 +135,8 @@ trial() {
         "$((SECONDS - start))" "$load"
     for t in $rest; do
         status=0
-        "$work/bin/base" compare "$out/base" "$out/new" --threshold "$t" --fail-on regression \
-            --out "$out/compare-$t" >"$out-$t.log" 2>&1 || status=$?
+        "$work/bin/base" compare "$out/base" "$out/new" --paired --threshold "$t" \
+            --fail-on regression --out "$out/compare-$t" >"$out-$t.log" 2>&1 || status=$?
         verdict "$out/compare-$t/compare.json" "$algorithm" "$n" "$factor" "$t" "$status" \
             "$((SECONDS - start))" "$load"
     done

@@ -155,6 +155,10 @@ pub struct CompareArgs {
     /// on the 2-core development VM was ×1.25).
     #[arg(long, default_value_t = 1.5)]
     pub drift_limit: f64,
+    /// BASE's round i and NEW's round i ran side by side (the merged sides of `tetbench ab`):
+    /// divide each pair's own drift out instead of the run-wide factor.
+    #[arg(long)]
+    pub paired: bool,
     /// Output directory (default: NEW/compare).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -314,6 +318,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
                 normalised: args.normalised,
                 drift_correction: !args.no_drift_correction,
                 drift_limit: args.drift_limit,
+                paired: args.paired,
                 fail_on: args.fail_on,
                 out: args.out.clone().unwrap_or_else(|| args.new.join("compare")),
             };

@@ -32,8 +32,8 @@ use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
 pub use crate::regress::compare_time::{
-    adjust_family, fmt_p, run_wide_factor, scaled, time_test, TimeTest, Verdict,
-    MIN_GROUPS_FOR_DRIFT,
+    adjust_family, fmt_p, pair_factors, paired_t_tests, run_wide_factor, scaled, time_test,
+    TimeTest, Verdict, MIN_GROUPS_FOR_DRIFT,
 };
 use crate::results::aggregate::GroupKey;
 use crate::results::samples;
@@ -113,6 +113,10 @@ pub struct CompareOptions {
     pub drift_correction: bool,
     /// A run-wide factor beyond this is a regression (or improvement) of its own.
     pub drift_limit: f64,
+    /// BASE's round i and NEW's round i ran side by side (`tetbench ab`): with drift
+    /// correction, each pair's own factor is divided out ([`pair_factors`]) instead of the
+    /// run-wide one.
+    pub paired: bool,
     pub fail_on: FailOn,
     pub out: PathBuf,
 }
@@ -194,6 +198,10 @@ pub struct Comparison {
     pub run_factor: Option<f64>,
     #[serde(default)]
     pub drift_corrected: bool,
+    /// With paired rounds (`ab`): each pair's NEW/BASE factor, divided out of that pair's
+    /// NEW round values instead of `run_factor`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pair_factors: Option<Vec<f64>>,
     pub test: String,
     pub groups: Vec<GroupComparison>,
     pub rows: Vec<RowComparison>,
@@ -329,11 +337,15 @@ pub fn compare(
     }
     let heat_dir = opt.out.join("heatmaps");
     let rounds = Rounds::of(&base, &new);
-    let unscaled = group_tests(&base.rows, &new.rows, opt, 1.0, rounds)?;
+    let unscaled = group_tests(&base.rows, &new.rows, opt, &[1.0], rounds)?;
     let run_factor = run_wide_factor(unscaled.iter().map(|g| &g.total));
-    let scale = match run_factor {
-        Some(f) if opt.drift_correction => f,
-        _ => 1.0,
+    let pair_factors = (opt.paired && opt.drift_correction && rounds.base == rounds.new)
+        .then(|| pair_factors(&group_pair_ratios(&base.rows, &new.rows, rounds, opt)?))
+        .flatten();
+    let scale: Vec<f64> = match (&pair_factors, run_factor) {
+        (Some(per_pair), _) => per_pair.clone(),
+        (None, Some(f)) if opt.drift_correction => vec![f],
+        _ => vec![1.0],
     };
     let pairs: Vec<(&Row, Option<&Row>)> = base
         .rows
@@ -348,7 +360,7 @@ pub fn compare(
                 let bs = round_values(b, "total_ms", rounds.base, opt.normalised)?;
                 let ns = scaled(
                     round_values(n, "total_ms", rounds.new, opt.normalised)?,
-                    scale,
+                    &scale,
                 );
                 (rounds.enough() && bs.len() >= 2 && ns.len() >= 2)
                     .then(|| mann_whitney_p(&bs, &ns))
@@ -363,7 +375,7 @@ pub fn compare(
             Some(n) => compare_rows(
                 b,
                 n,
-                (p_total, scale, rounds),
+                (p_total, &scale, rounds),
                 (base_dir, new_dir, &heat_dir),
                 opt,
             )?,
@@ -375,7 +387,7 @@ pub fn compare(
             rows.push(only(n, "only in new"));
         }
     }
-    let mut groups = group_tests(&base.rows, &new.rows, opt, scale, rounds)?;
+    let mut groups = group_tests(&base.rows, &new.rows, opt, &scale, rounds)?;
     adjust_family(
         groups.iter_mut().map(|g| &mut g.total),
         opt.threshold,
@@ -398,11 +410,19 @@ pub fn compare(
             .collect(),
         time_refused: rounds.refusal(),
         run_factor,
-        drift_corrected: scale != 1.0,
+        drift_corrected: scale != [1.0],
+        pair_factors,
         test: format!(
             "Mann–Whitney U (two-sided, α = {}, Holm-adjusted over the groups and over the \
-             rows) and ratio of medians ≥ {} (asv's rule)",
-            opt.alpha, opt.threshold
+             rows) and ratio of medians ≥ {} (asv's rule){}",
+            opt.alpha,
+            opt.threshold,
+            if scale.len() > 1 {
+                "; groups (paired rounds): a t-test of each group's per-pair ln(NEW/BASE), each \
+                 pair's drift divided out, variance pooled over the groups; ratio = exp(mean)"
+            } else {
+                ""
+            }
         ),
         groups,
         rows,
@@ -497,7 +517,7 @@ fn only(r: &Row, status: &str) -> RowComparison {
 fn compare_rows(
     b: &Row,
     n: &Row,
-    time: (Option<f64>, f64, Rounds),
+    time: (Option<f64>, &[f64], Rounds),
     dirs: (&Path, &Path, &Path),
     opt: &CompareOptions,
 ) -> anyhow::Result<RowComparison> {
@@ -677,7 +697,7 @@ fn group_tests(
     base: &[Row],
     new: &[Row],
     opt: &CompareOptions,
-    scale: f64,
+    scale: &[f64],
     rounds: Rounds,
 ) -> anyhow::Result<Vec<GroupComparison>> {
     let mut groups: Vec<GroupKey> = vec![];
@@ -687,8 +707,13 @@ fn group_tests(
         }
     }
     let mut out = vec![];
+    // Per group, per pair: the median over its rows of ln(NEW/BASE), NEW already divided by
+    // its pair's drift (only when `scale` holds one factor per pair).
+    let mut paired_logs: Vec<Option<Vec<f64>>> = vec![];
+    let pairs = scale.len();
     for group in groups {
         let (mut bs, mut ns, mut views) = (vec![], vec![], 0);
+        let mut per_pair: Vec<Vec<f64>> = vec![vec![]; pairs];
         for b in base.iter().filter(|r| group.matches(r)) {
             let Some(n) = new.iter().find(|n| key(n) == key(b)) else {
                 continue;
@@ -705,12 +730,23 @@ fn group_tests(
                 continue;
             }
             views += 1;
+            if pairs > 1 && bv.len() == pairs && nv.len() == pairs {
+                for (i, (b, n)) in bv.iter().zip(&nv).enumerate() {
+                    if *b > 0.0 && *n > 0.0 {
+                        per_pair[i].push((n / b).ln());
+                    }
+                }
+            }
             bs.extend(bv.iter().map(|x| x / m));
             ns.extend(nv.iter().map(|x| x / m));
         }
         if views == 0 {
             continue;
         }
+        paired_logs.push(
+            (pairs > 1 && per_pair.iter().all(|v| !v.is_empty()))
+                .then(|| per_pair.iter().map(|v| median(v)).collect()),
+        );
         out.push(GroupComparison {
             total: round_test("total_ms", &bs, &ns, opt, rounds),
             algorithm: group.algorithm,
@@ -719,7 +755,59 @@ fn group_tests(
             viewpoints: views,
         });
     }
+    // Paired rounds: every group judged by the paired t-test instead (when each has a value
+    // per pair and there are enough groups to pool the variance).
+    let logs: Option<Vec<Vec<f64>>> = paired_logs.into_iter().collect();
+    if let Some(tests) = logs.as_deref().and_then(paired_t_tests) {
+        for (g, (ratio, p)) in out.iter_mut().zip(tests) {
+            g.total = g
+                .total
+                .clone()
+                .with_paired(ratio, p, opt.threshold, opt.alpha);
+        }
+    }
     Ok(out)
+}
+
+/// Per group of [`GroupKey`], its NEW/BASE in each pair of rounds: the median over its rows of
+/// the row's NEW round value over its BASE round value. Rows whose values do not line up with
+/// the rounds (a round failed) are left out; a group left with none is skipped.
+fn group_pair_ratios(
+    base: &[Row],
+    new: &[Row],
+    rounds: Rounds,
+    opt: &CompareOptions,
+) -> Option<Vec<Vec<f64>>> {
+    let pairs = rounds.base as usize;
+    let mut groups: Vec<GroupKey> = vec![];
+    for r in base {
+        if !groups.iter().any(|g| g.matches(r)) {
+            groups.push(GroupKey::of(r));
+        }
+    }
+    let mut out = vec![];
+    for group in groups {
+        let mut per_pair: Vec<Vec<f64>> = vec![vec![]; pairs];
+        for b in base.iter().filter(|r| group.matches(r)) {
+            let Some(n) = new.iter().find(|n| key(n) == key(b)) else {
+                continue;
+            };
+            let bv = round_values(b, "total_ms", rounds.base, opt.normalised).ok()?;
+            let nv = round_values(n, "total_ms", rounds.new, opt.normalised).ok()?;
+            if bv.len() != pairs || nv.len() != pairs {
+                continue;
+            }
+            for (i, (b, n)) in bv.iter().zip(&nv).enumerate() {
+                if *b > 0.0 && n.is_finite() {
+                    per_pair[i].push(n / b);
+                }
+            }
+        }
+        if per_pair.iter().all(|v| !v.is_empty()) {
+            out.push(per_pair.iter().map(|v| median(v)).collect());
+        }
+    }
+    Some(out)
 }
 
 /// Where two renderings of the same row differ.

@@ -38,16 +38,26 @@ fn header(c: &Comparison) -> Vec<String> {
                 c.rounds.base, c.rounds.new
             ),
         },
-        match (c.run_factor, c.drift_corrected) {
-            (Some(f), true) => format!(
+        match (c.run_factor, c.drift_corrected, &c.pair_factors) {
+            (f, true, Some(per_pair)) => format!(
+                "drift per pair: NEW/BASE {} (median over the groups of each pair); each NEW \
+                 round was divided by its own pair's factor before the tests (run-wide {})",
+                per_pair
+                    .iter()
+                    .map(|f| format!("×{f:.3}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                f.map_or("-".into(), |f| format!("×{f:.3}"))
+            ),
+            (Some(f), true, None) => format!(
                 "run-wide factor: NEW/BASE ×{f:.3} (median over the groups); NEW's total_ms was \
                  divided by it before the tests, so ratios below are relative to the rest of the \
                  run (--no-drift-correction: absolute)"
             ),
-            (Some(f), false) => format!(
+            (Some(f), false, _) => format!(
                 "run-wide factor: NEW/BASE ×{f:.3} (median over the groups); not divided out"
             ),
-            (None, _) => "run-wide factor: too few groups to estimate; absolute times tested".into(),
+            (None, _, _) => "run-wide factor: too few groups to estimate; absolute times tested".into(),
         },
         format!(
             "outcome: {} — {} regression(s), {} improvement(s), {} other change(s) in {} rows, {} groups",
@@ -428,6 +438,7 @@ mod tests {
             alpha: 0.05,
             normalised: false,
             drift_correction: true,
+            paired: false,
             drift_limit: 1.5,
             fail_on: FailOn::Change,
             out,

@@ -6,6 +6,21 @@ use super::*;
 /// each, `rounds` rounds of `frames` frames around 10 ms × factor with 3 % noise; frame j
 /// of a round is further multiplied by `1 + drift·j` (the machine drifting during a round).
 fn run_dir(dir: &Path, factors: &[f64], rounds: u32, frames: u32, drift: f64, seed: u64) {
+    let machine = vec![1.0; rounds as usize];
+    run_dir_with_machine(dir, factors, &machine, frames, drift, seed);
+}
+
+/// [`run_dir`] with the machine's speed per round: round r's frames are further multiplied by
+/// `machine[r]` (the VM running a round slower or faster as a whole).
+fn run_dir_with_machine(
+    dir: &Path,
+    factors: &[f64],
+    machine: &[f64],
+    frames: u32,
+    drift: f64,
+    seed: u64,
+) {
+    let rounds = machine.len() as u32;
     std::fs::create_dir_all(dir).unwrap();
     let mut rng = crate::results::stats::TestRng::new(seed);
     let mut rows = vec![];
@@ -19,9 +34,9 @@ fn run_dir(dir: &Path, factors: &[f64], rounds: u32, frames: u32, drift: f64, se
                 frames: rounds * frames,
                 ..Default::default()
             };
-            for _ in 0..rounds {
+            for m in machine {
                 for j in 0..frames {
-                    let t = 10.0 * f * (1.0 + drift * j as f64) * (1.0 + 0.03 * rng.normal());
+                    let t = 10.0 * f * m * (1.0 + drift * j as f64) * (1.0 + 0.03 * rng.normal());
                     row.samples.total_ms.push(t);
                 }
             }
@@ -51,6 +66,7 @@ fn options(out: &Path, drift_correction: bool, drift_limit: f64) -> CompareOptio
         normalised: false,
         drift_correction,
         drift_limit,
+        paired: false,
         fail_on: FailOn::Regression,
         out: out.to_path_buf(),
     }
@@ -198,5 +214,71 @@ fn dirty_or_debug_sides_are_warned() {
     assert!(
         w[0].contains("dirty") && w[1].contains("debug build"),
         "{w:?}"
+    );
+}
+
+/// `ab`'s pairs: BASE's and NEW's round i ran side by side and share the machine's speed of
+/// that moment (here ×0.75–×1.3 from pair to pair), and group 3 is ×1.2 slower in NEW. Paired,
+/// each pair's own factor is divided out and only group 3 is slower; with the run-wide factor
+/// the machine's scatter between rounds hides it. A same-build pair stays clean either way.
+#[test]
+fn paired_rounds_divide_out_each_pairs_drift() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b, same) = (
+        tmp.path().join("a"),
+        tmp.path().join("b"),
+        tmp.path().join("same"),
+    );
+    let machine = [1.0, 1.3, 0.75, 1.2, 0.8];
+    run_dir_with_machine(&a, &[1.0; 8], &machine, 1, 0.0, 1);
+    let mut slow = [1.0; 8];
+    slow[3] = 1.2;
+    run_dir_with_machine(&b, &slow, &machine, 1, 0.0, 2);
+    run_dir_with_machine(&same, &[1.0; 8], &machine, 1, 0.0, 3);
+    let out = tmp.path().join("out");
+    let slower = |c: &Comparison| -> Vec<String> {
+        c.groups
+            .iter()
+            .filter(|g| g.total.verdict == Verdict::Slower)
+            .map(|g| g.algorithm.clone())
+            .collect()
+    };
+    let paired = CompareOptions {
+        paired: true,
+        ..options(&out, true, 1.5)
+    };
+    let c = compare(&a, &b, &paired).unwrap();
+    let factors = c
+        .pair_factors
+        .clone()
+        .expect("8 groups, 5 pairs: a factor per pair");
+    assert_eq!(factors.len(), 5);
+    assert!(
+        factors.iter().all(|f| (f - 1.0).abs() < 0.05),
+        "{factors:?}"
+    );
+    assert_eq!(slower(&c), ["alg3"], "{:#?}", c.groups);
+    assert_eq!(
+        slower(&compare(&a, &same, &paired).unwrap()),
+        Vec::<String>::new()
+    );
+
+    // Unpaired (`compare` of two separate runs): NEW's rounds met the machine in another
+    // order, and one run-wide factor leaves the rounds' scatter in the samples.
+    let (b2, same2) = (tmp.path().join("b2"), tmp.path().join("same2"));
+    let shuffled = [0.75, 1.0, 1.2, 0.8, 1.3];
+    run_dir_with_machine(&b2, &slow, &shuffled, 1, 0.0, 2);
+    run_dir_with_machine(&same2, &[1.0; 8], &shuffled, 1, 0.0, 3);
+    let unpaired = compare(&a, &b2, &options(&out, true, 1.5)).unwrap();
+    assert!(unpaired.pair_factors.is_none());
+    assert_eq!(
+        slower(&unpaired),
+        Vec::<String>::new(),
+        "{:#?}",
+        unpaired.groups
+    );
+    assert_eq!(
+        slower(&compare(&a, &same2, &paired).unwrap()),
+        Vec::<String>::new()
     );
 }

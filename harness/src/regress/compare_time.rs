@@ -84,6 +84,16 @@ fn decide(enough: bool, ratio: f64, p: Option<f64>, threshold: f64, alpha: f64) 
 }
 
 impl TimeTest {
+    /// Replaces the unpaired decision by the paired one ([`paired_t_tests`]): its ratio and p.
+    pub fn with_paired(mut self, ratio: f64, p: Option<f64>, threshold: f64, alpha: f64) -> Self {
+        if self.verdict != Verdict::TooFewSamples {
+            self.ratio = ratio;
+            self.p_value = p;
+            self.verdict = decide(true, ratio, p, threshold, alpha);
+        }
+        self
+    }
+
     /// The p-value as printed: raw, and the Holm-adjusted one that decides when there is one.
     pub fn p_label(&self) -> String {
         match self.p_adjusted {
@@ -124,13 +134,44 @@ pub fn adjust_family<'a>(
     }
 }
 
-/// NEW's samples divided by the run-wide factor (1: unchanged).
-pub fn scaled(v: Vec<f64>, scale: f64) -> Vec<f64> {
-    if scale == 1.0 {
-        v
-    } else {
-        v.into_iter().map(|x| x / scale).collect()
+/// NEW's round values divided by the drift: one factor for the whole run, or one per round
+/// when the rounds were paired with BASE's ([`pair_factors`]). Values that do not line up with
+/// the rounds (a round failed, so the row has one value) take the median of the factors.
+pub fn scaled(v: Vec<f64>, factors: &[f64]) -> Vec<f64> {
+    match factors {
+        [] | [1.0] => v,
+        [f] => v.into_iter().map(|x| x / f).collect(),
+        per_round if per_round.len() == v.len() => {
+            v.into_iter().zip(per_round).map(|(x, f)| x / f).collect()
+        }
+        per_round => {
+            let f = median(per_round);
+            v.into_iter().map(|x| x / f).collect()
+        }
     }
+}
+
+/// The drift of each pair of rounds run side by side (`tetbench ab`: BASE's round i and NEW's
+/// round i ran one after the other): per pair, the median over the groups of the group's
+/// NEW/BASE (itself the median over its rows). `ratios[g][i]` is group g's ratio in pair i;
+/// `None` with fewer than [`MIN_GROUPS_FOR_DRIFT`] groups, or when the groups disagree on the
+/// number of pairs.
+///
+/// Why per pair: on the 2-core VM two rounds of one build a few seconds apart differ as a
+/// whole by ×0.8–×1.2 (docs/regression.md, "A/B power"), and the pair that shares that moment
+/// shares that factor; dividing it out of each pair, rather than one median out of the whole
+/// run, leaves a group's residual scatter instead of the machine's.
+pub fn pair_factors(ratios: &[Vec<f64>]) -> Option<Vec<f64>> {
+    let pairs = ratios.first()?.len();
+    if ratios.len() < MIN_GROUPS_FOR_DRIFT || pairs == 0 || ratios.iter().any(|r| r.len() != pairs)
+    {
+        return None;
+    }
+    Some(
+        (0..pairs)
+            .map(|i| median(&ratios.iter().map(|r| r[i]).collect::<Vec<_>>()))
+            .collect(),
+    )
 }
 
 /// The median of the groups' ratios, from at least [`MIN_GROUPS_FOR_DRIFT`] groups.
@@ -147,6 +188,52 @@ pub fn run_wide_factor<'a>(group_totals: impl Iterator<Item = &'a TimeTest>) -> 
         .map(|t| t.ratio)
         .collect();
     (ratios.len() >= MIN_GROUPS_FOR_DRIFT).then(|| median(&ratios))
+}
+
+/// The paired test of `tetbench ab`, per group: `logs[g][i]` is group g's ln(NEW/BASE) in
+/// pair i with that pair's drift already divided out. Each pair is one independent sample (the
+/// viewpoints of a group were reduced to their median within the pair: they ran in the same
+/// seconds and are not independent of each other). A one-sample t-test of the mean against 0,
+/// with the variance pooled over all groups (df = groups × (pairs − 1)). Returns per group the
+/// ratio exp(mean) and the two-sided p; `None` with fewer than 3 pairs or
+/// [`MIN_GROUPS_FOR_DRIFT`] groups.
+///
+/// Why pooled and parametric: five pairs give a group five samples, and no rank test on five
+/// can go below p = 1/16 two-sided, let alone below α after Holm over a dozen groups; a t-test
+/// on five with its own variance has 4 degrees of freedom and a critical t near 7 after Holm.
+/// Pooling the variance over the groups (their scatter comes from the same machine) gives tens
+/// of degrees of freedom. Measured on the 2-core VM (docs/regression.md, "A/B power"):
+/// the residual per-pair scatter is 0.10–0.20 in ln units for every group.
+pub fn paired_t_tests(logs: &[Vec<f64>]) -> Option<Vec<(f64, Option<f64>)>> {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    let n = logs.first()?.len();
+    if n < 3 || logs.len() < MIN_GROUPS_FOR_DRIFT || logs.iter().any(|l| l.len() != n) {
+        return None;
+    }
+    let mean = |l: &[f64]| l.iter().sum::<f64>() / l.len() as f64;
+    let df = (logs.len() * (n - 1)) as f64;
+    let ss: f64 = logs
+        .iter()
+        .map(|l| {
+            let m = mean(l);
+            l.iter().map(|x| (x - m) * (x - m)).sum::<f64>()
+        })
+        .sum();
+    let se = (ss / df).sqrt() / (n as f64).sqrt();
+    let t_dist = StudentsT::new(0.0, 1.0, df).ok()?;
+    Some(
+        logs.iter()
+            .map(|l| {
+                let m = mean(l);
+                let p = if se > 0.0 {
+                    Some((2.0 * (1.0 - t_dist.cdf((m / se).abs()))).min(1.0))
+                } else {
+                    Some(if m == 0.0 { 1.0 } else { 0.0 })
+                };
+                (m.exp(), p)
+            })
+            .collect(),
+    )
 }
 
 pub fn fmt_p(p: Option<f64>) -> String {
@@ -193,6 +280,31 @@ mod tests {
             let t = time_test("total_ms", &a, &b, 1.10, 0.05);
             assert_eq!(t.verdict, Verdict::NoChange, "seed {seed}: {t:?}");
         }
+    }
+
+    /// Eight groups, five pairs, 5 % scatter per pair: the group made ×1.25 slower stands out,
+    /// the others do not; fewer than three pairs decide nothing.
+    #[test]
+    fn paired_t_finds_the_slower_group_only() {
+        let mut rng = TestRng::new(7);
+        let logs: Vec<Vec<f64>> = (0..8)
+            .map(|g| {
+                let shift = if g == 3 { 1.25f64.ln() } else { 0.0 };
+                (0..5).map(|_| shift + 0.05 * rng.normal()).collect()
+            })
+            .collect();
+        let tests = paired_t_tests(&logs).unwrap();
+        for (g, (ratio, p)) in tests.iter().enumerate() {
+            let p = p.unwrap();
+            if g == 3 {
+                assert!(*ratio > 1.15 && p < 1e-4, "{ratio} {p}");
+            } else {
+                assert!(p > 0.001, "group {g}: {ratio} {p}");
+            }
+        }
+        let short: Vec<Vec<f64>> = logs.iter().map(|l| l[..2].to_vec()).collect();
+        assert!(paired_t_tests(&short).is_none());
+        assert!(paired_t_tests(&logs[..4]).is_none());
     }
 
     /// One sample is never enough to decide.

@@ -200,6 +200,7 @@ pub fn history(
             alpha,
             normalised: false,
             drift_correction: true,
+            paired: false,
             drift_limit: 1.5,
             fail_on: FailOn::Never,
             out: out.join("pairs").join(format!("{}-{}", k, k + 1)),

@@ -126,6 +126,8 @@ fn ab_options(
             normalised: false,
             drift_correction: !judge.no_drift_correction,
             drift_limit: judge.drift_limit,
+            // BASE's round i and NEW's round i run back to back: the pairs are real.
+            paired: true,
             fail_on,
             out: out.join("compare"),
         },
