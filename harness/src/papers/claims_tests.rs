@@ -193,23 +193,28 @@ fn gator_table2_counts_the_split_and_says_what_the_loader_dropped() {
 fn havs_k_gt2_pixels_fail_past_two_percent() {
     let paper = 10_626u64;
     let edge = (paper as f64 * 0.98).ceil() as u64;
-    let x = |pixels: u64| Extra {
+    let x = |pixels: u64| spx2_kbuffer(6_615_778, pixels);
+    let m = Measured::default();
+    let at = evaluate_claims("havs", &m, &x(edge));
+    assert_eq!(verdict_of(&at, "H5", Some("spx2")), Verdict::Holds);
+    let below = evaluate_claims("havs", &m, &x(edge - 1));
+    assert_eq!(verdict_of(&below, "H5", Some("spx2")), Verdict::DoesNotHold);
+}
+
+/// spx2's k-buffer analysis (512², 14 viewpoints) with the given fragments and k > 2 pixels.
+fn spx2_kbuffer(fragments: u64, pixels_k_gt2: u64) -> Extra {
+    Extra {
         kbuffer: vec![crate::papers::havs::analysis::KbufferRow {
             dataset: "spx2".into(),
-            fragments: 6_615_778,
-            pixels_k_gt2: pixels,
+            fragments,
+            pixels_k_gt2,
             pixels_k_gt6: 512,
             ..Default::default()
         }],
         kbuffer_views: 14,
         kbuffer_resolution: 512,
         ..Default::default()
-    };
-    let m = Measured::default();
-    let at = evaluate_claims("havs", &m, &x(edge));
-    assert_eq!(verdict_of(&at, "H5", Some("spx2")), Verdict::Holds);
-    let below = evaluate_claims("havs", &m, &x(edge - 1));
-    assert_eq!(verdict_of(&below, "H5", Some("spx2")), Verdict::DoesNotHold);
+    }
 }
 
 fn counter_row(algorithm: &str, settings: &str, dataset: &str, counters: &str) -> Row {
@@ -288,18 +293,7 @@ fn havs_table2_fails_when_a_fragment_is_dropped_past_the_tolerance() {
     let paper = 6_615_778u64;
     // The last count inside the claim's 2 %, then one fragment fewer.
     let edge = (paper as f64 * 0.98).ceil() as u64;
-    let x = |fragments: u64| Extra {
-        kbuffer: vec![crate::papers::havs::analysis::KbufferRow {
-            dataset: "spx2".into(),
-            fragments,
-            pixels_k_gt2: 10_626,
-            pixels_k_gt6: 512,
-            ..Default::default()
-        }],
-        kbuffer_views: 14,
-        kbuffer_resolution: 512,
-        ..Default::default()
-    };
+    let x = |fragments: u64| spx2_kbuffer(fragments, 10_626);
     let m = Measured::default();
     let at = evaluate_claims("havs", &m, &x(edge));
     assert_eq!(verdict_of(&at, "H4", Some("spx2")), Verdict::Holds);
