@@ -23,6 +23,12 @@ pub(super) struct DatasetContext<'a> {
     reference_ms: f64,
 }
 
+/// What a renderer is prepared from: the voxels themselves, or the tets.
+enum PrepareInput<'a> {
+    Voxels(&'a datasets::VoxelVolume),
+    Tets(&'a datasets::TetMesh),
+}
+
 /// The row's fixed parts, before measuring (everything measured starts empty).
 fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Row {
     let c = ctx.config;
@@ -167,16 +173,22 @@ impl<'a> DatasetContext<'a> {
             let what = self.describe(renderer.as_ref());
             progress.activity(&format!("preparing {what}"));
             // A voxel renderer takes a voxel volume as it is; any other renderer needs the
-            // tets, split on first need outside the prepare's peak (as loading is).
-            let voxels = self.data.voxels().filter(|_| renderer.draws_voxels());
-            if voxels.is_none() {
-                let _ = guarded("splitting the volume into tets", || Ok(self.data.mesh()?));
-            }
+            // tets, split on first need before the prepare's peak is reset, so that the split
+            // (like loading) is not counted as the prepare's memory.
+            let input = match self.data.voxels().filter(|_| renderer.draws_voxels()) {
+                Some(volume) => Ok(PrepareInput::Voxels(volume)),
+                None => guarded("splitting the volume into tets", || Ok(self.data.mesh()?))
+                    .map(PrepareInput::Tets),
+            };
             // The first viewpoint's row carries the prepare's peak (host copies of the mesh).
             let peak_reset = reset_host_peak();
-            let prepared = guarded("prepare", || match voxels {
-                Some(volume) => renderer.prepare_voxels(self.gpu, volume, self.optics),
-                None => renderer.prepare(self.gpu, self.data.mesh()?, self.optics),
+            let prepared = input.and_then(|input| {
+                guarded("prepare", || match input {
+                    PrepareInput::Voxels(volume) => {
+                        renderer.prepare_voxels(self.gpu, volume, self.optics)
+                    }
+                    PrepareInput::Tets(mesh) => renderer.prepare(self.gpu, mesh, self.optics),
+                })
             });
             let prepare_peak = host_peak_bytes(peak_reset);
             match prepared {
