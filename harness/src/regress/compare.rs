@@ -165,6 +165,13 @@ pub struct GroupComparison {
     pub algorithm: String,
     pub settings: String,
     pub dataset: String,
+    /// The group's viewport ([`GroupKey`]): one variant at two sizes is two groups.
+    #[serde(default)]
+    pub width: u32,
+    #[serde(default)]
+    pub height: u32,
+    #[serde(default)]
+    pub projection: String,
     pub viewpoints: usize,
     /// Pooled `total_ms` test over the viewpoints.
     pub total: TimeTest,
@@ -752,6 +759,9 @@ fn group_tests(
             algorithm: group.algorithm,
             settings: group.settings.to_string(),
             dataset: group.dataset,
+            width: group.width,
+            height: group.height,
+            projection: group.projection,
             viewpoints: views,
         });
     }

@@ -45,7 +45,27 @@ pub struct Series {
     pub algorithm: String,
     pub settings: String,
     pub dataset: String,
+    /// The group's viewport: one variant at two sizes is two series.
+    pub width: u32,
+    pub height: u32,
     pub points: Vec<Point>,
+}
+
+impl Series {
+    /// The settings as charts and tables name the series, with the size when the same
+    /// variant and data set appear at more than one size in `h`.
+    pub fn label(&self, h: &History) -> String {
+        let sizes = h.series.iter().any(|o| {
+            (&o.algorithm, &o.settings, &o.dataset)
+                == (&self.algorithm, &self.settings, &self.dataset)
+                && (o.width, o.height) != (self.width, self.height)
+        });
+        if sizes {
+            format!("{} @ {}×{}", self.settings, self.width, self.height)
+        } else {
+            self.settings.clone()
+        }
+    }
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -242,8 +262,21 @@ pub fn history(
                 .filter(|_| points.last().is_some_and(|p| p.run + 1 == i))
             {
                 if let Some(gc) = cmp.groups.iter().find(|c| {
-                    (&c.algorithm, &c.settings, &c.dataset)
-                        == (&g.algorithm, &g.settings.to_string(), &g.dataset)
+                    (
+                        &c.algorithm,
+                        &c.settings,
+                        &c.dataset,
+                        c.width,
+                        c.height,
+                        &c.projection,
+                    ) == (
+                        &g.algorithm,
+                        &g.settings.to_string(),
+                        &g.dataset,
+                        g.width,
+                        g.height,
+                        &g.projection,
+                    )
                 }) {
                     match gc.total.verdict {
                         Verdict::Slower => changes.push(format!("slower ×{:.3}", gc.total.ratio)),
@@ -253,8 +286,14 @@ pub fn history(
                     }
                 }
                 let rows_here = cmp.rows.iter().filter(|r| {
-                    (&r.algorithm, &r.settings, &r.dataset)
-                        == (&g.algorithm, &g.settings.to_string(), &g.dataset)
+                    (&r.algorithm, &r.settings, &r.dataset, r.width, r.height)
+                        == (
+                            &g.algorithm,
+                            &g.settings.to_string(),
+                            &g.dataset,
+                            g.width,
+                            g.height,
+                        )
                 });
                 let mut psnr_moved = false;
                 let mut memory = false;
@@ -307,6 +346,8 @@ pub fn history(
             algorithm: g.algorithm.clone(),
             settings: g.settings.to_string(),
             dataset: g.dataset.clone(),
+            width: g.width,
+            height: g.height,
             points,
         });
     }
@@ -330,7 +371,7 @@ fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<(
         .iter()
         .filter(|s| s.algorithm == alg && s.dataset == dataset)
         .map(|s| Line {
-            label: s.settings.clone(),
+            label: s.label(h),
             points: s
                 .points
                 .iter()
@@ -365,7 +406,7 @@ fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<(
 #[derive(Serialize)]
 struct PageSeries<'a> {
     algorithm: &'a str,
-    settings: &'a str,
+    settings: String,
     dataset: &'a str,
     points: &'a [Point],
     steps: Vec<String>,
@@ -394,7 +435,7 @@ pub fn page(h: &History, charts: &[(String, String)]) -> anyhow::Result<String> 
         .iter()
         .map(|s| PageSeries {
             algorithm: &s.algorithm,
-            settings: &s.settings,
+            settings: s.label(h),
             dataset: &s.dataset,
             points: &s.points,
             steps: step_labels(h, s),
@@ -462,7 +503,7 @@ pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> 
             md,
             "| {} | {} | {} | {} | {} |",
             s.algorithm,
-            s.settings,
+            s.label(&h),
             s.dataset,
             cells.join(" → "),
             step_labels(&h, s).join(", ")
@@ -536,6 +577,8 @@ mod tests {
                 algorithm: hostile.into(),
                 settings: hostile.into(),
                 dataset: hostile.into(),
+                width: 64,
+                height: 64,
                 points: vec![Point {
                     run: 0,
                     total_ms: 1.0,
@@ -567,13 +610,16 @@ mod tests {
             let dir = tmp.path().join(name);
             std::fs::create_dir_all(&dir).unwrap();
             let mut rows = vec![];
-            for (g, f) in [(0, slow), (1, 1.0)] {
+            // alg0 at two sizes, only the 64² one made slower: one variant, two groups.
+            for (g, f, size) in [(0, slow, 64), (0, 1.0, 128), (1, 1.0, 64)] {
                 for (v, vp) in ["+x", "-x", "+y"].iter().enumerate() {
                     let mut row = Row {
                         algorithm: format!("alg{g}"),
                         settings: "k=2".parse().unwrap(),
                         dataset: "box:1k".into(),
                         viewpoint: vp.to_string(),
+                        width: size,
+                        height: size,
                         ..Default::default()
                     };
                     row.samples.total_ms = (0..5)
@@ -630,7 +676,16 @@ mod tests {
             "{:?}",
             alg0.points[3]
         );
-        assert!(h.series[1].points.iter().all(|p| p.step.is_none()));
+        // The same variant at 128² did not change: no step, and not the 64² group's verdict.
+        assert_eq!(
+            (h.series[1].algorithm.as_str(), h.series[1].width),
+            ("alg0", 128)
+        );
+        assert!(h.series[1]
+            .points
+            .iter()
+            .all(|p| p.step.is_none() && p.changes.is_empty()));
+        assert!(h.series[2].points.iter().all(|p| p.step.is_none()));
         let flat = history(&same, &out, 1.10, 0.05).unwrap();
         assert!(flat.series.iter().all(|s| s
             .points
