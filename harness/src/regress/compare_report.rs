@@ -84,10 +84,19 @@ fn metric<'a>(r: &'a RowComparison, name: &str) -> Option<&'a TimeTest> {
     r.times.iter().find(|t| t.metric == name)
 }
 
+/// What a group's test was made on: paired rounds (`ab`) or the viewpoints' round values.
+fn groups_basis(c: &Comparison) -> &'static str {
+    if c.pair_factors.is_some() {
+        "total_ms, paired: one ln(NEW/BASE) per pair, t-test pooled over the groups"
+    } else {
+        "total_ms pooled over viewpoints"
+    }
+}
+
 /// The terminal summary: header, group table, then only the rows with something to say.
 pub fn terminal(c: &Comparison) -> String {
     let mut s = header(c).join("\n");
-    s.push_str("\n\ngroups (total_ms pooled over viewpoints):\n");
+    s.push_str(&format!("\n\ngroups ({}):\n", groups_basis(c)));
     let w = c
         .groups
         .iter()
@@ -138,7 +147,7 @@ fn markdown(c: &Comparison) -> String {
             }
         }
     }
-    s.push_str("\n## Groups (total_ms pooled over viewpoints)\n\n");
+    s.push_str(&format!("\n## Groups ({})\n\n", groups_basis(c)));
     s.push_str("| algorithm | settings | data set | views | base ms | new ms | ratio | p (Holm) | verdict |\n|---|---|---|---:|---:|---:|---:|---:|---|\n");
     for g in &c.groups {
         let _ = writeln!(
