@@ -177,6 +177,25 @@ pub struct GroupComparison {
     pub total: TimeTest,
 }
 
+impl GroupComparison {
+    /// Whether this is the comparison of the reports' group `g`.
+    pub fn is(&self, g: &GroupKey) -> bool {
+        (&self.algorithm, &self.settings, &self.dataset)
+            == (&g.algorithm, &g.settings.to_string(), &g.dataset)
+            && (self.width, self.height, &self.projection) == (g.width, g.height, &g.projection)
+    }
+}
+
+impl RowComparison {
+    /// Whether the row belongs to group `g` (a row comparison keeps no projection: matched on
+    /// the rest).
+    pub fn in_group(&self, g: &GroupKey) -> bool {
+        (&self.algorithm, &self.settings, &self.dataset)
+            == (&g.algorithm, &g.settings.to_string(), &g.dataset)
+            && (self.width, self.height) == (g.width, g.height)
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Comparison {
     pub base: String,
@@ -347,7 +366,7 @@ pub fn compare(
     let unscaled = group_tests(&base.rows, &new.rows, opt, &[1.0], rounds)?;
     let run_factor = run_wide_factor(unscaled.iter().map(|g| &g.total));
     let pair_factors = (opt.paired && opt.drift_correction && rounds.base == rounds.new)
-        .then(|| pair_factors(&group_pair_ratios(&base.rows, &new.rows, rounds, opt)?))
+        .then(|| pair_factors(&group_pair_ratios(&base.rows, &new.rows, rounds, opt).ok()?))
         .flatten();
     let scale: Vec<f64> = match (&pair_factors, run_factor) {
         (Some(per_pair), _) => per_pair.clone(),
@@ -707,31 +726,16 @@ fn group_tests(
     scale: &[f64],
     rounds: Rounds,
 ) -> anyhow::Result<Vec<GroupComparison>> {
-    let mut groups: Vec<GroupKey> = vec![];
-    for r in base {
-        if !groups.iter().any(|g| g.matches(r)) {
-            groups.push(GroupKey::of(r));
-        }
-    }
     let mut out = vec![];
     // Per group, per pair: the median over its rows of ln(NEW/BASE), NEW already divided by
     // its pair's drift (only when `scale` holds one factor per pair).
     let mut paired_logs: Vec<Option<Vec<f64>>> = vec![];
     let pairs = scale.len();
-    for group in groups {
+    for (group, matched) in group_round_values(base, new, rounds, opt)? {
         let (mut bs, mut ns, mut views) = (vec![], vec![], 0);
         let mut per_pair: Vec<Vec<f64>> = vec![vec![]; pairs];
-        for b in base.iter().filter(|r| group.matches(r)) {
-            let Some(n) = new.iter().find(|n| key(n) == key(b)) else {
-                continue;
-            };
-            let (bv, nv) = (
-                round_values(b, "total_ms", rounds.base, opt.normalised)?,
-                scaled(
-                    round_values(n, "total_ms", rounds.new, opt.normalised)?,
-                    scale,
-                ),
-            );
+        for (bv, nv) in matched {
+            let nv = scaled(nv, scale);
             let m = median(&bv);
             if bv.is_empty() || nv.is_empty() || m.is_nan() || m <= 0.0 {
                 continue;
@@ -779,31 +783,49 @@ fn group_tests(
     Ok(out)
 }
 
-/// Per group of [`GroupKey`], its NEW/BASE in each pair of rounds: the median over its rows of
-/// the row's NEW round value over its BASE round value. Rows whose values do not line up with
-/// the rounds (a round failed) are left out; a group left with none is skipped.
+/// One matched row's `total_ms` round values: BASE's, then NEW's as measured (not yet scaled).
+type RoundPair = (Vec<f64>, Vec<f64>);
+
+/// Per group of [`GroupKey`] (in BASE's order), the round values of each BASE row and its NEW
+/// row (rows only in BASE are left out).
+fn group_round_values(
+    base: &[Row],
+    new: &[Row],
+    rounds: Rounds,
+    opt: &CompareOptions,
+) -> anyhow::Result<Vec<(GroupKey, Vec<RoundPair>)>> {
+    GroupKey::distinct(base)
+        .into_iter()
+        .map(|group| {
+            let mut matched = vec![];
+            for b in base.iter().filter(|r| group.matches(r)) {
+                let Some(n) = new.iter().find(|n| key(n) == key(b)) else {
+                    continue;
+                };
+                matched.push((
+                    round_values(b, "total_ms", rounds.base, opt.normalised)?,
+                    round_values(n, "total_ms", rounds.new, opt.normalised)?,
+                ));
+            }
+            Ok((group, matched))
+        })
+        .collect()
+}
+
+/// Per group, its NEW/BASE in each pair of rounds: the median over its rows of the row's NEW
+/// round value over its BASE round value. Rows whose values do not line up with the rounds (a
+/// round failed) are left out; a group left with none is skipped.
 fn group_pair_ratios(
     base: &[Row],
     new: &[Row],
     rounds: Rounds,
     opt: &CompareOptions,
-) -> Option<Vec<Vec<f64>>> {
+) -> anyhow::Result<Vec<Vec<f64>>> {
     let pairs = rounds.base as usize;
-    let mut groups: Vec<GroupKey> = vec![];
-    for r in base {
-        if !groups.iter().any(|g| g.matches(r)) {
-            groups.push(GroupKey::of(r));
-        }
-    }
     let mut out = vec![];
-    for group in groups {
+    for (_, matched) in group_round_values(base, new, rounds, opt)? {
         let mut per_pair: Vec<Vec<f64>> = vec![vec![]; pairs];
-        for b in base.iter().filter(|r| group.matches(r)) {
-            let Some(n) = new.iter().find(|n| key(n) == key(b)) else {
-                continue;
-            };
-            let bv = round_values(b, "total_ms", rounds.base, opt.normalised).ok()?;
-            let nv = round_values(n, "total_ms", rounds.new, opt.normalised).ok()?;
+        for (bv, nv) in matched {
             if bv.len() != pairs || nv.len() != pairs {
                 continue;
             }
@@ -817,7 +839,7 @@ fn group_pair_ratios(
             out.push(per_pair.iter().map(|v| median(v)).collect());
         }
     }
-    Some(out)
+    Ok(out)
 }
 
 /// Where two renderings of the same row differ.

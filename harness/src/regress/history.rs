@@ -230,14 +230,7 @@ pub fn history(
         )?));
     }
     // The reports' groups (variant × data set × viewport), matched across the runs.
-    let mut groups: Vec<GroupKey> = vec![];
-    for (_, f) in &files {
-        for r in &f.rows {
-            if !groups.iter().any(|g| g.matches(r)) {
-                groups.push(GroupKey::of(r));
-            }
-        }
-    }
+    let groups = GroupKey::distinct(files.iter().flat_map(|(_, f)| &f.rows));
     let mut series = vec![];
     for g in groups {
         let mut points: Vec<Point> = vec![];
@@ -261,23 +254,7 @@ pub fn history(
                 .as_ref()
                 .filter(|_| points.last().is_some_and(|p| p.run + 1 == i))
             {
-                if let Some(gc) = cmp.groups.iter().find(|c| {
-                    (
-                        &c.algorithm,
-                        &c.settings,
-                        &c.dataset,
-                        c.width,
-                        c.height,
-                        &c.projection,
-                    ) == (
-                        &g.algorithm,
-                        &g.settings.to_string(),
-                        &g.dataset,
-                        g.width,
-                        g.height,
-                        &g.projection,
-                    )
-                }) {
+                if let Some(gc) = cmp.groups.iter().find(|c| c.is(&g)) {
                     match gc.total.verdict {
                         Verdict::Slower => changes.push(format!("slower ×{:.3}", gc.total.ratio)),
                         Verdict::Faster => changes.push(format!("faster ×{:.3}", gc.total.ratio)),
@@ -285,16 +262,7 @@ pub fn history(
                         Verdict::NoChange => {}
                     }
                 }
-                let rows_here = cmp.rows.iter().filter(|r| {
-                    (&r.algorithm, &r.settings, &r.dataset, r.width, r.height)
-                        == (
-                            &g.algorithm,
-                            &g.settings.to_string(),
-                            &g.dataset,
-                            g.width,
-                            g.height,
-                        )
-                });
+                let rows_here = cmp.rows.iter().filter(|r| r.in_group(&g));
                 let mut psnr_moved = false;
                 let mut memory = false;
                 for r in rows_here {

@@ -40,6 +40,17 @@ impl GroupKey {
             && self.height == row.height
             && self.projection == row.projection
     }
+
+    /// The distinct groups of `rows`, in the order they first appear.
+    pub fn distinct<'a>(rows: impl IntoIterator<Item = &'a Row>) -> Vec<GroupKey> {
+        let mut groups: Vec<GroupKey> = vec![];
+        for r in rows {
+            if !groups.iter().any(|g| g.matches(r)) {
+                groups.push(GroupKey::of(r));
+            }
+        }
+        groups
+    }
 }
 
 /// One group's numbers.
