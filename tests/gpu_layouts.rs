@@ -32,6 +32,7 @@ fn wgsl_source(file: &str) -> String {
             include_str!("../renderers/raycast/src/cast.wgsl")
         ),
         "frame.wgsl" => include_str!("../renderers/splat/src/frame.wgsl").into(),
+        "splat.wgsl" => include_str!("../renderers/splat/src/splat.wgsl").into(),
         other => panic!("no WGSL file {other} is known to the layout test"),
     }
 }

@@ -126,38 +126,20 @@ fn walk_main(@builtin(global_invocation_id) id: vec3<u32>) {
     walk_out[id.x] = colour;
 }
 
-// Splat fill: instanced SPLAT_PX-pixel quads on a grid over the target, each fragment doing
-// what a splat fragment does (Grau & Tost 2007 §3.6): a bilinear lookup in two footprint
-// slices of a storage table, blended additively into a two-channel float sheet.
-const SPLAT_PX: f32 = 16.0;
-const SPLAT_GRID: u32 = 32u;
-const SPLAT_TARGET: f32 = 512.0;
+// Splat fill: what the splatter's compute pass does per voxel (Grau & Tost 2007 §3.6, our
+// splat.wgsl): walk the pixel centres of a SPLAT_PX-pixel square, a bilinear lookup in two
+// footprint slices of a storage table per centre, added to a two-u32 fixed-point sheet with
+// atomics. Squares half a square apart, so each pixel is hit several times, as overlapping
+// splats are. SPLAT_PX = 4 is a typical footprint of the paper's volumes at 256²-512², so the
+// rate per fragment carries its share of the per-voxel set-up.
+const SPLAT_PX: f32 = 4.0;
+const SPLAT_GRID: u32 = 128u;
+const SPLAT_TARGET: u32 = 512u;
 const SPLAT_SLICE: u32 = 32u;
+const SPLAT_ONE: f32 = 16777216.0;
 
 @group(0) @binding(7) var<storage, read> splat_table: array<f32>;
-
-struct SplatFill {
-    @builtin(position) pos: vec4<f32>,
-    @location(0) uv: vec2<f32>,
-    @location(1) @interpolate(flat) q: u32,
-}
-
-@vertex
-fn splat_vs(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> SplatFill {
-    var corners = array<vec2<f32>, 6>(
-        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0),
-        vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0));
-    let c = corners[vi];
-    let cell = ii % (SPLAT_GRID * SPLAT_GRID);
-    // Quads half a quad apart: each pixel is covered several times, as overlapping splats are.
-    let origin = vec2<f32>(f32(cell % SPLAT_GRID), f32(cell / SPLAT_GRID)) * (SPLAT_PX * 0.5) + 0.25;
-    let p = (origin + c * SPLAT_PX) / SPLAT_TARGET * 2.0 - 1.0;
-    var out: SplatFill;
-    out.pos = vec4<f32>(p.x, -p.y, 0.5, 1.0);
-    out.uv = c * f32(SPLAT_SLICE) - 0.5;
-    out.q = ii % 7u;
-    return out;
-}
+@group(0) @binding(8) var<storage, read_write> splat_sheet: array<atomic<u32>>;
 
 fn splat_texel(q: u32, x: i32, y: i32) -> f32 {
     let n = i32(SPLAT_SLICE);
@@ -175,8 +157,20 @@ fn splat_bilinear(q: u32, uv: vec2<f32>) -> f32 {
                mix(splat_texel(q, i.x, i.y + 1), splat_texel(q, i.x + 1, i.y + 1), t.x), t.y);
 }
 
-@fragment
-fn splat_fs(in: SplatFill) -> @location(0) vec4<f32> {
-    let w = mix(splat_bilinear(in.q, in.uv), splat_bilinear(in.q + 1u, in.uv), 0.5);
-    return vec4<f32>(w * 0.5, w, 0.0, 0.0);
+@compute @workgroup_size(256)
+fn splat_cs(@builtin(global_invocation_id) id: vec3<u32>) {
+    let cell = id.x % (SPLAT_GRID * SPLAT_GRID);
+    let origin = vec2<f32>(f32(cell % SPLAT_GRID), f32(cell / SPLAT_GRID)) * (SPLAT_PX * 0.5) + 0.25;
+    let q = id.x % 7u;
+    let lo = vec2<u32>(ceil(origin - 0.5));
+    let hi = vec2<u32>(ceil(origin + SPLAT_PX - 0.5));
+    for (var y = lo.y; y < hi.y; y++) {
+        for (var x = lo.x; x < hi.x; x++) {
+            let uv = (vec2<f32>(f32(x) + 0.5, f32(y) + 0.5) - origin) / SPLAT_PX * f32(SPLAT_SLICE) - 0.5;
+            let w = mix(splat_bilinear(q, uv), splat_bilinear(q + 1u, uv), 0.5);
+            let p = 2u * (y * SPLAT_TARGET + x);
+            atomicAdd(&splat_sheet[p], u32(w * 0.5 * SPLAT_ONE + 0.5));
+            atomicAdd(&splat_sheet[p + 1u], u32(w * SPLAT_ONE + 0.5));
+        }
+    }
 }

@@ -1,7 +1,7 @@
 //! The calibration's work-specific micro-benchmarks (`calibrate.wgsl`), one per counter that
-//! no generic figure prices: a ray step (`walk_main`), a splat fragment (`splat_vs` /
-//! `splat_fs`) and a key of render-core's GPU radix sort. Each returns its rate per second,
-//! best of the calibration's repetitions; 0 where the adapter cannot run it.
+//! no generic figure prices: a ray step (`walk_main`), a splat fragment (`splat_cs`) and a key
+//! of render-core's GPU radix sort. Each returns its rate per second, best of the
+//! calibration's repetitions; 0 where the adapter cannot run it.
 
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::gpu_sort::GpuRadixSort;
@@ -29,9 +29,9 @@ const WALK_CELLS: u64 = 1 << 19;
 const WALK_STEPS: u64 = 32; // calibrate.wgsl WALK_STEPS
 const WALK_TABLE: u64 = 4096; // calibrate.wgsl WALK_TABLE
 const WALK_INVOCATIONS: u64 = 32 * 1024;
-const SPLAT_GRID: u64 = 32; // calibrate.wgsl SPLAT_GRID
-const SPLAT_PX: u64 = 16; // calibrate.wgsl SPLAT_PX (each quad covers SPLAT_PX² centres)
-const SPLAT_TARGET: u32 = 512; // calibrate.wgsl SPLAT_TARGET
+const SPLAT_GRID: u64 = 128; // calibrate.wgsl SPLAT_GRID
+const SPLAT_PX: u64 = 4; // calibrate.wgsl SPLAT_PX (each square covers SPLAT_PX² centres)
+const SPLAT_TARGET: u64 = 512; // calibrate.wgsl SPLAT_TARGET
 const SPLAT_SLICE: u64 = 32; // calibrate.wgsl SPLAT_SLICE
 const SPLAT_REPEATS: u64 = 16;
 const GPU_SORT_KEYS: u32 = 1 << 18;
@@ -142,11 +142,8 @@ pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Resu
     Ok((WALK_INVOCATIONS * WALK_STEPS) as f64 / s)
 }
 
-/// Splat fragments per second into the splatter's sheet format (0 without float blending).
+/// Splat fragments per second of the splatter's compute fill (`splat_cs`).
 pub fn splat_fragments_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Result<f64> {
-    if !gpu.features.contains(wgpu::Features::FLOAT32_BLENDABLE) {
-        return Ok(0.0);
-    }
     let mut fill = Filler(0x9E37_79B9_7F4A_7C15);
     let table: Vec<f32> = (0..8 * SPLAT_SLICE * SPLAT_SLICE)
         .map(|_| fill.unit())
@@ -158,63 +155,46 @@ pub fn splat_fragments_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow
         "calibrate splat table",
         bytemuck::cast_slice(&table),
     )?;
+    let sheet = ledger.buffer(
+        gpu,
+        "calibrate splat sheet",
+        Lifetime::PerFrame,
+        SPLAT_TARGET * SPLAT_TARGET * 8,
+        wgpu::BufferUsages::STORAGE,
+    )?;
+    let c = wgpu::ShaderStages::COMPUTE;
     let group = gpu
         .device
         .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("calibrate splat"),
-            entries: &[render_core::bind::storage_entry(
-                7,
-                wgpu::ShaderStages::FRAGMENT,
-                true,
-            )],
+            entries: &[
+                render_core::bind::storage_entry(7, c, true),
+                render_core::bind::storage_entry(8, c, false),
+            ],
         });
     let layout = render_core::bind::pipeline_layout(gpu, "calibrate splat", &[Some(&group)]);
-    let format = wgpu::TextureFormat::Rg32Float;
-    let add = wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::One,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
-    };
-    let pipeline = gpu.triangle_pipeline(
-        "calibrate splat",
-        &layout,
-        module,
-        "splat_vs",
-        "splat_fs",
-        format,
-        Some(wgpu::BlendState {
-            color: add,
-            alpha: add,
-        }),
-        wgpu::ColorWrites::ALL,
-    );
+    let pipeline = gpu.compute_pipeline("calibrate splat", Some(&layout), module, "splat_cs");
     let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("calibrate splat"),
         layout: &group,
-        entries: &[render_core::bind::whole(7, &table_buf)],
+        entries: &[
+            render_core::bind::whole(7, &table_buf),
+            render_core::bind::whole(8, &sheet),
+        ],
     });
-    let (_, view) = render_core::bind::render_target(
-        gpu,
-        &mut ledger,
-        "calibrate splat sheet",
-        (SPLAT_TARGET, SPLAT_TARGET),
-        format,
-        wgpu::TextureUsages::RENDER_ATTACHMENT,
-    )?;
-    let quads = SPLAT_GRID * SPLAT_GRID * SPLAT_REPEATS;
+    let splats = SPLAT_GRID * SPLAT_GRID * SPLAT_REPEATS;
     let s = best_seconds(|| {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
-            let mut pass =
-                render_core::bind::color_pass(&mut enc, "calibrate splat", &view, true, true, None);
+            let mut pass = enc.begin_compute_pass(&Default::default());
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &bind, &[]);
-            pass.draw(0..6, 0..quads as u32);
+            pass.dispatch_workgroups((splats / 256) as u32, 1, 1);
         }
         gpu.queue.submit([enc.finish()]);
         gpu.wait()
     })?;
-    Ok((quads * SPLAT_PX * SPLAT_PX) as f64 / s)
+    Ok((splats * SPLAT_PX * SPLAT_PX) as f64 / s)
 }
 
 /// Keys per second of render-core's GPU radix sort (HAVS' and fragment PT's device sorts)

@@ -1,10 +1,15 @@
-// Classifies and composites one sheet (post-classification): the sheet holds the slab's mean
-// value (sum v*w / sum w) and its coverage w; the transfer function is applied to the mean,
-// the extinction weighted by the coverage (so the data set's boundary keeps its mass), over
-// the ray's length through the slab; front-to-back "under" blending into the image.
+// Classifies and composites one sheet (post-classification): the sheet holds the slab's
+// fixed-point sums (value * w, w) (splat.wgsl), so its mean value is sum v*w / sum w and its
+// coverage sum w; the transfer function is applied to the mean, the extinction weighted by
+// the coverage (so the data set's boundary keeps its mass), over the ray's length through the
+// slab; front-to-back "under" blending into the image. The pixel's sums are zeroed as they
+// are read: the next slab starts from an empty sheet without a clear pass.
+
+// 1 / SHEET_ONE (splat.wgsl).
+const SHEET_UNIT: f32 = 1.0 / 16777216.0;
 
 @group(0) @binding(0) var<uniform> fr: Frame;
-@group(0) @binding(1) var sheet: texture_2d<f32>;
+@group(0) @binding(1) var<storage, read_write> sheet: array<u32>;
 @group(0) @binding(2) var<storage, read> tf: array<vec4<f32>>;
 
 @vertex
@@ -16,7 +21,12 @@ fn fullscreen_vs(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32>
 
 @fragment
 fn composite_fs(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let sw = textureLoad(sheet, vec2<i32>(pos.xy), 0).xy;
+    let p = 2u * (u32(pos.y) * u32(fr.viewport.x) + u32(pos.x));
+    let sw = vec2<f32>(f32(sheet[p]), f32(sheet[p + 1u])) * SHEET_UNIT;
+    if (sheet[p + 1u] != 0u) {
+        sheet[p] = 0u;
+        sheet[p + 1u] = 0u;
+    }
     if (sw.y <= 1e-6) {
         discard;
     }

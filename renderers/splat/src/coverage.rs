@@ -1,17 +1,18 @@
 //! The splatter's work per frame, derived on the CPU from the same f32 arithmetic as the
 //! shaders (the roofline's counters, computed once per view and outside the timed frame):
 //!
-//! * splat fragments: the pixel centres each voxel's quad covers (`splat_vs` in splat.wgsl),
-//!   times the slabs that draw that voxel (slab i draws buckets i − r … i + r, `buckets.rs`);
+//! * splat fragments: the pixel centres each voxel's footprint square covers (`splat_cs` in
+//!   splat.wgsl), times the slabs that draw that voxel (slab i draws buckets i − r … i + r,
+//!   `buckets.rs`);
 //! * splats: the (voxel, slab) pairs drawn, the same sum without the areas (the row's `splats`
 //!   counts them from the bucket table; the tests check the two agree).
 //!
-//! A quad's pixels are the centres (k + ½) with left/top edge ≤ centre < right/bottom edge
-//! (the rasteriser's top-left rule on an axis-aligned rectangle). The rasteriser first snaps
-//! the corners to its sub-pixel grid (1/256 pixel on lavapipe, at least 1/16 by Vulkan's
-//! rules) and the corner passes through NDC and back, so a centre within a hair of an edge can
-//! go either way: [`FragmentCount`] also gives the counts with every edge moved in and out by
-//! [`EDGE_MARGIN`], which bound what any conforming rasteriser yields.
+//! A square's pixels are the centres (k + ½) with left/top edge ≤ centre < right/bottom edge
+//! (a rasteriser's top-left rule on an axis-aligned rectangle, which the compute pass applies
+//! itself). The GPU computes the square's centre in f32 through its own matrix product (fused
+//! multiply-adds may round differently), so a centre within a hair of an edge can go either
+//! way: [`FragmentCount`] also gives the counts with every edge moved in and out by
+//! [`EDGE_MARGIN`], which bound what the GPU yields.
 
 use anyhow::Context;
 use rayon::prelude::*;
@@ -21,8 +22,9 @@ use crate::buckets::{depth, SlabGeometry};
 use crate::gpu::FrameUniform;
 use crate::Splat;
 
-/// How far (pixels) an edge may move between this twin and the rasteriser: sub-pixel
-/// snapping (≤ 1/32 pixel at Vulkan's minimum 4 sub-pixel bits) plus f32 round-off.
+/// How far (pixels) an edge may move between this twin and the GPU: f32 round-off of the
+/// projection, with a wide margin (it also bounds a rasteriser's sub-pixel snapping, ≤ 1/32
+/// pixel at Vulkan's minimum 4 sub-pixel bits, should the splats be drawn as quads again).
 pub const EDGE_MARGIN: f64 = 1.0 / 16.0;
 
 /// What one frame's splats cover.
@@ -143,6 +145,32 @@ pub fn frame_fragments(
         .reduce(FragmentCount::default, |a, b| a + b)
 }
 
+/// Pixel centres of the voxels' squares that lie outside `rect` = [x0, y0, x1, y1) (the
+/// composite's scissor, which must hold every one of them).
+pub fn centres_outside(p: &QuadParams, voxels: &[[f32; 4]], rect: [u32; 4]) -> u64 {
+    let [x0, y0, x1, y1] = rect.map(|v| v as f64);
+    voxels
+        .par_iter()
+        .filter_map(|&v| p.quad(v))
+        .map(|q| {
+            let all = quad_pixels(q, p.viewport, 0.0);
+            // Centres inside the rectangle: the same rule on the square clipped to it.
+            let clip = |a: f32, lo: f64, hi: f64| (a as f64).clamp(lo, hi) as f32;
+            let inside = quad_pixels(
+                [
+                    clip(q[0], x0, x1),
+                    clip(q[1], y0, y1),
+                    clip(q[2], x0, x1),
+                    clip(q[3], y0, y1),
+                ],
+                p.viewport,
+                0.0,
+            );
+            all - inside
+        })
+        .sum()
+}
+
 impl Splat {
     /// Test hook: early splat elimination drops (and counts) every splat fragment, so the
     /// row's `ese_dropped_fragments` is the GPU's count of the fragments `splat_fragments`
@@ -151,6 +179,15 @@ impl Splat {
     pub fn counting_every_fragment(mut self) -> Splat {
         self.count_every_fragment = true;
         self
+    }
+
+    /// Footprint pixel centres of `camera`'s view outside `rect` (see [`centres_outside`]).
+    #[doc(hidden)]
+    pub fn centres_outside(&self, camera: &Camera, rect: [u32; 4]) -> anyhow::Result<u64> {
+        let st = self.state.as_ref().context("splat: prepare first")?;
+        let geom = self.geometry(st, camera);
+        let quad = QuadParams::of(&self.frame_uniform(camera, &geom, 0));
+        Ok(centres_outside(&quad, &st.set.voxels, rect))
     }
 
     /// The splat coverage of `camera`'s view (derived on the CPU, cached per view), and its

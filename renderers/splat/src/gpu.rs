@@ -32,6 +32,16 @@ pub struct FrameUniform {
     pub pad: [f32; 2],
 }
 
+/// Must match `Slab` in `splat.wgsl`: one slab's voxel range, at a dynamic offset per slab.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SlabUniform {
+    pub index: u32,
+    pub first: u32,
+    pub count: u32,
+    pub pad: u32,
+}
+
 /// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
 /// for the layout test (`tests/gpu_layouts.rs`).
 #[doc(hidden)]
@@ -43,6 +53,7 @@ pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
             kernel_radius, kernel_unit, density_scale, ese_alpha, kernel_radius_world,
             length_unit, pad
         }),
+        render_core::rust_layout!(SlabUniform => "splat.wgsl::Slab" { index, first, count, pad }),
     ]
 }
 
@@ -50,7 +61,6 @@ pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
 /// `min_uniform_buffer_offset_alignment` wgpu allows).
 pub const UNIFORM_STRIDE: u64 = 256;
 
-pub const SHEET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
 pub const IMAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 pub struct Pipelines {
@@ -62,7 +72,7 @@ pub struct Pipelines {
     pub bitonic: wgpu::ComputePipeline,
     pub splat_layout: wgpu::BindGroupLayout,
     pub slab_layout: wgpu::BindGroupLayout,
-    pub splat: wgpu::RenderPipeline,
+    pub splat: wgpu::ComputePipeline,
     pub composite_layout: wgpu::BindGroupLayout,
     pub composite: wgpu::RenderPipeline,
 }
@@ -76,13 +86,8 @@ fn uniform(binding: u32, vis: wgpu::ShaderStages, dynamic: bool) -> wgpu::BindGr
     }
 }
 
-fn float_texture(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    bind::texture_entry(
-        binding,
-        wgpu::ShaderStages::FRAGMENT,
-        false,
-        wgpu::TextureViewDimension::D2,
-    )
+fn float_texture(binding: u32, stage: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    bind::texture_entry(binding, stage, false, wgpu::TextureViewDimension::D2)
 }
 
 fn with_frame(body: &str) -> String {
@@ -93,7 +98,6 @@ impl Pipelines {
     pub fn new(gpu: &Gpu) -> Pipelines {
         let d = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
-        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
             d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some(label),
@@ -152,43 +156,32 @@ impl Pipelines {
         let splat_layout = layout(
             "splat sheet",
             &[
-                uniform(0, vf, false),
-                storage(1, wgpu::ShaderStages::VERTEX, true),
-                storage(2, wgpu::ShaderStages::FRAGMENT, true),
-                float_texture(3),
+                uniform(0, c, false),
+                storage(1, c, true),
+                storage(2, c, true),
+                float_texture(3, c),
                 // Fragments dropped by early splat elimination (counted, not timed).
-                storage(4, wgpu::ShaderStages::FRAGMENT, false),
+                storage(4, c, false),
+                storage(5, c, false),
             ],
         );
-        let slab_layout = layout(
-            "splat slab",
-            &[uniform(0, wgpu::ShaderStages::VERTEX, true)],
-        );
+        let slab_layout = layout("splat slab", &[uniform(0, c, true)]);
         let splat_module = gpu.shader("splat splat.wgsl", &with_frame(include_str!("splat.wgsl")));
-        let add = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let splat = gpu.triangle_pipeline(
+        let splat = gpu.compute_pipeline(
             "splat sheet",
-            &pipeline_layout("splat sheet", &[&splat_layout, &slab_layout]),
+            Some(&pipeline_layout(
+                "splat sheet",
+                &[&splat_layout, &slab_layout],
+            )),
             &splat_module,
-            "splat_vs",
-            "splat_fs",
-            SHEET_FORMAT,
-            Some(wgpu::BlendState {
-                color: add,
-                alpha: add,
-            }),
-            wgpu::ColorWrites::RED | wgpu::ColorWrites::GREEN,
+            "splat_cs",
         );
 
         let composite_layout = layout(
             "splat composite",
             &[
                 uniform(0, wgpu::ShaderStages::FRAGMENT, false),
-                float_texture(1),
+                storage(1, wgpu::ShaderStages::FRAGMENT, false),
                 storage(2, wgpu::ShaderStages::FRAGMENT, true),
             ],
         );

@@ -231,6 +231,26 @@ impl FootprintTable {
         s * self.texel_area() * self.thickness
     }
 
+    /// The table as `splat_cs` reads it: for each row q < rows − 1 a slice of (row q, row q + 1)
+    /// pairs, one per texel, bordered by a texel of zeros on every side ((footprint + 2)² pairs
+    /// a slice). One pair load serves both slices of the interpolation, and the border stands
+    /// for the zero outside the table, so the shader's lookup needs no bounds test.
+    pub fn gpu_pairs(&self) -> Vec<[f32; 2]> {
+        let n = self.footprint as usize;
+        let side = n + 2;
+        let rows = self.rows() as usize;
+        let mut out = vec![[0.0f32; 2]; (rows - 1) * side * side];
+        for q in 0..rows - 1 {
+            for ty in 0..n {
+                for tx in 0..n {
+                    let at = |row: usize| self.values[row * n * n + ty * n + tx];
+                    out[q * side * side + (ty + 1) * side + tx + 1] = [at(q), at(q + 1)];
+                }
+            }
+        }
+        out
+    }
+
     /// The value the shader computes: slice interpolated linearly in `delta`, bilinearly in
     /// (x, y) kernel units, 0 outside the table (CPU twin of `footprint()` in `splat.wgsl`).
     pub fn sample(&self, delta: f64, x: f64, y: f64) -> f64 {

@@ -10,9 +10,16 @@
 //! Per frame and brick (§3.1–3.6): view depth per voxel → depth sort (bitonic, the paper's,
 //! or render-core's radix sort) → gather into depth order → bucket boundaries on the GPU →
 //! read back only the bucket-end table (one u32 per slab) → slabs front to back: slab i
-//! clears its sheet, splats the voxels of buckets i − r … i + r with the footprint slice of
-//! their offset from the slab (one table of all slices, `kernel.rs`), then the sheet is
-//! classified (post-classification on the slab's mean value) and composited under the image.
+//! splats the voxels of buckets i − r … i + r with the footprint slice of their offset from
+//! the slab (one table of all slices, `kernel.rs`) into its sheet, then the sheet is
+//! classified (post-classification on the slab's mean value), composited under the image and
+//! zeroed for the next slab.
+//!
+//! The paper draws each splat as a point sprite and lets the blender add it to the sheet. Here
+//! a compute pass walks each footprint's pixel centres (the rasteriser's own coverage rule,
+//! `coverage.rs`) and adds to the sheet in fixed point with atomics: the same sums, exact and
+//! in any order. On lavapipe a splat quad's two triangles cost ~0.3 µs of set-up for one to a
+//! few dozen fragments, which made StagBeetle's 69 M splats a 41 s frame (docs/profile.md).
 //! Pixels already opaque discard their splats (early splat elimination, `ese`). Bricks (§4)
 //! split the voxels by octants when they exceed one storage binding (or `brick=N`); they are
 //! drawn in camera order, and kernels crossing a brick face are composited out of order (the
@@ -45,7 +52,7 @@ use render_core::{
 pub use buckets::{bucket_ends, depth, SlabGeometry};
 use coverage::{FragmentCount, QuadParams};
 pub use description::{from_settings, DESCRIPTION};
-use gpu::{FrameUniform, Pipelines, IMAGE_FORMAT, SHEET_FORMAT, UNIFORM_STRIDE};
+use gpu::{FrameUniform, Pipelines, SlabUniform, IMAGE_FORMAT, UNIFORM_STRIDE};
 use kernel::{FootprintTable, Kernel, SIGMA};
 use voxels::VoxelSet;
 
@@ -134,7 +141,8 @@ struct Targets {
     height: u32,
     image: wgpu::Texture,
     image_view: wgpu::TextureView,
-    sheet_view: wgpu::TextureView,
+    /// Per pixel two u32: the slab's fixed-point sums (splat.wgsl).
+    sheet: wgpu::Buffer,
     bytes: u64,
 }
 
@@ -173,7 +181,7 @@ pub struct Splat {
     /// The last view's splat coverage (work counters are derived once per view).
     coverage: Option<(QuadParams, SlabGeometry, FragmentCount)>,
     /// Test hook: every splat fragment is counted as dropped (`ese_dropped_fragments` becomes
-    /// the rasteriser's own count of splat fragments) and the image stays empty.
+    /// the GPU's own count of splat fragments) and the image stays empty.
     count_every_fragment: bool,
 }
 
@@ -368,6 +376,20 @@ impl Splat {
         Ok((geom, ends, keys))
     }
 
+    /// The pixels a sheet can hold, `[x0, y0, x1, y1)`: the effective voxels' box widened by
+    /// twice the kernel radius (a footprint square's corners lie √2 radii from its voxel, in
+    /// the plane facing the eye) and projected (`Camera::covered_rect`). Slabs composite only
+    /// these, which also zeroes everything the splats wrote.
+    pub fn composite_rect(&self, camera: &Camera) -> Option<[u32; 4]> {
+        let st = self.state.as_ref()?;
+        let pad = 2.0 * self.settings.radius * st.set.kernel_unit;
+        let bounds = datasets::Aabb {
+            min: st.set.min.map(|v| v - pad),
+            max: st.set.max.map(|v| v + pad),
+        };
+        Some(camera.covered_rect(&bounds))
+    }
+
     fn write_frame(&self, gpu: &Gpu, camera: &Camera, geom: &SlabGeometry, brick: usize) {
         let u = self.frame_uniform(camera, geom, brick);
         let st = self.state.as_ref().unwrap();
@@ -443,19 +465,19 @@ impl Splat {
             IMAGE_FORMAT,
             both | wgpu::TextureUsages::COPY_SRC,
         )?;
-        let (_, sheet_view) = render_target(
+        // Created zeroed; every composite zeroes what it read.
+        let sheet = ledger.buffer(
             gpu,
-            &mut ledger,
             "splat sheet buffer",
-            (width, height),
-            SHEET_FORMAT,
-            both,
+            Lifetime::PerFrame,
+            width as u64 * height as u64 * 8,
+            wgpu::BufferUsages::STORAGE,
         )?;
         self.targets = Some(Targets {
             width,
             height,
             image_view,
-            sheet_view,
+            sheet,
             image,
             bytes: ledger.per_frame,
         });
@@ -468,12 +490,33 @@ impl Splat {
         gpu: &Gpu,
         geom: &SlabGeometry,
         ends: &[u32],
+        rect: [u32; 4],
         stats: &mut BrickStats,
         clock: &mut FrameClock,
     ) {
         let st = self.state.as_ref().unwrap();
         let t = self.targets.as_ref().unwrap();
         let t0 = Instant::now();
+        let [x0, y0, x1, y1] = rect;
+        // Each slab's voxel range, one dynamic-offset entry per slab (written before this
+        // brick's submit, so each brick sees its own).
+        let drawn = geom.num_slabs.min(st.max_slabs);
+        let mut slabs = vec![0u8; drawn as usize * UNIFORM_STRIDE as usize];
+        for i in 0..drawn {
+            let range = geom.splat_range(ends, i);
+            let o = i as usize * UNIFORM_STRIDE as usize;
+            let u = SlabUniform {
+                index: i,
+                first: range.start,
+                count: range.len() as u32,
+                pad: 0,
+            };
+            slabs[o..o + std::mem::size_of::<SlabUniform>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
+        }
+        if !slabs.is_empty() {
+            gpu.queue.write_buffer(&st.slab_buf, 0, &slabs);
+        }
         let splat_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("splat sheet"),
             layout: &st.pipes.splat_layout,
@@ -486,6 +529,7 @@ impl Splat {
                     resource: wgpu::BindingResource::TextureView(&t.image_view),
                 },
                 entry(4, &st.ese_dropped),
+                entry(5, &t.sheet),
             ],
         });
         let slab_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -496,7 +540,7 @@ impl Splat {
                 resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                     buffer: &st.slab_buf,
                     offset: 0,
-                    size: wgpu::BufferSize::new(16),
+                    size: wgpu::BufferSize::new(std::mem::size_of::<SlabUniform>() as u64),
                 }),
             }],
         });
@@ -505,15 +549,12 @@ impl Splat {
             layout: &st.pipes.composite_layout,
             entries: &[
                 entry(0, &st.frame_buf),
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&t.sheet_view),
-                },
+                entry(1, &t.sheet),
                 entry(2, &st.tf_buf),
             ],
         });
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        for i in 0..geom.num_slabs.min(st.max_slabs) {
+        for i in 0..drawn {
             let range = geom.splat_range(ends, i);
             if range.is_empty() {
                 continue;
@@ -521,11 +562,15 @@ impl Splat {
             stats.slabs += 1;
             stats.splats += range.len() as u64;
             {
-                let mut pass = color_pass(&mut enc, "splat slab", &t.sheet_view, true, true, None);
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("splat slab"),
+                    timestamp_writes: None,
+                });
                 pass.set_pipeline(&st.pipes.splat);
                 pass.set_bind_group(0, &splat_bind, &[]);
                 pass.set_bind_group(1, &slab_bind, &[(i as u64 * UNIFORM_STRIDE) as u32]);
-                pass.draw(0..6, range);
+                let (x, y) = gpu::workgroups(range.len() as u32);
+                pass.dispatch_workgroups(x, y, 1);
             }
             let mut pass = color_pass(
                 &mut enc,
@@ -535,6 +580,7 @@ impl Splat {
                 true,
                 None,
             );
+            pass.set_scissor_rect(x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0));
             pass.set_pipeline(&st.pipes.composite);
             pass.set_bind_group(0, &comp_bind, &[]);
             pass.draw(0..3, 0..1);
@@ -618,7 +664,7 @@ impl Splat {
             gpu,
             "splat footprint slices",
             Lifetime::Persistent,
-            bytemuck::cast_slice(&table.values),
+            bytemuck::cast_slice(&table.gpu_pairs()),
             storage,
         )?;
         let tf_buf = ledger.buffer_init(
@@ -635,17 +681,12 @@ impl Splat {
             .sqrt();
         let max_slabs =
             ((d + 2.0 * s.radius * set.kernel_unit) / (s.slab * set.kernel_unit)).ceil() as u32 + 4;
-        let mut slab_params = vec![0u8; max_slabs as usize * UNIFORM_STRIDE as usize];
-        for i in 0..max_slabs as usize {
-            let o = i * UNIFORM_STRIDE as usize;
-            params_u32(&mut slab_params[o..o + 4], i as u32);
-        }
-        let slab_buf = ledger.buffer_init(
+        let slab_buf = ledger.buffer(
             gpu,
-            "splat slab indices",
-            Lifetime::Persistent,
-            &slab_params,
-            wgpu::BufferUsages::UNIFORM,
+            "splat slab ranges",
+            Lifetime::PerFrame,
+            max_slabs as u64 * UNIFORM_STRIDE,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         )?;
         let frame_buf = ledger.buffer(
             gpu,
@@ -797,6 +838,7 @@ impl Renderer for Splat {
         enc.clear_buffer(&st.ese_dropped, 0, None);
         color_pass(&mut enc, "splat clear", &t.image_view, true, true, None);
         clock.submit(gpu, [enc.finish()]);
+        let rect = self.composite_rect(camera).expect("prepared");
         let mut stats = BrickStats::default();
         for b in order {
             if self.state.as_ref().unwrap().set.bricks[b].range.is_empty() {
@@ -804,7 +846,7 @@ impl Renderer for Splat {
             }
             self.write_frame(gpu, camera, &geom, b);
             let (ends, _) = self.buckets(gpu, b, &geom, row, false, &mut stats, &mut clock)?;
-            self.draw_brick(gpu, &geom, &ends, &mut stats, &mut clock);
+            self.draw_brick(gpu, &geom, &ends, rect, &mut stats, &mut clock);
         }
         let st = self.state.as_ref().unwrap();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -844,12 +886,16 @@ impl Renderer for Splat {
                 ("slabs".into(), stats.slabs as f64),
                 ("splats".into(), stats.splats as f64),
                 ("splat_fragments".into(), cover.fragments as f64),
-                // Each drawn slab composites one viewport-covering triangle.
+                // Each drawn slab composites one viewport-covering triangle, scissored to the
+                // rectangle its sheet can hold (the splats themselves are a compute pass:
+                // `splat_fragments`).
                 (
                     "fragments".into(),
-                    stats.slabs as f64 * camera.width as f64 * camera.height as f64,
+                    stats.slabs as f64
+                        * (rect[2].saturating_sub(rect[0]) as f64)
+                        * (rect[3].saturating_sub(rect[1]) as f64),
                 ),
-                ("triangles".into(), (2 * stats.splats + stats.slabs) as f64),
+                ("triangles".into(), stats.slabs as f64),
                 (
                     match self.settings.buckets {
                         Buckets::Cpu => "cpu_sort_keys",
@@ -888,10 +934,6 @@ impl Renderer for Splat {
             .context("splat: read_image before render")?;
         gpu.read_rgba32f(&t.image)
     }
-}
-
-fn params_u32(dst: &mut [u8], v: u32) {
-    dst.copy_from_slice(&v.to_le_bytes());
 }
 
 impl std::fmt::Debug for Splat {

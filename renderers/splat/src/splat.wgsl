@@ -1,41 +1,83 @@
-// Splatting one slab (Grau & Tost §3.6): one quad per voxel of buckets i - r ... i + r (the
-// paper draws point sprites), its footprint slice looked up in the table of all slices and
-// added to the sheet: rg = (sum of value * footprint, sum of footprint).
+// Splatting one slab (Grau & Tost §3.6) as a compute pass: one invocation per voxel of
+// buckets i - r ... i + r (the paper draws point sprites; on a software rasteriser a quad's
+// triangle setup costs more than its few fragments). Each invocation walks the pixel centres
+// of its voxel's footprint square — the rasteriser's rule for an axis-aligned quad: a centre
+// on the left/top edge is in, on the right/bottom edge out (coverage.rs is the CPU twin) —
+// looks up the footprint slice of its offset from the slab (one table of all slices,
+// kernel.rs) and adds (value * footprint, footprint) to the sheet in fixed point, so the sums
+// are exact and independent of the invocations' order.
 
 struct Slab {
     index: u32,
+    // This slab's voxels: sorted_in[first .. first + count].
+    first: u32,
+    count: u32,
+    pad: u32,
 }
+
+// Sheet sums are stored as round(x * SHEET_ONE) in u32 (composite.wgsl divides back): a
+// footprint's sum over the voxels of one slab is about 1 (the kernels on the lattice sum to
+// 1, kernel.rs), far below the 2^32 / 2^24 = 256 that would wrap, and each term is rounded to
+// 6e-8.
+const SHEET_ONE: f32 = 16777216.0;
 
 @group(0) @binding(0) var<uniform> fr: Frame;
 @group(0) @binding(1) var<storage, read> sorted_in: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> table: array<f32>;
+@group(0) @binding(2) var<storage, read> table: array<vec2<f32>>;
 @group(0) @binding(3) var image_tex: texture_2d<f32>;
 // Splat fragments early splat elimination dropped (the row's `ese_dropped_fragments`).
 @group(0) @binding(4) var<storage, read_write> ese_dropped: atomic<u32>;
+// Per pixel (sum value * w, sum w), row-major, y down.
+@group(0) @binding(5) var<storage, read_write> sheet: array<atomic<u32>>;
 @group(1) @binding(0) var<uniform> slab: Slab;
 
-struct SplatOut {
-    @builtin(position) pos: vec4<f32>,
-    // Offset from the voxel centre in kernel units.
-    @location(0) kxy: vec2<f32>,
-    // Voxel centre behind the slab's front plane, in slabs.
-    @location(1) @interpolate(flat) delta: f32,
-    @location(2) @interpolate(flat) value: f32,
+// Where a voxel's footprint is looked up this slab: the two slice rows its offset from the
+// slab falls between (kernel.rs, FootprintTable::gpu_pairs) and the weight of the second.
+struct Slices {
+    base: u32,
+    fq: f32,
 }
 
-@vertex
-fn splat_vs(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> SplatOut {
-    var out: SplatOut;
-    let v = sorted_in[ii];
+fn slices_of(delta: f32) -> Slices {
+    let rows = (2u * fr.radius_slabs + 1u) * fr.subslices + 1u;
+    let qf = clamp((delta + f32(fr.radius_slabs)) * f32(fr.subslices), 0.0, f32(rows - 1u));
+    let q0 = min(u32(floor(qf)), rows - 2u);
+    let side = fr.footprint + 2u;
+    return Slices(q0 * side * side, qf - f32(q0));
+}
+
+// Twin of FootprintTable::sample (kernel.rs): linear between slice rows, bilinear in a slice,
+// 0 outside the table (the pairs' zero border; u, v are clamped onto it).
+fn footprint(sl: Slices, kxy: vec2<f32>) -> f32 {
+    let f = f32(fr.footprint);
+    let u = clamp((kxy.x + fr.kernel_radius) / (2.0 * fr.kernel_radius) * f - 0.5, -1.0, f - 0.5);
+    let v = clamp((kxy.y + fr.kernel_radius) / (2.0 * fr.kernel_radius) * f - 0.5, -1.0, f - 0.5);
+    let x0 = floor(u);
+    let y0 = floor(v);
+    let fx = u - x0;
+    let fy = v - y0;
+    let side = fr.footprint + 2u;
+    let i = sl.base + u32(y0 + 1.0) * side + u32(x0 + 1.0);
+    let t = mix(mix(table[i], table[i + 1u], fx), mix(table[i + side], table[i + side + 1u], fx), fy);
+    return mix(t.x, t.y, sl.fq);
+}
+
+// First pixel index whose centre k + 1/2 is >= edge, clamped to [0, n].
+fn first_centre(edge: f32, n: f32) -> u32 {
+    return u32(clamp(ceil(edge - 0.5), 0.0, n));
+}
+
+@compute @workgroup_size(256)
+fn splat_cs(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = g.x + g.y * nwg.x * 256u;
+    if (i >= slab.count) {
+        return;
+    }
+    let v = sorted_in[slab.first + i];
     let d = view_depth(fr, v.xyz);
-    var corners = array<vec2<f32>, 6>(
-        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(-1.0, 1.0),
-        vec2<f32>(-1.0, 1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0));
-    let c = corners[vi];
     let clip = fr.view_proj * vec4<f32>(v.xyz, 1.0);
     if (clip.w <= 0.0 || d <= 0.0) {
-        out.pos = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-        return out;
+        return;
     }
     let ndc = clip.xy / clip.w;
     var ppw = fr.focal_px;
@@ -44,55 +86,30 @@ fn splat_vs(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     }
     let half_px = fr.kernel_radius_world * ppw;
     let centre = vec2<f32>((ndc.x + 1.0) * 0.5 * fr.viewport.x, (1.0 - ndc.y) * 0.5 * fr.viewport.y);
-    let corner = centre + c * half_px;
-    out.pos = vec4<f32>(corner.x / fr.viewport.x * 2.0 - 1.0, 1.0 - corner.y / fr.viewport.y * 2.0, 0.5, 1.0);
-    out.kxy = c * fr.kernel_radius;
-    out.delta = (d - fr.d0) * fr.inv_delta - f32(slab.index);
-    out.value = v.w;
-    return out;
-}
-
-fn texel(q: u32, tx: i32, ty: i32) -> f32 {
-    let n = i32(fr.footprint);
-    if (tx < 0 || ty < 0 || tx >= n || ty >= n) {
-        return 0.0;
-    }
-    return table[q * fr.footprint * fr.footprint + u32(ty) * fr.footprint + u32(tx)];
-}
-
-fn tile(q: u32, u: f32, v: f32) -> f32 {
-    let x0 = floor(u);
-    let y0 = floor(v);
-    let fx = u - x0;
-    let fy = v - y0;
-    let ix = i32(x0);
-    let iy = i32(y0);
-    return mix(mix(texel(q, ix, iy), texel(q, ix + 1, iy), fx),
-               mix(texel(q, ix, iy + 1), texel(q, ix + 1, iy + 1), fx), fy);
-}
-
-// Twin of FootprintTable::sample (kernel.rs): linear between slice rows, bilinear in a slice.
-fn footprint(delta: f32, kxy: vec2<f32>) -> f32 {
-    let rows = (2u * fr.radius_slabs + 1u) * fr.subslices + 1u;
-    let qf = clamp((delta + f32(fr.radius_slabs)) * f32(fr.subslices), 0.0, f32(rows - 1u));
-    let q0 = min(u32(floor(qf)), rows - 2u);
-    let fq = qf - f32(q0);
-    let f = f32(fr.footprint);
-    let u = (kxy.x + fr.kernel_radius) / (2.0 * fr.kernel_radius) * f - 0.5;
-    let v = (kxy.y + fr.kernel_radius) / (2.0 * fr.kernel_radius) * f - 0.5;
-    return mix(tile(q0, u, v), tile(q0 + 1u, u, v), fq);
-}
-
-@fragment
-fn splat_fs(in: SplatOut) -> @location(0) vec4<f32> {
-    // Early splat elimination: nothing behind an opaque pixel can show.
-    if (fr.ese_alpha <= 1.0) {
-        let a = textureLoad(image_tex, vec2<i32>(in.pos.xy), 0).a;
-        if (a >= fr.ese_alpha) {
-            atomicAdd(&ese_dropped, 1u);
-            discard;
+    let x0 = first_centre(centre.x - half_px, fr.viewport.x);
+    let x1 = first_centre(centre.x + half_px, fr.viewport.x);
+    let y0 = first_centre(centre.y - half_px, fr.viewport.y);
+    let y1 = first_centre(centre.y + half_px, fr.viewport.y);
+    // Kernel units per pixel: the quad's corners are +-kernel_radius.
+    let k_per_px = fr.kernel_radius / half_px;
+    let slices = slices_of((d - fr.d0) * fr.inv_delta - f32(slab.index));
+    let value = clamp(v.w, 0.0, 1.0);
+    let width = u32(fr.viewport.x);
+    for (var y = y0; y < y1; y++) {
+        for (var x = x0; x < x1; x++) {
+            // Early splat elimination: nothing behind an opaque pixel can show.
+            if (fr.ese_alpha <= 1.0) {
+                let a = textureLoad(image_tex, vec2<i32>(i32(x), i32(y)), 0).a;
+                if (a >= fr.ese_alpha) {
+                    atomicAdd(&ese_dropped, 1u);
+                    continue;
+                }
+            }
+            let kxy = (vec2<f32>(f32(x) + 0.5, f32(y) + 0.5) - centre) * k_per_px;
+            let w = max(footprint(slices, kxy), 0.0) * fr.density_scale;
+            let p = 2u * (y * width + x);
+            atomicAdd(&sheet[p], u32(w * value * SHEET_ONE + 0.5));
+            atomicAdd(&sheet[p + 1u], u32(w * SHEET_ONE + 0.5));
         }
     }
-    let w = footprint(in.delta, in.kxy) * fr.density_scale;
-    return vec4<f32>(w * in.value, w, 0.0, 0.0);
 }

@@ -1,6 +1,6 @@
 //! The splatter's work counters against the GPU's own counts (issue 23, item 6):
-//! `splat_fragments` (derived on the CPU, `coverage.rs`) against the fragments the rasteriser
-//! produced, counted by the early-splat-elimination atomic with every fragment dropped;
+//! `splat_fragments` (derived on the CPU, `coverage.rs`) against the fragments the compute
+//! pass visited, counted by the early-splat-elimination atomic with every fragment dropped;
 //! `splats` against the bucket table's ranges; the composite's fragments and the triangles.
 
 use datasets::TetMesh;
@@ -25,7 +25,7 @@ fn camera(mesh: &TetMesh, vp: &str, dir: [f64; 3], projection: Projection) -> Ca
 }
 
 #[test]
-fn splat_fragments_bound_the_rasterisers_count_and_splats_match_the_buckets() {
+fn splat_fragments_bound_the_gpus_count_and_splats_match_the_buckets() {
     let gpu = gpu();
     let mesh = datasets::gen_volume::from_volume_spec("vol:20x18x16").unwrap();
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
@@ -54,22 +54,67 @@ fn splat_fragments_bound_the_rasterisers_count_and_splats_match_the_buckets() {
             assert!(cover.fragments > 10_000, "{what}: {cover:?}");
             assert!(
                 (cover.at_least..=cover.at_most).contains(&rasterised),
-                "{what}: the GPU rasterised {rasterised} splat fragments, the twin {cover:?}"
+                "{what}: the GPU visited {rasterised} splat fragments, the twin {cover:?}"
             );
             assert_eq!(counter(&stats, "splat_fragments"), cover.fragments as f64);
             assert_eq!(counter(&stats, "splats"), cover.splats as f64, "{what}");
             let slabs = counter(&stats, "slabs");
-            assert_eq!(counter(&stats, "fragments"), slabs * 64.0 * 48.0);
-            assert_eq!(
-                counter(&stats, "triangles"),
-                2.0 * cover.splats as f64 + slabs
+            // The composite covers the sheet's rectangle: the volume with its kernels.
+            let [x0, y0, x1, y1] = r.composite_rect(&cam).unwrap();
+            assert!(
+                x0 < x1 && y0 < y1 && (x1 - x0) * (y1 - y0) <= 64 * 48,
+                "{what}"
             );
+            assert_eq!(
+                counter(&stats, "fragments"),
+                slabs * ((x1 - x0) * (y1 - y0)) as f64
+            );
+            assert_eq!(counter(&stats, "triangles"), slabs);
             let voxels = counter(&stats, "effective_voxels");
             let sorted = match buckets {
                 Buckets::Cpu => "cpu_sort_keys",
                 Buckets::Gpu => "gpu_sort_keys",
             };
             assert_eq!(counter(&stats, sorted), voxels);
+        }
+    }
+}
+
+/// The composite is scissored to `composite_rect`, and it also zeroes the sheet: a footprint
+/// pixel outside the rectangle would stay in the sheet for every later slab. Checked from a
+/// distance (the volume a small part of the viewport), where the rectangle is a real cut.
+#[test]
+fn every_footprint_lies_inside_the_composite_rectangle() {
+    let gpu = gpu();
+    let mesh = datasets::gen_volume::from_volume_spec("vol:20x18x16").unwrap();
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    let mut r = Splat::new(SplatSettings::default());
+    r.prepare(&gpu, &mesh, &optics).unwrap();
+    for (vp, dir, proj) in [
+        ("+x+y+z", [1.0, 1.0, 1.0], Projection::default()),
+        ("+x", [1.0, 0.0, 0.0], Projection::Orthographic),
+    ] {
+        let fit = camera(&mesh, vp, dir, proj);
+        // Fitted to a box three times the volume's: the volume is a ninth of the view.
+        let b = mesh.bounds();
+        let c = b.center();
+        let wider = datasets::Aabb {
+            min: std::array::from_fn(|a| c[a] - 1.5 * (b.max[a] - b.min[a])),
+            max: std::array::from_fn(|a| c[a] + 1.5 * (b.max[a] - b.min[a])),
+        };
+        let far = Camera::fit(&wider, &Viewpoint::new(vp, dir), proj, 256, 192);
+        for cam in [fit, far] {
+            let rect = r.composite_rect(&cam).unwrap();
+            let [x0, y0, x1, y1] = rect;
+            let what = format!("{vp} at {}x{}: {rect:?}", cam.width, cam.height);
+            assert_eq!(r.centres_outside(&cam, rect).unwrap(), 0, "{what}");
+            if cam.width == 256 {
+                assert!((x1 - x0) * (y1 - y0) < 256 * 192 / 2, "{what}");
+                // The check can fail: the rectangle's middle half leaves pixels out.
+                let (qx, qy) = ((x1 - x0) / 4, (y1 - y0) / 4);
+                let narrower = [x0 + qx, y0 + qy, x1 - qx, y1 - qy];
+                assert!(r.centres_outside(&cam, narrower).unwrap() > 0, "{what}");
+            }
         }
     }
 }
