@@ -69,7 +69,8 @@ pub struct Pipelines {
     pub gather: wgpu::ComputePipeline,
     pub boundaries: wgpu::ComputePipeline,
     pub bitonic_layout: wgpu::BindGroupLayout,
-    pub bitonic: wgpu::ComputePipeline,
+    pub bitonic_wide: wgpu::ComputePipeline,
+    pub bitonic_narrow: wgpu::ComputePipeline,
     pub splat_layout: wgpu::BindGroupLayout,
     pub slab_layout: wgpu::BindGroupLayout,
     pub splat: wgpu::ComputePipeline,
@@ -146,11 +147,17 @@ impl Pipelines {
         );
         let bitonic_module = gpu.shader("splat bitonic.wgsl", include_str!("bitonic.wgsl"));
         let bpl = pipeline_layout("splat bitonic", &[&bitonic_layout]);
-        let bitonic = gpu.compute_pipeline(
-            "splat bitonic",
+        let bitonic_wide = gpu.compute_pipeline(
+            "splat bitonic wide",
             Some(&bpl),
             &bitonic_module,
-            "bitonic_stage",
+            "bitonic_wide",
+        );
+        let bitonic_narrow = gpu.compute_pipeline(
+            "splat bitonic narrow",
+            Some(&bpl),
+            &bitonic_module,
+            "bitonic_narrow",
         );
 
         let splat_layout = layout(
@@ -214,7 +221,8 @@ impl Pipelines {
             gather,
             boundaries,
             bitonic_layout,
-            bitonic,
+            bitonic_wide,
+            bitonic_narrow,
             splat_layout,
             slab_layout,
             splat,
@@ -232,6 +240,50 @@ pub fn workgroups(threads: u32) -> (u32, u32) {
     (x, wg.div_ceil(x))
 }
 
+/// One dispatch of the bitonic sort (bitonic.wgsl), four compare-exchanges per invocation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BitonicStep {
+    /// Stage (k, j), j ≥ 4 (`bitonic_wide`).
+    Wide { k: u32, j: u32 },
+    /// Stages (k, 2) and (k, 1), or (2, 1) alone (`bitonic_narrow`).
+    Narrow { k: u32 },
+}
+
+impl BitonicStep {
+    /// The `Stage` uniform (k, j, n, 0); a narrow step's j is 0.
+    pub fn uniform(self, n: u32) -> [u32; 4] {
+        match self {
+            BitonicStep::Wide { k, j } => [k, j, n, 0],
+            BitonicStep::Narrow { k } => [k, 0, n, 0],
+        }
+    }
+
+    /// Invocations of the step over `n` elements.
+    pub fn invocations(self, n: u32) -> u32 {
+        match self {
+            BitonicStep::Wide { .. } => n / 8,
+            BitonicStep::Narrow { .. } => n / 4,
+        }
+    }
+}
+
+/// The dispatches of a bitonic sort of `n` (a power of two, ≥ 4) elements: the network's
+/// stages ([`bitonic_stages`]) in its order, (k, 2) and (k, 1) in one dispatch.
+pub fn bitonic_steps(n: u32) -> Vec<BitonicStep> {
+    let mut out = vec![];
+    let mut k = 2;
+    while k <= n {
+        let mut j = k / 2;
+        while j >= 4 {
+            out.push(BitonicStep::Wide { k, j });
+            j /= 2;
+        }
+        out.push(BitonicStep::Narrow { k });
+        k *= 2;
+    }
+    out
+}
+
 /// The (k, j) stages of a bitonic network over `n` (a power of two) elements.
 pub fn bitonic_stages(n: u32) -> Vec<(u32, u32)> {
     let mut out = vec![];
@@ -245,4 +297,38 @@ pub fn bitonic_stages(n: u32) -> Vec<(u32, u32)> {
         k *= 2;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The (k, j) stages a list of steps performs, in order.
+    fn expand(steps: &[BitonicStep]) -> Vec<(u32, u32)> {
+        let mut out = vec![];
+        for &step in steps {
+            match step {
+                BitonicStep::Wide { k, j } => out.push((k, j)),
+                BitonicStep::Narrow { k } => {
+                    if k >= 4 {
+                        out.push((k, 2));
+                    }
+                    out.push((k, 1));
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn the_steps_perform_the_networks_stages_in_its_order() {
+        for shift in 2..=24 {
+            let n = 1u32 << shift;
+            assert_eq!(expand(&bitonic_steps(n)), bitonic_stages(n), "n = {n}");
+        }
+        // A wrong step list is caught: the narrow step without its (k, 2) stage.
+        let mut wrong = expand(&bitonic_steps(64));
+        wrong.retain(|&(k, j)| !(k == 8 && j == 2));
+        assert_ne!(wrong, bitonic_stages(64));
+    }
 }

@@ -297,12 +297,12 @@ impl Splat {
                         .context("radix sorter missing")?
                         .encode(&mut enc, &st.keys, &st.vals, n, false)?,
                     GpuSort::Bitonic => {
-                        let stages = gpu::bitonic_stages(padded);
-                        let mut params = vec![0u8; stages.len() * UNIFORM_STRIDE as usize];
-                        for (s, &(k, j)) in stages.iter().enumerate() {
+                        let steps = gpu::bitonic_steps(padded);
+                        let mut params = vec![0u8; steps.len() * UNIFORM_STRIDE as usize];
+                        for (s, step) in steps.iter().enumerate() {
                             let o = s * UNIFORM_STRIDE as usize;
                             params[o..o + 16]
-                                .copy_from_slice(bytemuck::cast_slice(&[k, j, padded, 0u32]));
+                                .copy_from_slice(bytemuck::cast_slice(&step.uniform(padded)));
                         }
                         gpu.queue.write_buffer(&st.bitonic_buf, 0, &params);
                         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -322,10 +322,13 @@ impl Splat {
                             ],
                         });
                         let mut pass = enc.begin_compute_pass(&Default::default());
-                        pass.set_pipeline(&st.pipes.bitonic);
-                        let (x, y) = gpu::workgroups(padded);
-                        for s in 0..stages.len() {
+                        for (s, &step) in steps.iter().enumerate() {
+                            pass.set_pipeline(match step {
+                                gpu::BitonicStep::Wide { .. } => &st.pipes.bitonic_wide,
+                                gpu::BitonicStep::Narrow { .. } => &st.pipes.bitonic_narrow,
+                            });
                             pass.set_bind_group(0, &bind, &[(s as u64 * UNIFORM_STRIDE) as u32]);
+                            let (x, y) = gpu::workgroups(step.invocations(padded));
                             pass.dispatch_workgroups(x, y, 1);
                         }
                     }
@@ -700,7 +703,7 @@ impl Splat {
             (Buckets::Gpu, GpuSort::Bitonic) => largest.next_power_of_two().max(256),
             _ => largest,
         };
-        let stages = gpu::bitonic_stages(padded_max as u32).len().max(1);
+        let stages = gpu::bitonic_steps(padded_max as u32).len().max(1);
         let bitonic_buf = ledger.buffer(
             gpu,
             "splat bitonic stages",
