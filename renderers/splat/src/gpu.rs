@@ -268,7 +268,7 @@ impl BitonicStep {
 }
 
 /// The dispatches of a bitonic sort of `n` (a power of two, ≥ 4) elements: the network's
-/// stages ([`bitonic_stages`]) in its order, (k, 2) and (k, 1) in one dispatch.
+/// stages (`bitonic_stages` in the tests) in its order, (k, 2) and (k, 1) in one dispatch.
 pub fn bitonic_steps(n: u32) -> Vec<BitonicStep> {
     let mut out = vec![];
     let mut k = 2;
@@ -284,24 +284,24 @@ pub fn bitonic_steps(n: u32) -> Vec<BitonicStep> {
     out
 }
 
-/// The (k, j) stages of a bitonic network over `n` (a power of two) elements.
-pub fn bitonic_stages(n: u32) -> Vec<(u32, u32)> {
-    let mut out = vec![];
-    let mut k = 2;
-    while k <= n {
-        let mut j = k / 2;
-        while j > 0 {
-            out.push((k, j));
-            j /= 2;
-        }
-        k *= 2;
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The (k, j) stages of a bitonic network over `n` (a power of two) elements.
+    fn bitonic_stages(n: u32) -> Vec<(u32, u32)> {
+        let mut out = vec![];
+        let mut k = 2;
+        while k <= n {
+            let mut j = k / 2;
+            while j > 0 {
+                out.push((k, j));
+                j /= 2;
+            }
+            k *= 2;
+        }
+        out
+    }
 
     /// The (k, j) stages a list of steps performs, in order.
     fn expand(steps: &[BitonicStep]) -> Vec<(u32, u32)> {

@@ -231,21 +231,17 @@ impl FootprintTable {
         s * self.texel_area() * self.thickness
     }
 
-    /// The table as `splat_cs` reads it: for each row q < rows − 1 a slice of (row q, row q + 1)
-    /// pairs, one per texel, bordered by a texel of zeros on every side ((footprint + 2)² pairs
-    /// a slice). One pair load serves both slices of the interpolation, and the border stands
-    /// for the zero outside the table, so the shader's lookup needs no bounds test.
-    pub fn gpu_pairs(&self) -> Vec<[f32; 2]> {
+    /// The table as `splat_cs` reads it: each slice bordered by a texel of zeros on every side
+    /// ((footprint + 2)² values a slice), which stands for the zero outside the table, so the
+    /// shader's lookup needs no bounds test.
+    pub fn bordered(&self) -> Vec<f32> {
         let n = self.footprint as usize;
         let side = n + 2;
-        let rows = self.rows() as usize;
-        let mut out = vec![[0.0f32; 2]; (rows - 1) * side * side];
-        for q in 0..rows - 1 {
-            for ty in 0..n {
-                for tx in 0..n {
-                    let at = |row: usize| self.values[row * n * n + ty * n + tx];
-                    out[q * side * side + (ty + 1) * side + tx + 1] = [at(q), at(q + 1)];
-                }
+        let mut out = vec![0.0f32; self.rows() as usize * side * side];
+        for (q, slice) in self.values.chunks_exact(n * n).enumerate() {
+            for (ty, row) in slice.chunks_exact(n).enumerate() {
+                let o = q * side * side + (ty + 1) * side + 1;
+                out[o..o + n].copy_from_slice(row);
             }
         }
         out

@@ -667,7 +667,7 @@ impl Splat {
             gpu,
             "splat footprint slices",
             Lifetime::Persistent,
-            bytemuck::cast_slice(&table.gpu_pairs()),
+            bytemuck::cast_slice(&table.bordered()),
             storage,
         )?;
         let tf_buf = ledger.buffer_init(

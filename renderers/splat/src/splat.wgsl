@@ -23,7 +23,7 @@ const SHEET_ONE: f32 = 16777216.0;
 
 @group(0) @binding(0) var<uniform> fr: Frame;
 @group(0) @binding(1) var<storage, read> sorted_in: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> table: array<vec2<f32>>;
+@group(0) @binding(2) var<storage, read> table: array<f32>;
 @group(0) @binding(3) var image_tex: texture_2d<f32>;
 // Splat fragments early splat elimination dropped (the row's `ese_dropped_fragments`).
 @group(0) @binding(4) var<storage, read_write> ese_dropped: atomic<u32>;
@@ -31,8 +31,9 @@ const SHEET_ONE: f32 = 16777216.0;
 @group(0) @binding(5) var<storage, read_write> sheet: array<atomic<u32>>;
 @group(1) @binding(0) var<uniform> slab: Slab;
 
-// Where a voxel's footprint is looked up this slab: the two slice rows its offset from the
-// slab falls between (kernel.rs, FootprintTable::gpu_pairs) and the weight of the second.
+// Where a voxel's footprint is looked up this slab: the first of the two slice rows its
+// offset from the slab falls between (kernel.rs, FootprintTable::bordered) and the weight of
+// the second.
 struct Slices {
     base: u32,
     fq: f32,
@@ -46,20 +47,21 @@ fn slices_of(delta: f32) -> Slices {
     return Slices(q0 * side * side, qf - f32(q0));
 }
 
+fn bilinear(i: u32, side: u32, fx: f32, fy: f32) -> f32 {
+    return mix(mix(table[i], table[i + 1u], fx), mix(table[i + side], table[i + side + 1u], fx), fy);
+}
+
 // Twin of FootprintTable::sample (kernel.rs): linear between slice rows, bilinear in a slice,
-// 0 outside the table (the pairs' zero border; u, v are clamped onto it).
+// 0 outside the table (the slices' zero border; u, v are clamped onto it).
 fn footprint(sl: Slices, kxy: vec2<f32>) -> f32 {
     let f = f32(fr.footprint);
     let u = clamp((kxy.x + fr.kernel_radius) / (2.0 * fr.kernel_radius) * f - 0.5, -1.0, f - 0.5);
     let v = clamp((kxy.y + fr.kernel_radius) / (2.0 * fr.kernel_radius) * f - 0.5, -1.0, f - 0.5);
     let x0 = floor(u);
     let y0 = floor(v);
-    let fx = u - x0;
-    let fy = v - y0;
     let side = fr.footprint + 2u;
     let i = sl.base + u32(y0 + 1.0) * side + u32(x0 + 1.0);
-    let t = mix(mix(table[i], table[i + 1u], fx), mix(table[i + side], table[i + side + 1u], fx), fy);
-    return mix(t.x, t.y, sl.fq);
+    return mix(bilinear(i, side, u - x0, v - y0), bilinear(i + side * side, side, u - x0, v - y0), sl.fq);
 }
 
 // First pixel index whose centre k + 1/2 is >= edge, clamped to [0, n].
