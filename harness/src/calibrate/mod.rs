@@ -6,8 +6,8 @@
 //! triangle blended additively into the target format the algorithms use), compute throughput
 //! (vec4 FMA chains), storage-copy bandwidth (a compute copy between two storage buffers), the
 //! CPU radix sort of `render_core::sort` (HAVS §5.1) in keys/s, and the work-specific ones of
-//! `work.rs`: ray steps (a walk through 144-byte cells), splat fragments (a
-//! footprint lookup blended into a two-channel float sheet) and render-core's GPU radix sort.
+//! `work.rs`: ray steps (a walk through 144-byte cells), splat fragments (a compute pass's
+//! footprint lookup added into a two-u32 fixed-point sheet) and render-core's GPU radix sort.
 //! Each figure is the best of five timed repetitions after one warm-up (a roofline wants the
 //! backend's peak, and on a busy machine the best repetition is the one least disturbed), by
 //! wall clock around submit-and-wait, so it is comparable with the rows' `total_ms`. The

@@ -212,9 +212,9 @@ pub struct Calibration {
     /// table lookup each), the ray caster's unit of work. 0 in calibrations made before it.
     #[serde(default)]
     pub ray_steps_per_sec: f64,
-    /// Quad fragments doing a two-slice bilinear footprint lookup, blended into Rg32Float
-    /// (the splatter's sheet); 0 where the adapter cannot blend 32-bit floats, and in
-    /// calibrations made before it.
+    /// Footprint pixels of the splatter's compute fill: a two-slice bilinear footprint lookup
+    /// added with atomics into a fixed-point sheet (4×4-pixel footprints); 0 in calibrations
+    /// made before it.
     #[serde(default)]
     pub splat_fragments_per_sec: f64,
     /// render-core's GPU radix sort on 2^18 f32 keys. 0 in calibrations made before it.
@@ -234,7 +234,7 @@ impl Calibration {
              CPU radix sort    {:.1} M keys/s (2^20 f32 keys)\n\
              GPU radix sort    {:.1} M keys/s (2^18 f32 keys)\n\
              ray steps         {:.2} M steps/s (144-byte cell walk)\n\
-             splat fill        {:.1} M fragments/s (footprint lookup, Rg32Float)\n\
+             splat fill        {:.1} M fragments/s (compute footprint lookup, 4x4 px)\n\
              measured in {:.1} s on {}",
             self.adapter,
             self.driver,
