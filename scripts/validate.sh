@@ -11,8 +11,9 @@
 # only change constants at their extremes (HAVS k 2 and 16, ray casting 1×1 and 2×2 tiles and
 # 4 and 32 peel layers, one splatting kernel and grid).
 # Pass "chunked": the default variants (ray casting with its 2D table) on box:24k, the device
-# requested with 256 KiB storage bindings and no timestamp queries (TETBENCH_MAX_STORAGE_BINDING,
-# TETBENCH_TIMESTAMPS; as tests/device_limits.rs), so that every chunked path runs under the
+# requested with 256 KiB storage bindings, no timestamp queries and render passes of 4,096
+# triangles (TETBENCH_MAX_STORAGE_BINDING, TETBENCH_TIMESTAMPS, TETBENCH_MAX_TRIANGLES_PER_PASS;
+# as tests/device_limits.rs), so that every chunked and multi-pass path runs under the
 # layer too.
 #
 # Installs vulkan-validationlayers when no Khronos layer is found (VK_ADD_LAYER_PATH may name a
@@ -104,7 +105,7 @@ PY
 }
 run_pass variants -- --all-variants --datasets box:1k,shell:1k \
     --settings 'k=2|16;tiles=1x1|2x2;layers=4|32;radius=2;slab=1;grid=32'
-run_pass chunked TETBENCH_MAX_STORAGE_BINDING=262144 TETBENCH_TIMESTAMPS=off -- \
+run_pass chunked TETBENCH_MAX_STORAGE_BINDING=262144 TETBENCH_TIMESTAMPS=off TETBENCH_MAX_TRIANGLES_PER_PASS=4096 -- \
     --datasets box:24k --settings table=2d
 
 log="$out/layer.log"

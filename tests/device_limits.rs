@@ -104,10 +104,15 @@ fn small_bindings_give_the_same_image_as_the_adapters_own() {
     let n = mesh.num_tets() as u64;
     let high = open(&DeviceRequest::default());
     let low_bytes = LOW_BINDING;
+    // Render passes of a few hundred triangles as well: the whole mesh's draws (GATOR's and
+    // fragment PT's tets, HAVS's faces) then span dozens of passes, which must blend (or
+    // continue the k-buffer) exactly as one pass does.
     let low = open(&DeviceRequest {
         max_storage_binding: Some(low_bytes),
+        max_triangles_per_pass: Some(500),
         ..Default::default()
     });
+    assert_eq!(low.triangles_per_pass, 500);
     assert_eq!(
         low.max_storage_binding(),
         low_bytes,

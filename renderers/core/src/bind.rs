@@ -425,3 +425,70 @@ mod tests {
         assert_eq!(bytemuck::cast_slice::<u8, u32>(&back), &data[..]);
     }
 }
+
+/// Triangles per render pass when a whole mesh is drawn. Lavapipe bins every triangle of a
+/// pass before it rasterises the pass's tiles, and shades and bins a draw's vertices whole, so
+/// one pass or one draw over a large mesh holds host memory in proportion to it. Measured on
+/// `box:2m` at 512² (resident peak of the run): HAVS's 4 M faces in one draw 1.68 GB, in draws
+/// of 262,144 triangles 0.80 GB; GATOR (draws of 1,024 tets already) in one pass 0.95 GB, in
+/// passes of 262,144 tets 0.57 GB, frame times within their spread (docs/profile.md).
+pub const MAX_TRIANGLES_PER_PASS: u32 = 1 << 20;
+
+/// Vertices per draw call within such a pass (a multiple of 12: whole triangles, and whole
+/// tets of four triangles).
+pub const MAX_VERTICES_PER_DRAW: u32 = 3 * (1 << 18);
+
+/// `vertices` cut into the ranges of consecutive render passes of at most `triangles_per_pass`
+/// triangles (a multiple of 4: [`crate::Gpu::triangles_per_pass`]), in order; one empty range
+/// when there is nothing to draw (the caller's one pass still clears its target).
+pub fn pass_slices(
+    vertices: std::ops::Range<u32>,
+    triangles_per_pass: u32,
+) -> Vec<std::ops::Range<u32>> {
+    let per_pass = 3 * triangles_per_pass.max(4);
+    let mut out: Vec<_> = vertices
+        .clone()
+        .step_by(per_pass as usize)
+        .map(|start| start..(start + per_pass).min(vertices.end))
+        .collect();
+    if out.is_empty() {
+        out.push(vertices.start..vertices.start);
+    }
+    out
+}
+
+/// Draws `vertices` (one instance) in consecutive calls of at most [`MAX_VERTICES_PER_DRAW`]:
+/// the same primitives in the same order.
+pub fn draw_in_slices(pass: &mut wgpu::RenderPass<'_>, vertices: std::ops::Range<u32>) {
+    for start in vertices.clone().step_by(MAX_VERTICES_PER_DRAW as usize) {
+        pass.draw(
+            start..(start + MAX_VERTICES_PER_DRAW).min(vertices.end),
+            0..1,
+        );
+    }
+}
+
+#[cfg(test)]
+mod slice_tests {
+    use super::*;
+
+    #[test]
+    fn passes_and_draws_cover_the_vertices_in_order_in_whole_tets() {
+        let per_pass = 3 * MAX_TRIANGLES_PER_PASS;
+        let p = MAX_TRIANGLES_PER_PASS;
+        assert_eq!(pass_slices(0..0, p), vec![0..0]);
+        assert_eq!(pass_slices(0..12, p), vec![0..12]);
+        assert_eq!(pass_slices(0..30, 4), vec![0..12, 12..24, 24..30]);
+        assert_eq!(
+            pass_slices(0..2 * per_pass + 12, p),
+            vec![
+                0..per_pass,
+                per_pass..2 * per_pass,
+                2 * per_pass..2 * per_pass + 12
+            ]
+        );
+        assert_eq!(per_pass % 12, 0);
+        assert_eq!(MAX_VERTICES_PER_DRAW % 12, 0);
+        assert_eq!(per_pass % MAX_VERTICES_PER_DRAW, 0);
+    }
+}

@@ -29,6 +29,9 @@ pub struct Gpu {
     pub adapter: AdapterDescription,
     pub features: wgpu::Features,
     pub limits: wgpu::Limits,
+    /// Triangles per render pass when a whole mesh is drawn
+    /// ([`crate::bind::MAX_TRIANGLES_PER_PASS`] unless the request asked for fewer).
+    pub triangles_per_pass: u32,
 }
 
 /// Features used when present; none is required, each algorithm checks what it needs.
@@ -56,12 +59,17 @@ pub struct DeviceRequest {
     pub max_storage_binding: Option<u64>,
     /// Leave the timestamp-query features off even where the adapter has them.
     pub no_timestamps: bool,
+    /// Draw whole meshes in render passes of at most this many triangles (rounded down to a
+    /// multiple of 4, at least 4); `None`: [`crate::bind::MAX_TRIANGLES_PER_PASS`].
+    pub max_triangles_per_pass: Option<u32>,
 }
 
 /// Environment variable of [`DeviceRequest::max_storage_binding`] (bytes).
 pub const ENV_MAX_STORAGE_BINDING: &str = "TETBENCH_MAX_STORAGE_BINDING";
 /// Environment variable of [`DeviceRequest::no_timestamps`] (`off` turns them off).
 pub const ENV_TIMESTAMPS: &str = "TETBENCH_TIMESTAMPS";
+/// Environment variable of [`DeviceRequest::max_triangles_per_pass`].
+pub const ENV_MAX_TRIANGLES_PER_PASS: &str = "TETBENCH_MAX_TRIANGLES_PER_PASS";
 
 impl DeviceRequest {
     /// The request `TETBENCH_MAX_STORAGE_BINDING=BYTES` and `TETBENCH_TIMESTAMPS=off` describe
@@ -84,9 +92,16 @@ impl DeviceRequest {
             Some("off") => true,
             Some(v) => anyhow::bail!("{ENV_TIMESTAMPS}={v:?}: expected on or off"),
         };
+        let max_triangles_per_pass = match var(ENV_MAX_TRIANGLES_PER_PASS) {
+            None => None,
+            Some(v) => Some(v.trim().parse::<u32>().map_err(|_| {
+                anyhow!("{ENV_MAX_TRIANGLES_PER_PASS}={v:?}: expected a number of triangles")
+            })?),
+        };
         Ok(DeviceRequest {
             max_storage_binding,
             no_timestamps,
+            max_triangles_per_pass,
         })
     }
 
@@ -103,7 +118,17 @@ impl DeviceRequest {
         if self.no_timestamps {
             parts.push("timestamp queries off".to_string());
         }
+        if let Some(n) = self.max_triangles_per_pass {
+            parts.push(format!(
+                "render passes of at most {} triangles",
+                Self::pass_size(n)
+            ));
+        }
         parts.join(", ")
+    }
+
+    fn pass_size(n: u32) -> u32 {
+        (n / 4 * 4).max(4)
     }
 }
 
@@ -185,6 +210,10 @@ impl Gpu {
             },
             features,
             limits,
+            triangles_per_pass: request.max_triangles_per_pass.map_or(
+                crate::bind::MAX_TRIANGLES_PER_PASS,
+                DeviceRequest::pass_size,
+            ),
         })
     }
 
@@ -477,6 +506,9 @@ pub enum Lifetime {
     PerFrame,
 }
 
+/// Largest piece [`MemoryLedger::buffer_init`] stages at once (see there).
+pub const UPLOAD_CHUNK: usize = 16 << 20;
+
 /// Counts every buffer and texture an algorithm allocates.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct MemoryLedger {
@@ -515,7 +547,8 @@ impl MemoryLedger {
         }))
     }
 
-    /// Creates a buffer holding `data` and records it.
+    /// Creates a buffer holding `data` and records it; data past [`UPLOAD_CHUNK`] bytes is
+    /// uploaded piece by piece, each piece's staging copy released before the next.
     pub fn buffer_init(
         &mut self,
         gpu: &Gpu,
@@ -531,7 +564,21 @@ impl MemoryLedger {
             data.len() as u64,
             usage | wgpu::BufferUsages::COPY_DST,
         )?;
-        gpu.queue.write_buffer(&buf, 0, data);
+        if data.len() <= UPLOAD_CHUNK {
+            gpu.queue.write_buffer(&buf, 0, data);
+        } else {
+            // Each write is staged in a copy of its bytes until a submission carries it; in
+            // pieces, each flushed and waited for, the copies of a large upload never add up
+            // (on lavapipe, where "device" memory is host memory, a mesh's buffers were
+            // otherwise held three times during prepare: the caller's array, the staging copy
+            // and the buffer).
+            for (i, piece) in data.chunks(UPLOAD_CHUNK).enumerate() {
+                gpu.queue
+                    .write_buffer(&buf, (i * UPLOAD_CHUNK) as u64, piece);
+                gpu.queue.submit([]);
+                gpu.wait()?;
+            }
+        }
         Ok(buf)
     }
 
@@ -655,7 +702,8 @@ mod tests {
             .unwrap(),
             DeviceRequest {
                 max_storage_binding: Some(262144),
-                no_timestamps: true
+                no_timestamps: true,
+                max_triangles_per_pass: None,
             }
         );
         let e = DeviceRequest::from_vars(vars(&[(ENV_MAX_STORAGE_BINDING, "4k")]))

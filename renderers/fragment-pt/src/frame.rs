@@ -134,15 +134,31 @@ pub(crate) fn render(
     }
     {
         let (_, view) = st.target.as_ref().expect("target created above");
-        let timestamps = qs.map(|q| wgpu::RenderPassTimestampWrites {
-            query_set: q,
-            beginning_of_pass_write_index: Some(2),
-            end_of_pass_write_index: Some(3),
-        });
-        let mut pass = color_pass(&mut enc, "fragment-pt pass 2", view, true, true, timestamps);
-        pass.set_pipeline(&st.pass2);
-        pass.set_bind_group(0, &st.pass2_bind, &[]);
-        pass.draw(0..st.tets * 12, 0..1);
+        // In passes of bounded size (render_core::bind::pass_slices), the first clearing the
+        // target and the rest blending onto it; the timestamps bracket them all.
+        let slices = render_core::bind::pass_slices(0..st.tets * 12, gpu.triangles_per_pass);
+        let last = slices.len() - 1;
+        for (i, slice) in slices.into_iter().enumerate() {
+            // wgpu refuses timestamp writes with neither index: middle passes take none.
+            let timestamps =
+                qs.filter(|_| i == 0 || i == last)
+                    .map(|q| wgpu::RenderPassTimestampWrites {
+                        query_set: q,
+                        beginning_of_pass_write_index: (i == 0).then_some(2),
+                        end_of_pass_write_index: (i == last).then_some(3),
+                    });
+            let mut pass = color_pass(
+                &mut enc,
+                "fragment-pt pass 2",
+                view,
+                i == 0,
+                true,
+                timestamps,
+            );
+            pass.set_pipeline(&st.pass2);
+            pass.set_bind_group(0, &st.pass2_bind, &[]);
+            render_core::bind::draw_in_slices(&mut pass, slice);
+        }
     }
     if let Some((q, buf)) = &st.queries {
         enc.resolve_query_set(q, 0..4, buf, 0);

@@ -661,29 +661,46 @@ impl Renderer for GatorPt {
                 label: Some("gator frame"),
             });
         st.timer.begin(&mut enc);
-        {
-            let mut pass = render_core::bind::color_pass(
-                &mut enc,
-                "gator fans",
-                &target.view,
-                true,
-                true,
-                None,
-            );
-            pass.set_pipeline(&st.pipeline);
-            pass.set_bind_group(0, &st.mesh.g0, &[]);
-            pass.set_index_buffer(st.index_buf.slice(..), wgpu::IndexFormat::Uint16);
-            for chunk in &st.chunks {
-                pass.set_bind_group(1, &chunk.bind_group, &[]);
-                let mut start = chunk.range.start;
-                while start < chunk.range.end {
-                    let len = (chunk.range.end - start).min(TETS_PER_DRAW);
-                    // Vertex index = fan index + base_vertex = 5·(sorted position) + node.
-                    pass.draw_indexed(0..(12 * len) as u32, (start * NODES as u64) as i32, 0..1);
-                    start += len;
+        // Draws of TETS_PER_DRAW in passes of at most `gpu.triangles_per_pass` (4 a tet; see
+        // render_core::bind::MAX_TRIANGLES_PER_PASS): the first pass clears the target, the rest blend onto it.
+        let tets_per_pass = (gpu.triangles_per_pass / 4).max(1) as u64;
+        let mut pass: Option<wgpu::RenderPass<'static>> = None;
+        let mut in_pass = 0u64;
+        let mut first = true;
+        let open_pass = |enc: &mut wgpu::CommandEncoder, first: bool| {
+            let mut p =
+                render_core::bind::color_pass(enc, "gator fans", &target.view, first, true, None)
+                    .forget_lifetime();
+            p.set_pipeline(&st.pipeline);
+            p.set_bind_group(0, &st.mesh.g0, &[]);
+            p.set_index_buffer(st.index_buf.slice(..), wgpu::IndexFormat::Uint16);
+            p
+        };
+        for chunk in &st.chunks {
+            let mut start = chunk.range.start;
+            while start < chunk.range.end {
+                if pass.is_none() || in_pass >= tets_per_pass {
+                    drop(pass.take());
+                    pass = Some(open_pass(&mut enc, first));
+                    first = false;
+                    in_pass = 0;
                 }
+                let p = pass.as_mut().expect("opened above");
+                p.set_bind_group(1, &chunk.bind_group, &[]);
+                let len = (chunk.range.end - start)
+                    .min(TETS_PER_DRAW)
+                    .min(tets_per_pass - in_pass);
+                // Vertex index = fan index + base_vertex = 5·(sorted position) + node.
+                p.draw_indexed(0..(12 * len) as u32, (start * NODES as u64) as i32, 0..1);
+                start += len;
+                in_pass += len;
             }
         }
+        if first {
+            // Nothing drawn: the one pass still clears the target.
+            open_pass(&mut enc, true);
+        }
+        drop(pass);
         st.timer.end(&mut enc);
         clock.submit(gpu, [enc.finish()]);
         clock.wait(gpu)?;

@@ -354,20 +354,23 @@ impl State {
                 Some(rows.len() as u64 * row_bytes),
             );
         }
-        {
-            let mut pass = render_core::bind::color_pass(
-                &mut enc,
-                "havs faces",
-                &t.dummy_view,
-                true,
-                false,
-                None,
-            );
-            pass.set_pipeline(&self.draw_pipeline);
-            // Chunks in order: the faces stay in sorted order across chunk boundaries.
-            for (range, bg) in self.chunks.iter().zip(&t.bind_groups) {
+        // Chunks in order, each in passes of bounded size (render_core::bind::pass_slices): the
+        // faces stay in sorted order across chunk and pass boundaries, and the k-buffer lives
+        // in storage buffers, so a new pass (its dummy attachment cleared) continues it.
+        for (range, bg) in self.chunks.iter().zip(&t.bind_groups) {
+            let vertices = 0..((range.end - range.start) * 3) as u32;
+            for slice in render_core::bind::pass_slices(vertices, gpu.triangles_per_pass) {
+                let mut pass = render_core::bind::color_pass(
+                    &mut enc,
+                    "havs faces",
+                    &t.dummy_view,
+                    true,
+                    false,
+                    None,
+                );
+                pass.set_pipeline(&self.draw_pipeline);
                 pass.set_bind_group(0, bg, &[]);
-                pass.draw(0..((range.end - range.start) * 3) as u32, 0..1);
+                render_core::bind::draw_in_slices(&mut pass, slice);
             }
         }
         {
