@@ -418,20 +418,24 @@ impl TetMesh {
         })
     }
 
-    /// Outward unit normal of each face of each tet (face order [`TET_FACES`]).
+    /// Outward unit normal of each face of each tet (face order [`TET_FACES`]), computed once
+    /// for the whole mesh and kept (48 bytes a tet).
     pub fn face_normals(&self) -> &[[[f32; 3]; 4]] {
         self.cache.normals.get_or_init(|| {
             (0..self.tets.len())
                 .into_par_iter()
-                .map(|t| {
-                    let p = self.tet_points(t);
-                    TET_FACES.map(|[a, b, c]| {
-                        let n = cross(sub(p[b], p[a]), sub(p[c], p[a]));
-                        let l = norm(n).max(f64::MIN_POSITIVE);
-                        n.map(|x| (x / l) as f32)
-                    })
-                })
+                .map(|t| self.tet_face_normals(t))
                 .collect()
+        })
+    }
+
+    /// The entry of [`Self::face_normals`] for tet `t`, computed alone (nothing kept).
+    pub fn tet_face_normals(&self, t: usize) -> [[f32; 3]; 4] {
+        let p = self.tet_points(t);
+        TET_FACES.map(|[a, b, c]| {
+            let n = cross(sub(p[b], p[a]), sub(p[c], p[a]));
+            let l = norm(n).max(f64::MIN_POSITIVE);
+            n.map(|x| (x / l) as f32)
         })
     }
 

@@ -145,69 +145,78 @@ impl MeshLayout {
                 [t / per, t % per]
             }
         };
-        let normals = mesh.face_normals();
-        let per_tet: Vec<([[u32; 4]; TEXELS_PER_TET], f64, f64)> = (0..n)
-            .into_par_iter()
-            .map(|t| {
-                let p = mesh.tet_points(t);
-                let q: [[f64; 3]; 4] = p.map(|v| [0, 1, 2].map(|a| v[a] - origin[a]));
-                // Unit outward normals in f64 (mesh.face_normals is f32 already; recompute in
-                // f64 from the OCS points for the best f32 rounding).
-                let nrm: [[f64; 3]; 4] = std::array::from_fn(|f| {
-                    let [a, bb, c] = datasets::TET_FACES[f];
-                    let u = sub(q[bb], q[a]);
-                    let w = sub(q[c], q[a]);
-                    let x = cross(u, w);
-                    let l = dot(x, x).sqrt();
-                    if l > 0.0 {
-                        x.map(|v| v / l)
-                    } else {
-                        normals[t][f].map(|v| v as f64)
-                    }
-                });
-                let s = mesh.tets[t]
-                    .map(|v| (mesh.scalars[v as usize] as f64 - optics.scalar_min) * inv_range);
-                let g = datasets::mesh::linear_gradient(q, s);
-                let centre = [0, 1, 2].map(|a| 0.25 * (q[0][a] + q[1][a] + q[2][a] + q[3][a]));
-                let c = 0.25 * (s[0] + s[1] + s[2] + s[3]) - dot(g, centre);
-                let f = |x: f64| (x as f32).to_bits();
-                let a = adjacency[t].map(tref);
-                let texels = [
-                    [f(q[0][0]), f(q[0][1]), f(q[0][2]), f(q[3][0])],
-                    [f(q[1][0]), f(q[1][1]), f(q[1][2]), f(q[3][1])],
-                    [f(q[2][0]), f(q[2][1]), f(q[2][2]), f(q[3][2])],
-                    [f(nrm[0][0]), f(nrm[0][1]), f(nrm[0][2]), f(nrm[3][0])],
-                    [f(nrm[1][0]), f(nrm[1][1]), f(nrm[1][2]), f(nrm[3][1])],
-                    [f(nrm[2][0]), f(nrm[2][1]), f(nrm[2][2]), f(nrm[3][2])],
-                    [a[0][0], a[0][1], a[1][0], a[1][1]],
-                    [a[2][0], a[2][1], a[3][0], a[3][1]],
-                    [f(g[0]), f(g[1]), f(g[2]), f(c)],
-                ];
-                let mut longest: f64 = 0.0;
-                let mut sum = 0.0;
-                for i in 0..4 {
-                    for j in i + 1..4 {
-                        let e = sub(q[i], q[j]);
-                        let l = dot(e, e).sqrt();
-                        longest = longest.max(l);
-                        sum += l;
-                    }
+        // One tet's texels, its longest edge and its mean edge.
+        let pack = |t: usize| -> ([[u32; 4]; TEXELS_PER_TET], f64, f64) {
+            let p = mesh.tet_points(t);
+            let q: [[f64; 3]; 4] = p.map(|v| [0, 1, 2].map(|a| v[a] - origin[a]));
+            // Unit outward normals in f64 (mesh.face_normals is f32 already; recompute in
+            // f64 from the OCS points for the best f32 rounding).
+            let nrm: [[f64; 3]; 4] = std::array::from_fn(|f| {
+                let [a, bb, c] = datasets::TET_FACES[f];
+                let u = sub(q[bb], q[a]);
+                let w = sub(q[c], q[a]);
+                let x = cross(u, w);
+                let l = dot(x, x).sqrt();
+                if l > 0.0 {
+                    x.map(|v| v / l)
+                } else {
+                    mesh.tet_face_normals(t)[f].map(|v| v as f64)
                 }
-                (texels, longest, sum / 6.0)
-            })
-            .collect();
-        let mut chunks: Vec<Vec<[u32; 4]>> = (0..chunks_needed)
-            .map(|c| {
-                let count = (n as u64 - c * per as u64).min(per as u64) as usize;
-                Vec::with_capacity(count * TEXELS_PER_TET)
-            })
-            .collect();
+            });
+            let s = mesh.tets[t]
+                .map(|v| (mesh.scalars[v as usize] as f64 - optics.scalar_min) * inv_range);
+            let g = datasets::mesh::linear_gradient(q, s);
+            let centre = [0, 1, 2].map(|a| 0.25 * (q[0][a] + q[1][a] + q[2][a] + q[3][a]));
+            let c = 0.25 * (s[0] + s[1] + s[2] + s[3]) - dot(g, centre);
+            let f = |x: f64| (x as f32).to_bits();
+            let a = adjacency[t].map(tref);
+            let texels = [
+                [f(q[0][0]), f(q[0][1]), f(q[0][2]), f(q[3][0])],
+                [f(q[1][0]), f(q[1][1]), f(q[1][2]), f(q[3][1])],
+                [f(q[2][0]), f(q[2][1]), f(q[2][2]), f(q[3][2])],
+                [f(nrm[0][0]), f(nrm[0][1]), f(nrm[0][2]), f(nrm[3][0])],
+                [f(nrm[1][0]), f(nrm[1][1]), f(nrm[1][2]), f(nrm[3][1])],
+                [f(nrm[2][0]), f(nrm[2][1]), f(nrm[2][2]), f(nrm[3][2])],
+                [a[0][0], a[0][1], a[1][0], a[1][1]],
+                [a[2][0], a[2][1], a[3][0], a[3][1]],
+                [f(g[0]), f(g[1]), f(g[2]), f(c)],
+            ];
+            let mut longest: f64 = 0.0;
+            let mut sum = 0.0;
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    let e = sub(q[i], q[j]);
+                    let l = dot(e, e).sqrt();
+                    longest = longest.max(l);
+                    sum += l;
+                }
+            }
+            (texels, longest, sum / 6.0)
+        };
+        // Each binding's texels written in place (no whole-mesh intermediate: at 20 M tets
+        // one took 3.2 GB beside the 2.9 GB of bindings); the mean edges are summed in tet
+        // order, as one sequential pass would.
+        let mut chunks: Vec<Vec<[u32; 4]>> = Vec::with_capacity(chunks_needed as usize);
         let mut longest_edge: f64 = 0.0;
         let mut edge_sum = 0.0;
-        for (t, (texels, longest, mean)) in per_tet.into_iter().enumerate() {
-            chunks[t / per as usize].extend_from_slice(&texels);
-            longest_edge = longest_edge.max(longest);
-            edge_sum += mean;
+        for c in 0..chunks_needed as usize {
+            let start = c * per as usize;
+            let count = (n - start).min(per as usize);
+            let mut texels = vec![[0u32; 4]; count * TEXELS_PER_TET];
+            let edges: Vec<(f64, f64)> = texels
+                .par_chunks_mut(TEXELS_PER_TET)
+                .enumerate()
+                .map(|(i, out)| {
+                    let (tet, longest, mean) = pack(start + i);
+                    out.copy_from_slice(&tet);
+                    (longest, mean)
+                })
+                .collect();
+            for (longest, mean) in edges {
+                longest_edge = longest_edge.max(longest);
+                edge_sum += mean;
+            }
+            chunks.push(texels);
         }
         Ok(MeshLayout {
             tets_per_chunk: per,
