@@ -426,15 +426,8 @@ mod tests {
     }
 }
 
-/// Triangles per render pass when a whole mesh is drawn. Lavapipe bins every triangle of a
-/// pass before it rasterises the pass's tiles, and shades and bins a draw's vertices whole, so
-/// one pass or one draw over a large mesh holds host memory in proportion to it. Measured on
-/// `box:2m` at 512² (resident peak of the run): HAVS's 4 M faces in one draw 1.68 GB, in draws
-/// of 262,144 triangles 0.80 GB; GATOR (draws of 1,024 tets already) in one pass 0.95 GB, in
-/// passes of 262,144 tets 0.57 GB, frame times within their spread (docs/profile.md).
-pub const MAX_TRIANGLES_PER_PASS: u32 = 1 << 20;
-
-/// Vertices per draw call within such a pass (a multiple of 12: whole triangles, and whole
+/// Vertices per draw call in a render pass over a whole mesh ([`crate::gpu::MAX_TRIANGLES_PER_PASS`]
+/// says why they are bounded; a multiple of 12: whole triangles, and whole
 /// tets of four triangles).
 pub const MAX_VERTICES_PER_DRAW: u32 = 3 * (1 << 18);
 
@@ -474,8 +467,8 @@ mod slice_tests {
 
     #[test]
     fn passes_and_draws_cover_the_vertices_in_order_in_whole_tets() {
-        let per_pass = 3 * MAX_TRIANGLES_PER_PASS;
-        let p = MAX_TRIANGLES_PER_PASS;
+        let per_pass = 3 * crate::gpu::MAX_TRIANGLES_PER_PASS;
+        let p = crate::gpu::MAX_TRIANGLES_PER_PASS;
         assert_eq!(pass_slices(0..0, p), vec![0..0]);
         assert_eq!(pass_slices(0..12, p), vec![0..12]);
         assert_eq!(pass_slices(0..30, 4), vec![0..12, 12..24, 24..30]);

@@ -30,7 +30,7 @@ pub struct Gpu {
     pub features: wgpu::Features,
     pub limits: wgpu::Limits,
     /// Triangles per render pass when a whole mesh is drawn
-    /// ([`crate::bind::MAX_TRIANGLES_PER_PASS`] unless the request asked for fewer).
+    /// ([`MAX_TRIANGLES_PER_PASS`] unless the request asked for fewer).
     pub triangles_per_pass: u32,
 }
 
@@ -60,7 +60,7 @@ pub struct DeviceRequest {
     /// Leave the timestamp-query features off even where the adapter has them.
     pub no_timestamps: bool,
     /// Draw whole meshes in render passes of at most this many triangles (rounded down to a
-    /// multiple of 4, at least 4); `None`: [`crate::bind::MAX_TRIANGLES_PER_PASS`].
+    /// multiple of 4, at least 4); `None`: [`MAX_TRIANGLES_PER_PASS`].
     pub max_triangles_per_pass: Option<u32>,
 }
 
@@ -210,10 +210,9 @@ impl Gpu {
             },
             features,
             limits,
-            triangles_per_pass: request.max_triangles_per_pass.map_or(
-                crate::bind::MAX_TRIANGLES_PER_PASS,
-                DeviceRequest::pass_size,
-            ),
+            triangles_per_pass: request
+                .max_triangles_per_pass
+                .map_or(MAX_TRIANGLES_PER_PASS, DeviceRequest::pass_size),
         })
     }
 
@@ -505,6 +504,14 @@ pub enum Lifetime {
     /// Scratch of one frame (k-buffers, sort buffers, render targets).
     PerFrame,
 }
+
+/// Triangles per render pass when a whole mesh is drawn. Lavapipe bins every triangle of a
+/// pass before it rasterises the pass's tiles, and shades and bins a draw's vertices whole, so
+/// one pass or one draw over a large mesh holds host memory in proportion to it. Measured on
+/// `box:2m` at 512² (resident peak of the run): HAVS's 4 M faces in one draw 1.68 GB, in draws
+/// of 262,144 triangles 0.80 GB; GATOR (draws of 1,024 tets already) in one pass 0.95 GB, in
+/// passes of 262,144 tets 0.57 GB, frame times within their spread (docs/profile.md; `crate::bind::pass_slices` cuts the draws).
+pub const MAX_TRIANGLES_PER_PASS: u32 = 1 << 20;
 
 /// Largest piece [`MemoryLedger::buffer_init`] stages at once (see there).
 pub const UPLOAD_CHUNK: usize = 16 << 20;

@@ -662,7 +662,7 @@ impl Renderer for GatorPt {
             });
         st.timer.begin(&mut enc);
         // Draws of TETS_PER_DRAW in passes of at most `gpu.triangles_per_pass` (4 a tet; see
-        // render_core::bind::MAX_TRIANGLES_PER_PASS): the first pass clears the target, the rest blend onto it.
+        // render_core::gpu::MAX_TRIANGLES_PER_PASS): the first pass clears the target, the rest blend onto it.
         let tets_per_pass = (gpu.triangles_per_pass / 4).max(1) as u64;
         let mut pass: Option<wgpu::RenderPass<'static>> = None;
         let mut in_pass = 0u64;
