@@ -426,6 +426,25 @@ mod tests {
     }
 }
 
+/// Uniform entries addressed with dynamic offsets are this far apart (the largest
+/// `min_uniform_buffer_offset_alignment` wgpu allows).
+pub const UNIFORM_STRIDE: u64 = 256;
+
+/// `items` laid out one every [`UNIFORM_STRIDE`] bytes: the contents of a uniform buffer whose
+/// entry `i` is bound at dynamic offset `i × UNIFORM_STRIDE`.
+pub fn strided_uniforms<T: bytemuck::Pod>(items: &[T]) -> Vec<u8> {
+    let stride = UNIFORM_STRIDE as usize;
+    assert!(
+        std::mem::size_of::<T>() <= stride,
+        "a uniform entry over {stride} bytes"
+    );
+    let mut out = vec![0u8; items.len() * stride];
+    for (entry, item) in out.chunks_exact_mut(stride).zip(items) {
+        entry[..std::mem::size_of::<T>()].copy_from_slice(bytemuck::bytes_of(item));
+    }
+    out
+}
+
 /// Vertices per draw call in a render pass over a whole mesh ([`crate::gpu::MAX_TRIANGLES_PER_PASS`]
 /// says why they are bounded; a multiple of 12: whole triangles, and whole
 /// tets of four triangles).
@@ -483,5 +502,15 @@ mod slice_tests {
         assert_eq!(per_pass % 12, 0);
         assert_eq!(MAX_VERTICES_PER_DRAW % 12, 0);
         assert_eq!(per_pass % MAX_VERTICES_PER_DRAW, 0);
+    }
+
+    #[test]
+    fn strided_uniforms_put_entry_i_at_i_strides() {
+        let bytes = strided_uniforms(&[[1u32, 2, 3, 4], [5, 6, 7, 8]]);
+        assert_eq!(bytes.len(), 2 * UNIFORM_STRIDE as usize);
+        let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+        assert_eq!((word(0), word(12)), (1, 4));
+        assert_eq!(word(16), 0);
+        assert_eq!((word(256), word(268)), (5, 8));
     }
 }

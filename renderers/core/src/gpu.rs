@@ -510,7 +510,8 @@ pub enum Lifetime {
 /// one pass or one draw over a large mesh holds host memory in proportion to it. Measured on
 /// `box:2m` at 512² (resident peak of the run): HAVS's 4 M faces in one draw 1.68 GB, in draws
 /// of 262,144 triangles 0.80 GB; GATOR (draws of 1,024 tets already) in one pass 0.95 GB, in
-/// passes of 262,144 tets 0.57 GB, frame times within their spread (docs/profile.md; `crate::bind::pass_slices` cuts the draws).
+/// passes of 262,144 tets 0.57 GB, frame times within their spread (docs/profile.md).
+/// `crate::bind::pass_slices` cuts a mesh's vertices into such passes.
 pub const MAX_TRIANGLES_PER_PASS: u32 = 1 << 20;
 
 /// Largest piece [`MemoryLedger::buffer_init`] stages at once (see there).

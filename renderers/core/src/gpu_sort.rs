@@ -25,8 +25,8 @@ use crate::gpu::{Gpu, Lifetime, MemoryLedger};
 /// Keys per workgroup tile (256 threads × 16 sub-blocks); must match `TILE` in the shader.
 pub const TILE: u32 = 4096;
 const PASSES: usize = 4;
-/// Uniform offsets must be multiples of `min_uniform_buffer_offset_alignment` (≤ 256).
-const PARAM_STRIDE: u64 = 256;
+/// Each pass's parameters, at dynamic-offset spacing.
+const PARAM_STRIDE: u64 = crate::bind::UNIFORM_STRIDE;
 
 const MAP_IN: u32 = 1;
 const DESCENDING: u32 = 2;
@@ -190,25 +190,25 @@ impl GpuRadixSort {
         }
         let num_tiles = n.div_ceil(TILE);
         let dir = if descending { DESCENDING } else { 0 };
-        let mut params = vec![0u8; PARAM_STRIDE as usize * PASSES];
-        for pass in 0..PASSES {
-            let mut flags = dir;
-            if pass == 0 {
-                flags |= MAP_IN;
-            }
-            if pass == PASSES - 1 {
-                flags |= UNMAP_OUT;
-            }
-            let p = Params {
-                n,
-                shift: 8 * pass as u32,
-                num_tiles,
-                flags,
-            };
-            let o = pass * PARAM_STRIDE as usize;
-            params[o..o + 16].copy_from_slice(bytemuck::bytes_of(&p));
-        }
-        self.queue.write_buffer(&self.params, 0, &params);
+        let params: Vec<Params> = (0..PASSES)
+            .map(|pass| {
+                let mut flags = dir;
+                if pass == 0 {
+                    flags |= MAP_IN;
+                }
+                if pass == PASSES - 1 {
+                    flags |= UNMAP_OUT;
+                }
+                Params {
+                    n,
+                    shift: 8 * pass as u32,
+                    num_tiles,
+                    flags,
+                }
+            })
+            .collect();
+        self.queue
+            .write_buffer(&self.params, 0, &crate::bind::strided_uniforms(&params));
         let bytes = wgpu::BufferSize::new(n as u64 * 4);
         fn range(b: &wgpu::Buffer, size: Option<wgpu::BufferSize>) -> wgpu::BindingResource<'_> {
             wgpu::BindingResource::Buffer(wgpu::BufferBinding {

@@ -662,7 +662,8 @@ impl Renderer for GatorPt {
             });
         st.timer.begin(&mut enc);
         // Draws of TETS_PER_DRAW in passes of at most `gpu.triangles_per_pass` (4 a tet; see
-        // render_core::gpu::MAX_TRIANGLES_PER_PASS): the first pass clears the target, the rest blend onto it.
+        // render_core::gpu::MAX_TRIANGLES_PER_PASS): the first pass clears the target, the
+        // rest blend onto it. A chunk's bind group is set once per pass it spans.
         let tets_per_pass = (gpu.triangles_per_pass / 4).max(1) as u64;
         let mut pass: Option<wgpu::RenderPass<'static>> = None;
         let mut in_pass = 0u64;
@@ -678,15 +679,20 @@ impl Renderer for GatorPt {
         };
         for chunk in &st.chunks {
             let mut start = chunk.range.start;
+            let mut bound = false;
             while start < chunk.range.end {
                 if pass.is_none() || in_pass >= tets_per_pass {
                     drop(pass.take());
                     pass = Some(open_pass(&mut enc, first));
                     first = false;
                     in_pass = 0;
+                    bound = false;
                 }
                 let p = pass.as_mut().expect("opened above");
-                p.set_bind_group(1, &chunk.bind_group, &[]);
+                if !bound {
+                    p.set_bind_group(1, &chunk.bind_group, &[]);
+                    bound = true;
+                }
                 let len = (chunk.range.end - start)
                     .min(TETS_PER_DRAW)
                     .min(tets_per_pass - in_pass);

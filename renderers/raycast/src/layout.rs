@@ -149,7 +149,7 @@ impl MeshLayout {
         let pack = |t: usize| -> ([[u32; 4]; TEXELS_PER_TET], f64, f64) {
             let p = mesh.tet_points(t);
             let q: [[f64; 3]; 4] = p.map(|v| [0, 1, 2].map(|a| v[a] - origin[a]));
-            // Unit outward normals in f64 (mesh.face_normals is f32 already; recompute in
+            // Unit outward normals in f64 (the mesh's own are f32; recompute in
             // f64 from the OCS points for the best f32 rounding).
             let nrm: [[f64; 3]; 4] = std::array::from_fn(|f| {
                 let [a, bb, c] = datasets::TET_FACES[f];

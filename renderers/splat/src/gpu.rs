@@ -57,10 +57,6 @@ pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
     ]
 }
 
-/// Uniform entries addressed with dynamic offsets are this far apart (the largest
-/// `min_uniform_buffer_offset_alignment` wgpu allows).
-pub const UNIFORM_STRIDE: u64 = 256;
-
 pub const IMAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 pub struct Pipelines {

@@ -52,8 +52,9 @@ use render_core::{
 pub use buckets::{bucket_ends, depth, SlabGeometry};
 use coverage::{FragmentCount, QuadParams};
 pub use description::{from_settings, DESCRIPTION};
-use gpu::{FrameUniform, Pipelines, SlabUniform, IMAGE_FORMAT, UNIFORM_STRIDE};
+use gpu::{FrameUniform, Pipelines, SlabUniform, IMAGE_FORMAT};
 use kernel::{FootprintTable, Kernel, SIGMA};
+use render_core::bind::{strided_uniforms, UNIFORM_STRIDE};
 use voxels::VoxelSet;
 
 /// Where the per-slab buckets are built.
@@ -298,13 +299,10 @@ impl Splat {
                         .encode(&mut enc, &st.keys, &st.vals, n, false)?,
                     GpuSort::Bitonic => {
                         let steps = gpu::bitonic_steps(padded);
-                        let mut params = vec![0u8; steps.len() * UNIFORM_STRIDE as usize];
-                        for (s, step) in steps.iter().enumerate() {
-                            let o = s * UNIFORM_STRIDE as usize;
-                            params[o..o + 16]
-                                .copy_from_slice(bytemuck::cast_slice(&step.uniform(padded)));
-                        }
-                        gpu.queue.write_buffer(&st.bitonic_buf, 0, &params);
+                        let params: Vec<[u32; 4]> =
+                            steps.iter().map(|step| step.uniform(padded)).collect();
+                        gpu.queue
+                            .write_buffer(&st.bitonic_buf, 0, &strided_uniforms(&params));
                         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                             label: Some("splat bitonic"),
                             layout: &st.pipes.bitonic_layout,
@@ -504,21 +502,19 @@ impl Splat {
         // Each slab's voxel range, one dynamic-offset entry per slab (written before this
         // brick's submit, so each brick sees its own).
         let drawn = geom.num_slabs.min(st.max_slabs);
-        let mut slabs = vec![0u8; drawn as usize * UNIFORM_STRIDE as usize];
-        for i in 0..drawn {
-            let range = geom.splat_range(ends, i);
-            let o = i as usize * UNIFORM_STRIDE as usize;
-            let u = SlabUniform {
-                index: i,
+        let ranges: Vec<_> = (0..drawn).map(|i| geom.splat_range(ends, i)).collect();
+        let slabs: Vec<SlabUniform> = (0..drawn)
+            .zip(&ranges)
+            .map(|(index, range)| SlabUniform {
+                index,
                 first: range.start,
                 count: range.len() as u32,
                 pad: 0,
-            };
-            slabs[o..o + std::mem::size_of::<SlabUniform>()]
-                .copy_from_slice(bytemuck::bytes_of(&u));
-        }
+            })
+            .collect();
         if !slabs.is_empty() {
-            gpu.queue.write_buffer(&st.slab_buf, 0, &slabs);
+            gpu.queue
+                .write_buffer(&st.slab_buf, 0, &strided_uniforms(&slabs));
         }
         let splat_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("splat sheet"),
@@ -557,8 +553,7 @@ impl Splat {
             ],
         });
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        for i in 0..drawn {
-            let range = geom.splat_range(ends, i);
+        for (i, range) in (0..drawn).zip(ranges) {
             if range.is_empty() {
                 continue;
             }
