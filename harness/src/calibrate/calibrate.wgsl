@@ -127,12 +127,16 @@ fn walk_main(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Splat fill: what the splatter's compute pass does per voxel (Grau & Tost 2007 §3.6, our
-// splat.wgsl): walk the pixel centres of a SPLAT_PX-pixel square, a bilinear lookup in two
-// footprint slices of a storage table per centre, added to a two-u32 fixed-point sheet with
-// atomics. Squares half a square apart, so each pixel is hit several times, as overlapping
-// splats are. SPLAT_PX = 4 is a typical footprint of the paper's volumes at 256²-512², so the
-// rate per fragment carries its share of the per-voxel set-up.
+// splat.wgsl): walk the pixel centres of a SPLAT_PX-pixel square; per centre and per slab of
+// the voxel's SPLAT_RING (2r + 1 for the default r = 2), a bilinear lookup in two footprint
+// slices of a storage table, added to that slab's two-u32 fixed-point sums with atomics. A
+// splat fragment is one (voxel, slab, pixel), as the row's `splat_fragments` counts them.
+// Squares half a square apart, so each pixel is hit several times, as overlapping splats are.
+// SPLAT_PX = 4 is a typical footprint of the paper's volumes at 256²-512², so the rate per
+// fragment carries its share of the per-voxel set-up. The table holds no zeros: the
+// splatter's skipped zero terms (the footprint square's corners) are the row's saving.
 const SPLAT_PX: f32 = 4.0;
+const SPLAT_RING: u32 = 5u;
 const SPLAT_GRID: u32 = 128u;
 const SPLAT_TARGET: u32 = 512u;
 const SPLAT_SLICE: u32 = 32u;
@@ -161,16 +165,19 @@ fn splat_bilinear(q: u32, uv: vec2<f32>) -> f32 {
 fn splat_cs(@builtin(global_invocation_id) id: vec3<u32>) {
     let cell = id.x % (SPLAT_GRID * SPLAT_GRID);
     let origin = vec2<f32>(f32(cell % SPLAT_GRID), f32(cell / SPLAT_GRID)) * (SPLAT_PX * 0.5) + 0.25;
-    let q = id.x % 7u;
+    let q = id.x % 3u;
     let lo = vec2<u32>(ceil(origin - 0.5));
     let hi = vec2<u32>(ceil(origin + SPLAT_PX - 0.5));
     for (var y = lo.y; y < hi.y; y++) {
         for (var x = lo.x; x < hi.x; x++) {
             let uv = (vec2<f32>(f32(x) + 0.5, f32(y) + 0.5) - origin) / SPLAT_PX * f32(SPLAT_SLICE) - 0.5;
-            let w = mix(splat_bilinear(q, uv), splat_bilinear(q + 1u, uv), 0.5);
-            let p = 2u * (y * SPLAT_TARGET + x);
-            atomicAdd(&splat_sheet[p], u32(w * 0.5 * SPLAT_ONE + 0.5));
-            atomicAdd(&splat_sheet[p + 1u], u32(w * SPLAT_ONE + 0.5));
+            let pixel = (y * SPLAT_TARGET + x) * SPLAT_RING;
+            for (var o = 0u; o < SPLAT_RING; o++) {
+                let w = mix(splat_bilinear(q + o, uv), splat_bilinear(q + o + 1u, uv), 0.5);
+                let p = 2u * (pixel + o);
+                atomicAdd(&splat_sheet[p], u32(w * 0.5 * SPLAT_ONE + 0.5));
+                atomicAdd(&splat_sheet[p + 1u], u32(w * SPLAT_ONE + 0.5));
+            }
         }
     }
 }

@@ -39,7 +39,7 @@ use crate::results::Row;
 pub mod work;
 
 /// Bumped whenever a kernel or its size changes (old cache files are then re-measured).
-pub const CALIBRATION_VERSION: u32 = 4;
+pub const CALIBRATION_VERSION: u32 = 5;
 
 const GRID: u64 = 256; // calibrate.wgsl GRID
 const TRIANGLES: u64 = GRID * GRID * 2;

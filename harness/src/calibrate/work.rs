@@ -33,6 +33,7 @@ const SPLAT_GRID: u64 = 128; // calibrate.wgsl SPLAT_GRID
 const SPLAT_PX: u64 = 4; // calibrate.wgsl SPLAT_PX (each square covers SPLAT_PX² centres)
 const SPLAT_TARGET: u64 = 512; // calibrate.wgsl SPLAT_TARGET
 const SPLAT_SLICE: u64 = 32; // calibrate.wgsl SPLAT_SLICE
+const SPLAT_RING: u64 = 5; // calibrate.wgsl SPLAT_RING
 const SPLAT_REPEATS: u64 = 16;
 const GPU_SORT_KEYS: u32 = 1 << 18;
 
@@ -159,7 +160,7 @@ pub fn splat_fragments_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow
         gpu,
         "calibrate splat sheet",
         Lifetime::PerFrame,
-        SPLAT_TARGET * SPLAT_TARGET * 8,
+        SPLAT_TARGET * SPLAT_TARGET * 8 * SPLAT_RING,
         wgpu::BufferUsages::STORAGE,
     )?;
     let c = wgpu::ShaderStages::COMPUTE;
@@ -194,7 +195,7 @@ pub fn splat_fragments_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow
         gpu.queue.submit([enc.finish()]);
         gpu.wait()
     })?;
-    Ok((splats * SPLAT_PX * SPLAT_PX) as f64 / s)
+    Ok((splats * SPLAT_PX * SPLAT_PX * SPLAT_RING) as f64 / s)
 }
 
 /// Keys per second of render-core's GPU radix sort (HAVS' and fragment PT's device sorts)

@@ -44,6 +44,18 @@ impl SlabGeometry {
         (s.max(0.0) as u32).min(self.num_slabs - 1)
     }
 
+    /// The voxel range of bucket `b` alone: the voxels whose slab is `b`.
+    pub fn bucket_range(&self, ends: &[u32], b: u32) -> std::ops::Range<u32> {
+        let start = if b > 0 { ends[b as usize - 1] } else { 0 };
+        start..ends[b as usize].max(start)
+    }
+
+    /// Sheets a pass holds at once: slab i splats buckets i − r … i + r, so a bucket's voxels
+    /// belong to 2r + 1 consecutive sheets (a ring, `splat.wgsl`).
+    pub fn ring(&self) -> u32 {
+        2 * self.radius_slabs + 1
+    }
+
     /// The voxel range slab `i` splats: from the start of bucket i − r to the end of i + r.
     pub fn splat_range(&self, ends: &[u32], i: u32) -> std::ops::Range<u32> {
         let r = self.radius_slabs;

@@ -1,9 +1,10 @@
-// Classifies and composites one sheet (post-classification): the sheet holds the slab's
-// fixed-point sums (value * w, w) (splat.wgsl), so its mean value is sum v*w / sum w and its
-// coverage sum w; the transfer function is applied to the mean, the extinction weighted by
-// the coverage (so the data set's boundary keeps its mass), over the ray's length through the
-// slab; front-to-back "under" blending into the image. The pixel's sums are zeroed as they
-// are read: the next slab starts from an empty sheet without a clear pass.
+// Classifies and composites one slab's sheet (post-classification): ring slot `slab.slot`
+// holds the slab's fixed-point sums (value * w, w) (splat.wgsl), so its mean value is
+// sum v*w / sum w and its coverage sum w; the transfer function is applied to the mean, the
+// extinction weighted by the coverage (so the data set's boundary keeps its mass), over the
+// ray's length through the slab; front-to-back "under" blending into the image. The pixel's
+// sums are zeroed as they are read: the slot is empty, without a clear pass, for the slab
+// 2r + 1 further on.
 
 // 1 / SHEET_ONE (splat.wgsl).
 const SHEET_UNIT: f32 = 1.0 / 16777216.0;
@@ -11,6 +12,19 @@ const SHEET_UNIT: f32 = 1.0 / 16777216.0;
 @group(0) @binding(0) var<uniform> fr: Frame;
 @group(0) @binding(1) var<storage, read_write> sheet: array<u32>;
 @group(0) @binding(2) var<storage, read> tf: array<vec4<f32>>;
+@group(1) @binding(0) var<uniform> slab: Slab;
+
+// Must match `Slab` in splat.wgsl.
+struct Slab {
+    first: u32,
+    count: u32,
+    first_slab: u32,
+    last_slab: u32,
+    slot: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
 
 @vertex
 fn fullscreen_vs(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
@@ -21,7 +35,8 @@ fn fullscreen_vs(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32>
 
 @fragment
 fn composite_fs(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = 2u * (u32(pos.y) * u32(fr.viewport.x) + u32(pos.x));
+    let ring = 2u * fr.radius_slabs + 1u;
+    let p = 2u * ((u32(pos.y) * u32(fr.viewport.x) + u32(pos.x)) * ring + slab.slot);
     let sw = vec2<f32>(f32(sheet[p]), f32(sheet[p + 1u])) * SHEET_UNIT;
     if (sheet[p + 1u] != 0u) {
         sheet[p] = 0u;

@@ -181,6 +181,15 @@ impl Splat {
         self
     }
 
+    /// Each slab splats buckets i − r … i + r into its own sheet, the paper's order (§3.6),
+    /// instead of each bucket once into the ring of sheets: the twin the ring must equal bit
+    /// for bit.
+    #[doc(hidden)]
+    pub fn slab_by_slab(mut self) -> Splat {
+        self.slab_by_slab = true;
+        self
+    }
+
     /// Footprint pixel centres of `camera`'s view outside `rect` (see [`centres_outside`]).
     #[doc(hidden)]
     pub fn centres_outside(&self, camera: &Camera, rect: [u32; 4]) -> anyhow::Result<u64> {

@@ -32,14 +32,20 @@ pub struct FrameUniform {
     pub pad: [f32; 2],
 }
 
-/// Must match `Slab` in `splat.wgsl`: one slab's voxel range, at a dynamic offset per slab.
+/// Must match `Slab` in `splat.wgsl` (and `composite.wgsl`): one step of a brick, at a dynamic
+/// offset per step — add the sorted voxels `first .. first + count` to the sheets of slabs
+/// `first_slab ..= last_slab`, then composite ring slot `slot`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SlabUniform {
-    pub index: u32,
     pub first: u32,
     pub count: u32,
-    pub pad: u32,
+    pub first_slab: u32,
+    pub last_slab: u32,
+    pub slot: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 /// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
@@ -53,7 +59,9 @@ pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
             kernel_radius, kernel_unit, density_scale, ese_alpha, kernel_radius_world,
             length_unit, pad
         }),
-        render_core::rust_layout!(SlabUniform => "splat.wgsl::Slab" { index, first, count, pad }),
+        render_core::rust_layout!(SlabUniform => "splat.wgsl::Slab" {
+            first, count, first_slab, last_slab, slot, pad0, pad1, pad2
+        }),
     ]
 }
 
@@ -168,7 +176,11 @@ impl Pipelines {
                 storage(5, c, false),
             ],
         );
-        let slab_layout = layout("splat slab", &[uniform(0, c, true)]);
+        // The step: the splat pass reads its bucket, the composite its ring slot.
+        let slab_layout = layout(
+            "splat slab",
+            &[uniform(0, c | wgpu::ShaderStages::FRAGMENT, true)],
+        );
         let splat_module = gpu.shader("splat splat.wgsl", &with_frame(include_str!("splat.wgsl")));
         let splat = gpu.compute_pipeline(
             "splat sheet",
@@ -200,7 +212,7 @@ impl Pipelines {
         };
         let composite = gpu.triangle_pipeline(
             "splat composite",
-            &pipeline_layout("splat composite", &[&composite_layout]),
+            &pipeline_layout("splat composite", &[&composite_layout, &slab_layout]),
             &composite_module,
             "fullscreen_vs",
             "composite_fs",

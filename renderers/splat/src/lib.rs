@@ -142,8 +142,10 @@ struct Targets {
     height: u32,
     image: wgpu::Texture,
     image_view: wgpu::TextureView,
-    /// Per pixel two u32: the slab's fixed-point sums (splat.wgsl).
+    /// Per pixel and ring slot two u32: a slab's fixed-point sums (splat.wgsl).
     sheet: wgpu::Buffer,
+    /// Sheets in the ring, 2r + 1.
+    ring: u64,
     bytes: u64,
 }
 
@@ -184,6 +186,9 @@ pub struct Splat {
     /// Test hook: every splat fragment is counted as dropped (`ese_dropped_fragments` becomes
     /// the GPU's own count of splat fragments) and the image stays empty.
     count_every_fragment: bool,
+    /// Test hook: each slab splats its buckets i − r … i + r on its own (the paper's order),
+    /// instead of each bucket once into a ring of sheets.
+    slab_by_slab: bool,
 }
 
 /// What one brick of one frame did.
@@ -203,6 +208,7 @@ impl Splat {
             targets: None,
             coverage: None,
             count_every_fragment: false,
+            slab_by_slab: false,
         }
     }
 
@@ -449,12 +455,24 @@ impl Splat {
     }
 
     fn ensure_targets(&mut self, gpu: &Gpu, width: u32, height: u32) -> anyhow::Result<()> {
+        let ring = 2 * self.state.as_ref().unwrap().table.radius_slabs as u64 + 1;
         if self
             .targets
             .as_ref()
-            .is_some_and(|t| t.width == width && t.height == height)
+            .is_some_and(|t| t.width == width && t.height == height && t.ring == ring)
         {
             return Ok(());
+        }
+        let sheet_bytes = width as u64 * height as u64 * ring * 8;
+        if sheet_bytes > gpu.max_storage_binding() {
+            bail!(
+                "splat: {width}×{height} pixels with {ring} sheets in the ring (kernel radius {} \
+                 over slab {}) need a {sheet_bytes}-byte sheet buffer, above this adapter's \
+                 {}-byte storage binding; use a smaller viewport or thicker slabs",
+                self.settings.radius,
+                self.settings.slab,
+                gpu.max_storage_binding()
+            );
         }
         let mut ledger = MemoryLedger::default();
         let both = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
@@ -469,9 +487,9 @@ impl Splat {
         // Created zeroed; every composite zeroes what it read.
         let sheet = ledger.buffer(
             gpu,
-            "splat sheet buffer",
+            "splat sheet ring",
             Lifetime::PerFrame,
-            width as u64 * height as u64 * 8,
+            sheet_bytes,
             wgpu::BufferUsages::STORAGE,
         )?;
         self.targets = Some(Targets {
@@ -479,6 +497,7 @@ impl Splat {
             height,
             image_view,
             sheet,
+            ring,
             image,
             bytes: ledger.per_frame,
         });
@@ -499,22 +518,53 @@ impl Splat {
         let t = self.targets.as_ref().unwrap();
         let t0 = Instant::now();
         let [x0, y0, x1, y1] = rect;
-        // Each slab's voxel range, one dynamic-offset entry per slab (written before this
-        // brick's submit, so each brick sees its own).
+        // One dynamic-offset entry per step t (written before this brick's submit, so each
+        // brick sees its own): splat bucket t into the sheets of slabs t − r … t + r (a ring of
+        // 2r + 1, slot = slab mod 2r + 1), then composite slab t − r, whose last bucket that
+        // was. Empty buckets are not dispatched, and slabs with nothing to splat not
+        // composited (their slot stayed empty). The test hook `slab_by_slab` takes the paper's
+        // steps instead: slab t splats buckets t − r … t + r into its sheet alone.
         let drawn = geom.num_slabs.min(st.max_slabs);
-        let ranges: Vec<_> = (0..drawn).map(|i| geom.splat_range(ends, i)).collect();
-        let slabs: Vec<SlabUniform> = (0..drawn)
-            .zip(&ranges)
-            .map(|(index, range)| SlabUniform {
-                index,
-                first: range.start,
-                count: range.len() as u32,
-                pad: 0,
+        let r = if self.slab_by_slab {
+            0
+        } else {
+            geom.radius_slabs
+        };
+        let steps: Vec<(SlabUniform, Option<u32>)> = (0..drawn + r)
+            .map(|t| {
+                let (voxels, slabs) = match (t < drawn, self.slab_by_slab) {
+                    (false, _) => (0..0, 0..=0),
+                    (true, false) => (
+                        geom.bucket_range(ends, t),
+                        t.saturating_sub(r)..=(t + r).min(drawn - 1),
+                    ),
+                    (true, true) => (geom.splat_range(ends, t), t..=t),
+                };
+                let composite = t
+                    .checked_sub(r)
+                    .filter(|&s| s < drawn && !geom.splat_range(ends, s).is_empty());
+                let step = SlabUniform {
+                    first: voxels.start,
+                    count: voxels.len() as u32,
+                    first_slab: *slabs.start(),
+                    last_slab: *slabs.end(),
+                    slot: composite.map_or(0, |s| s % geom.ring()),
+                    ..Default::default()
+                };
+                (step, composite)
             })
             .collect();
-        if !slabs.is_empty() {
+        for s in 0..drawn {
+            let range = geom.splat_range(ends, s);
+            if !range.is_empty() {
+                stats.slabs += 1;
+                stats.splats += range.len() as u64;
+            }
+        }
+        let uniforms: Vec<SlabUniform> = steps.iter().map(|(u, _)| *u).collect();
+        if !uniforms.is_empty() {
             gpu.queue
-                .write_buffer(&st.slab_buf, 0, &strided_uniforms(&slabs));
+                .write_buffer(&st.slab_buf, 0, &strided_uniforms(&uniforms));
         }
         let splat_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("splat sheet"),
@@ -553,35 +603,34 @@ impl Splat {
             ],
         });
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        for (i, range) in (0..drawn).zip(ranges) {
-            if range.is_empty() {
-                continue;
-            }
-            stats.slabs += 1;
-            stats.splats += range.len() as u64;
-            {
+        for (index, (step, composite)) in steps.iter().enumerate() {
+            let offset = (index as u64 * UNIFORM_STRIDE) as u32;
+            if step.count > 0 {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("splat slab"),
+                    label: Some("splat bucket"),
                     timestamp_writes: None,
                 });
                 pass.set_pipeline(&st.pipes.splat);
                 pass.set_bind_group(0, &splat_bind, &[]);
-                pass.set_bind_group(1, &slab_bind, &[(i as u64 * UNIFORM_STRIDE) as u32]);
-                let (x, y) = gpu::workgroups(range.len() as u32);
+                pass.set_bind_group(1, &slab_bind, &[offset]);
+                let (x, y) = gpu::workgroups(step.count);
                 pass.dispatch_workgroups(x, y, 1);
             }
-            let mut pass = color_pass(
-                &mut enc,
-                "splat composite",
-                &t.image_view,
-                false,
-                true,
-                None,
-            );
-            pass.set_scissor_rect(x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0));
-            pass.set_pipeline(&st.pipes.composite);
-            pass.set_bind_group(0, &comp_bind, &[]);
-            pass.draw(0..3, 0..1);
+            if composite.is_some() {
+                let mut pass = color_pass(
+                    &mut enc,
+                    "splat composite",
+                    &t.image_view,
+                    false,
+                    true,
+                    None,
+                );
+                pass.set_scissor_rect(x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0));
+                pass.set_pipeline(&st.pipes.composite);
+                pass.set_bind_group(0, &comp_bind, &[]);
+                pass.set_bind_group(1, &slab_bind, &[offset]);
+                pass.draw(0..3, 0..1);
+            }
         }
         clock.submit(gpu, [enc.finish()]);
         stats.splat_ms += t0.elapsed().as_secs_f64() * 1e3;
@@ -679,11 +728,12 @@ impl Splat {
             .sqrt();
         let max_slabs =
             ((d + 2.0 * s.radius * set.kernel_unit) / (s.slab * set.kernel_unit)).ceil() as u32 + 4;
+        // One entry per step of a brick: each bucket, then the last r slabs' composites.
         let slab_buf = ledger.buffer(
             gpu,
-            "splat slab ranges",
+            "splat slab steps",
             Lifetime::PerFrame,
-            max_slabs as u64 * UNIFORM_STRIDE,
+            (max_slabs + table.radius_slabs) as u64 * UNIFORM_STRIDE,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         )?;
         let frame_buf = ledger.buffer(

@@ -1,18 +1,30 @@
-// Splatting one slab (Grau & Tost §3.6) as a compute pass: one invocation per voxel of
-// buckets i - r ... i + r (the paper draws point sprites; on a software rasteriser a quad's
-// triangle setup costs more than its few fragments). Each invocation walks the pixel centres
-// of its voxel's footprint square — the rasteriser's rule for an axis-aligned quad: a centre
-// on the left/top edge is in, on the right/bottom edge out (coverage.rs is the CPU twin) —
-// looks up the footprint slice of its offset from the slab (one table of all slices,
-// kernel.rs) and adds (value * footprint, footprint) to the sheet in fixed point, so the sums
-// are exact and independent of the invocations' order.
+// Splatting (Grau & Tost §3.6) as a compute pass: one invocation per voxel of one bucket.
+// The paper draws point sprites; on a software rasteriser a quad's triangle setup costs more
+// than its few fragments. A voxel of bucket b belongs to the sheets of slabs b - r ... b + r
+// (each slab splats buckets i - r ... i + r), so its invocation projects it once and adds to
+// all 2r + 1 of them, held as a ring of sheets (slot = slab mod (2r + 1)); slab b - r is then
+// complete and the host composites it before bucket b + 1, which reuses its slot. The sums
+// are those of splatting each slab on its own, term for term: only the voxel's projection
+// and its pixel walk are shared. Each invocation walks the pixel centres of its footprint
+// square — the rasteriser's rule for an axis-aligned quad: a centre on the left/top edge is
+// in, on the right/bottom edge out (coverage.rs is the CPU twin) — looks up the footprint
+// slice of its offset from each slab (one table of all slices, kernel.rs) and adds
+// (value * footprint, footprint) in fixed point, so the sums are exact and independent of
+// the invocations' order.
 
+// One step of a brick: add voxels sorted_in[first .. first + count] to the sheets of slabs
+// first_slab ... last_slab, then composite ring slot `slot` (composite.wgsl). A step is one
+// bucket and the slabs it belongs to; the test hook `Splat::slab_by_slab` makes it the
+// paper's slab i (buckets i - r ... i + r into slab i alone), the twin the ring must equal.
 struct Slab {
-    index: u32,
-    // This slab's voxels: sorted_in[first .. first + count].
     first: u32,
     count: u32,
-    pad: u32,
+    first_slab: u32,
+    last_slab: u32,
+    slot: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // Sheet sums are stored as round(x * SHEET_ONE) in u32 (composite.wgsl divides back): a
@@ -27,7 +39,8 @@ const SHEET_ONE: f32 = 16777216.0;
 @group(0) @binding(3) var image_tex: texture_2d<f32>;
 // Splat fragments early splat elimination dropped (the row's `ese_dropped_fragments`).
 @group(0) @binding(4) var<storage, read_write> ese_dropped: atomic<u32>;
-// Per pixel (sum value * w, sum w), row-major, y down.
+// Per pixel and ring slot (sum value * w, sum w): pixels row-major, y down, each pixel's
+// 2r + 1 slots together (one cache line for r = 2).
 @group(0) @binding(5) var<storage, read_write> sheet: array<atomic<u32>>;
 @group(1) @binding(0) var<uniform> slab: Slab;
 
@@ -51,17 +64,30 @@ fn bilinear(i: u32, side: u32, fx: f32, fy: f32) -> f32 {
     return mix(mix(table[i], table[i + 1u], fx), mix(table[i + side], table[i + side + 1u], fx), fy);
 }
 
-// Twin of FootprintTable::sample (kernel.rs): linear between slice rows, bilinear in a slice,
-// 0 outside the table (the slices' zero border; u, v are clamped onto it).
-fn footprint(sl: Slices, kxy: vec2<f32>) -> f32 {
+// Where a pixel falls in a footprint slice: the table index of its bilinear cell relative to
+// the slice's start, and the fractions. Twin of FootprintTable::sample (kernel.rs): bilinear
+// in a slice, 0 outside the table (the slices' zero border; u, v are clamped onto it).
+struct Cell {
+    at: u32,
+    fx: f32,
+    fy: f32,
+}
+
+fn cell_of(kxy: vec2<f32>) -> Cell {
     let f = f32(fr.footprint);
     let u = clamp((kxy.x + fr.kernel_radius) / (2.0 * fr.kernel_radius) * f - 0.5, -1.0, f - 0.5);
     let v = clamp((kxy.y + fr.kernel_radius) / (2.0 * fr.kernel_radius) * f - 0.5, -1.0, f - 0.5);
     let x0 = floor(u);
     let y0 = floor(v);
     let side = fr.footprint + 2u;
-    let i = sl.base + u32(y0 + 1.0) * side + u32(x0 + 1.0);
-    return mix(bilinear(i, side, u - x0, v - y0), bilinear(i + side * side, side, u - x0, v - y0), sl.fq);
+    return Cell(u32(y0 + 1.0) * side + u32(x0 + 1.0), u - x0, v - y0);
+}
+
+// The footprint of one slab: linear between its two slice rows.
+fn footprint(sl: Slices, c: Cell) -> f32 {
+    let side = fr.footprint + 2u;
+    let i = sl.base + c.at;
+    return mix(bilinear(i, side, c.fx, c.fy), bilinear(i + side * side, side, c.fx, c.fy), sl.fq);
 }
 
 // First pixel index whose centre k + 1/2 is >= edge, clamped to [0, n].
@@ -94,24 +120,47 @@ fn splat_cs(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups
     let y1 = first_centre(centre.y + half_px, fr.viewport.y);
     // Kernel units per pixel: the quad's corners are +-kernel_radius.
     let k_per_px = fr.kernel_radius / half_px;
-    let slices = slices_of((d - fr.d0) * fr.inv_delta - f32(slab.index));
+    // The slabs this step adds to, and the first one's ring slot.
+    let ring = 2u * fr.radius_slabs + 1u;
+    let s0 = slab.first_slab;
+    let s1 = slab.last_slab;
+    let slot0 = s0 % ring;
+    let in_slabs = (d - fr.d0) * fr.inv_delta;
     let value = clamp(v.w, 0.0, 1.0);
     let width = u32(fr.viewport.x);
+    var dropped = 0u;
     for (var y = y0; y < y1; y++) {
         for (var x = x0; x < x1; x++) {
-            // Early splat elimination: nothing behind an opaque pixel can show.
+            // Early splat elimination: nothing behind an opaque pixel can show. The image
+            // holds the slabs before s0, so this drops no more than testing each slab would.
             if (fr.ese_alpha <= 1.0) {
                 let a = textureLoad(image_tex, vec2<i32>(i32(x), i32(y)), 0).a;
                 if (a >= fr.ese_alpha) {
-                    atomicAdd(&ese_dropped, 1u);
+                    dropped += s1 + 1u - s0;
                     continue;
                 }
             }
             let kxy = (vec2<f32>(f32(x) + 0.5, f32(y) + 0.5) - centre) * k_per_px;
-            let w = max(footprint(slices, kxy), 0.0) * fr.density_scale;
-            let p = 2u * (y * width + x);
-            atomicAdd(&sheet[p], u32(w * value * SHEET_ONE + 0.5));
-            atomicAdd(&sheet[p + 1u], u32(w * SHEET_ONE + 0.5));
+            let c = cell_of(kxy);
+            let pixel = (y * width + x) * ring;
+            var slot = slot0;
+            for (var s = s0; s <= s1; s++) {
+                let w = max(footprint(slices_of(in_slabs - f32(s)), c), 0.0) * fr.density_scale;
+                let p = 2u * (pixel + slot);
+                // A term that rounds to 0 adds nothing: skip its atomic.
+                let wv = u32(w * value * SHEET_ONE + 0.5);
+                let ww = u32(w * SHEET_ONE + 0.5);
+                if (wv != 0u) {
+                    atomicAdd(&sheet[p], wv);
+                }
+                if (ww != 0u) {
+                    atomicAdd(&sheet[p + 1u], ww);
+                }
+                slot = select(slot + 1u, 0u, slot + 1u == ring);
+            }
         }
+    }
+    if (dropped != 0u) {
+        atomicAdd(&ese_dropped, dropped);
     }
 }
