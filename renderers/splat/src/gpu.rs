@@ -73,6 +73,7 @@ pub struct Pipelines {
     pub gather: wgpu::ComputePipeline,
     pub boundaries: wgpu::ComputePipeline,
     pub bitonic_layout: wgpu::BindGroupLayout,
+    pub bitonic_double: wgpu::ComputePipeline,
     pub bitonic_wide: wgpu::ComputePipeline,
     pub bitonic_narrow: wgpu::ComputePipeline,
     pub splat_layout: wgpu::BindGroupLayout,
@@ -151,6 +152,12 @@ impl Pipelines {
         );
         let bitonic_module = gpu.shader("splat bitonic.wgsl", include_str!("bitonic.wgsl"));
         let bpl = pipeline_layout("splat bitonic", &[&bitonic_layout]);
+        let bitonic_double = gpu.compute_pipeline(
+            "splat bitonic double",
+            Some(&bpl),
+            &bitonic_module,
+            "bitonic_double",
+        );
         let bitonic_wide = gpu.compute_pipeline(
             "splat bitonic wide",
             Some(&bpl),
@@ -229,6 +236,7 @@ impl Pipelines {
             gather,
             boundaries,
             bitonic_layout,
+            bitonic_double,
             bitonic_wide,
             bitonic_narrow,
             splat_layout,
@@ -251,6 +259,8 @@ pub fn workgroups(threads: u32) -> (u32, u32) {
 /// One dispatch of the bitonic sort (bitonic.wgsl), four compare-exchanges per invocation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BitonicStep {
+    /// Stages (k, j) and (k, j / 2), j ≥ 8 (`bitonic_double`).
+    Double { k: u32, j: u32 },
     /// Stage (k, j), j ≥ 4 (`bitonic_wide`).
     Wide { k: u32, j: u32 },
     /// Stages (k, 2) and (k, 1), or (2, 1) alone (`bitonic_narrow`).
@@ -261,7 +271,7 @@ impl BitonicStep {
     /// The `Stage` uniform (k, j, n, 0); a narrow step's j is 0.
     pub fn uniform(self, n: u32) -> [u32; 4] {
         match self {
-            BitonicStep::Wide { k, j } => [k, j, n, 0],
+            BitonicStep::Double { k, j } | BitonicStep::Wide { k, j } => [k, j, n, 0],
             BitonicStep::Narrow { k } => [k, 0, n, 0],
         }
     }
@@ -269,6 +279,7 @@ impl BitonicStep {
     /// Invocations of the step over `n` elements.
     pub fn invocations(self, n: u32) -> u32 {
         match self {
+            BitonicStep::Double { .. } => n / 16,
             BitonicStep::Wide { .. } => n / 8,
             BitonicStep::Narrow { .. } => n / 4,
         }
@@ -283,8 +294,13 @@ pub fn bitonic_steps(n: u32) -> Vec<BitonicStep> {
     while k <= n {
         let mut j = k / 2;
         while j >= 4 {
-            out.push(BitonicStep::Wide { k, j });
-            j /= 2;
+            if j >= 8 {
+                out.push(BitonicStep::Double { k, j });
+                j /= 4;
+            } else {
+                out.push(BitonicStep::Wide { k, j });
+                j /= 2;
+            }
         }
         out.push(BitonicStep::Narrow { k });
         k *= 2;
@@ -316,6 +332,7 @@ mod tests {
         let mut out = vec![];
         for &step in steps {
             match step {
+                BitonicStep::Double { k, j } => out.extend([(k, j), (k, j / 2)]),
                 BitonicStep::Wide { k, j } => out.push((k, j)),
                 BitonicStep::Narrow { k } => {
                     if k >= 4 {

@@ -328,6 +328,7 @@ impl Splat {
                         let mut pass = enc.begin_compute_pass(&Default::default());
                         for (s, &step) in steps.iter().enumerate() {
                             pass.set_pipeline(match step {
+                                gpu::BitonicStep::Double { .. } => &st.pipes.bitonic_double,
                                 gpu::BitonicStep::Wide { .. } => &st.pipes.bitonic_wide,
                                 gpu::BitonicStep::Narrow { .. } => &st.pipes.bitonic_narrow,
                             });
