@@ -90,17 +90,19 @@ pub fn bucket_ends(sorted_depths: &[f32], g: &SlabGeometry) -> Vec<u32> {
 }
 
 /// The CPU-bucket pipeline of one brick: depths, stable radix sort (render-core's, the
-/// paper's CPU baseline sorts on the host), gather, bucket table.
+/// paper's CPU baseline sorts on the host), bucket table, gather.
 #[derive(Default)]
 pub struct CpuBuckets {
     keys: Vec<f32>,
     order: Vec<u32>,
     scratch: RadixScratch,
     pub sorted_keys: Vec<f32>,
-    pub sorted: Vec<[f32; 4]>,
+    piece: Vec<[f32; 4]>,
 }
 
 impl CpuBuckets {
+    /// Sorts `voxels` by depth and returns the bucket table; [`Self::gather`] then writes
+    /// them in that order.
     pub fn run(&mut self, voxels: &[[f32; 4]], depth_row: [f32; 4], g: &SlabGeometry) -> Vec<u32> {
         use rayon::prelude::*;
         self.keys.clear();
@@ -110,10 +112,21 @@ impl CpuBuckets {
         self.sorted_keys.clear();
         self.sorted_keys
             .par_extend(self.order.par_iter().map(|&i| self.keys[i as usize]));
-        self.sorted.clear();
-        self.sorted
-            .par_extend(self.order.par_iter().map(|&i| voxels[i as usize]));
         bucket_ends(&self.sorted_keys, g)
+    }
+
+    /// The voxels of the last [`Self::run`] in depth order, `PIECE` at a time: `write(first,
+    /// piece)` uploads each, so the host holds one piece of the sorted set, not all of it.
+    pub fn gather(&mut self, voxels: &[[f32; 4]], mut write: impl FnMut(usize, &[[f32; 4]])) {
+        use rayon::prelude::*;
+        // 16 MB: large enough that each upload streams, small beside the voxels themselves.
+        const PIECE: usize = 1 << 20;
+        for (p, order) in self.order.chunks(PIECE).enumerate() {
+            self.piece.clear();
+            self.piece
+                .par_extend(order.par_iter().map(|&i| voxels[i as usize]));
+            write(p * PIECE, &self.piece);
+        }
     }
 }
 

@@ -267,9 +267,12 @@ impl Splat {
         let t0 = Instant::now();
         match self.settings.buckets {
             Buckets::Cpu => {
-                let ends = st.cpu.run(&st.set.voxels[range], row, geom);
-                gpu.queue
-                    .write_buffer(&st.sorted, 0, bytemuck::cast_slice(&st.cpu.sorted));
+                let voxels = &st.set.voxels[range];
+                let ends = st.cpu.run(voxels, row, geom);
+                let (queue, sorted) = (&gpu.queue, &st.sorted);
+                st.cpu.gather(voxels, |first, piece| {
+                    queue.write_buffer(sorted, first as u64 * 16, bytemuck::cast_slice(piece))
+                });
                 stats.buckets_ms += t0.elapsed().as_secs_f64() * 1e3;
                 let keys = if want_keys {
                     st.cpu.sorted_keys.clone()
