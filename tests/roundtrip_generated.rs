@@ -266,7 +266,7 @@ fn resampling_reproduces_linear_fields() {
     for k in 0..5 {
         for j in 0..7 {
             for i in 0..9 {
-                let v = vg.values[vg.index(i, j, k)] as f64;
+                let v = vg.values.get(vg.index(i, j, k)) as f64;
                 assert!(
                     (v - f(vg.point(i, j, k))).abs() < 2e-6,
                     "({i},{j},{k}): {v}"
@@ -284,7 +284,7 @@ fn resampling_reproduces_linear_fields() {
             for i in 0..21 {
                 let p = vg.point(i, j, k);
                 let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-                let v = vg.values[vg.index(i, j, k)] as f64;
+                let v = vg.values.get(vg.index(i, j, k)) as f64;
                 if r > 0.6 && r < 0.9 {
                     inside += 1;
                     assert!((v - f(p)).abs() < 2e-6, "{p:?}: {v}");
@@ -304,22 +304,22 @@ fn voxel_grid_to_tets() {
         dims: [4, 3, 5],
         spacing: [0.5, 1.0, 2.0],
         origin: [1.0, 2.0, 3.0],
-        values: (0..60).map(|v| v as f32).collect(),
+        values: (0..60).map(|v| v as f32).collect::<Vec<_>>().into(),
         scalar_name: "v".into(),
     };
     let m = vg.to_tets().unwrap();
     assert_eq!(m.num_tets(), 5 * 3 * 2 * 4);
     assert_eq!(m.points[vg.index(3, 2, 4)], [2.5, 4.0, 11.0]);
-    assert_eq!(m.scalars, vg.values);
+    assert_eq!(m.scalars, vg.values.to_vec());
     assert!((total_volume(&m) - 1.5 * 2.0 * 8.0).abs() < 1e-9);
     // And back: resampling on its own lattice returns the voxel values.
     let back = VoxelGrid::resample(&m, vg.dims);
     assert_eq!(back.origin, vg.origin);
-    for (a, b) in back.values.iter().zip(&vg.values) {
+    for (a, b) in back.values.iter().zip(vg.values.iter()) {
         assert!((a - b).abs() < 1e-4, "{a} {b}");
     }
     let bad = VoxelGrid {
-        values: vec![0.0; 3],
+        values: vec![0.0; 3].into(),
         ..vg
     };
     assert!(bad.to_tets().is_err());

@@ -210,7 +210,7 @@ pub fn volume_grid(spec: &VolumeSpec) -> Result<VoxelGrid, ErrorKind> {
             dims,
             spacing: [1.0; 3],
             origin: [0.0; 3],
-            values,
+            values: values.into(),
             scalar_name: "bumps".into(),
         });
     }
@@ -275,7 +275,7 @@ mod tests {
     fn effective_count_is_exact_and_the_mesh_keeps_its_grid() {
         let m = from_volume_spec("vol:24x20x16:eff=1500").unwrap();
         let g = m.source_grid.as_ref().unwrap();
-        assert_eq!(g.values.iter().filter(|&&v| v > 0.0).count(), 1500);
+        assert_eq!(g.values.iter().filter(|&v| v > 0.0).count(), 1500);
         assert_eq!(m.num_points(), g.num_voxels());
         assert_eq!(m.points[g.index(3, 2, 1)], [3.0, 2.0, 1.0]);
         // Only support cells are split; all of them are non-degenerate.

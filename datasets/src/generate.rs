@@ -246,6 +246,14 @@ pub struct FieldEval {
 }
 
 impl FieldEval {
+    /// A value the field never exceeds, where one is known: the blobs' summed amplitudes.
+    pub fn upper_bound(&self) -> Option<f64> {
+        match self.field {
+            Field::Blobs => Some(self.blobs.iter().map(|b| b.amplitude.max(0.0)).sum()),
+            _ => None,
+        }
+    }
+
     pub fn new(field: Field, seed: u64) -> FieldEval {
         let blobs = (0..8u64)
             .map(|b| {

@@ -27,7 +27,7 @@ pub mod write_vtu;
 
 pub use dataset::{Dataset, LazyDataset, LoadOptions, Plot3dField};
 pub use error::{ErrorKind, LoadError, Location};
-pub use grid::VoxelGrid;
+pub use grid::{GridValues, VoxelGrid};
 pub use mesh::{
     Aabb, BoundaryFace, QualityStats, RepairReport, TetMesh, UniqueFaces, NO_NEIGHBOUR, TET_FACES,
 };

@@ -429,7 +429,7 @@ fn decode(
         dims,
         spacing: h.spacing,
         origin: h.origin,
-        values: values.clone(),
+        values: values.clone().into(),
         scalar_name: SCALAR_NAME.into(),
     };
     let mut mesh = TetMesh::new(

@@ -46,7 +46,7 @@ impl VoxelGrid {
         TetMesh::new(
             "volume",
             points,
-            self.values.clone(),
+            self.values.to_vec(),
             self.scalar_name.clone(),
             structured_tets(self.dims),
         )
@@ -147,7 +147,7 @@ impl VoxelGrid {
                 dims,
                 spacing,
                 origin,
-                values,
+                values: values.into(),
                 scalar_name: mesh.scalar_name.clone(),
             },
             inside,
@@ -313,7 +313,7 @@ pub fn split_cells(
     TetMesh::new(
         "volume",
         points,
-        grid.values.clone(),
+        grid.values.to_vec(),
         grid.scalar_name.clone(),
         tets,
     )

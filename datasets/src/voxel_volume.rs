@@ -113,7 +113,7 @@ impl VoxelVolume {
             return Err(ErrorKind::NonFinite {
                 what: "scalar of point".into(),
                 index: i as u64,
-                value: *v as f64,
+                value: v as f64,
             });
         }
         let volume = VoxelVolume {
@@ -192,7 +192,7 @@ impl VoxelVolume {
             // A point is used when one of the (up to 8) cells around it is kept, i.e. when a
             // point of its 3×3×3 neighbourhood (clamped to the grid) is non-zero.
             CellCover::Support => {
-                if g.values[index] != 0.0 {
+                if g.values.get(index) != 0.0 {
                     return true;
                 }
                 let d = g.dims;
@@ -201,7 +201,7 @@ impl VoxelVolume {
                 let hi = [0, 1, 2].map(|a| (ijk[a] + 1).min(d[a] - 1));
                 (lo[2]..=hi[2]).any(|k| {
                     (lo[1]..=hi[1])
-                        .any(|j| (lo[0]..=hi[0]).any(|i| g.values[g.index(i, j, k)] != 0.0))
+                        .any(|j| (lo[0]..=hi[0]).any(|i| g.values.get(g.index(i, j, k)) != 0.0))
                 })
             }
         }
@@ -255,7 +255,7 @@ fn all_cells_footprint(g: &VoxelGrid) -> Footprint {
         .par_iter()
         .fold(
             || (f32::INFINITY, f32::NEG_INFINITY),
-            |(lo, hi), &v| (lo.min(v), hi.max(v)),
+            |(lo, hi), v| (lo.min(v), hi.max(v)),
         )
         .reduce(
             || (f32::INFINITY, f32::NEG_INFINITY),
@@ -283,9 +283,8 @@ fn support_footprint(g: &VoxelGrid) -> Footprint {
     }
     let plane = nx * ny;
     let nonzero = |k: usize| -> Vec<bool> {
-        g.values[k * plane..(k + 1) * plane]
-            .iter()
-            .map(|&v| v != 0.0)
+        (k * plane..(k + 1) * plane)
+            .map(|i| g.values.get(i) != 0.0)
             .collect()
     };
     // Any non-zero in the clamped 3×3 window around each point of a plane.
@@ -335,7 +334,7 @@ fn support_footprint(g: &VoxelGrid) -> Footprint {
                 let below = (k > 0).then(|| &near_masks[at(k - 1)]);
                 let above = (k + 1 < nz).then(|| &near_masks[at(k + 1)]);
                 let here = &near_masks[at(k)];
-                let values = &g.values[k * plane..(k + 1) * plane];
+                let values = g.values.slice(k * plane..(k + 1) * plane);
                 for p in 0..plane {
                     let used =
                         here[p] || below.is_some_and(|m| m[p]) || above.is_some_and(|m| m[p]);
@@ -364,18 +363,17 @@ mod tests {
     /// A grid with non-zero values in a few places, borders and corners included, so that
     /// clamping at every face is exercised.
     fn sparse_grid(dims: [usize; 3], nonzero: &[[usize; 3]]) -> VoxelGrid {
-        let mut g = VoxelGrid {
+        let mut values = vec![0.0; dims.iter().product()];
+        for (n, &[i, j, k]) in nonzero.iter().enumerate() {
+            values[i + dims[0] * (j + dims[1] * k)] = 1.0 + n as f32;
+        }
+        VoxelGrid {
             dims,
             spacing: [0.5, 1.25, 0.75],
             origin: [-1.0, 2.0, 0.25],
-            values: vec![0.0; dims.iter().product()],
+            values: values.into(),
             scalar_name: "s".into(),
-        };
-        for (n, &[i, j, k]) in nonzero.iter().enumerate() {
-            let at = g.index(i, j, k);
-            g.values[at] = 1.0 + n as f32;
         }
-        g
     }
 
     /// About one point in eight non-zero, scattered by a fixed hash (no generator needed: this
@@ -405,7 +403,8 @@ mod tests {
                 for i in 0..d[0] - 1 {
                     let keep = cover == CellCover::All
                         || (0..8).any(|b| {
-                            g.values[g.index(i + (b & 1), j + (b >> 1 & 1), k + (b >> 2 & 1))]
+                            g.values
+                                .get(g.index(i + (b & 1), j + (b >> 1 & 1), k + (b >> 2 & 1)))
                                 != 0.0
                         });
                     if keep {
@@ -425,7 +424,7 @@ mod tests {
                 }
             }
         }
-        TetMesh::new("ref", points, g.values.clone(), "s", tets).unwrap()
+        TetMesh::new("ref", points, g.values.to_vec(), "s", tets).unwrap()
     }
 
     #[test]
@@ -496,11 +495,15 @@ mod tests {
         assert!(matches!(err, Err(ErrorKind::EmptyMesh(_))));
         assert!(VoxelVolume::new("e", empty, CellSplit::Five, CellCover::All).is_ok());
         let mut nan = sparse_grid([3, 3, 3], &[[1, 1, 1]]);
-        nan.values[4] = f32::NAN;
+        let mut values = nan.values.to_vec();
+        values[4] = f32::NAN;
+        nan.values = values.into();
         let err = VoxelVolume::new("n", Arc::new(nan), CellSplit::Six, CellCover::All);
         assert!(matches!(err, Err(ErrorKind::NonFinite { index: 4, .. })));
         let mut short = sparse_grid([3, 3, 3], &[[1, 1, 1]]);
-        short.values.pop();
+        let mut values = short.values.to_vec();
+        values.pop();
+        short.values = values.into();
         let err = VoxelVolume::new("s", Arc::new(short), CellSplit::Six, CellCover::All);
         assert!(matches!(err, Err(ErrorKind::CountMismatch { .. })));
     }

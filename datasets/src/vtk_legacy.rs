@@ -1324,7 +1324,7 @@ impl VtkFile {
                 dims,
                 spacing,
                 origin,
-                values: scalars.clone(),
+                values: scalars.clone().into(),
                 scalar_name: scalar_name.clone(),
             })
         });

@@ -498,7 +498,7 @@ impl<'a> XmlFile<'a> {
                 dims,
                 spacing,
                 origin: [0, 1, 2].map(|a| origin[a] + whole[2 * a] as f64 * spacing[a]),
-                values,
+                values: values.into(),
                 scalar_name: scalar_name.clone(),
             };
             let mut mesh = vg.to_tets().map_err(|k| LoadError::new(self.path, k))?;

@@ -222,7 +222,7 @@ fn structured_grid_and_image_data() {
     let vg = ds.volume.as_ref().unwrap();
     assert_eq!(vg.dims, [3, 2, 2]);
     assert_eq!(vg.origin, [10.5, 0.0, 0.0]);
-    assert_eq!(vg.values[..3], [4.0, 6.0, 8.0]);
+    assert_eq!(vg.values.slice(0..3)[..], [4.0, 6.0, 8.0]);
     assert_eq!(ds.mesh.num_tets(), 10);
     assert_eq!(ds.mesh.points[1], [11.0, 0.0, 0.0]);
     assert!(ds

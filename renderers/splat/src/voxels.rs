@@ -124,7 +124,7 @@ impl VoxelSet {
         let mut chosen: Vec<(f32, u32)> = (0..g.num_voxels())
             .into_par_iter()
             .filter_map(|i| {
-                let s = optics.normalise(g.values[i] as f64);
+                let s = optics.normalise(g.values.get(i) as f64);
                 (tf.kappa_at(s) > 0.0 && inside(i)).then_some((s as f32, i as u32))
             })
             .collect();

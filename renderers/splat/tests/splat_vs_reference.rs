@@ -112,7 +112,7 @@ fn single_voxel_matches_its_analytic_projection() {
         dims: [n; 3],
         spacing: [1.0; 3],
         origin: [0.0; 3],
-        values,
+        values: values.into(),
         scalar_name: "one".into(),
     };
     let mut mesh = vg.to_tets().unwrap();
