@@ -168,8 +168,6 @@ struct State {
     radix: Option<GpuRadixSort>,
     cpu: buckets::CpuBuckets,
     max_slabs: u32,
-    /// GPU bytes of the voxel arrays (the paper's 16 bytes per voxel).
-    voxel_bytes: u64,
     length_unit: f64,
     ledger: MemoryLedger,
     frame_bytes: u64,
@@ -697,8 +695,13 @@ impl Splat {
         );
         let mut ledger = MemoryLedger::default();
         let storage = wgpu::BufferUsages::STORAGE;
-        let bricks: Vec<wgpu::Buffer> = set
-            .bricks
+        // The GPU buckets read each brick's voxels on the device; the CPU buckets sort them on
+        // the host and upload each brick sorted (`sorted`), so they keep no device copy.
+        let on_device: &[voxels::Brick] = match s.buckets {
+            Buckets::Gpu => &set.bricks,
+            Buckets::Cpu => &[],
+        };
+        let bricks: Vec<wgpu::Buffer> = on_device
             .iter()
             .map(|b| {
                 ledger.buffer_init(
@@ -710,7 +713,6 @@ impl Splat {
                 )
             })
             .collect::<anyhow::Result<_>>()?;
-        let voxel_bytes = ledger.persistent;
         let table_buf = ledger.buffer_init(
             gpu,
             "splat footprint slices",
@@ -822,7 +824,6 @@ impl Splat {
             radix,
             cpu: Default::default(),
             max_slabs,
-            voxel_bytes,
             length_unit: optics.length_unit,
             ledger,
             frame_bytes,
@@ -959,13 +960,10 @@ impl Renderer for Splat {
                 // Early splat elimination drops these; each pixel it touches is already at
                 // least ESE_ALPHA opaque, so it changes that pixel by at most 1 − ESE_ALPHA.
                 ("ese_dropped_fragments".into(), ese_dropped as f64),
+                // The paper's (x, y, z, value) texel.
                 (
                     "bytes_per_voxel".into(),
-                    if eff > 0.0 {
-                        st.voxel_bytes as f64 / eff
-                    } else {
-                        0.0
-                    },
+                    std::mem::size_of::<[f32; 4]>() as f64,
                 ),
                 (
                     "voxels_per_sec".into(),
