@@ -14,18 +14,6 @@ const SHEET_UNIT: f32 = 1.0 / 16777216.0;
 @group(0) @binding(2) var<storage, read> tf: array<vec4<f32>>;
 @group(1) @binding(0) var<uniform> slab: Slab;
 
-// Must match `Slab` in splat.wgsl.
-struct Slab {
-    first: u32,
-    count: u32,
-    first_slab: u32,
-    last_slab: u32,
-    slot: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-}
-
 @vertex
 fn fullscreen_vs(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
     let x = f32((vi << 1u) & 2u) * 2.0 - 1.0;

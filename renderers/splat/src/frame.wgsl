@@ -34,3 +34,19 @@ fn view_depth(fr: Frame, p: vec3<f32>) -> f32 {
     let r = fr.depth_row;
     return -(r.x * p.x + r.y * p.y + r.z * p.z + r.w);
 }
+
+// One step of a brick (splat.wgsl, composite.wgsl; must match `SlabUniform` in gpu.rs): add
+// voxels sorted_in[first .. first + count] to the sheets of slabs first_slab ... last_slab,
+// then composite ring slot `slot`. A step is one bucket and the slabs it belongs to; the test
+// hook `Splat::slab_by_slab` makes it the paper's slab i (buckets i - r ... i + r into slab i
+// alone), the twin the ring must equal.
+struct Slab {
+    first: u32,
+    count: u32,
+    first_slab: u32,
+    last_slab: u32,
+    slot: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}

@@ -32,9 +32,9 @@ pub struct FrameUniform {
     pub pad: [f32; 2],
 }
 
-/// Must match `Slab` in `splat.wgsl` (and `composite.wgsl`): one step of a brick, at a dynamic
-/// offset per step — add the sorted voxels `first .. first + count` to the sheets of slabs
-/// `first_slab ..= last_slab`, then composite ring slot `slot`.
+/// Must match `Slab` in `frame.wgsl` (read by `splat.wgsl` and `composite.wgsl`): one step
+/// of a brick, at a dynamic offset per step — add the sorted voxels `first .. first + count`
+/// to the sheets of slabs `first_slab ..= last_slab`, then composite ring slot `slot`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SlabUniform {
@@ -59,7 +59,7 @@ pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
             kernel_radius, kernel_unit, density_scale, ese_alpha, kernel_radius_world,
             length_unit, pad
         }),
-        render_core::rust_layout!(SlabUniform => "splat.wgsl::Slab" {
+        render_core::rust_layout!(SlabUniform => "frame.wgsl::Slab" {
             first, count, first_slab, last_slab, slot, pad0, pad1, pad2
         }),
     ]

@@ -12,21 +12,6 @@
 // (value * footprint, footprint) in fixed point, so the sums are exact and independent of
 // the invocations' order.
 
-// One step of a brick: add voxels sorted_in[first .. first + count] to the sheets of slabs
-// first_slab ... last_slab, then composite ring slot `slot` (composite.wgsl). A step is one
-// bucket and the slabs it belongs to; the test hook `Splat::slab_by_slab` makes it the
-// paper's slab i (buckets i - r ... i + r into slab i alone), the twin the ring must equal.
-struct Slab {
-    first: u32,
-    count: u32,
-    first_slab: u32,
-    last_slab: u32,
-    slot: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-}
-
 // Sheet sums are stored as round(x * SHEET_ONE) in u32 (composite.wgsl divides back): a
 // footprint's sum over the voxels of one slab is about 1 (the kernels on the lattice sum to
 // 1, kernel.rs), far below the 2^32 / 2^24 = 256 that would wrap, and each term is rounded to
