@@ -26,30 +26,6 @@ impl From<Vec<f32>> for GridValues {
 }
 
 impl GridValues {
-    /// Non-negative `values` as levels of `max / 65535`: 0 stays 0 and any positive value
-    /// at least level 1, so the non-zero voxels are exactly those of `values`; the rest move
-    /// by at most half a step.
-    pub fn levels_of(values: &[f32]) -> GridValues {
-        let max = values
-            .par_iter()
-            .copied()
-            .fold(|| 0.0f32, f32::max)
-            .reduce(|| 0.0, f32::max);
-        let step = if max > 0.0 {
-            max / u16::MAX as f32
-        } else {
-            1.0
-        };
-        let levels = values
-            .par_iter()
-            .map(|&v| match v {
-                v if v <= 0.0 => 0,
-                v => ((v / step).round() as u16).max(1),
-            })
-            .collect();
-        GridValues::Levels { levels, step }
-    }
-
     pub fn len(&self) -> usize {
         match self {
             GridValues::F32(v) => v.len(),
@@ -89,14 +65,6 @@ impl GridValues {
     /// All values as f32 (a split mesh's point scalars).
     pub fn to_vec(&self) -> Vec<f32> {
         self.par_iter().collect()
-    }
-
-    /// Bytes held.
-    pub fn bytes(&self) -> usize {
-        match self {
-            GridValues::F32(v) => v.len() * 4,
-            GridValues::Levels { levels, .. } => levels.len() * 2,
-        }
     }
 }
 

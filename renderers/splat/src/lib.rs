@@ -527,6 +527,7 @@ impl Splat {
         // composited (their slot stayed empty). The test hook `slab_by_slab` takes the paper's
         // steps instead: slab t splats buckets t − r … t + r into its sheet alone.
         let drawn = geom.num_slabs.min(st.max_slabs);
+        let splat_ranges: Vec<_> = (0..drawn).map(|s| geom.splat_range(ends, s)).collect();
         let r = if self.slab_by_slab {
             0
         } else {
@@ -540,11 +541,11 @@ impl Splat {
                         geom.bucket_range(ends, t),
                         t.saturating_sub(r)..=(t + r).min(drawn - 1),
                     ),
-                    (true, true) => (geom.splat_range(ends, t), t..=t),
+                    (true, true) => (splat_ranges[t as usize].clone(), t..=t),
                 };
                 let composite = t
                     .checked_sub(r)
-                    .filter(|&s| s < drawn && !geom.splat_range(ends, s).is_empty());
+                    .filter(|&s| s < drawn && !splat_ranges[s as usize].is_empty());
                 let step = SlabUniform {
                     first: voxels.start,
                     count: voxels.len() as u32,
@@ -556,12 +557,9 @@ impl Splat {
                 (step, composite)
             })
             .collect();
-        for s in 0..drawn {
-            let range = geom.splat_range(ends, s);
-            if !range.is_empty() {
-                stats.slabs += 1;
-                stats.splats += range.len() as u64;
-            }
+        for range in splat_ranges.iter().filter(|r| !r.is_empty()) {
+            stats.slabs += 1;
+            stats.splats += range.len() as u64;
         }
         let uniforms: Vec<SlabUniform> = steps.iter().map(|(u, _)| *u).collect();
         if !uniforms.is_empty() {
