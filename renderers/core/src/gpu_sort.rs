@@ -64,8 +64,12 @@ fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     crate::bind::storage_entry(binding, wgpu::ShaderStages::COMPUTE, read_only)
 }
 
-fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    crate::bind::uniform_entry(binding, wgpu::ShaderStages::COMPUTE)
+/// The parameter block of a pass: read-only storage, not a uniform buffer, because lavapipe
+/// (Mesa 22.3) compiles a new shader with a uniform buffer's loop-steering values folded in
+/// each time its bind group is set again, and keeps each until the pipeline is dropped
+/// (docs/profile.md, "Uniform buffers on lavapipe").
+fn params_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    storage_entry(binding, true)
 }
 
 impl GpuRadixSort {
@@ -92,7 +96,7 @@ impl GpuRadixSort {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("radix sort"),
             entries: &[
-                uniform_entry(0),
+                params_entry(0),
                 storage_entry(1, true),
                 storage_entry(2, true),
                 storage_entry(3, false),
@@ -126,7 +130,7 @@ impl GpuRadixSort {
                 "radix sort params",
                 Lifetime::PerFrame,
                 PARAM_STRIDE * PASSES as u64,
-                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             )?,
             tmp_keys: ledger.buffer(
                 gpu,
@@ -359,7 +363,7 @@ impl GpuCentroidKeys {
     pub fn new(gpu: &Gpu, ledger: &mut MemoryLedger) -> anyhow::Result<GpuCentroidKeys> {
         let device = &gpu.device;
         let module = gpu.shader("gpu_sort.wgsl", include_str!("gpu_sort.wgsl"));
-        let uniform = uniform_entry(0);
+        let uniform = params_entry(0);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("centroid keys"),
             entries: &[
@@ -385,7 +389,7 @@ impl GpuCentroidKeys {
             "centroid key params",
             Lifetime::PerFrame,
             std::mem::size_of::<KeyParams>() as u64,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
         Ok(GpuCentroidKeys {
             device: gpu.device.clone(),

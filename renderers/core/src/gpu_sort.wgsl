@@ -26,7 +26,7 @@ const MAP_IN: u32 = 1u;
 const DESCENDING: u32 = 2u;
 const UNMAP_OUT: u32 = 4u;
 
-@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(0) var<storage, read> params: Params;
 @group(0) @binding(1) var<storage, read> keys_in: array<u32>;
 @group(0) @binding(2) var<storage, read> vals_in: array<u32>;
 @group(0) @binding(3) var<storage, read_write> keys_out: array<u32>;
@@ -201,7 +201,7 @@ struct KeyParams {
     pad: u32,
 }
 
-@group(1) @binding(0) var<uniform> kp: KeyParams;
+@group(1) @binding(0) var<storage, read> kp: KeyParams;
 @group(1) @binding(1) var<storage, read> key_points: array<f32>;
 @group(1) @binding(2) var<storage, read> key_prims: array<u32>;
 @group(1) @binding(3) var<storage, read_write> key_out: array<f32>;

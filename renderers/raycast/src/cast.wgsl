@@ -38,7 +38,7 @@ struct PassParams {
 @group(1) @binding(7) var<storage, read> tiles: array<TileRect>;
 // The tiles that still have active rays; workgroup z picks one.
 @group(1) @binding(8) var<storage, read> active_tiles: array<u32>;
-@group(1) @binding(9) var<uniform> pass_params: PassParams;
+@group(1) @binding(9) var<storage, read> pass_params: PassParams;
 
 // Linear interpolation coordinate as render_core::preintegration samples its tables.
 fn axis(x: f32, n: u32) -> vec2<f32> {

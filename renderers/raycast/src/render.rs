@@ -262,7 +262,8 @@ impl Renderer for Raycast {
         render_core::bind::check_storage_bindings(
             gpu,
             &format!("raycast on {} ({} mesh bindings)", gpu.adapter.name, slots),
-            (slots + 6) as u32,
+            // Group 0: the frame and the mesh; group 1: the traversal's nine buffers.
+            (1 + slots + 9) as u32,
         )?;
         let mut ledger = MemoryLedger::default();
         let storage = wgpu::BufferUsages::STORAGE;
@@ -331,7 +332,7 @@ impl Renderer for Raycast {
             "raycast frame params",
             Lifetime::PerFrame,
             std::mem::size_of::<FrameParams>() as u64,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
         let pipes = Pipelines::new(gpu, slots);
         let mut entries = vec![render_core::bind::whole(0, &frame_params)];

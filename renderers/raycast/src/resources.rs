@@ -77,7 +77,6 @@ fn uint_texture_entry(binding: u32, dim: wgpu::TextureViewDimension) -> wgpu::Bi
 
 const RO: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: true };
 const RW: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: false };
-const UNIFORM: wgpu::BufferBindingType = wgpu::BufferBindingType::Uniform;
 
 pub const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -98,9 +97,15 @@ pub struct Pipelines {
 
 impl Pipelines {
     /// Layouts and pipelines for a mesh in `slots` storage bindings.
+    ///
+    /// The frame's and the pass's parameters are read-only storage buffers, not uniform
+    /// buffers: lavapipe (Mesa 22.3) compiles a new shader with the branch-steering values of
+    /// a uniform buffer folded in each time its bind group is set again (every pass here) and
+    /// keeps each until the pipeline is dropped (docs/profile.md, "Uniform buffers on
+    /// lavapipe").
     pub fn new(gpu: &Gpu, slots: usize) -> Pipelines {
         let dev = &gpu.device;
-        let mut mesh_entries = vec![buffer_entry(0, UNIFORM, false)];
+        let mut mesh_entries = vec![buffer_entry(0, RO, false)];
         mesh_entries.extend((1..=slots as u32).map(|b| buffer_entry(b, RO, false)));
         let mesh_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("raycast frame + mesh"),
@@ -122,7 +127,7 @@ impl Pipelines {
                 buffer_entry(6, RW, false),
                 buffer_entry(7, RO, false),
                 buffer_entry(8, RO, false),
-                buffer_entry(9, UNIFORM, false),
+                buffer_entry(9, RO, false),
             ],
         });
         let probe_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -301,18 +306,12 @@ impl Target {
             MAX_TILES as u64 * 4,
             storage,
         )?;
-        let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        let params = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         let pass_flags: Vec<wgpu::Buffer> = (0..2u32)
             .map(|c| {
                 let mut bytes = [0u8; 16];
                 bytes[..4].copy_from_slice(&c.to_le_bytes());
-                ledger.buffer_init(
-                    gpu,
-                    "raycast pass flag",
-                    Lifetime::PerFrame,
-                    &bytes,
-                    uniform,
-                )
+                ledger.buffer_init(gpu, "raycast pass flag", Lifetime::PerFrame, &bytes, params)
             })
             .collect::<anyhow::Result<_>>()?;
         let size = wgpu::Extent3d {

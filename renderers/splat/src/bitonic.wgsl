@@ -20,7 +20,7 @@ struct Stage {
     pad: u32,
 }
 
-@group(0) @binding(0) var<uniform> st: Stage;
+@group(0) @binding(0) var<storage, read> st: Stage;
 @group(0) @binding(1) var<storage, read_write> keys: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> vals: array<vec4<u32>>;
 

@@ -9,10 +9,10 @@
 // 1 / SHEET_ONE (splat.wgsl).
 const SHEET_UNIT: f32 = 1.0 / 16777216.0;
 
-@group(0) @binding(0) var<uniform> fr: Frame;
+@group(0) @binding(0) var<storage, read> fr: Frame;
 @group(0) @binding(1) var<storage, read_write> sheet: array<u32>;
 @group(0) @binding(2) var<storage, read> tf: array<vec4<f32>>;
-@group(1) @binding(0) var<uniform> slab: Slab;
+@group(1) @binding(0) var<storage, read> slab: Slab;
 
 @vertex
 fn fullscreen_vs(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {

@@ -1,7 +1,7 @@
 // Per-brick GPU bucket construction (Grau & Tost §3.3-3.5): view transform -> (sort, in
 // bitonic.wgsl or render-core's radix sort) -> gather into depth order -> bucket boundaries.
 
-@group(0) @binding(0) var<uniform> fr: Frame;
+@group(0) @binding(0) var<storage, read> fr: Frame;
 @group(0) @binding(1) var<storage, read> voxels: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> keys: array<f32>;
 @group(0) @binding(3) var<storage, read_write> vals: array<u32>;

@@ -83,15 +83,6 @@ pub struct Pipelines {
     pub composite: wgpu::RenderPipeline,
 }
 
-fn uniform(binding: u32, vis: wgpu::ShaderStages, dynamic: bool) -> wgpu::BindGroupLayoutEntry {
-    let e = bind::uniform_entry(binding, vis);
-    if dynamic {
-        bind::with_dynamic_offset(e)
-    } else {
-        e
-    }
-}
-
 fn float_texture(binding: u32, stage: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     bind::texture_entry(binding, stage, false, wgpu::TextureViewDimension::D2)
 }
@@ -101,6 +92,13 @@ fn with_frame(body: &str) -> String {
 }
 
 impl Pipelines {
+    /// Every parameter block (frame, step, bitonic stage) is a read-only storage buffer, not a
+    /// uniform buffer: lavapipe (Mesa 22.3) keeps about 64 KB for every dispatch that sets a
+    /// bind group holding a uniform buffer again, and frees none of it while the device lives
+    /// (heaptrack; the mechanism inside the driver is not known). With one pass per step the
+    /// memory grew with every frame (Teapot, GPU buckets, 256²: 529 MB after one frame, 734 MB
+    /// after five, 920 MB after nine; 488 and 495 MB after one and five with storage buffers).
+    /// The images are bit for bit the same (docs/profile.md, "Uniform buffers on lavapipe").
     pub fn new(gpu: &Gpu) -> Pipelines {
         let d = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
@@ -119,7 +117,7 @@ impl Pipelines {
         let compute_layout = layout(
             "splat buckets",
             &[
-                uniform(0, c, false),
+                storage(0, c, true),
                 storage(1, c, true),
                 storage(2, c, false),
                 storage(3, c, false),
@@ -145,7 +143,7 @@ impl Pipelines {
         let bitonic_layout = layout(
             "splat bitonic",
             &[
-                uniform(0, c, true),
+                bind::with_dynamic_offset(storage(0, c, true)),
                 storage(1, c, false),
                 storage(2, c, false),
             ],
@@ -174,7 +172,7 @@ impl Pipelines {
         let splat_layout = layout(
             "splat sheet",
             &[
-                uniform(0, c, false),
+                storage(0, c, true),
                 storage(1, c, true),
                 storage(2, c, true),
                 float_texture(3, c),
@@ -186,7 +184,11 @@ impl Pipelines {
         // The step: the splat pass reads its bucket, the composite its ring slot.
         let slab_layout = layout(
             "splat slab",
-            &[uniform(0, c | wgpu::ShaderStages::FRAGMENT, true)],
+            &[bind::with_dynamic_offset(storage(
+                0,
+                c | wgpu::ShaderStages::FRAGMENT,
+                true,
+            ))],
         );
         let splat_module = gpu.shader("splat splat.wgsl", &with_frame(include_str!("splat.wgsl")));
         let splat = gpu.compute_pipeline(
@@ -202,7 +204,7 @@ impl Pipelines {
         let composite_layout = layout(
             "splat composite",
             &[
-                uniform(0, wgpu::ShaderStages::FRAGMENT, false),
+                storage(0, wgpu::ShaderStages::FRAGMENT, true),
                 storage(1, wgpu::ShaderStages::FRAGMENT, false),
                 storage(2, wgpu::ShaderStages::FRAGMENT, true),
             ],

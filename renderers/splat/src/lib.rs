@@ -738,14 +738,14 @@ impl Splat {
             "splat slab steps",
             Lifetime::PerFrame,
             (max_slabs + table.radius_slabs) as u64 * UNIFORM_STRIDE,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
         let frame_buf = ledger.buffer(
             gpu,
             "splat frame",
             Lifetime::PerFrame,
             std::mem::size_of::<FrameUniform>() as u64,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
         let largest = set.largest_brick().max(1);
         let padded_max = match (s.buckets, s.sort) {
@@ -758,7 +758,7 @@ impl Splat {
             "splat bitonic stages",
             Lifetime::PerFrame,
             stages as u64 * UNIFORM_STRIDE,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
         let gpu_side = s.buckets == Buckets::Gpu;
         let key_len = if gpu_side { padded_max } else { 1 } as u64;

@@ -18,7 +18,7 @@
 // 6e-8.
 const SHEET_ONE: f32 = 16777216.0;
 
-@group(0) @binding(0) var<uniform> fr: Frame;
+@group(0) @binding(0) var<storage, read> fr: Frame;
 @group(0) @binding(1) var<storage, read> sorted_in: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> table: array<f32>;
 @group(0) @binding(3) var image_tex: texture_2d<f32>;
@@ -27,7 +27,7 @@ const SHEET_ONE: f32 = 16777216.0;
 // Per pixel and ring slot (sum value * w, sum w): pixels row-major, y down, each pixel's
 // 2r + 1 slots together (one cache line for r = 2).
 @group(0) @binding(5) var<storage, read_write> sheet: array<atomic<u32>>;
-@group(1) @binding(0) var<uniform> slab: Slab;
+@group(1) @binding(0) var<storage, read> slab: Slab;
 
 // Where a voxel's footprint is looked up this slab: the first of the two slice rows its
 // offset from the slab falls between (kernel.rs, FootprintTable::bordered) and the weight of
