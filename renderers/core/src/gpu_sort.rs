@@ -65,9 +65,9 @@ fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
 }
 
 /// The parameter block of a pass: read-only storage, not a uniform buffer, because lavapipe
-/// (Mesa 22.3) compiles a new shader with a uniform buffer's loop-steering values folded in
-/// each time its bind group is set again, and keeps each until the pipeline is dropped
-/// (docs/profile.md, "Uniform buffers on lavapipe").
+/// (Mesa 22.3) keeps memory for every dispatch that sets a bind group holding a uniform buffer
+/// again and frees none of it while the device lives (docs/profile.md, "Uniform buffers on
+/// lavapipe").
 fn params_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     storage_entry(binding, true)
 }
