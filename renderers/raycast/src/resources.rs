@@ -99,10 +99,9 @@ impl Pipelines {
     /// Layouts and pipelines for a mesh in `slots` storage bindings.
     ///
     /// The frame's and the pass's parameters are read-only storage buffers, not uniform
-    /// buffers: lavapipe (Mesa 22.3) compiles a new shader with the branch-steering values of
-    /// a uniform buffer folded in each time its bind group is set again (every pass here) and
-    /// keeps each until the pipeline is dropped (docs/profile.md, "Uniform buffers on
-    /// lavapipe").
+    /// buffers: lavapipe (Mesa 22.3) keeps memory for every pass that sets a bind group holding
+    /// a uniform buffer again and frees none of it while the device lives (docs/profile.md,
+    /// "Uniform buffers on lavapipe").
     pub fn new(gpu: &Gpu, slots: usize) -> Pipelines {
         let dev = &gpu.device;
         let mut mesh_entries = vec![buffer_entry(0, RO, false)];
