@@ -426,12 +426,13 @@ mod tests {
     }
 }
 
-/// Uniform entries addressed with dynamic offsets are this far apart (the largest
-/// `min_uniform_buffer_offset_alignment` wgpu allows).
+/// Uniform or storage entries addressed with dynamic offsets are this far apart (the largest
+/// `min_uniform_buffer_offset_alignment` and `min_storage_buffer_offset_alignment` wgpu
+/// allows).
 pub const UNIFORM_STRIDE: u64 = 256;
 
-/// `items` laid out one every [`UNIFORM_STRIDE`] bytes: the contents of a uniform buffer whose
-/// entry `i` is bound at dynamic offset `i × UNIFORM_STRIDE`.
+/// `items` laid out one every [`UNIFORM_STRIDE`] bytes: the contents of a uniform or storage
+/// buffer whose entry `i` is bound at dynamic offset `i × UNIFORM_STRIDE`.
 pub fn strided_uniforms<T: bytemuck::Pod>(items: &[T]) -> Vec<u8> {
     let stride = UNIFORM_STRIDE as usize;
     assert!(

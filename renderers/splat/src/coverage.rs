@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use render_core::Camera;
 
 use crate::buckets::{depth, SlabGeometry};
-use crate::gpu::FrameUniform;
+use crate::gpu::FrameParams;
 use crate::Splat;
 
 /// How far (pixels) an edge may move between this twin and the GPU: f32 round-off of the
@@ -63,7 +63,7 @@ pub struct QuadParams {
 }
 
 impl QuadParams {
-    pub(crate) fn of(u: &FrameUniform) -> QuadParams {
+    pub(crate) fn of(u: &FrameParams) -> QuadParams {
         QuadParams {
             view_proj: u.view_proj,
             depth_row: u.depth_row,
@@ -195,7 +195,7 @@ impl Splat {
     pub fn centres_outside(&self, camera: &Camera, rect: [u32; 4]) -> anyhow::Result<u64> {
         let st = self.state.as_ref().context("splat: prepare first")?;
         let geom = self.geometry(st, camera);
-        let quad = QuadParams::of(&self.frame_uniform(camera, &geom, 0));
+        let quad = QuadParams::of(&self.frame_params(camera, &geom, 0));
         Ok(centres_outside(&quad, &st.set.voxels, rect))
     }
 
@@ -204,7 +204,7 @@ impl Splat {
     pub fn fragment_count(&mut self, camera: &Camera) -> anyhow::Result<FragmentCount> {
         let st = self.state.as_ref().context("splat: prepare first")?;
         let geom = self.geometry(st, camera);
-        let quad = QuadParams::of(&self.frame_uniform(camera, &geom, 0));
+        let quad = QuadParams::of(&self.frame_params(camera, &geom, 0));
         if let Some((q, g, c)) = &self.coverage {
             if *q == quad && *g == geom {
                 return Ok(*c);

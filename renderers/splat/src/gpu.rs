@@ -1,4 +1,4 @@
-//! Pipelines, bind group layouts and the per-frame uniform of the splatter.
+//! Pipelines, bind group layouts and the per-frame parameters of the splatter.
 
 use render_core::bind::{self, storage_entry as storage};
 use render_core::Gpu;
@@ -6,7 +6,7 @@ use render_core::Gpu;
 /// Must match `Frame` in `frame.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct FrameUniform {
+pub struct FrameParams {
     pub view_proj: [[f32; 4]; 4],
     pub depth_row: [f32; 4],
     pub viewport: [f32; 2],
@@ -37,7 +37,7 @@ pub struct FrameUniform {
 /// to the sheets of slabs `first_slab ..= last_slab`, then composite ring slot `slot`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct SlabUniform {
+pub struct SlabParams {
     pub first: u32,
     pub count: u32,
     pub first_slab: u32,
@@ -53,13 +53,13 @@ pub struct SlabUniform {
 #[doc(hidden)]
 pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
     vec![
-        render_core::rust_layout!(FrameUniform => "frame.wgsl::Frame" {
+        render_core::rust_layout!(FrameParams => "frame.wgsl::Frame" {
             view_proj, depth_row, viewport, tan_half, focal_px, perspective, d0, inv_delta,
             delta_world, num_slabs, n, padded, radius_slabs, subslices, footprint, tf_entries,
             kernel_radius, kernel_unit, density_scale, ese_alpha, kernel_radius_world,
             length_unit, pad
         }),
-        render_core::rust_layout!(SlabUniform => "frame.wgsl::Slab" {
+        render_core::rust_layout!(SlabParams => "frame.wgsl::Slab" {
             first, count, first_slab, last_slab, slot, pad0, pad1, pad2
         }),
     ]
@@ -270,8 +270,8 @@ pub enum BitonicStep {
 }
 
 impl BitonicStep {
-    /// The `Stage` uniform (k, j, n, 0); a narrow step's j is 0.
-    pub fn uniform(self, n: u32) -> [u32; 4] {
+    /// The `Stage` block (k, j, n, 0); a narrow step's j is 0.
+    pub fn params(self, n: u32) -> [u32; 4] {
         match self {
             BitonicStep::Double { k, j } | BitonicStep::Wide { k, j } => [k, j, n, 0],
             BitonicStep::Narrow { k } => [k, 0, n, 0],

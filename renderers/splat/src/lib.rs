@@ -52,7 +52,7 @@ use render_core::{
 pub use buckets::{bucket_ends, depth, SlabGeometry};
 use coverage::{FragmentCount, QuadParams};
 pub use description::{from_settings, DESCRIPTION};
-use gpu::{FrameUniform, Pipelines, SlabUniform, IMAGE_FORMAT};
+use gpu::{FrameParams, Pipelines, SlabParams, IMAGE_FORMAT};
 use kernel::{FootprintTable, Kernel, SIGMA};
 use render_core::bind::{strided_uniforms, UNIFORM_STRIDE};
 use voxels::VoxelSet;
@@ -307,7 +307,7 @@ impl Splat {
                     GpuSort::Bitonic => {
                         let steps = gpu::bitonic_steps(padded);
                         let params: Vec<[u32; 4]> =
-                            steps.iter().map(|step| step.uniform(padded)).collect();
+                            steps.iter().map(|step| step.params(padded)).collect();
                         gpu.queue
                             .write_buffer(&st.bitonic_buf, 0, &strided_uniforms(&params));
                         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -400,13 +400,13 @@ impl Splat {
     }
 
     fn write_frame(&self, gpu: &Gpu, camera: &Camera, geom: &SlabGeometry, brick: usize) {
-        let u = self.frame_uniform(camera, geom, brick);
+        let u = self.frame_params(camera, geom, brick);
         let st = self.state.as_ref().unwrap();
         gpu.queue
             .write_buffer(&st.frame_buf, 0, bytemuck::bytes_of(&u));
     }
 
-    fn frame_uniform(&self, camera: &Camera, geom: &SlabGeometry, brick: usize) -> FrameUniform {
+    fn frame_params(&self, camera: &Camera, geom: &SlabGeometry, brick: usize) -> FrameParams {
         let st = self.state.as_ref().unwrap();
         let n = st.set.bricks.get(brick).map_or(0, |b| b.range.len()) as u32;
         let padded = match (self.settings.buckets, self.settings.sort) {
@@ -424,7 +424,7 @@ impl Splat {
             }
         };
         let unit = st.set.kernel_unit;
-        FrameUniform {
+        FrameParams {
             view_proj: camera.view_proj_f32(),
             depth_row: depth_row(camera),
             viewport: [w as f32, h as f32],
@@ -533,7 +533,7 @@ impl Splat {
         } else {
             geom.radius_slabs
         };
-        let steps: Vec<(SlabUniform, Option<u32>)> = (0..drawn + r)
+        let steps: Vec<(SlabParams, Option<u32>)> = (0..drawn + r)
             .map(|t| {
                 let (voxels, slabs) = match (t < drawn, self.slab_by_slab) {
                     (false, _) => (0..0, 0..=0),
@@ -546,7 +546,7 @@ impl Splat {
                 let composite = t
                     .checked_sub(r)
                     .filter(|&s| s < drawn && !splat_ranges[s as usize].is_empty());
-                let step = SlabUniform {
+                let step = SlabParams {
                     first: voxels.start,
                     count: voxels.len() as u32,
                     first_slab: *slabs.start(),
@@ -561,10 +561,10 @@ impl Splat {
             stats.slabs += 1;
             stats.splats += range.len() as u64;
         }
-        let uniforms: Vec<SlabUniform> = steps.iter().map(|(u, _)| *u).collect();
-        if !uniforms.is_empty() {
+        let params: Vec<SlabParams> = steps.iter().map(|(u, _)| *u).collect();
+        if !params.is_empty() {
             gpu.queue
-                .write_buffer(&st.slab_buf, 0, &strided_uniforms(&uniforms));
+                .write_buffer(&st.slab_buf, 0, &strided_uniforms(&params));
         }
         let splat_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("splat sheet"),
@@ -589,7 +589,7 @@ impl Splat {
                 resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                     buffer: &st.slab_buf,
                     offset: 0,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<SlabUniform>() as u64),
+                    size: wgpu::BufferSize::new(std::mem::size_of::<SlabParams>() as u64),
                 }),
             }],
         });
@@ -744,7 +744,7 @@ impl Splat {
             gpu,
             "splat frame",
             Lifetime::PerFrame,
-            std::mem::size_of::<FrameUniform>() as u64,
+            std::mem::size_of::<FrameParams>() as u64,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
         let largest = set.largest_brick().max(1);
