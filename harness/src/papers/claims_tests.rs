@@ -390,3 +390,44 @@ fn peers_have_no_cpu_gpu_split_in_havs_table5() {
         .contains("no CPU/GPU split"));
     assert_eq!(pt.cells[2].ours, Some(300.0), "total ms of a peer");
 }
+
+#[test]
+fn quick_plans_run_a_subset_of_the_full_variants_and_every_variant_a_claim_names() {
+    use crate::algorithms::{selected_settings, SettingsFilter};
+    let all = claims::all().unwrap();
+    let mut narrowed = 0;
+    for module in PAPERS.iter() {
+        let p = module.paper();
+        for spec in module.plan() {
+            if spec.quick_settings.is_none() {
+                continue;
+            }
+            narrowed += 1;
+            let filter = |quick: bool| {
+                SettingsFilter::parse(spec.settings_for(quick).map_or("", |s| s.as_str())).unwrap()
+            };
+            for alg in &spec.algorithms {
+                let full = selected_settings(alg, &filter(false)).unwrap();
+                let quick = selected_settings(alg, &filter(true)).unwrap();
+                assert!(quick.len() < full.len(), "{}: quick run of {alg}", p.id);
+                for q in &quick {
+                    assert!(full.contains(q), "{}: {q} is not a full-mode variant", p.id);
+                }
+                let named = all
+                    .iter()
+                    .filter(|c| c.paper == p.id)
+                    .flat_map(|c| [Some(&c.a), c.b.as_ref()].into_iter().flatten())
+                    .filter(|v| &v.algorithm == alg);
+                for v in named {
+                    assert!(
+                        quick.iter().any(|q| q.includes(&v.settings)),
+                        "{}: the quick run of {alg} lacks {}",
+                        p.id,
+                        v.settings_text()
+                    );
+                }
+            }
+        }
+    }
+    assert!(narrowed > 0, "no plan narrows its quick run");
+}

@@ -29,8 +29,9 @@ use crate::results::machine::MachineInfo;
 pub struct Args {
     /// `havs`, `gator`, `fragment-pt`, `raycast`, `splat` or `all`.
     pub paper: String,
-    /// Fewer viewpoints and frames, no reference images: minutes on a 2-core machine without
-    /// a GPU. The report says what was shrunk.
+    /// Fewer viewpoints and frames, no reference images, only the variants the paper's tables
+    /// and claims compare: minutes on a 2-core machine without a GPU. The report says what
+    /// was shrunk.
     #[arg(long)]
     pub quick: bool,
     /// Output directory; each paper writes OUT/<paper>/ (replaced).
@@ -323,7 +324,7 @@ pub(crate) fn write_report(
         )
     } else if session.quick {
         format!(
-            "**Quick mode**: viewpoint(s) {QUICK_VIEWPOINTS} instead of the paper's, the viewport side divided by {QUICK_RESOLUTION_DIVISOR} (e.g. 256² for the papers' 512²), {QUICK_FRAMES} timed frame after {QUICK_WARMUP} warm-up, no reference images (no PSNR); data sets at the papers' sizes. Figures are indicative only."
+            "**Quick mode**: viewpoint(s) {QUICK_VIEWPOINTS} instead of the paper's, the viewport side divided by {QUICK_RESOLUTION_DIVISOR} (e.g. 256² for the papers' 512²), {QUICK_FRAMES} timed frame after {QUICK_WARMUP} warm-up, no reference images (no PSNR); data sets at the papers' sizes; only the variants the paper's tables and claims compare where a plan adds others (each run's settings are under Runs). Figures are indicative only."
         )
     } else {
         format!(

@@ -53,6 +53,19 @@ pub struct RunSpec {
     /// The transfer function (a preset name); `None` is the suite's `low-opacity`.
     pub tf: Option<&'static str>,
     pub settings: Option<String>,
+    /// The quick run's settings where they differ from `settings`: only the variants the
+    /// paper's tables and claims compare; the others beside them run in the full mode.
+    pub quick_settings: Option<String>,
+}
+
+impl RunSpec {
+    /// The settings of the run in this mode.
+    pub fn settings_for(&self, quick: bool) -> Option<&String> {
+        match (&self.quick_settings, quick) {
+            (Some(q), true) => Some(q),
+            _ => self.settings.as_ref(),
+        }
+    }
 }
 
 /// The quick mode's viewpoint (one diagonal of the 14), frames and warm-up.
@@ -229,7 +242,7 @@ impl Session {
             } else {
                 FULL_WARMUP
             }),
-            settings: spec.settings.clone(),
+            settings: spec.settings_for(self.quick).cloned(),
             no_reference: self.quick,
             cache_dir: self.cache_dir.clone(),
             external: self.external.clone(),
@@ -242,8 +255,7 @@ impl Session {
             datasets.join(","),
             self.resolution(spec.resolution),
             spec.tf.map(|t| format!(" --tf {t}")).unwrap_or_default(),
-            spec.settings
-                .as_ref()
+            spec.settings_for(self.quick)
                 .map(|s| format!(" --settings '{s}'"))
                 .unwrap_or_default(),
             if self.quick {

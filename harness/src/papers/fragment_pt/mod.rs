@@ -74,6 +74,7 @@ impl PaperModule for FragmentPt {
             resolution: 512,
             tf: None,
             settings: Some(FRAGMENT_SETTINGS.into()),
+            quick_settings: None,
         }];
         for (label, alg, settings) in TABLE2.iter().skip(1) {
             let Some(alg) = alg else { continue };
@@ -85,6 +86,7 @@ impl PaperModule for FragmentPt {
                 resolution: 512,
                 tf: None,
                 settings: (!settings.is_empty()).then(|| settings.to_string()),
+                quick_settings: None,
             });
         }
         plan

@@ -157,6 +157,7 @@ impl PaperModule for Gator {
             resolution: 512,
             tf: None,
             settings: Some("variant=constant|linear".into()),
+            quick_settings: None,
         }]
     }
 

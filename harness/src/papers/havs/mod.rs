@@ -70,6 +70,7 @@ impl PaperModule for Havs {
             resolution: 512,
             tf: None,
             settings: Some(HAVS_SETTINGS.into()),
+            quick_settings: None,
         }];
         // Table 5's other rows.
         for (label, alg, settings) in TABLE5_ALGORITHMS.iter().skip(1) {
@@ -81,6 +82,7 @@ impl PaperModule for Havs {
                 resolution: 512,
                 tf: None,
                 settings: settings.map(String::from),
+                quick_settings: None,
             });
         }
         plan

@@ -52,6 +52,7 @@ impl PaperModule for Raycast {
                 "tiles={};table=2d|3d;mode=passes;et=on",
                 TILINGS.join("|")
             )),
+            quick_settings: None,
         }]
     }
 
