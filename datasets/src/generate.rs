@@ -273,6 +273,33 @@ impl FieldEval {
         self.field.name()
     }
 
+    /// The blob field sampled on the lattice `origin + i·h` (`dims` points per axis), where a
+    /// sample costs a few multiplications: each blob's Gaussian is the product of one factor
+    /// per axis, computed once per grid line. Equal to [`FieldEval::eval`] at the lattice points
+    /// up to rounding (the product of three `exp` against one `exp` of the sum). `None` for
+    /// the other fields.
+    pub fn on_lattice(&self, dims: [usize; 3], origin: [f64; 3], h: [f64; 3]) -> Option<Lattice> {
+        if self.field != Field::Blobs {
+            return None;
+        }
+        let factors = std::array::from_fn(|a| {
+            self.blobs
+                .iter()
+                .flat_map(|b| {
+                    (0..dims[a]).map(move |i| {
+                        let d = origin[a] + i as f64 * h[a] - b.center[a];
+                        (-d * d * b.inv_two_sigma2).exp()
+                    })
+                })
+                .collect()
+        });
+        Some(Lattice {
+            dims,
+            amplitudes: self.blobs.iter().map(|b| b.amplitude).collect(),
+            factors,
+        })
+    }
+
     pub fn eval(&self, p: [f64; 3]) -> f64 {
         let [x, y, z] = p;
         match self.field {
@@ -295,6 +322,27 @@ impl FieldEval {
             Field::Radial => (x * x + y * y + z * z).sqrt(),
             Field::Linear => 0.3 + 0.5 * x - 0.25 * y + 0.125 * z,
         }
+    }
+}
+
+/// The blob field on a lattice ([`FieldEval::on_lattice`]).
+pub struct Lattice {
+    dims: [usize; 3],
+    amplitudes: Vec<f64>,
+    /// Per axis, blob-major: `factors[a][b * dims[a] + i]`.
+    factors: [Vec<f64>; 3],
+}
+
+impl Lattice {
+    /// The field at lattice point (i, j, k).
+    pub fn at(&self, [i, j, k]: [usize; 3]) -> f64 {
+        let [nx, ny, nz] = self.dims;
+        let [fx, fy, fz] = &self.factors;
+        self.amplitudes
+            .iter()
+            .enumerate()
+            .map(|(b, amp)| amp * fx[b * nx + i] * fy[b * ny + j] * fz[b * nz + k])
+            .sum()
     }
 }
 
@@ -684,6 +732,28 @@ fn hex_six_tets(v: [u32; 8], out: &mut Vec<[u32; 4]>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn blob_lattice_agrees_with_the_field_at_every_point() {
+        let field = FieldEval::new(Field::Blobs, 11);
+        let (dims, origin, h) = ([7, 5, 9], [-1.0, -0.8, -1.2], [0.3, 0.4, 0.27]);
+        let lattice = field.on_lattice(dims, origin, h).unwrap();
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let p = std::array::from_fn(|a| origin[a] + [i, j, k][a] as f64 * h[a]);
+                    let (want, got) = (field.eval(p), lattice.at([i, j, k]));
+                    assert!(
+                        (want - got).abs() <= 1e-12 * want.max(1e-300),
+                        "{want} {got}"
+                    );
+                }
+            }
+        }
+        assert!(FieldEval::new(Field::Radial, 11)
+            .on_lattice(dims, origin, h)
+            .is_none());
+    }
 
     #[test]
     fn sizes_and_specs_parse() {

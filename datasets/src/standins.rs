@@ -644,6 +644,10 @@ pub fn splat_volume(dims: [usize; 3], effective: usize, seed: u64) -> VoxelGrid 
     let h: [f64; 3] = std::array::from_fn(|a| 2.0 / (dims[a].max(2) - 1) as f64);
     // Levels of a step the field cannot exceed, at least 1: 0 is kept for "empty".
     let step = field.upper_bound().unwrap_or(1.0).max(f64::MIN_POSITIVE) / u16::MAX as f64;
+    // Sampled separably: eight exp per point were most of StagBeetle's generation.
+    let lattice = field
+        .on_lattice(dims, [-1.0; 3], h)
+        .expect("the blob field is separable");
     let mut levels: Vec<u16> = (0..n)
         .into_par_iter()
         .map(|g| {
@@ -652,8 +656,7 @@ pub fn splat_volume(dims: [usize; 3], effective: usize, seed: u64) -> VoxelGrid 
                 (g / dims[0]) % dims[1],
                 g / (dims[0] * dims[1]),
             ];
-            let p = std::array::from_fn(|a| -1.0 + ijk[a] as f64 * h[a]);
-            (field.eval(p) / step).round().clamp(1.0, u16::MAX as f64) as u16
+            (lattice.at(ijk) / step).round().clamp(1.0, u16::MAX as f64) as u16
         })
         .collect();
     let effective = effective.min(n);
