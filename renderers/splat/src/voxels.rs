@@ -5,7 +5,7 @@
 //! storage binding — the volume is split into octants, each brick drawn on its own in
 //! camera order).
 
-use datasets::{TetMesh, VoxelGrid, VoxelVolume};
+use datasets::{GridValues, TetMesh, VoxelGrid, VoxelVolume};
 use rayon::prelude::*;
 use render_core::Optics;
 
@@ -120,12 +120,28 @@ impl VoxelSet {
         brick_cap: usize,
     ) -> VoxelSet {
         let tf = &optics.tf;
+        // The normalised value of a grid value, if its κ is > 0.
+        let classify = |v: f32| {
+            let s = optics.normalise(v as f64);
+            (tf.kappa_at(s) > 0.0).then_some(s as f32)
+        };
+        // A grid of 16-bit levels has at most 2^16 values: each is classified once, not once
+        // per point (StagBeetle: 342 M points).
+        let per_level: Option<Vec<Option<f32>>> = match &g.values {
+            GridValues::Levels { step, .. } => {
+                Some((0..=u16::MAX).map(|l| classify(l as f32 * step)).collect())
+            }
+            GridValues::F32(_) => None,
+        };
         // κ first: on a large volume most points are empty, and `inside` may cost more.
         let mut chosen: Vec<(f32, u32)> = (0..g.num_voxels())
             .into_par_iter()
             .filter_map(|i| {
-                let s = optics.normalise(g.values.get(i) as f64);
-                (tf.kappa_at(s) > 0.0 && inside(i)).then_some((s as f32, i as u32))
+                let s = match (&per_level, &g.values) {
+                    (Some(table), GridValues::Levels { levels, .. }) => table[levels[i] as usize],
+                    _ => classify(g.values.get(i)),
+                }?;
+                inside(i).then_some((s, i as u32))
             })
             .collect();
         // The paper's list of relevant voxels sorted by value (ties by grid index).
