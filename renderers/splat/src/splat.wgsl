@@ -19,6 +19,10 @@
 const SHEET_ONE: f32 = 16777216.0;
 
 @group(0) @binding(0) var<storage, read> fr: Frame;
+// The invocation's copy of the frame block, read once at its start: with `fr` read in the
+// pixel loop, among the atomics on `sheet`, Teapot and Engine (CPU buckets, 256²) took
+// 10-20 % longer a frame (docs/profile.md, "Uniform buffers on lavapipe").
+var<private> frame: Frame;
 @group(0) @binding(1) var<storage, read> sorted_in: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> table: array<f32>;
 @group(0) @binding(3) var image_tex: texture_2d<f32>;
@@ -38,10 +42,10 @@ struct Slices {
 }
 
 fn slices_of(delta: f32) -> Slices {
-    let rows = (2u * fr.radius_slabs + 1u) * fr.subslices + 1u;
-    let qf = clamp((delta + f32(fr.radius_slabs)) * f32(fr.subslices), 0.0, f32(rows - 1u));
+    let rows = (2u * frame.radius_slabs + 1u) * frame.subslices + 1u;
+    let qf = clamp((delta + f32(frame.radius_slabs)) * f32(frame.subslices), 0.0, f32(rows - 1u));
     let q0 = min(u32(floor(qf)), rows - 2u);
-    let side = fr.footprint + 2u;
+    let side = frame.footprint + 2u;
     return Slices(q0 * side * side, qf - f32(q0));
 }
 
@@ -59,18 +63,18 @@ struct Cell {
 }
 
 fn cell_of(kxy: vec2<f32>) -> Cell {
-    let f = f32(fr.footprint);
-    let u = clamp((kxy.x + fr.kernel_radius) / (2.0 * fr.kernel_radius) * f - 0.5, -1.0, f - 0.5);
-    let v = clamp((kxy.y + fr.kernel_radius) / (2.0 * fr.kernel_radius) * f - 0.5, -1.0, f - 0.5);
+    let f = f32(frame.footprint);
+    let u = clamp((kxy.x + frame.kernel_radius) / (2.0 * frame.kernel_radius) * f - 0.5, -1.0, f - 0.5);
+    let v = clamp((kxy.y + frame.kernel_radius) / (2.0 * frame.kernel_radius) * f - 0.5, -1.0, f - 0.5);
     let x0 = floor(u);
     let y0 = floor(v);
-    let side = fr.footprint + 2u;
+    let side = frame.footprint + 2u;
     return Cell(u32(y0 + 1.0) * side + u32(x0 + 1.0), u - x0, v - y0);
 }
 
 // The footprint of one slab: linear between its two slice rows.
 fn footprint(sl: Slices, c: Cell) -> f32 {
-    let side = fr.footprint + 2u;
+    let side = frame.footprint + 2u;
     let i = sl.base + c.at;
     return mix(bilinear(i, side, c.fx, c.fy), bilinear(i + side * side, side, c.fx, c.fy), sl.fq);
 }
@@ -86,41 +90,42 @@ fn splat_cs(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups
     if (i >= slab.count) {
         return;
     }
+    frame = fr;
     let v = sorted_in[slab.first + i];
-    let d = view_depth(fr, v.xyz);
-    let clip = fr.view_proj * vec4<f32>(v.xyz, 1.0);
+    let d = view_depth(frame, v.xyz);
+    let clip = frame.view_proj * vec4<f32>(v.xyz, 1.0);
     if (clip.w <= 0.0 || d <= 0.0) {
         return;
     }
     let ndc = clip.xy / clip.w;
-    var ppw = fr.focal_px;
-    if (fr.perspective != 0u) {
-        ppw = fr.focal_px / d;
+    var ppw = frame.focal_px;
+    if (frame.perspective != 0u) {
+        ppw = frame.focal_px / d;
     }
-    let half_px = fr.kernel_radius_world * ppw;
-    let centre = vec2<f32>((ndc.x + 1.0) * 0.5 * fr.viewport.x, (1.0 - ndc.y) * 0.5 * fr.viewport.y);
-    let x0 = first_centre(centre.x - half_px, fr.viewport.x);
-    let x1 = first_centre(centre.x + half_px, fr.viewport.x);
-    let y0 = first_centre(centre.y - half_px, fr.viewport.y);
-    let y1 = first_centre(centre.y + half_px, fr.viewport.y);
+    let half_px = frame.kernel_radius_world * ppw;
+    let centre = vec2<f32>((ndc.x + 1.0) * 0.5 * frame.viewport.x, (1.0 - ndc.y) * 0.5 * frame.viewport.y);
+    let x0 = first_centre(centre.x - half_px, frame.viewport.x);
+    let x1 = first_centre(centre.x + half_px, frame.viewport.x);
+    let y0 = first_centre(centre.y - half_px, frame.viewport.y);
+    let y1 = first_centre(centre.y + half_px, frame.viewport.y);
     // Kernel units per pixel: the quad's corners are +-kernel_radius.
-    let k_per_px = fr.kernel_radius / half_px;
+    let k_per_px = frame.kernel_radius / half_px;
     // The slabs this step adds to, and the first one's ring slot.
-    let ring = 2u * fr.radius_slabs + 1u;
+    let ring = 2u * frame.radius_slabs + 1u;
     let s0 = slab.first_slab;
     let s1 = slab.last_slab;
     let slot0 = s0 % ring;
-    let in_slabs = (d - fr.d0) * fr.inv_delta;
+    let in_slabs = (d - frame.d0) * frame.inv_delta;
     let value = clamp(v.w, 0.0, 1.0);
-    let width = u32(fr.viewport.x);
+    let width = u32(frame.viewport.x);
     var dropped = 0u;
     for (var y = y0; y < y1; y++) {
         for (var x = x0; x < x1; x++) {
             // Early splat elimination: nothing behind an opaque pixel can show. The image
             // holds the slabs before s0, so this drops no more than testing each slab would.
-            if (fr.ese_alpha <= 1.0) {
+            if (frame.ese_alpha <= 1.0) {
                 let a = textureLoad(image_tex, vec2<i32>(i32(x), i32(y)), 0).a;
-                if (a >= fr.ese_alpha) {
+                if (a >= frame.ese_alpha) {
                     dropped += s1 + 1u - s0;
                     continue;
                 }
@@ -130,7 +135,7 @@ fn splat_cs(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups
             let pixel = (y * width + x) * ring;
             var slot = slot0;
             for (var s = s0; s <= s1; s++) {
-                let w = max(footprint(slices_of(in_slabs - f32(s)), c), 0.0) * fr.density_scale;
+                let w = max(footprint(slices_of(in_slabs - f32(s)), c), 0.0) * frame.density_scale;
                 let p = 2u * (pixel + slot);
                 // A term that rounds to 0 adds nothing: skip its atomic.
                 let wv = u32(w * value * SHEET_ONE + 0.5);
