@@ -363,11 +363,10 @@ impl GpuCentroidKeys {
     pub fn new(gpu: &Gpu, ledger: &mut MemoryLedger) -> anyhow::Result<GpuCentroidKeys> {
         let device = &gpu.device;
         let module = gpu.shader("gpu_sort.wgsl", include_str!("gpu_sort.wgsl"));
-        let uniform = params_entry(0);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("centroid keys"),
             entries: &[
-                uniform,
+                params_entry(0),
                 storage_entry(1, true),
                 storage_entry(2, true),
                 storage_entry(3, false),
