@@ -38,7 +38,15 @@ pub struct Raycast {
 }
 
 struct State {
-    layout: MeshLayout,
+    /// The OCS origin of the packed mesh ([`MeshLayout::origin`]).
+    origin: [f64; 3],
+    /// Storage bindings of the packed mesh and their bytes. The packed texels themselves live
+    /// only on the GPU: a host copy was the mesh again at 144 B/tet (2.9 GB at 20 M tets).
+    mesh_bindings: usize,
+    mesh_bytes: u64,
+    /// The binding size the mesh was packed for, so that [`Raycast::layout`] packs it again
+    /// the same way.
+    max_binding: u64,
     tets: u64,
     ledger: MemoryLedger,
     pipes: Pipelines,
@@ -108,9 +116,10 @@ impl Raycast {
             .ok_or_else(|| anyhow!("raycast: prepare first"))
     }
 
-    /// The packed mesh (for the CPU twin).
-    pub fn layout(&self) -> anyhow::Result<&MeshLayout> {
-        Ok(&self.state()?.layout)
+    /// The packed mesh as the GPU holds it, packed again on the host (for the CPU twin;
+    /// `mesh` and `optics` must be those of the prepare).
+    pub fn layout(&self, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<MeshLayout> {
+        MeshLayout::build(mesh, optics, self.state()?.max_binding)
     }
 
     /// Runs the shader's `exit_of` for arbitrary rays: (origin, direction, tet, λ at entry) →
@@ -207,7 +216,7 @@ impl Raycast {
             layers,
             tile_passes: last.tile_passes.clone(),
             tile_size: last.tile_size,
-            ray_frame: RayFrame::new(&last.camera, st.layout.origin),
+            ray_frame: RayFrame::new(&last.camera, st.origin),
             bias: (PEEL_BIAS * st.length_unit) as f32,
             max_steps: st.max_steps,
         })
@@ -257,8 +266,9 @@ impl Renderer for Raycast {
         let max_binding = self.max_binding.map_or(gpu.max_storage_binding(), |b| {
             b.min(gpu.max_storage_binding())
         });
-        let layout = MeshLayout::build(mesh, optics, max_binding)?;
+        let mut layout = MeshLayout::build(mesh, optics, max_binding)?;
         let slots = layout.chunks.len();
+        let mesh_bytes = layout.bytes();
         render_core::bind::check_storage_bindings(
             gpu,
             &format!("raycast on {} ({} mesh bindings)", gpu.adapter.name, slots),
@@ -267,16 +277,17 @@ impl Renderer for Raycast {
         )?;
         let mut ledger = MemoryLedger::default();
         let storage = wgpu::BufferUsages::STORAGE;
-        let chunk_buffers: Vec<wgpu::Buffer> = layout
-            .chunks
-            .iter()
+        // Each binding's host texels are dropped once uploaded: the GPU's copy is the only one
+        // kept (`layout` keeps its addressing and origin).
+        let chunk_buffers: Vec<wgpu::Buffer> = std::mem::take(&mut layout.chunks)
+            .into_iter()
             .enumerate()
             .map(|(c, data)| {
                 ledger.buffer_init(
                     gpu,
                     &format!("raycast mesh binding {c}"),
                     Lifetime::Persistent,
-                    bytemuck::cast_slice(data),
+                    bytemuck::cast_slice(&data),
                     storage,
                 )
             })
@@ -349,7 +360,10 @@ impl Renderer for Raycast {
         let max_steps = (64.0 * (n as f64).cbrt()).ceil() as u32 + 1024;
         let persistent = ledger.persistent;
         self.state = Some(State {
-            layout,
+            origin: layout.origin,
+            mesh_bindings: slots,
+            mesh_bytes,
+            max_binding,
             tets: n,
             ledger,
             pipes,
@@ -448,9 +462,9 @@ fn frame(
     let mut clock = FrameClock::start();
     gpu.queue
         .write_buffer(&t.tile_rects, 0, bytemuck::cast_slice(&rects));
-    let rf = RayFrame::new(camera, st.layout.origin);
+    let rf = RayFrame::new(camera, st.origin);
     let p4 = |v: [f32; 3]| [v[0], v[1], v[2], 0.0];
-    let model = glam::DMat4::from_translation(glam::DVec3::from(st.layout.origin));
+    let model = glam::DMat4::from_translation(glam::DVec3::from(st.origin));
     let vp: glam::Mat4 = (camera.view_proj() * model).as_mat4();
     // λ of the farthest point any ray can reach inside the fitted frustum (slightly beyond far).
     let lambda_far = camera.far * 2.0;
@@ -688,10 +702,10 @@ fn frame(
         ("skipped_entries".to_string(), stats[STAT_SKIPPED] as f64),
         (
             "mesh_bytes_per_tet".to_string(),
-            st.layout.bytes() as f64 / st.tets.max(1) as f64,
+            st.mesh_bytes as f64 / st.tets.max(1) as f64,
         ),
         ("table_bytes".to_string(), st.table_bytes as f64),
-        ("mesh_bindings".to_string(), st.layout.chunks.len() as f64),
+        ("mesh_bindings".to_string(), st.mesh_bindings as f64),
     ];
     st.last = Some(LastFrame {
         camera: camera.clone(),

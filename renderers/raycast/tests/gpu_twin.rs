@@ -91,7 +91,7 @@ fn one_step_on_the_gpu_agrees_with_the_cpu_twin() {
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     let mut r = Raycast::new(exact()).with_max_binding(mesh.num_tets().div_ceil(2) as u64 * 144);
     r.prepare(&gpu, &mesh, &optics).unwrap();
-    let layout = r.layout().unwrap().clone();
+    let layout = r.layout(&mesh, &optics).unwrap();
     assert_eq!(layout.chunks.len(), 2);
     let mut rng = Rng(7);
     let scale = mesh.bounds().diagonal() as f32;
@@ -196,7 +196,7 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
         "a shell needs at least two layers, got {}",
         d.layers_used
     );
-    let layout = r.layout().unwrap();
+    let layout = r.layout(&mesh, &optics).unwrap();
     let mut reentering = 0;
     let mut twin_steps = 0u64;
     for y in 0..d.height {
@@ -204,7 +204,7 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
             let i = (y * d.width + x) as usize;
             let entries: Vec<_> = d.layers.iter().map(|l| l[i]).collect();
             let (o, dir) = d.ray_frame.ray(x as f32 + 0.5, y as f32 + 0.5);
-            let w = step::walk(layout, &entries, o, dir, d.bias, d.max_steps);
+            let w = step::walk(&layout, &entries, o, dir, d.bias, d.max_steps);
             assert_eq!(w.steps, d.steps[i], "pixel ({x}, {y})");
             assert!(!w.stalled);
             twin_steps += w.steps as u64;
