@@ -1,5 +1,5 @@
 // Per-frame (and per-brick: n, padded) parameters shared by every splat shader; prepended to
-// each shader file. Must match `FrameUniform` in gpu.rs.
+// each shader file. Must match `FrameParams` in gpu.rs.
 struct Frame {
     view_proj: mat4x4<f32>,
     // Row 2 of the view matrix: view depth d = -(row . (p, 1)).
@@ -35,7 +35,7 @@ fn view_depth(fr: Frame, p: vec3<f32>) -> f32 {
     return -(r.x * p.x + r.y * p.y + r.z * p.z + r.w);
 }
 
-// One step of a brick (splat.wgsl, composite.wgsl; must match `SlabUniform` in gpu.rs): add
+// One step of a brick (splat.wgsl, composite.wgsl; must match `SlabParams` in gpu.rs): add
 // voxels sorted_in[first .. first + count] to the sheets of slabs first_slab ... last_slab,
 // then composite ring slot `slot`. A step is one bucket and the slabs it belongs to; the test
 // hook `Splat::slab_by_slab` makes it the paper's slab i (buckets i - r ... i + r into slab i

@@ -127,19 +127,20 @@ impl VoxelSet {
         };
         // A grid of 16-bit levels has at most 2^16 values: each is classified once, not once
         // per point (StagBeetle: 342 M points).
-        let per_level: Option<Vec<Option<f32>>> = match &g.values {
-            GridValues::Levels { step, .. } => {
-                Some((0..=u16::MAX).map(|l| classify(l as f32 * step)).collect())
-            }
+        let per_level: Option<(&[u16], Vec<Option<f32>>)> = match &g.values {
+            GridValues::Levels { levels, step } => Some((
+                levels,
+                (0..=u16::MAX).map(|l| classify(l as f32 * step)).collect(),
+            )),
             GridValues::F32(_) => None,
         };
         // κ first: on a large volume most points are empty, and `inside` may cost more.
         let mut chosen: Vec<(f32, u32)> = (0..g.num_voxels())
             .into_par_iter()
             .filter_map(|i| {
-                let s = match (&per_level, &g.values) {
-                    (Some(table), GridValues::Levels { levels, .. }) => table[levels[i] as usize],
-                    _ => classify(g.values.get(i)),
+                let s = match &per_level {
+                    Some((levels, table)) => table[levels[i] as usize],
+                    None => classify(g.values.get(i)),
                 }?;
                 inside(i).then_some((s, i as u32))
             })
@@ -300,4 +301,38 @@ fn build(
         })
         .collect();
     Node::Split { mid, children }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use render_core::TransferFunction;
+
+    /// The per-level classification of a 16-bit grid selects what classifying each point's
+    /// value selects (the same grid held as f32).
+    #[test]
+    fn a_levels_grid_selects_the_voxels_of_its_f32_values() {
+        let levels = datasets::standins::splat_volume([21, 17, 13], 700, 9);
+        let values: Vec<f32> = levels.values.iter().collect();
+        let f32_grid = VoxelGrid {
+            values: values.clone().into(),
+            ..levels.clone()
+        };
+        let bounds = datasets::Aabb {
+            min: levels.point(0, 0, 0),
+            max: levels.point(20, 16, 12),
+        };
+        let range = values
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        for tf in ["zero-floor", "low-opacity"] {
+            let tf = TransferFunction::preset(tf).unwrap();
+            let optics = Optics::for_extent(tf, &bounds, range);
+            let select = |g: &VoxelGrid| VoxelSet::select(g, |_| true, 0, false, &optics, 256);
+            let (a, b) = (select(&levels), select(&f32_grid));
+            assert!(!a.voxels.is_empty());
+            assert_eq!(a.voxels, b.voxels);
+            assert_eq!(a.bricks, b.bricks);
+        }
+    }
 }
