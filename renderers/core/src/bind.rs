@@ -15,6 +15,16 @@ pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::Bind
     buffer_entry(binding, visibility, wgpu::BufferBindingType::Uniform)
 }
 
+/// The entry of a parameter block that a pass binds again (per pass, dispatch or draw): a
+/// read-only storage buffer, not a uniform buffer. Lavapipe (Mesa 22.3) keeps about 64 KB for
+/// every dispatch that sets a bind group holding a uniform buffer again and frees none of it
+/// while the device lives, so memory grew with every frame (Teapot splatted at 256²: 529 MB
+/// after one frame, 920 MB after nine; the mechanism inside the driver is not known).
+/// docs/profile.md, "Uniform buffers on lavapipe".
+pub fn params_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    storage_entry(binding, visibility, true)
+}
+
 /// A storage buffer entry of a bind-group layout.
 pub fn storage_entry(
     binding: u32,

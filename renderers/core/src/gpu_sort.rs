@@ -64,12 +64,9 @@ fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     crate::bind::storage_entry(binding, wgpu::ShaderStages::COMPUTE, read_only)
 }
 
-/// The parameter block of a pass: read-only storage, not a uniform buffer, because lavapipe
-/// (Mesa 22.3) keeps memory for every dispatch that sets a bind group holding a uniform buffer
-/// again and frees none of it while the device lives (docs/profile.md, "Uniform buffers on
-/// lavapipe").
+/// The parameter block of a pass ([`crate::bind::params_entry`]).
 fn params_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    storage_entry(binding, true)
+    crate::bind::params_entry(binding, wgpu::ShaderStages::COMPUTE)
 }
 
 impl GpuRadixSort {

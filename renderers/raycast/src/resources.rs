@@ -49,16 +49,16 @@ pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
     ]
 }
 
+/// Every stage the ray caster's bind groups are visible to.
+const STAGES: wgpu::ShaderStages =
+    wgpu::ShaderStages::VERTEX_FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
+
 fn buffer_entry(
     binding: u32,
     ty: wgpu::BufferBindingType,
     dynamic: bool,
 ) -> wgpu::BindGroupLayoutEntry {
-    let e = bind::buffer_entry(
-        binding,
-        wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        ty,
-    );
+    let e = bind::buffer_entry(binding, STAGES, ty);
     if dynamic {
         bind::with_dynamic_offset(e)
     } else {
@@ -96,15 +96,11 @@ pub struct Pipelines {
 }
 
 impl Pipelines {
-    /// Layouts and pipelines for a mesh in `slots` storage bindings.
-    ///
-    /// The frame's and the pass's parameters are read-only storage buffers, not uniform
-    /// buffers: lavapipe (Mesa 22.3) keeps memory for every pass that sets a bind group holding
-    /// a uniform buffer again and frees none of it while the device lives (docs/profile.md,
-    /// "Uniform buffers on lavapipe").
+    /// Layouts and pipelines for a mesh in `slots` storage bindings. The frame's and the
+    /// pass's parameters are bound with [`bind::params_entry`] (set again every pass).
     pub fn new(gpu: &Gpu, slots: usize) -> Pipelines {
         let dev = &gpu.device;
-        let mut mesh_entries = vec![buffer_entry(0, RO, false)];
+        let mut mesh_entries = vec![bind::params_entry(0, STAGES)];
         mesh_entries.extend((1..=slots as u32).map(|b| buffer_entry(b, RO, false)));
         let mesh_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("raycast frame + mesh"),
@@ -126,7 +122,7 @@ impl Pipelines {
                 buffer_entry(6, RW, false),
                 buffer_entry(7, RO, false),
                 buffer_entry(8, RO, false),
-                buffer_entry(9, RO, false),
+                bind::params_entry(9, STAGES),
             ],
         });
         let probe_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

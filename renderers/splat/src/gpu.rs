@@ -92,13 +92,9 @@ fn with_frame(body: &str) -> String {
 }
 
 impl Pipelines {
-    /// Every parameter block (frame, step, bitonic stage) is a read-only storage buffer, not a
-    /// uniform buffer: lavapipe (Mesa 22.3) keeps about 64 KB for every dispatch that sets a
-    /// bind group holding a uniform buffer again, and frees none of it while the device lives
-    /// (heaptrack; the mechanism inside the driver is not known). With one pass per step the
-    /// memory grew with every frame (Teapot, GPU buckets, 256²: 529 MB after one frame, 734 MB
-    /// after five, 920 MB after nine; 488 and 495 MB after one and five with storage buffers).
-    /// The images are bit for bit the same (docs/profile.md, "Uniform buffers on lavapipe").
+    /// Every parameter block (frame, step, bitonic stage) is bound with
+    /// [`bind::params_entry`]: a uniform buffer set again before every dispatch made lavapipe's
+    /// memory grow with every frame. The images are bit for bit the same.
     pub fn new(gpu: &Gpu) -> Pipelines {
         let d = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
@@ -117,7 +113,7 @@ impl Pipelines {
         let compute_layout = layout(
             "splat buckets",
             &[
-                storage(0, c, true),
+                bind::params_entry(0, c),
                 storage(1, c, true),
                 storage(2, c, false),
                 storage(3, c, false),
@@ -143,7 +139,7 @@ impl Pipelines {
         let bitonic_layout = layout(
             "splat bitonic",
             &[
-                bind::with_dynamic_offset(storage(0, c, true)),
+                bind::with_dynamic_offset(bind::params_entry(0, c)),
                 storage(1, c, false),
                 storage(2, c, false),
             ],
@@ -172,7 +168,7 @@ impl Pipelines {
         let splat_layout = layout(
             "splat sheet",
             &[
-                storage(0, c, true),
+                bind::params_entry(0, c),
                 storage(1, c, true),
                 storage(2, c, true),
                 float_texture(3, c),
@@ -184,10 +180,9 @@ impl Pipelines {
         // The step: the splat pass reads its bucket, the composite its ring slot.
         let slab_layout = layout(
             "splat slab",
-            &[bind::with_dynamic_offset(storage(
+            &[bind::with_dynamic_offset(bind::params_entry(
                 0,
                 c | wgpu::ShaderStages::FRAGMENT,
-                true,
             ))],
         );
         let splat_module = gpu.shader("splat splat.wgsl", &with_frame(include_str!("splat.wgsl")));
@@ -204,7 +199,7 @@ impl Pipelines {
         let composite_layout = layout(
             "splat composite",
             &[
-                storage(0, wgpu::ShaderStages::FRAGMENT, true),
+                bind::params_entry(0, wgpu::ShaderStages::FRAGMENT),
                 storage(1, wgpu::ShaderStages::FRAGMENT, false),
                 storage(2, wgpu::ShaderStages::FRAGMENT, true),
             ],
