@@ -29,8 +29,16 @@ apt_install() {
 # A Vulkan driver: any installed ICD (a GPU's, or Mesa's lavapipe software rasteriser) plus the
 # Vulkan loader. On a machine with neither, Mesa's drivers give lavapipe.
 have_vulkan_icd() {
+    # Manifests named by the loader's variables first (a GPU machine whose driver lives outside
+    # the standard folders, e.g. /usr/local/nvidia/share/vulkan/icd.d), colon-separated.
+    local f list files
+    for list in "${VK_DRIVER_FILES:-}" "${VK_ICD_FILENAMES:-}"; do
+        IFS=: read -r -a files <<<"$list"
+        for f in "${files[@]}"; do
+            [ -n "$f" ] && [ -e "$f" ] && return 0
+        done
+    done
     # Any one manifest will do (`ls a b c` would fail as soon as one directory has none).
-    local f
     for f in /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json \
         /usr/local/share/vulkan/icd.d/*.json; do
         [ -e "$f" ] && return 0
@@ -46,8 +54,13 @@ ensure_prerequisites() {
         echo "tetbench: cargo not found; install Rust first (https://rustup.rs)" >&2
         exit 1
     fi
+    command -v cc >/dev/null 2>&1 || apt_install gcc libc6-dev
+    ensure_vulkan_runtime
+}
+
+# What a built tetbench needs to run (no compiler): the Vulkan loader and a driver.
+ensure_vulkan_runtime() {
     local need=()
-    command -v cc >/dev/null 2>&1 || need+=(gcc libc6-dev)
     have_vulkan_loader || need+=(libvulkan1)
     have_vulkan_icd || need+=(mesa-vulkan-drivers)
     if [ "${#need[@]}" -gt 0 ]; then

@@ -6,6 +6,7 @@
 #   calibrate   tetbench calibrate --force                     → calibration.json
 #   suite       the default suite with --rounds 5               → results.json, results.csv, samples.csv
 #   reproduce   tetbench reproduce PAPER --quick for each paper → reproduce/
+#   validate    scripts/validate.sh under the Khronos layer, with --validate → validation.txt
 #   peers       the default suite of VTK's mappers, when VTK is installed → peers/
 #
 # into ONE directory, reports/baselines/ADAPTER-DATE/ (the shape of scripts/baseline.sh's:
@@ -19,6 +20,8 @@
 #   --papers LIST      reproduce only these papers (comma-separated: havs, gator, fragment-pt,
 #                      raycast, splat; default all)
 #   --skip-peers       skip the VTK peers
+#   --validate         also run scripts/validate.sh with this binary (needs the Khronos layer:
+#                      installed, or VK_ADD_LAYER_PATH naming its manifest's folder)
 #   --out DIR          output directory (default reports/baselines/ADAPTER-DATE)
 #   --bin PATH         use this tetbench binary instead of building one
 #   -- ARGS            passed to the suite's `tetbench run` (e.g. -- --datasets box:1k)
@@ -31,6 +34,7 @@ allow_software=0
 rounds=5
 papers=all
 skip_peers=0
+validate=0
 out=""
 bin=""
 suite_args=()
@@ -41,17 +45,19 @@ while [ $# -gt 0 ]; do
         --quick) papers="" ;;
         --papers) papers=${2:?--papers needs a list}; shift ;;
         --skip-peers) skip_peers=1 ;;
+        --validate) validate=1 ;;
         --out) out=${2:?--out needs a directory}; shift ;;
         --bin) bin=${2:?--bin needs a path}; shift ;;
         --) shift; suite_args=("$@"); break ;;
-        -h|--help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,27p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "scripts/gpu.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
     esac
     shift
 done
 case "$rounds" in ''|*[!0-9]*|0) echo "scripts/gpu.sh: --rounds $rounds: need a whole number ≥ 1" >&2; exit 2 ;; esac
 
-ensure_prerequisites
+# A given binary needs no Rust (the GPU machine may have none), only Vulkan.
+if [ -n "$bin" ]; then ensure_vulkan_runtime; else ensure_prerequisites; fi
 script_start=$(date +%s)
 timings=()
 # `step NAME CMD…`: runs CMD, records and prints its wall time; a failing step is recorded and
@@ -135,6 +141,13 @@ if [ -n "$papers" ]; then
     find "$dest/reproduce" -type d -name images -prune -exec rm -rf {} + 2>/dev/null || true
 fi
 
+if [ "$validate" -eq 1 ]; then
+    # The whole output of the script: each pass's rows and seconds, then the layer's count of
+    # errors and warnings (and the first distinct ones when there are any).
+    validate_run() { TETBENCH_VALIDATE_OUT="$tmp/validate" scripts/validate.sh --bin "$bin" >"$dest/validation.txt" 2>&1; }
+    step validate validate_run
+fi
+
 vtk_python="${TETBENCH_VTK_PYTHON:-$PWD/.venv-vtk/bin/python}"
 if [ "$skip_peers" -eq 1 ]; then
     echo "=== gpu.sh: peers skipped (--skip-peers)" >&2
@@ -157,9 +170,13 @@ total=$(($(date +%s) - script_start))
     echo
     echo "- adapter: $adapter${software:+ (software: $software)}"
     echo "- date (UTC): $(date -u +%Y-%m-%dT%H:%M:%SZ)"
-    echo "- commit: $(git rev-parse HEAD 2>/dev/null || echo unknown)$(git diff --quiet 2>/dev/null || echo ' (uncommitted changes)')"
+    # The commit the binary was built from (its rows record it), not the checkout's: a carried
+    # binary may run in a copy of the tree without .git.
+    commit=$(grep -m1 -o '"git_commit": *"[0-9a-f]*"' "$dest/results.json" 2>/dev/null | grep -o '[0-9a-f]\{40\}' || true)
+    dirty=$(grep -m1 -o '"git_dirty": *[a-z]*' "$dest/results.json" 2>/dev/null | grep -o '[a-z]*$' || true)
+    echo "- commit: ${commit:-unknown (no results.json)}$([ "$dirty" = true ] && echo ' (built with uncommitted changes)')"
     echo "- command: scripts/gpu.sh ${orig_args[*]:-}"
-    echo "- options: rounds $rounds; papers ${papers:-none}; peers $([ "$skip_peers" -eq 1 ] && echo skipped || echo 'when VTK is installed')"
+    echo "- options: rounds $rounds; papers ${papers:-none}; validation $([ "$validate" -eq 1 ] && echo yes || echo no); peers $([ "$skip_peers" -eq 1 ] && echo skipped || echo 'when VTK is installed')"
     echo
     echo "| step | seconds | |"
     echo "|---|---:|---|"

@@ -19,10 +19,27 @@
 # Installs vulkan-validationlayers when no Khronos layer is found (VK_ADD_LAYER_PATH may name a
 # directory holding another VkLayer_khronos_validation.json). Output: $TETBENCH_VALIDATE_OUT
 # (default TARGET_DIR/validate/): the layer's log, each pass's log and results.
+#
+# `--bin PATH` validates that tetbench binary instead of building a debug one (a release binary
+# carried to a lent GPU's machine, which has no Rust: scripts/gpu.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/common.sh
-ensure_prerequisites
+bin=""
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --bin) bin=${2:?--bin needs a path}; shift ;;
+        *) echo "scripts/validate.sh: unknown option $1 (only --bin PATH)" >&2; exit 2 ;;
+    esac
+    shift
+done
+if [ -n "$bin" ]; then
+    [ -x "$bin" ] || { echo "scripts/validate.sh: no tetbench binary at $bin" >&2; exit 1; }
+    bin=$(cd "$(dirname "$bin")" && pwd)/$(basename "$bin")
+    ensure_vulkan_runtime
+else
+    ensure_prerequisites
+fi
 
 start=$SECONDS
 layer_manifest=VkLayer_khronos_validation.json
@@ -46,8 +63,10 @@ rm -rf "$out"
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 
-cargo build -q -p harness --bin tetbench
-bin="$target_dir/debug/tetbench"
+if [ -z "$bin" ]; then
+    cargo build -q -p harness --bin tetbench
+    bin="$target_dir/debug/tetbench"
+fi
 
 export VK_INSTANCE_LAYERS=VK_LAYER_KHRONOS_validation
 # wgpu's backend validation: wgpu asks for the layer as well and adds its own checks.
