@@ -131,11 +131,14 @@ impl State {
                     bytes,
                     usage,
                 )?;
-                let heads = self.ledger.buffer(
+                // Every fragment shaded, counted per pixel with an atomic: the racy per-pixel
+                // counts (`Pixel.info`) lose updates on a GPU, and the difference is the
+                // frame's `race_lost_updates`.
+                let shaded = self.ledger.buffer(
                     gpu,
-                    "havs target unused heads",
+                    "havs target fragments shaded per pixel",
                     Lifetime::PerFrame,
-                    16,
+                    npx * 4,
                     usage,
                 )?;
                 let nodes = self.ledger.buffer(
@@ -145,7 +148,7 @@ impl State {
                     16,
                     usage,
                 )?;
-                (kb, heads, nodes, 0)
+                (kb, shaded, nodes, 0)
             }
             Mode::RaceFree => {
                 // Start from a pool of 8 fragments per pixel; `render` grows it when a view needs more.
@@ -341,18 +344,21 @@ impl State {
         }
         enc.clear_buffer(&t.pixels, 0, None);
         enc.clear_buffer(&self.counters, 0, None);
-        // Bytes per pixel: k entries of 8 bytes (fragment race), one list head of 4 (race free).
-        let (per_pixel, rows_buffer) = match s.mode {
-            Mode::FragmentRace => (s.k as u64 * 8, &t.kentries),
-            Mode::RaceFree => (4, &t.heads),
-        };
-        let row_bytes = t.width as u64 * per_pixel;
+        // Per pixel: k entries of 8 bytes (fragment race) and, in both modes, a u32 in `heads`
+        // (the race-free list head, or the fragment race's count of fragments shaded).
+        let mut row_buffers = vec![(4, &t.heads)];
+        if s.mode == Mode::FragmentRace {
+            row_buffers.push((s.k as u64 * 8, &t.kentries));
+        }
         if !rows.is_empty() {
-            enc.clear_buffer(
-                rows_buffer,
-                rows.start as u64 * row_bytes,
-                Some(rows.len() as u64 * row_bytes),
-            );
+            for (per_pixel, buffer) in row_buffers {
+                let row_bytes = t.width as u64 * per_pixel;
+                enc.clear_buffer(
+                    buffer,
+                    rows.start as u64 * row_bytes,
+                    Some(rows.len() as u64 * row_bytes),
+                );
+            }
         }
         // Chunks in order, each in passes of bounded size (render_core::bind::pass_slices): the
         // faces stay in sorted order across chunk and pass boundaries, and the k-buffer lives
@@ -398,9 +404,19 @@ impl State {
             // the table (early ray termination, §4).
             ("et_culled_fragments".to_string(), c[4] as f64),
         ];
-        if s.mode == Mode::RaceFree {
-            counters.push(("lists_over_512".to_string(), c[2] as f64));
-            counters.push(("nodes".to_string(), c[3] as f64));
+        match s.mode {
+            Mode::RaceFree => {
+                counters.push(("lists_over_512".to_string(), c[2] as f64));
+                counters.push(("nodes".to_string(), c[3] as f64));
+            }
+            // Fragments whose read-modify-write of their pixel another fragment overwrote (the
+            // race the paper accepted, §4): shaded (an exact atomic count per pixel) less what
+            // the racy per-pixel counts kept. 0 where fragments of a pixel run one after the
+            // other (lavapipe); their k-buffer updates were lost too, so `fragments` is short
+            // by this much.
+            Mode::FragmentRace => {
+                counters.push(("race_lost_updates".to_string(), c[5] as f64));
+            }
         }
         counters.push(("faces".to_string(), self.num_faces as f64));
         // The roofline's work: every unique face is one triangle, and the sort orders them all.

@@ -55,10 +55,11 @@ struct Pixel {
 // K entries per pixel: (v, d); d = 0 marks an empty entry (cleared with clear_buffer).
 @group(0) @binding(7) var<storage, read_write> kentries: array<vec2<f32>>;
 // 0: fragments, 1: out-of-order pops, 2: lists longer than MAX_LIST, 3: nodes appended,
-// 4: fragments culled by early ray termination (never shaded nor looked up in the table).
+// 4: fragments culled by early ray termination (never shaded nor looked up in the table),
+// 5: fragment-race pixel updates lost to the race (shaded less counted, per pixel).
 @group(0) @binding(8) var<storage, read_write> counters: array<atomic<u32>, 8>;
 // Race-free mode: head of each pixel's list (node index + 1; 0 = empty) and the nodes
-// (v bits, d bits, submission index, next).
+// (v bits, d bits, submission index, next). Fragment-race mode: fragments shaded per pixel.
 @group(0) @binding(9) var<storage, read_write> heads: array<atomic<u32>>;
 @group(0) @binding(10) var<storage, read_write> nodes: array<vec4<u32>>;
 
@@ -148,6 +149,9 @@ fn store_entries(p: u32, st: ptr<function, KState>) {
 @fragment
 fn fs_kbuffer(in: VOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let p = pixel_index(in.pos);
+    // Not the paper's: an exact count of the pixel's fragments, against which the drain pass
+    // measures the updates the race lost (`race_lost_updates`).
+    atomicAdd(&heads[p], 1u);
     // §4, early ray termination as the paper's fragment program does it: read the pixel's
     // accumulated opacity first and stop above the threshold, before the k-buffer is read or
     // the table sampled. Culled fragments are counted (racing like the other per-pixel counts).
@@ -203,6 +207,12 @@ fn drain(@builtin(global_invocation_id) g: vec3<u32>) {
     }
     if info.w != 0u {
         atomicAdd(&counters[4], info.w);
+    }
+    // Every fragment shaded adds one to info.y or info.w unless another fragment's write of
+    // the pixel overwrote it.
+    let shaded = atomicLoad(&heads[p]);
+    if shaded > info.y + info.w {
+        atomicAdd(&counters[5], shaded - info.y - info.w);
     }
 }
 

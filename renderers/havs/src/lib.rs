@@ -155,9 +155,10 @@ impl Havs {
 
     /// Per pixel of the last frame (row-major), as `fs_kbuffer` counted them in
     /// `mode=fragment-race`: `[fragments the k-buffer took in, out-of-order pops before the
-    /// drain pass]` (`Pixel.info.y`, `.z` of `havs.wgsl`). For the test that holds the racy
-    /// pass to its CPU twin ([`kbuffer`]); race-free mode keeps no per-pixel counts (zeros).
-    pub fn read_pixel_counts(&self, gpu: &Gpu) -> anyhow::Result<Vec<[u32; 2]>> {
+    /// drain pass, fragments shaded]` (`Pixel.info.y`, `.z` of `havs.wgsl`, racing, and the
+    /// exact atomic count in `heads`). For the test that holds the racy pass to its CPU twin
+    /// ([`kbuffer`]); race-free mode keeps no per-pixel counts (zeros and list heads).
+    pub fn read_pixel_counts(&self, gpu: &Gpu) -> anyhow::Result<Vec<[u32; 3]>> {
         let t = self
             .state
             .as_ref()
@@ -166,7 +167,13 @@ impl Havs {
         let n = t.width as u64 * t.height as u64;
         let bytes = gpu.read_buffer(&t.pixels, 0, n * 32)?;
         let px: &[[u32; 8]] = bytemuck::cast_slice(&bytes);
-        Ok(px.iter().map(|p| [p[5], p[6]]).collect())
+        let shaded = gpu.read_buffer(&t.heads, 0, n * 4)?;
+        let shaded: &[u32] = bytemuck::cast_slice(&shaded);
+        Ok(px
+            .iter()
+            .zip(shaded)
+            .map(|(p, &s)| [p[5], p[6], s])
+            .collect())
     }
 
     /// Per pixel of the last frame (row-major), in `mode=race-free`: the fragments `fs_append`
