@@ -83,6 +83,9 @@ fn the_racy_single_pass_counts_what_its_cpu_twin_counts_per_pixel() {
     // compare are not all zero; 48² keeps the per-pixel lists short enough to check quickly.
     let mesh = datasets::generate::from_spec("onion:4k", 1).unwrap();
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    // Out-of-order pops over all three views: k = 3 has a handful (8 on lavapipe, none on an
+    // H200, whose rasteriser puts some fragments elsewhere), k = 2 thousands.
+    let mut all_pops = 0;
     for (k, projection) in [
         (2, Projection::default()),
         (2, Projection::Orthographic),
@@ -129,10 +132,7 @@ fn the_racy_single_pass_counts_what_its_cpu_twin_counts_per_pixel() {
             fragments > 10 * 48 * 48 / 4,
             "{what}: only {fragments} fragments"
         );
-        assert!(
-            pops > 0,
-            "{what}: the twin finds no out-of-order pop; nothing is compared"
-        );
+        all_pops += pops;
         eprintln!(
             "{what}: twin {fragments} fragments, {pops} out-of-order pops; racy pass {} / {}; \
              lost to the race {}; race-free pass {} / {} (lists over 512: {})",
@@ -208,4 +208,8 @@ fn the_racy_single_pass_counts_what_its_cpu_twin_counts_per_pixel() {
             );
         }
     }
+    assert!(
+        all_pops > 0,
+        "the twin finds no out-of-order pop in any view; the pop counts compare nothing"
+    );
 }
