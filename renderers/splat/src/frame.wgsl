@@ -46,7 +46,9 @@ struct Slab {
     first_slab: u32,
     last_slab: u32,
     slot: u32,
-    pad0: u32,
+    // Invocations per voxel (splat.wgsl): invocation j of a voxel takes rows j, j + lanes, ...
+    // of its footprint.
+    lanes: u32,
     pad1: u32,
     pad2: u32,
 }

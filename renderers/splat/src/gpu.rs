@@ -43,7 +43,8 @@ pub struct SlabParams {
     pub first_slab: u32,
     pub last_slab: u32,
     pub slot: u32,
-    pub pad0: u32,
+    /// Invocations per voxel: each takes every `lanes`-th row of the voxel's footprint.
+    pub lanes: u32,
     pub pad1: u32,
     pub pad2: u32,
 }
@@ -60,7 +61,7 @@ pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
             length_unit, pad
         }),
         render_core::rust_layout!(SlabParams => "frame.wgsl::Slab" {
-            first, count, first_slab, last_slab, slot, pad0, pad1, pad2
+            first, count, first_slab, last_slab, slot, lanes, pad1, pad2
         }),
     ]
 }

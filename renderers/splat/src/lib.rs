@@ -112,6 +112,11 @@ impl Default for SplatSettings {
 
 /// A pixel at least this opaque drops the splats behind it (the error this allows is at most
 /// 1 − ESE_ALPHA per pixel).
+/// Footprint rows per invocation of the splat pass (`Splat::lanes`), and the most invocations
+/// one voxel is split over.
+const ROWS_PER_LANE: f64 = 2.0;
+const MAX_LANES: u32 = 64;
+
 pub const ESE_ALPHA: f32 = 0.999;
 
 /// Transfer function table entries (linear between entries).
@@ -456,6 +461,36 @@ impl Splat {
         }
     }
 
+    /// Invocations per voxel in the splat pass (`SlabParams::lanes`): about one per
+    /// [`ROWS_PER_LANE`] rows of the largest footprint of the frame, the nearest slab's (a
+    /// footprint is 2 · kernel radius · pixels per world unit wide), at most [`MAX_LANES`].
+    /// Any value gives the same image; this one keeps each invocation's pixel walk short.
+    fn lanes(&self, camera: &Camera, geom: &SlabGeometry) -> u32 {
+        let st = self.state.as_ref().unwrap();
+        let radius_world = self.settings.radius * st.set.kernel_unit;
+        let focal = match camera.projection {
+            render_core::Projection::Perspective { fovy_deg } => {
+                0.5 * camera.height as f64 / (fovy_deg.to_radians() * 0.5).tan()
+            }
+            render_core::Projection::Orthographic => {
+                camera.height as f64 / (2.0 * camera.ortho_half_height)
+            }
+        };
+        let px_per_world = if camera.is_perspective() {
+            // The nearest depth a voxel of the first slab can have; a camera at or inside the
+            // volume gets the most lanes.
+            let near = geom.d0 as f64;
+            if near <= radius_world {
+                return MAX_LANES;
+            }
+            focal / near
+        } else {
+            focal
+        };
+        let rows = 2.0 * radius_world * px_per_world + 2.0;
+        ((rows / ROWS_PER_LANE).ceil() as u32).clamp(1, MAX_LANES)
+    }
+
     fn ensure_targets(&mut self, gpu: &Gpu, width: u32, height: u32) -> anyhow::Result<()> {
         let ring = 2 * self.state.as_ref().unwrap().table.radius_slabs as u64 + 1;
         if self
@@ -507,12 +542,14 @@ impl Splat {
     }
 
     /// Splats the slabs of one brick (its sorted voxels and bucket table are ready).
+    #[allow(clippy::too_many_arguments)]
     fn draw_brick(
         &self,
         gpu: &Gpu,
         geom: &SlabGeometry,
         ends: &[u32],
         rect: [u32; 4],
+        lanes: u32,
         stats: &mut BrickStats,
         clock: &mut FrameClock,
     ) {
@@ -552,6 +589,7 @@ impl Splat {
                     first_slab: *slabs.start(),
                     last_slab: *slabs.end(),
                     slot: composite.map_or(0, |s| s % geom.ring()),
+                    lanes,
                     ..Default::default()
                 };
                 (step, composite)
@@ -613,7 +651,7 @@ impl Splat {
                 pass.set_pipeline(&st.pipes.splat);
                 pass.set_bind_group(0, &splat_bind, &[]);
                 pass.set_bind_group(1, &slab_bind, &[offset]);
-                let (x, y) = gpu::workgroups(step.count);
+                let (x, y) = gpu::workgroups(step.count * lanes);
                 pass.dispatch_workgroups(x, y, 1);
             }
             if composite.is_some() {
@@ -890,6 +928,7 @@ impl Renderer for Splat {
         color_pass(&mut enc, "splat clear", &t.image_view, true, true, None);
         clock.submit(gpu, [enc.finish()]);
         let rect = self.composite_rect(camera).expect("prepared");
+        let lanes = self.lanes(camera, &geom);
         let mut stats = BrickStats::default();
         for b in order {
             if self.state.as_ref().unwrap().set.bricks[b].range.is_empty() {
@@ -897,7 +936,7 @@ impl Renderer for Splat {
             }
             self.write_frame(gpu, camera, &geom, b);
             let (ends, _) = self.buckets(gpu, b, &geom, row, false, &mut stats, &mut clock)?;
-            self.draw_brick(gpu, &geom, &ends, rect, &mut stats, &mut clock);
+            self.draw_brick(gpu, &geom, &ends, rect, lanes, &mut stats, &mut clock);
         }
         let st = self.state.as_ref().unwrap();
         let mut enc = gpu.device.create_command_encoder(&Default::default());

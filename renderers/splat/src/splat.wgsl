@@ -84,9 +84,16 @@ fn first_centre(edge: f32, n: f32) -> u32 {
     return u32(clamp(ceil(edge - 0.5), 0.0, n));
 }
 
+// A voxel's footprint is split by rows over `slab.lanes` invocations (the host sizes it from
+// the largest footprint of the frame, `Splat::lanes`): one invocation per voxel walked up to
+// thousands of pixels one after the other, and a bucket holds too few voxels to fill a GPU
+// (docs/gpu.md). The sums are fixed point, so the split changes no bit of the image.
 @compute @workgroup_size(256)
 fn splat_cs(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = g.x + g.y * nwg.x * 256u;
+    let lanes = max(slab.lanes, 1u);
+    let flat = g.x + g.y * nwg.x * 256u;
+    let i = flat / lanes;
+    let lane = flat % lanes;
     if (i >= slab.count) {
         return;
     }
@@ -119,7 +126,7 @@ fn splat_cs(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups
     let value = clamp(v.w, 0.0, 1.0);
     let width = u32(frame.viewport.x);
     var dropped = 0u;
-    for (var y = y0; y < y1; y++) {
+    for (var y = y0 + lane; y < y1; y += lanes) {
         for (var x = x0; x < x1; x++) {
             // Early splat elimination: nothing behind an opaque pixel can show. The image
             // holds the slabs before s0, so this drops no more than testing each slab would.
