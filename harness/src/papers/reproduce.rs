@@ -361,7 +361,7 @@ pub(crate) fn write_report(
     } else {
         let _ = writeln!(
             md,
-            "From `reports/papers/claims.csv`; one verdict per data set: {}. The rule (`harness/src/papers/verdict.rs`): a difference inside the samples' spread (frames' range) or the claim's tolerance is *within noise*, and one frame per side never orders two sides; a claim about GPU speed measured on a software rasteriser is *not testable on this adapter* (its numbers are still shown); *not checkable* says what is missing.\n",
+            "From `reports/papers/claims.csv`; one verdict per data set: {}. The rule (`harness/src/papers/verdict.rs`): a difference inside the samples' spread (frames' range) or the claim's tolerance is *within noise*, and one frame per side never orders two sides; a claim about GPU speed measured on a software rasteriser is *not testable on this adapter* (its numbers are still shown), and on a real GPU a band of absolute GPU rates (the paper's GPU's) is tested by its lower end only; *not checkable* says what is missing.\n",
             tally_text(&report.claims)
         );
         md.push_str(&claims::markdown(&report.claims));
