@@ -190,6 +190,14 @@ impl Splat {
         self
     }
 
+    /// Splits each voxel's footprint over `lanes` invocations on any adapter (the split a GPU
+    /// gets, `Splat::lanes`): the image must not change by a bit.
+    #[doc(hidden)]
+    pub fn with_lanes(mut self, lanes: u32) -> Splat {
+        self.forced_lanes = Some(lanes);
+        self
+    }
+
     /// Footprint pixel centres of `camera`'s view outside `rect` (see [`centres_outside`]).
     #[doc(hidden)]
     pub fn centres_outside(&self, camera: &Camera, rect: [u32; 4]) -> anyhow::Result<u64> {

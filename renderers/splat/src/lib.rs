@@ -192,6 +192,9 @@ pub struct Splat {
     /// Test hook: each slab splats its buckets i − r … i + r on its own (the paper's order),
     /// instead of each bucket once into a ring of sheets.
     slab_by_slab: bool,
+    /// Test hook: invocations per voxel in the splat pass, whatever the adapter
+    /// (`Splat::lanes`).
+    forced_lanes: Option<u32>,
 }
 
 /// What one brick of one frame did.
@@ -212,6 +215,7 @@ impl Splat {
             coverage: None,
             count_every_fragment: false,
             slab_by_slab: false,
+            forced_lanes: None,
         }
     }
 
@@ -461,11 +465,20 @@ impl Splat {
         }
     }
 
-    /// Invocations per voxel in the splat pass (`SlabParams::lanes`): about one per
+    /// Invocations per voxel in the splat pass (`SlabParams::lanes`). On a GPU, about one per
     /// [`ROWS_PER_LANE`] rows of the largest footprint of the frame, the nearest slab's (a
-    /// footprint is 2 · kernel radius · pixels per world unit wide), at most [`MAX_LANES`].
-    /// Any value gives the same image; this one keeps each invocation's pixel walk short.
-    fn lanes(&self, camera: &Camera, geom: &SlabGeometry) -> u32 {
+    /// footprint is 2 · kernel radius · pixels per world unit wide), at most [`MAX_LANES`]:
+    /// a bucket's few voxels, each walking its whole footprint alone, left an H200 waiting
+    /// (docs/gpu.md). On a CPU adapter one: lavapipe's two cores are busy with a bucket's voxels
+    /// already, and the split cost Engine and Lobster 25-40 % a frame there. Any value gives
+    /// the same image.
+    fn lanes(&self, gpu: &Gpu, camera: &Camera, geom: &SlabGeometry) -> u32 {
+        if let Some(lanes) = self.forced_lanes {
+            return lanes.max(1);
+        }
+        if gpu.adapter.device_type == "Cpu" {
+            return 1;
+        }
         let st = self.state.as_ref().unwrap();
         let radius_world = self.settings.radius * st.set.kernel_unit;
         let focal = match camera.projection {
@@ -928,7 +941,7 @@ impl Renderer for Splat {
         color_pass(&mut enc, "splat clear", &t.image_view, true, true, None);
         clock.submit(gpu, [enc.finish()]);
         let rect = self.composite_rect(camera).expect("prepared");
-        let lanes = self.lanes(camera, &geom);
+        let lanes = self.lanes(gpu, camera, &geom);
         let mut stats = BrickStats::default();
         for b in order {
             if self.state.as_ref().unwrap().set.bricks[b].range.is_empty() {

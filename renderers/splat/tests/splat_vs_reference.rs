@@ -275,6 +275,44 @@ fn the_ring_of_sheets_equals_splatting_slab_by_slab() {
     }
 }
 
+/// The splat pass split over several invocations per voxel (rows j, j + lanes, ... of the
+/// footprint each), as GPUs run it, adds the same fixed-point terms as one invocation per
+/// voxel, as lavapipe runs it: the images are bit-identical. A lane that skipped or repeated a
+/// row would change them.
+#[test]
+fn splitting_a_footprint_over_invocations_changes_no_bit() {
+    let gpu = gpu();
+    let mesh = volume("vol:20x18x16");
+    let optics = Optics::for_mesh(TransferFunction::preset("high-opacity").unwrap(), &mesh);
+    // 96² and a near camera: footprints of a dozen rows and more, so 3 and 7 lanes split them.
+    let cam = camera(&mesh, "+x+y+z", [1.0, 1.0, 1.0], Projection::default(), 96);
+    for buckets in [Buckets::Cpu, Buckets::Gpu] {
+        let settings = SplatSettings {
+            buckets,
+            ..Default::default()
+        };
+        let image = |r: Splat| {
+            let mut r = r;
+            r.prepare(&gpu, &mesh, &optics).unwrap();
+            r.render(&gpu, &cam).unwrap();
+            r.read_image(&gpu).unwrap()
+        };
+        let one = image(Splat::new(settings.clone()).with_lanes(1));
+        assert!(
+            one.pixels.iter().any(|p| p[3] > 0.5),
+            "{buckets:?}: an empty image compares nothing"
+        );
+        for lanes in [3, 7, 64] {
+            let split = image(Splat::new(settings.clone()).with_lanes(lanes));
+            assert_eq!(
+                max_diff(&one, &split),
+                0.0,
+                "{buckets:?} buckets, {lanes} lanes"
+            );
+        }
+    }
+}
+
 /// A tet mesh without a grid is resampled (`grid` points on its longest side) and the result
 /// still resembles the reference.
 #[test]
