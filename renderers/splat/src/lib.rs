@@ -112,12 +112,14 @@ impl Default for SplatSettings {
 
 /// A pixel at least this opaque drops the splats behind it (the error this allows is at most
 /// 1 − ESE_ALPHA per pixel).
-/// Footprint rows per invocation of the splat pass (`Splat::lanes`), and the most invocations
-/// one voxel is split over.
+pub const ESE_ALPHA: f32 = 0.999;
+
+/// Footprint rows per invocation of the splat pass (`Splat::lanes`), the most invocations one
+/// voxel is split over, and the most invocations of one dispatch (a bucket of many voxels is
+/// split less, so that voxels × lanes stays a u32 the dispatch can hold).
 const ROWS_PER_LANE: f64 = 2.0;
 const MAX_LANES: u32 = 64;
-
-pub const ESE_ALPHA: f32 = 0.999;
+const MAX_SPLAT_INVOCATIONS: u32 = 1 << 30;
 
 /// Transfer function table entries (linear between entries).
 const TF_ENTRIES: usize = 256;
@@ -602,7 +604,9 @@ impl Splat {
                     first_slab: *slabs.start(),
                     last_slab: *slabs.end(),
                     slot: composite.map_or(0, |s| s % geom.ring()),
-                    lanes,
+                    lanes: lanes
+                        .min(MAX_SPLAT_INVOCATIONS / (voxels.len() as u32).max(1))
+                        .max(1),
                     ..Default::default()
                 };
                 (step, composite)
@@ -664,7 +668,7 @@ impl Splat {
                 pass.set_pipeline(&st.pipes.splat);
                 pass.set_bind_group(0, &splat_bind, &[]);
                 pass.set_bind_group(1, &slab_bind, &[offset]);
-                let (x, y) = gpu::workgroups(step.count * lanes);
+                let (x, y) = gpu::workgroups(step.count * step.lanes);
                 pass.dispatch_workgroups(x, y, 1);
             }
             if composite.is_some() {
