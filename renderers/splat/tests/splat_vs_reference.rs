@@ -25,7 +25,12 @@ fn max_diff(a: &Image, b: &Image) -> f32 {
 }
 
 fn render(gpu: &Gpu, s: SplatSettings, mesh: &TetMesh, optics: &Optics, cam: &Camera) -> Image {
-    let mut r = Splat::new(s);
+    render_splat(gpu, Splat::new(s), mesh, optics, cam)
+}
+
+/// One frame of a renderer already built (with its test hooks set).
+fn render_splat(gpu: &Gpu, r: Splat, mesh: &TetMesh, optics: &Optics, cam: &Camera) -> Image {
+    let mut r = r;
     r.prepare(gpu, mesh, optics).unwrap();
     let stats = r.render(gpu, cam).unwrap();
     assert!(stats.total_ms > 0.0);
@@ -257,12 +262,7 @@ fn the_ring_of_sheets_equals_splatting_slab_by_slab() {
                 ese: false,
                 ..Default::default()
             };
-            let image = |r: Splat| {
-                let mut r = r;
-                r.prepare(&gpu, &mesh, &optics).unwrap();
-                r.render(&gpu, &cam).unwrap();
-                r.read_image(&gpu).unwrap()
-            };
+            let image = |r: Splat| render_splat(&gpu, r, &mesh, &optics, &cam);
             let ring = image(Splat::new(settings.clone()));
             let twin = image(Splat::new(settings).slab_by_slab());
             let what = format!("radius {radius}, slab {slab}, {buckets:?} buckets, {brick:?}");
@@ -291,12 +291,7 @@ fn splitting_a_footprint_over_invocations_changes_no_bit() {
             buckets,
             ..Default::default()
         };
-        let image = |r: Splat| {
-            let mut r = r;
-            r.prepare(&gpu, &mesh, &optics).unwrap();
-            r.render(&gpu, &cam).unwrap();
-            r.read_image(&gpu).unwrap()
-        };
+        let image = |r: Splat| render_splat(&gpu, r, &mesh, &optics, &cam);
         let one = image(Splat::new(settings.clone()).with_lanes(1));
         assert!(
             one.pixels.iter().any(|p| p[3] > 0.5),
