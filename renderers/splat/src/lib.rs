@@ -481,17 +481,11 @@ impl Splat {
         if gpu.adapter.device_type == "Cpu" {
             return 1;
         }
-        let st = self.state.as_ref().unwrap();
-        let radius_world = self.settings.radius * st.set.kernel_unit;
-        let focal = match camera.projection {
-            render_core::Projection::Perspective { fovy_deg } => {
-                0.5 * camera.height as f64 / (fovy_deg.to_radians() * 0.5).tan()
-            }
-            render_core::Projection::Orthographic => {
-                camera.height as f64 / (2.0 * camera.ortho_half_height)
-            }
-        };
-        let px_per_world = if camera.is_perspective() {
+        // The frame's own projection constants, as the shaders get them (any brick's).
+        let u = self.frame_params(camera, geom, 0);
+        let radius_world = u.kernel_radius_world as f64;
+        let focal = u.focal_px as f64;
+        let px_per_world = if u.perspective != 0 {
             // The nearest depth a voxel of the first slab can have; a camera at or inside the
             // volume gets the most lanes.
             let near = geom.d0 as f64;
