@@ -23,7 +23,12 @@ impl Renderer for FailsAt {
     fn settings(&self) -> render_core::Settings {
         self.inner.settings()
     }
-    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+    fn prepare(
+        &mut self,
+        gpu: &Gpu,
+        mesh: &std::sync::Arc<TetMesh>,
+        optics: &Optics,
+    ) -> anyhow::Result<Prepared> {
         self.inner.prepare(gpu, mesh, optics)
     }
     fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {

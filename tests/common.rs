@@ -5,6 +5,8 @@
 
 use std::path::PathBuf;
 
+use std::sync::Arc;
+
 use datasets::TetMesh;
 use render_core::{Camera, Gpu, Image, Optics, Projection, TransferFunction, Viewpoint};
 
@@ -27,13 +29,13 @@ pub fn data_file(name: &str) -> Option<PathBuf> {
 }
 
 /// SPX (12,936 tets) from the data directory, or `None` with a printed skip.
-pub fn spx() -> Option<TetMesh> {
+pub fn spx() -> Option<Arc<TetMesh>> {
     let path = data_file("spx.vtk")?;
     let mesh = datasets::load::load(&path, &Default::default())
         .unwrap_or_else(|e| panic!("{}: {e:#}", path.display()))
         .mesh;
     assert_eq!(mesh.num_tets(), 12936, "{}", path.display());
-    Some(mesh)
+    Some(Arc::new(mesh))
 }
 
 /// The headless GPU (lavapipe where there is no other); wgpu wants `XDG_RUNTIME_DIR`.
@@ -68,14 +70,14 @@ pub fn view(dir: [f64; 3]) -> Viewpoint {
 
 /// One picture to check: mesh, optics, camera and the exact reference image.
 pub struct Scene<'a> {
-    pub mesh: &'a TetMesh,
+    pub mesh: &'a Arc<TetMesh>,
     pub optics: &'a Optics,
     pub camera: Camera,
     pub reference: Image,
 }
 
 impl<'a> Scene<'a> {
-    pub fn new(mesh: &'a TetMesh, optics: &'a Optics, camera: Camera) -> Self {
+    pub fn new(mesh: &'a Arc<TetMesh>, optics: &'a Optics, camera: Camera) -> Self {
         let reference = reference::render(mesh, optics, &camera);
         Scene {
             mesh,
@@ -116,7 +118,7 @@ pub fn rmse(a: &Image, b: &Image) -> f64 {
 /// A 12³-point grid (6,655 tets) with a smooth field that crosses most of the transfer
 /// function's range: convex, so every visibility order is right and the error left is the
 /// algorithm's own approximation.
-pub fn grid_mesh() -> TetMesh {
+pub fn grid_mesh() -> Arc<TetMesh> {
     let n = 12;
     let mut points = Vec::new();
     let mut scalars = Vec::new();
@@ -134,21 +136,23 @@ pub fn grid_mesh() -> TetMesh {
             }
         }
     }
-    TetMesh::new(
-        "grid",
-        points,
-        scalars,
-        "f",
-        datasets::volume::structured_tets([n, n, n]),
+    Arc::new(
+        TetMesh::new(
+            "grid",
+            points,
+            scalars,
+            "f",
+            datasets::volume::structured_tets([n, n, n]),
+        )
+        .unwrap(),
     )
-    .unwrap()
 }
 
 /// A comb: a base bar with teeth one cell wide and one cell thick, cut from a structured grid.
 /// Rays from a diagonal leave and re-enter the mesh between teeth, and cross the corner tets
 /// of a tooth entering and leaving through two boundary faces of the same tet — the case the
 /// single tag of HAVS gets wrong (Callahan et al. 2005, §4).
-pub fn comb_mesh() -> TetMesh {
+pub fn comb_mesh() -> Arc<TetMesh> {
     let dims = [17usize, 13, 3];
     let mut points = Vec::new();
     let mut scalars = Vec::new();
@@ -173,7 +177,7 @@ pub fn comb_mesh() -> TetMesh {
             }
         }
     }
-    TetMesh::new("comb", points, scalars, "f", tets).unwrap()
+    Arc::new(TetMesh::new("comb", points, scalars, "f", tets).unwrap())
 }
 
 /// A renderer's per-frame counter by name (NaN when absent, so a comparison with it fails).

@@ -24,8 +24,8 @@ const LOW_BINDING: u64 = 256 << 10;
 const MESH: &str = "box:24k";
 const SIZE: u32 = 32;
 
-fn mesh() -> TetMesh {
-    datasets::generate::from_spec(MESH, 1).unwrap()
+fn mesh() -> std::sync::Arc<TetMesh> {
+    std::sync::Arc::new(datasets::generate::from_spec(MESH, 1).unwrap())
 }
 
 fn open(request: &DeviceRequest) -> Gpu {
@@ -40,7 +40,7 @@ fn open(request: &DeviceRequest) -> Gpu {
 fn render(
     gpu: &Gpu,
     renderer: &mut dyn Renderer,
-    mesh: &TetMesh,
+    mesh: &std::sync::Arc<TetMesh>,
     optics: &Optics,
 ) -> (Image, Option<f64>) {
     let cam = camera(mesh, &view([1.0, 1.0, 1.0]), Projection::default(), SIZE);
@@ -177,7 +177,7 @@ fn small_bindings_give_the_same_image_as_the_adapters_own() {
 /// depend on them. With them off every algorithm must still render (no path may assume them).
 #[test]
 fn gpu_time_appears_exactly_with_timestamp_queries() {
-    let mesh = datasets::generate::from_spec("box:1k", 1).unwrap();
+    let mesh = std::sync::Arc::new(datasets::generate::from_spec("box:1k", 1).unwrap());
     let optics = optics(&mesh, "low-opacity");
     let with = open(&DeviceRequest::default());
     let without = open(&DeviceRequest {

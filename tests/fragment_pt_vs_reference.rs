@@ -13,7 +13,7 @@ use tetbench_tests::{assert_finite, camera, gpu, grid_mesh, optics, spx, view, S
 
 fn render(
     gpu: &Gpu,
-    mesh: &TetMesh,
+    mesh: &std::sync::Arc<TetMesh>,
     optics: &Optics,
     shading: Shading,
     sort: SortMode,

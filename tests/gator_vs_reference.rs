@@ -12,7 +12,7 @@ use tetbench_tests::{assert_finite, camera, gpu, grid_mesh, optics, spx, view, S
 
 fn render(
     gpu: &Gpu,
-    mesh: &TetMesh,
+    mesh: &std::sync::Arc<TetMesh>,
     optics: &Optics,
     cells: CellModel,
     order: VisibilityOrder,

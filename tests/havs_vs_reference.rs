@@ -15,7 +15,7 @@ use tetbench_tests::{
 
 fn render(
     gpu: &Gpu,
-    mesh: &TetMesh,
+    mesh: &std::sync::Arc<TetMesh>,
     optics: &Optics,
     settings: HavsSettings,
     camera: &Camera,
@@ -176,7 +176,7 @@ fn havs_k6_on_spx_is_close_to_the_reference() {
 /// somewhere and further from it. (CPU only: the model is the twin of the race-free GPU mode.)
 #[test]
 fn the_sliver_onion_needs_more_than_k_2() {
-    let mesh = datasets::generate::from_spec("onion:10k", 1).unwrap();
+    let mesh = std::sync::Arc::new(datasets::generate::from_spec("onion:10k", 1).unwrap());
     assert_eq!(mesh.quality().slivers, mesh.num_tets());
     let optics = optics(&mesh, "low-opacity");
     let camera = camera(&mesh, &fixed_viewpoints()[6], Projection::default(), 64);
@@ -299,7 +299,7 @@ struct Derived {
 /// within the table's bound, and GPU vs reference within the bound both imply.
 fn check_against_twin_and_reference(
     what: &str,
-    mesh: &TetMesh,
+    mesh: &std::sync::Arc<TetMesh>,
     optics: &Optics,
     camera: &Camera,
     table_size: u32,
@@ -407,7 +407,7 @@ fn havs_in_orthographic_projection_is_its_twin_and_within_the_table_bound() {
 fn havs_without_early_termination_is_its_twin_and_within_1_512_of_et_on() {
     // A generated box seen along a diagonal: deep enough for the opaque transfer function to
     // saturate pixels (the comb's teeth are too thin).
-    let mesh = datasets::generate::from_spec("box:6k", 1).unwrap();
+    let mesh = std::sync::Arc::new(datasets::generate::from_spec("box:6k", 1).unwrap());
     let optics = optics(&mesh, "high-opacity");
     let cam = camera(&mesh, &fixed_viewpoints()[6], Projection::default(), 64);
     let (off, _) = check_against_twin_and_reference(

@@ -312,9 +312,10 @@ fn mpvonc_is_valid_across_interior_faces_of_non_convex_meshes() {
 #[test]
 fn centroid_orders_satisfy_their_sort_invariants() {
     let mesh = random_delaunay(300, 5);
+    // The sorter keeps its centroids in f32 (the keys are f32 too).
     let centroid = |t: u32| {
         let p = mesh.tet_points(t as usize);
-        [0, 1, 2].map(|a| 0.25 * (p[0][a] + p[1][a] + p[2][a] + p[3][a]))
+        [0, 1, 2].map(|a| (0.25 * (p[0][a] + p[1][a] + p[2][a] + p[3][a])) as f32 as f64)
     };
     let mut radix = VisibilitySorter::default();
     let mut merge = VisibilitySorter::new(VisibilityOrder::CentroidMerge);

@@ -15,7 +15,7 @@ use tetbench_tests::{assert_finite, camera, gpu, grid_mesh, optics, view, Scene}
 #[test]
 fn every_algorithm_is_within_its_declared_tolerance_of_the_reference() {
     let gpu = gpu();
-    let mesh = grid_mesh();
+    let mesh = std::sync::Arc::new(grid_mesh());
     let optics = optics(&mesh, "low-opacity");
     let scene = Scene::new(
         &mesh,

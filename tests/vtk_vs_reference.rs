@@ -35,7 +35,7 @@ fn camera(mesh: &TetMesh, name: &str, dir: [f64; 3]) -> Camera {
 /// Renders `cameras` with one VTK mapper (one Python process for all of them).
 fn vtk_images(
     gpu: &Gpu,
-    mesh: &TetMesh,
+    mesh: &std::sync::Arc<TetMesh>,
     optics: &Optics,
     peer: VtkPeer,
     cameras: &[Camera],
@@ -59,7 +59,7 @@ fn vtk_images(
 
 fn check(
     what: &str,
-    mesh: &TetMesh,
+    mesh: &std::sync::Arc<TetMesh>,
     cameras: &[Camera],
     peer: impl Fn() -> VtkPeer,
 ) -> Vec<ImageError> {
@@ -96,22 +96,22 @@ fn displayed(mapper: VtkMapper) -> VtkPeer {
     VtkPeer::new(mapper, Integrator::Linear, Readout::Framebuffer, true)
 }
 
-fn spx() -> Option<TetMesh> {
+fn spx() -> Option<std::sync::Arc<TetMesh>> {
     let path = tetbench_tests::data_file("spx.vtk")?;
     let mesh = datasets::load::load(&path, &Default::default())
         .unwrap()
         .mesh;
     assert_eq!(mesh.num_tets(), 12936);
-    Some(mesh)
+    Some(std::sync::Arc::new(mesh))
 }
 
-fn shell() -> TetMesh {
+fn shell() -> std::sync::Arc<TetMesh> {
     let mesh = datasets::registry::Registry::new(None)
         .resolve("shell:20k", &Default::default())
         .unwrap()
         .mesh;
     assert!(!mesh.is_convex());
-    mesh
+    std::sync::Arc::new(mesh)
 }
 
 #[test]

@@ -96,15 +96,23 @@ pub struct LazyDataset {
 
 #[derive(Debug)]
 enum Content {
-    Mesh(Box<Dataset>),
+    /// The mesh is shared (`Arc`): a renderer that reads it every frame keeps a handle to this
+    /// one instead of a copy (at 20 M tets a copy is 385 MB).
+    Mesh {
+        mesh: Arc<TetMesh>,
+        volume: Option<Arc<VoxelGrid>>,
+    },
     Voxels(Box<VoxelVolume>),
 }
 
 impl From<Dataset> for LazyDataset {
     fn from(ds: Dataset) -> LazyDataset {
         LazyDataset {
-            source: ds.source.clone(),
-            content: Content::Mesh(Box::new(ds)),
+            source: ds.source,
+            content: Content::Mesh {
+                mesh: Arc::new(ds.mesh),
+                volume: ds.volume,
+            },
         }
     }
 }
@@ -122,14 +130,14 @@ impl LazyDataset {
     pub fn voxels(&self) -> Option<&VoxelVolume> {
         match &self.content {
             Content::Voxels(v) => Some(v),
-            Content::Mesh(_) => None,
+            Content::Mesh { .. } => None,
         }
     }
 
     /// The tet mesh, split from the voxels on first use.
-    pub fn mesh(&self) -> Result<&TetMesh, LoadError> {
+    pub fn mesh(&self) -> Result<&Arc<TetMesh>, LoadError> {
         match &self.content {
-            Content::Mesh(ds) => Ok(&ds.mesh),
+            Content::Mesh { mesh, .. } => Ok(mesh),
             Content::Voxels(v) => v.mesh().map_err(|k| LoadError::new(&self.source, k)),
         }
     }
@@ -137,14 +145,14 @@ impl LazyDataset {
     /// Whether the tet mesh exists (always for a mesh; for voxels, once [`Self::mesh`] ran).
     pub fn tets_built(&self) -> bool {
         match &self.content {
-            Content::Mesh(_) => true,
+            Content::Mesh { .. } => true,
             Content::Voxels(v) => v.tets_built(),
         }
     }
 
     pub fn num_points(&self) -> usize {
         match &self.content {
-            Content::Mesh(ds) => ds.mesh.num_points(),
+            Content::Mesh { mesh, .. } => mesh.num_points(),
             Content::Voxels(v) => v.num_points(),
         }
     }
@@ -152,7 +160,7 @@ impl LazyDataset {
     /// Tets of the mesh, counted without splitting the voxels.
     pub fn num_tets(&self) -> usize {
         match &self.content {
-            Content::Mesh(ds) => ds.mesh.num_tets(),
+            Content::Mesh { mesh, .. } => mesh.num_tets(),
             Content::Voxels(v) => v.num_tets(),
         }
     }
@@ -160,7 +168,7 @@ impl LazyDataset {
     /// The mesh's [`TetMesh::bounds`], without splitting the voxels.
     pub fn bounds(&self) -> Aabb {
         match &self.content {
-            Content::Mesh(ds) => ds.mesh.bounds(),
+            Content::Mesh { mesh, .. } => mesh.bounds(),
             Content::Voxels(v) => v.bounds(),
         }
     }
@@ -168,7 +176,7 @@ impl LazyDataset {
     /// The mesh's [`TetMesh::scalar_range`], without splitting the voxels.
     pub fn scalar_range(&self) -> (f32, f32) {
         match &self.content {
-            Content::Mesh(ds) => ds.mesh.scalar_range(),
+            Content::Mesh { mesh, .. } => mesh.scalar_range(),
             Content::Voxels(v) => v.scalar_range(),
         }
     }
@@ -176,9 +184,10 @@ impl LazyDataset {
     /// The data set with its mesh (split now if it was voxels), sharing the grid.
     pub fn into_dataset(self) -> Result<Dataset, LoadError> {
         match self.content {
-            Content::Mesh(ds) => Ok(Dataset {
+            Content::Mesh { mesh, volume } => Ok(Dataset {
+                mesh: Arc::unwrap_or_clone(mesh),
+                volume,
                 source: self.source,
-                ..*ds
             }),
             Content::Voxels(v) => {
                 let volume = Some(Arc::clone(v.grid()));

@@ -108,7 +108,6 @@ struct DerivedCache {
     bounds: OnceLock<Aabb>,
     adjacency: OnceLock<Vec<[u32; 4]>>,
     boundary: OnceLock<Vec<BoundaryFace>>,
-    unique_faces: OnceLock<UniqueFaces>,
     gradients: OnceLock<Vec<[f32; 3]>>,
     normals: OnceLock<Vec<[[f32; 3]; 4]>>,
     quality: OnceLock<QualityStats>,
@@ -401,21 +400,22 @@ impl TetMesh {
     }
 
     /// Every triangle once: interior faces from the lower-numbered tet, boundary faces outward.
-    pub fn unique_faces(&self) -> &UniqueFaces {
-        self.cache.unique_faces.get_or_init(|| {
-            let adj = self.adjacency();
-            let mut faces = Vec::with_capacity(self.tets.len() * 2 + 64);
-            let mut boundary = Vec::with_capacity(faces.capacity());
-            for (t, a) in adj.iter().enumerate() {
-                for (f, &n) in a.iter().enumerate() {
-                    if n == NO_NEIGHBOUR || (n as usize) > t {
-                        faces.push(TET_FACES[f].map(|i| self.tets[t][i]));
-                        boundary.push(n == NO_NEIGHBOUR);
-                    }
+    /// Built on each call and not kept (unlike the adjacency it is made from): its one user,
+    /// HAVS's prepare, turns it into its own face array at once, and a cached copy would hold
+    /// 13 bytes a face (520 MB at 20 M tets) for the rest of the run (issue 27, item 6).
+    pub fn unique_faces(&self) -> UniqueFaces {
+        let adj = self.adjacency();
+        let mut faces = Vec::with_capacity(self.tets.len() * 2 + 64);
+        let mut boundary = Vec::with_capacity(faces.capacity());
+        for (t, a) in adj.iter().enumerate() {
+            for (f, &n) in a.iter().enumerate() {
+                if n == NO_NEIGHBOUR || (n as usize) > t {
+                    faces.push(TET_FACES[f].map(|i| self.tets[t][i]));
+                    boundary.push(n == NO_NEIGHBOUR);
                 }
             }
-            UniqueFaces { faces, boundary }
-        })
+        }
+        UniqueFaces { faces, boundary }
     }
 
     /// Outward unit normal of each face of each tet (face order [`TET_FACES`]), computed once

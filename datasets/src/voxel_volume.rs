@@ -76,7 +76,9 @@ pub struct VoxelVolume {
     split: CellSplit,
     cover: CellCover,
     footprint: OnceLock<Footprint>,
-    mesh: OnceLock<TetMesh>,
+    /// Shared (`Arc`) so that renderers which read the mesh every frame keep a handle, not
+    /// a copy.
+    mesh: OnceLock<Arc<TetMesh>>,
 }
 
 impl VoxelVolume {
@@ -215,18 +217,18 @@ impl VoxelVolume {
     /// The split mesh, built on first use and kept; it shares the grid
     /// ([`TetMesh::source_grid`]), so the values are held by the grid and once more as the
     /// mesh's point scalars, only while the mesh exists.
-    pub fn mesh(&self) -> Result<&TetMesh, ErrorKind> {
+    pub fn mesh(&self) -> Result<&Arc<TetMesh>, ErrorKind> {
         if let Some(m) = self.mesh.get() {
             return Ok(m);
         }
-        let m = self.split_now()?;
+        let m = Arc::new(self.split_now()?);
         Ok(self.mesh.get_or_init(|| m))
     }
 
     /// The split mesh, the volume given up.
     pub fn into_mesh(mut self) -> Result<TetMesh, ErrorKind> {
         match self.mesh.take() {
-            Some(m) => Ok(m),
+            Some(m) => Ok(Arc::unwrap_or_clone(m)),
             None => self.split_now(),
         }
     }

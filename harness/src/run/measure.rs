@@ -26,7 +26,7 @@ pub(super) struct DatasetContext<'a> {
 /// What a renderer is prepared from: the voxels themselves, or the tets.
 enum PrepareInput<'a> {
     Voxels(&'a datasets::VoxelVolume),
-    Tets(&'a datasets::TetMesh),
+    Tets(&'a std::sync::Arc<datasets::TetMesh>),
 }
 
 /// The row's fixed parts, before measuring (everything measured starts empty).

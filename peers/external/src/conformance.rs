@@ -509,7 +509,7 @@ pub fn check(
         std::fs::create_dir_all(dir)
             .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
     }
-    let mesh = l_mesh();
+    let mesh = std::sync::Arc::new(l_mesh());
     let optics = Optics::for_mesh(
         TransferFunction::preset("low-opacity").expect("a preset"),
         &mesh,

@@ -340,7 +340,12 @@ impl Renderer for ExternalRenderer {
         self.spec.row_settings()
     }
 
-    fn prepare(&mut self, _gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+    fn prepare(
+        &mut self,
+        _gpu: &Gpu,
+        mesh: &std::sync::Arc<TetMesh>,
+        optics: &Optics,
+    ) -> anyhow::Result<Prepared> {
         self.prepare_mesh(mesh, optics)
     }
 

@@ -183,7 +183,12 @@ impl Renderer for VtkPeer {
         )
     }
 
-    fn prepare(&mut self, _gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+    fn prepare(
+        &mut self,
+        _gpu: &Gpu,
+        mesh: &std::sync::Arc<TetMesh>,
+        optics: &Optics,
+    ) -> anyhow::Result<Prepared> {
         self.client.prepare_mesh(mesh, optics).with_context(|| {
             format!(
                 "VTK peer {} under {} could not set up the mesh; if VTK is missing: {}",

@@ -4,6 +4,8 @@
 //! [`Renderer::render`] per camera (timings) → [`Renderer::read_image`] (only when the harness
 //! wants the picture, so readback never pollutes the timings).
 
+use std::sync::Arc;
+
 use datasets::{TetMesh, VoxelVolume};
 
 use crate::gpu::Gpu;
@@ -47,8 +49,16 @@ pub trait Renderer {
     /// description's `build` takes).
     fn settings(&self) -> Settings;
 
-    /// Uploads the mesh and every view-independent table.
-    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared>;
+    /// Uploads the mesh and every view-independent table. The mesh is shared: a renderer that
+    /// reads it every frame (a CPU visibility sort, work counters) keeps a clone of the `Arc`,
+    /// never a copy of the mesh, so that a run holds each mesh once (at 20 M tets a copy is
+    /// 385 MB; issue 27).
+    fn prepare(
+        &mut self,
+        gpu: &Gpu,
+        mesh: &Arc<TetMesh>,
+        optics: &Optics,
+    ) -> anyhow::Result<Prepared>;
 
     /// Whether [`Renderer::prepare_voxels`] draws a voxel data set from its grid alone (the
     /// splatter): a run then never splits such a data set into tets for this renderer.

@@ -161,7 +161,8 @@ pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
 
 /// Everything uploaded by `prepare`.
 struct State {
-    mesh: TetMesh,
+    /// The loaded mesh, shared: the CPU sort variants and the work counters read it per frame.
+    mesh: std::sync::Arc<TetMesh>,
     tets: u32,
     ledger: MemoryLedger,
     model_bytes: u64,
@@ -328,7 +329,12 @@ impl Renderer for FragmentPt {
         description::settings_of(&self.settings)
     }
 
-    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+    fn prepare(
+        &mut self,
+        gpu: &Gpu,
+        mesh: &std::sync::Arc<TetMesh>,
+        optics: &Optics,
+    ) -> anyhow::Result<Prepared> {
         self.state = None;
         if !gpu.features.contains(wgpu::Features::FLOAT32_BLENDABLE) {
             bail!(
@@ -599,7 +605,7 @@ impl Renderer for FragmentPt {
         let range = optics.scalar_max - optics.scalar_min;
         let persistent = ledger.persistent;
         self.state = Some(State {
-            mesh: mesh.clone(),
+            mesh: std::sync::Arc::clone(mesh),
             tets: n as u32,
             ledger,
             model_bytes,

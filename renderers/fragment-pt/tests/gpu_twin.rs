@@ -93,7 +93,7 @@ fn gpu_pass1_matches_cpu_twin() {
             128,
             128,
         );
-        let mesh = build_mesh(&mut rng, &camera, 6000, 1000);
+        let mesh = std::sync::Arc::new(build_mesh(&mut rng, &camera, 6000, 1000));
         let tf = TransferFunction::preset("low-opacity").expect("low-opacity preset");
         let optics = Optics::for_mesh(tf, &mesh);
         let mut r = FragmentPt::new(FragmentPtSettings {
@@ -188,7 +188,7 @@ fn gpu_pass1_matches_cpu_twin() {
 #[test]
 fn split_bindings_draw_the_same_image() {
     let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
-    let mesh = datasets::generate::from_spec("box:1k", 1).unwrap();
+    let mesh = std::sync::Arc::new(datasets::generate::from_spec("box:1k", 1).unwrap());
     let tf = TransferFunction::preset("high-opacity").unwrap();
     let optics = Optics::for_mesh(tf, &mesh);
     let vp = Viewpoint::new("oblique", [0.4, 0.6, 0.7]);

@@ -60,7 +60,9 @@ fn main() -> anyhow::Result<()> {
         gpu.adapter.name, gpu.adapter.backend, gpu.adapter.driver
     );
     for file in files {
-        let mesh = datasets::load::load(std::path::Path::new(&file), &Default::default())?.mesh;
+        let mesh = std::sync::Arc::new(
+            datasets::load::load(std::path::Path::new(&file), &Default::default())?.mesh,
+        );
         let optics = Optics::for_mesh(
             TransferFunction::preset("low-opacity").expect("preset"),
             &mesh,

@@ -463,8 +463,9 @@ struct State {
     order_buf: wgpu::Buffer,
     index_buf: wgpu::Buffer,
     chunks: Vec<DrawChunk>,
-    /// The mesh as prepared (the visibility sorter reads its centroids / face adjacency).
-    host_mesh: TetMesh,
+    /// The loaded mesh, shared, not copied (the visibility sorter reads its centroids / face
+    /// adjacency, the counters its silhouette).
+    host_mesh: std::sync::Arc<TetMesh>,
     sorter: VisibilitySorter,
     order: Vec<u32>,
     timer: FrameTimer,
@@ -487,7 +488,12 @@ impl Renderer for GatorPt {
         description::settings_of(self.cells, self.order)
     }
 
-    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+    fn prepare(
+        &mut self,
+        gpu: &Gpu,
+        mesh: &std::sync::Arc<TetMesh>,
+        optics: &Optics,
+    ) -> anyhow::Result<Prepared> {
         self.state = None;
         if !gpu.features.contains(wgpu::Features::FLOAT32_BLENDABLE) {
             bail!("gator-pt needs FLOAT32_BLENDABLE (blending into an Rgba32Float target); adapter {} lacks it", gpu.adapter.name);
@@ -580,7 +586,7 @@ impl Renderer for GatorPt {
         // Per-mesh work of the visibility order (centroids; MPVONC's face planes) is done here,
         // not in the first timed frame.
         let mut sorter = VisibilitySorter::new(self.order);
-        let host_mesh = mesh.clone();
+        let host_mesh = std::sync::Arc::clone(mesh);
         let mut order = Vec::with_capacity(n as usize);
         let warm = Camera::fit(
             &mesh.bounds(),

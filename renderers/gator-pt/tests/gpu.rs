@@ -411,8 +411,8 @@ fn closed_form_error(
 fn constant_field_images_are_exact_even_for_degenerate_views() {
     let gpu = gpu();
     let kappa = 2.5;
-    let coarse = box_mesh([6, 5, 4], [1.0, 0.8, 0.6]);
-    let fine = box_mesh([11, 9, 7], [1.0, 0.8, 0.6]);
+    let coarse = std::sync::Arc::new(box_mesh([6, 5, 4], [1.0, 0.8, 0.6]));
+    let fine = std::sync::Arc::new(box_mesh([11, 9, 7], [1.0, 0.8, 0.6]));
     let oblique = Viewpoint::new("oblique", [0.3, 0.5, 0.8]);
     for cells in [CellModel::Constant, CellModel::Linear] {
         let mut r = GatorPt::new(cells, VisibilityOrder::CentroidRadix);
@@ -446,7 +446,13 @@ fn constant_field_images_are_exact_even_for_degenerate_views() {
     }
 }
 
-fn render(gpu: &Gpu, r: &mut GatorPt, mesh: &TetMesh, optics: &Optics, cam: &Camera) -> Image {
+fn render(
+    gpu: &Gpu,
+    r: &mut GatorPt,
+    mesh: &std::sync::Arc<TetMesh>,
+    optics: &Optics,
+    cam: &Camera,
+) -> Image {
     let prepared = r.prepare(gpu, mesh, optics).unwrap();
     assert_eq!(prepared.tets, mesh.num_tets() as u64);
     assert!(
@@ -464,7 +470,7 @@ fn render(gpu: &Gpu, r: &mut GatorPt, mesh: &TetMesh, optics: &Optics, cam: &Cam
 fn chunked_bindings_draw_the_same_image() {
     let gpu = gpu();
     // 3·2·2 cells · 5 = 60 tets (16 per 256-byte binding: 4 chunks), 36 points (3 chunks).
-    let mesh = box_mesh([4, 3, 3], [1.0, 0.8, 0.7]);
+    let mesh = std::sync::Arc::new(box_mesh([4, 3, 3], [1.0, 0.8, 0.7]));
     assert_eq!((mesh.num_tets(), mesh.num_points()), (60, 36));
     let tf = TransferFunction::preset("high-opacity").unwrap();
     let optics = Optics::for_mesh(tf, &mesh);

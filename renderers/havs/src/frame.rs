@@ -450,7 +450,7 @@ mod tests {
     fn render(
         gpu: &Gpu,
         r: &mut Havs,
-        mesh: &TetMesh,
+        mesh: &std::sync::Arc<TetMesh>,
         cam: &Camera,
     ) -> (Image, Vec<(String, f64)>) {
         let tf = TransferFunction::preset("high-opacity").unwrap();
@@ -474,7 +474,7 @@ mod tests {
     #[test]
     fn split_bindings_render_the_same_image() {
         let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
-        let mesh = datasets::generate::from_spec("box:1k", 1).unwrap();
+        let mesh = std::sync::Arc::new(datasets::generate::from_spec("box:1k", 1).unwrap());
         let vp = Viewpoint::new("oblique", [0.4, 0.6, 0.7]);
         let cam = Camera::fit(&mesh.bounds(), &vp, Projection::default(), 48, 48);
         for sort in [SortMode::CpuRadix, SortMode::GpuRadix] {

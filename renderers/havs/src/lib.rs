@@ -320,29 +320,29 @@ struct State {
 /// so a fragment knows it lies on the boundary; whether it is an entry or an exit is decided in
 /// the fragment shader from the face's orientation (boundary faces are wound outward).
 pub fn tagged_geometry(mesh: &TetMesh, optics: &Optics) -> abuffer::Geometry {
-    let uf = mesh.unique_faces();
+    let datasets::UniqueFaces {
+        mut faces,
+        boundary,
+    } = mesh.unique_faces();
     let mut verts: Vec<[f32; 4]> = mesh
         .points
         .iter()
         .zip(&mesh.scalars)
         .map(|(p, &s)| [p[0], p[1], p[2], optics.normalise(s as f64) as f32])
         .collect();
+    // Boundary faces are redirected to the vertex copies in place: at 20 M tets a second face
+    // array would be 481 MB more at the prepare's peak.
     let mut copy = vec![u32::MAX; mesh.points.len()];
-    let mut faces = Vec::with_capacity(uf.faces.len());
-    for (f, &b) in uf.faces.iter().zip(&uf.boundary) {
-        if b {
-            faces.push(f.map(|v| {
-                if copy[v as usize] == u32::MAX {
-                    let mut c = verts[v as usize];
-                    c[3] += 2.0;
-                    copy[v as usize] = verts.len() as u32;
-                    verts.push(c);
-                }
-                copy[v as usize]
-            }));
-        } else {
-            faces.push(*f);
-        }
+    for (f, _) in faces.iter_mut().zip(&boundary).filter(|(_, &b)| b) {
+        *f = f.map(|v| {
+            if copy[v as usize] == u32::MAX {
+                let mut c = verts[v as usize];
+                c[3] += 2.0;
+                copy[v as usize] = verts.len() as u32;
+                verts.push(c);
+            }
+            copy[v as usize]
+        });
     }
     abuffer::Geometry { verts, faces }
 }
@@ -386,7 +386,12 @@ impl Renderer for Havs {
         description::settings_of(&self.settings)
     }
 
-    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+    fn prepare(
+        &mut self,
+        gpu: &Gpu,
+        mesh: &std::sync::Arc<TetMesh>,
+        optics: &Optics,
+    ) -> anyhow::Result<Prepared> {
         let s = self.settings;
         if s.k < 1 || s.k > MAX_K {
             bail!("HAVS: k = {} is outside 1..={MAX_K}", s.k);
@@ -426,13 +431,18 @@ impl Renderer for Havs {
         )?;
         check_storage_bindings(gpu, "HAVS", 6 + verts_buf.bindings() + faces_buf.bindings())?;
         let num_faces = faces.len() as u64;
-        let centroids: Vec<[f32; 3]> = faces
-            .par_iter()
-            .map(|f| {
-                let p = f.map(|v| verts[v as usize]);
-                [0, 1, 2].map(|a| (p[0][a] + p[1][a] + p[2][a]) / 3.0)
-            })
-            .collect();
+        // Only the CPU sort reads face centroids (12 B a face); the GPU sort's key pass
+        // computes them from the uploaded faces.
+        let centroids: Vec<[f32; 3]> = match s.sort {
+            SortMode::CpuRadix => faces
+                .par_iter()
+                .map(|f| {
+                    let p = f.map(|v| verts[v as usize]);
+                    [0, 1, 2].map(|a| (p[0][a] + p[1][a] + p[2][a]) / 3.0)
+                })
+                .collect(),
+            SortMode::GpuRadix => Vec::new(),
+        };
 
         // The 3D pre-integrated table (s_front, s_back, length), lengths up to the longest
         // edge: no segment inside a tet is longer.

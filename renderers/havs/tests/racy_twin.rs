@@ -65,7 +65,7 @@ fn twin_counts(lists: &[Vec<(f32, f32, u32)>], k: usize) -> Vec<[u32; 3]> {
 
 fn render(
     gpu: &Gpu,
-    mesh: &datasets::TetMesh,
+    mesh: &std::sync::Arc<datasets::TetMesh>,
     optics: &Optics,
     s: HavsSettings,
     camera: &Camera,
@@ -81,7 +81,7 @@ fn the_racy_single_pass_counts_what_its_cpu_twin_counts_per_pixel() {
     let gpu = gpu();
     // The sliver onion breaks a k = 2 buffer almost everywhere (issue 15), so the counts to
     // compare are not all zero; 48² keeps the per-pixel lists short enough to check quickly.
-    let mesh = datasets::generate::from_spec("onion:4k", 1).unwrap();
+    let mesh = std::sync::Arc::new(datasets::generate::from_spec("onion:4k", 1).unwrap());
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     // Out-of-order pops over all three views: k = 3 has a handful (8 on lavapipe, none on an
     // H200, whose rasteriser puts some fragments elsewhere), k = 2 thousands.

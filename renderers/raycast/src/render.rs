@@ -260,7 +260,12 @@ impl Renderer for Raycast {
         self.settings.to_settings()
     }
 
-    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+    fn prepare(
+        &mut self,
+        gpu: &Gpu,
+        mesh: &std::sync::Arc<TetMesh>,
+        optics: &Optics,
+    ) -> anyhow::Result<Prepared> {
         self.state = None;
         self.settings.validate()?;
         let max_binding = self.max_binding.map_or(gpu.max_storage_binding(), |b| {

@@ -49,7 +49,7 @@ impl Rng {
 
 #[test]
 fn layout_is_144_bytes_per_tet_and_splits_across_bindings() {
-    let mesh = shell();
+    let mesh = std::sync::Arc::new(shell());
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     let n = mesh.num_tets() as u64;
     let one = MeshLayout::build(&mesh, &optics, 1 << 27).unwrap();
@@ -87,7 +87,7 @@ fn layout_is_144_bytes_per_tet_and_splits_across_bindings() {
 #[test]
 fn one_step_on_the_gpu_agrees_with_the_cpu_twin() {
     let gpu = gpu();
-    let mesh = shell();
+    let mesh = std::sync::Arc::new(shell());
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     let mut r = Raycast::new(exact()).with_max_binding(mesh.num_tets().div_ceil(2) as u64 * 144);
     r.prepare(&gpu, &mesh, &optics).unwrap();
@@ -150,7 +150,7 @@ fn one_step_on_the_gpu_agrees_with_the_cpu_twin() {
 fn render(
     gpu: &Gpu,
     r: &mut Raycast,
-    mesh: &TetMesh,
+    mesh: &std::sync::Arc<TetMesh>,
     optics: &Optics,
     view: usize,
     size: u32,
@@ -182,7 +182,7 @@ fn counter(stats: &render_core::FrameStats, name: &str) -> f64 {
 #[test]
 fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
     let gpu = gpu();
-    let mesh = shell();
+    let mesh = std::sync::Arc::new(shell());
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     let settings = RaycastSettings {
         tiles: 6,
@@ -269,14 +269,16 @@ fn one_tet_costs_one_step_per_covered_pixel() {
         [0.0, 1.0, 0.0],
         [0.0, 0.0, 1.0],
     ];
-    let mesh = TetMesh::new(
-        "one tet",
-        points,
-        vec![0.0, 0.3, 0.6, 1.0],
-        "s",
-        vec![[0, 1, 2, 3]],
-    )
-    .expect("a valid tet");
+    let mesh = std::sync::Arc::new(
+        TetMesh::new(
+            "one tet",
+            points,
+            vec![0.0, 0.3, 0.6, 1.0],
+            "s",
+            vec![[0, 1, 2, 3]],
+        )
+        .expect("a valid tet"),
+    );
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     for mode in [Mode::Passes, Mode::Loop] {
         let mut r = Raycast::new(RaycastSettings { mode, ..exact() });
@@ -295,7 +297,7 @@ fn one_tet_costs_one_step_per_covered_pixel() {
 #[test]
 fn images_match_the_reference_on_a_non_convex_mesh_in_both_modes_and_across_bindings() {
     let gpu = gpu();
-    let mesh = shell();
+    let mesh = std::sync::Arc::new(shell());
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     let size = 64;
     let mut passes = Raycast::new(exact());
@@ -343,9 +345,11 @@ fn spx_matches_the_reference() {
     let Some(path) = datasets::registry::test_data_file("spx.vtk") else {
         return;
     };
-    let mesh = datasets::load::load(&path, &Default::default())
-        .unwrap()
-        .mesh;
+    let mesh = std::sync::Arc::new(
+        datasets::load::load(&path, &Default::default())
+            .unwrap()
+            .mesh,
+    );
     let gpu = gpu();
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     let mut r = Raycast::new(exact());

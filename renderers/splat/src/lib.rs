@@ -892,7 +892,12 @@ impl Renderer for Splat {
         description::settings_of(&self.settings)
     }
 
-    fn prepare(&mut self, gpu: &Gpu, mesh: &TetMesh, optics: &Optics) -> anyhow::Result<Prepared> {
+    fn prepare(
+        &mut self,
+        gpu: &Gpu,
+        mesh: &std::sync::Arc<TetMesh>,
+        optics: &Optics,
+    ) -> anyhow::Result<Prepared> {
         let grid = self.settings.grid;
         self.prepare_set(gpu, optics, mesh.num_tets(), |cap| {
             VoxelSet::new(mesh, optics, grid, cap)

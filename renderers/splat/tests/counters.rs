@@ -27,7 +27,7 @@ fn camera(mesh: &TetMesh, vp: &str, dir: [f64; 3], projection: Projection) -> Ca
 #[test]
 fn splat_fragments_bound_the_gpus_count_and_splats_match_the_buckets() {
     let gpu = gpu();
-    let mesh = datasets::gen_volume::from_volume_spec("vol:20x18x16").unwrap();
+    let mesh = std::sync::Arc::new(datasets::gen_volume::from_volume_spec("vol:20x18x16").unwrap());
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     for (vp, dir, proj) in [
         ("+x+y+z", [1.0, 1.0, 1.0], Projection::default()),
@@ -86,7 +86,7 @@ fn splat_fragments_bound_the_gpus_count_and_splats_match_the_buckets() {
 #[test]
 fn every_footprint_lies_inside_the_composite_rectangle() {
     let gpu = gpu();
-    let mesh = datasets::gen_volume::from_volume_spec("vol:20x18x16").unwrap();
+    let mesh = std::sync::Arc::new(datasets::gen_volume::from_volume_spec("vol:20x18x16").unwrap());
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     let mut r = Splat::new(SplatSettings::default());
     r.prepare(&gpu, &mesh, &optics).unwrap();

@@ -24,12 +24,24 @@ fn max_diff(a: &Image, b: &Image) -> f32 {
         .fold(0.0, f32::max)
 }
 
-fn render(gpu: &Gpu, s: SplatSettings, mesh: &TetMesh, optics: &Optics, cam: &Camera) -> Image {
+fn render(
+    gpu: &Gpu,
+    s: SplatSettings,
+    mesh: &std::sync::Arc<TetMesh>,
+    optics: &Optics,
+    cam: &Camera,
+) -> Image {
     render_splat(gpu, Splat::new(s), mesh, optics, cam)
 }
 
 /// One frame of a renderer already built (with its test hooks set).
-fn render_splat(gpu: &Gpu, r: Splat, mesh: &TetMesh, optics: &Optics, cam: &Camera) -> Image {
+fn render_splat(
+    gpu: &Gpu,
+    r: Splat,
+    mesh: &std::sync::Arc<TetMesh>,
+    optics: &Optics,
+    cam: &Camera,
+) -> Image {
     let mut r = r;
     r.prepare(gpu, mesh, optics).unwrap();
     let stats = r.render(gpu, cam).unwrap();
@@ -58,7 +70,7 @@ fn volume(spec: &str) -> TetMesh {
 #[test]
 fn gpu_bucket_boundaries_equal_the_cpu_twin() {
     let gpu = gpu();
-    let mesh = volume("vol:20x18x16");
+    let mesh = std::sync::Arc::new(volume("vol:20x18x16"));
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     for (vp, dir, proj) in [
         ("+x+y+z", [1.0, 1.0, 1.0], Projection::default()),
@@ -122,6 +134,7 @@ fn single_voxel_matches_its_analytic_projection() {
     };
     let mut mesh = vg.to_tets().unwrap();
     mesh.source_grid = Some(Arc::new(vg));
+    let mesh = Arc::new(mesh);
     let kappa = 30.0;
     let rgb = [1.0, 0.5, 0.25];
     let tf = TransferFunction {
@@ -175,7 +188,7 @@ fn single_voxel_matches_its_analytic_projection() {
 #[test]
 fn smooth_volume_agrees_with_the_reference_of_its_tet_split() {
     let gpu = gpu();
-    let mesh = volume("vol:28");
+    let mesh = std::sync::Arc::new(volume("vol:28"));
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     for (proj, name) in [
         (Projection::default(), "perspective"),
@@ -248,7 +261,7 @@ fn smooth_volume_agrees_with_the_reference_of_its_tet_split() {
 #[test]
 fn the_ring_of_sheets_equals_splatting_slab_by_slab() {
     let gpu = gpu();
-    let mesh = volume("vol:20x18x16");
+    let mesh = std::sync::Arc::new(volume("vol:20x18x16"));
     let optics = Optics::for_mesh(TransferFunction::preset("high-opacity").unwrap(), &mesh);
     let cam = camera(&mesh, "+x+y+z", [1.0, 1.0, 1.0], Projection::default(), 64);
     for (radius, slab) in [(1.5, 1.5), (2.0, 1.0), (2.0, 0.5)] {
@@ -282,7 +295,7 @@ fn the_ring_of_sheets_equals_splatting_slab_by_slab() {
 #[test]
 fn splitting_a_footprint_over_invocations_changes_no_bit() {
     let gpu = gpu();
-    let mesh = volume("vol:20x18x16");
+    let mesh = std::sync::Arc::new(volume("vol:20x18x16"));
     let optics = Optics::for_mesh(TransferFunction::preset("high-opacity").unwrap(), &mesh);
     // 96² and a near camera: footprints of a dozen rows and more, so 3 and 7 lanes split them.
     let cam = camera(&mesh, "+x+y+z", [1.0, 1.0, 1.0], Projection::default(), 96);
@@ -313,7 +326,7 @@ fn splitting_a_footprint_over_invocations_changes_no_bit() {
 #[test]
 fn resampled_mesh_is_close_to_the_reference() {
     let gpu = gpu();
-    let mesh = datasets::generate::from_spec("box:3k", 1).unwrap();
+    let mesh = std::sync::Arc::new(datasets::generate::from_spec("box:3k", 1).unwrap());
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
     let cam = camera(&mesh, "+x+y+z", [1.0, 1.0, 1.0], Projection::default(), 96);
     let reference = reference::render(&mesh, &optics, &cam);
@@ -347,7 +360,7 @@ fn resampled_mesh_is_close_to_the_reference() {
 #[test]
 fn early_splat_elimination_counts_what_it_drops() {
     let gpu = gpu();
-    let mesh = volume("vol:24");
+    let mesh = std::sync::Arc::new(volume("vol:24"));
     let optics = Optics::for_mesh(TransferFunction::preset("high-opacity").unwrap(), &mesh);
     let cam = camera(&mesh, "+x+y+z", [1.0, 1.0, 1.0], Projection::default(), 64);
     let frame = |ese: bool| {

@@ -26,7 +26,7 @@ fn a_voxel_only_data_set_renders_bit_for_bit_as_its_split_mesh() {
         let lazy = registry.resolve_lazy(spec, &options).unwrap();
         let volume = lazy.voxels().expect("a generated volume stays voxels");
         let eager = registry.resolve(spec, &options).unwrap();
-        let mesh = &eager.mesh;
+        let mesh = &std::sync::Arc::new(eager.mesh);
         assert_eq!(lazy.num_tets(), mesh.num_tets(), "{spec}");
         assert_eq!(lazy.bounds(), mesh.bounds(), "{spec}");
         let tf = TransferFunction::preset(tf).unwrap();
