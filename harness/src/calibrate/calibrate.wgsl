@@ -46,6 +46,34 @@ fn fill_fs() -> @location(0) vec4<f32> {
     return vec4<f32>(0.01, 0.01, 0.01, 0.01);
 }
 
+// Rasterisation of triangles that cover pixels, as projected cells do: one right triangle with
+// legs of `leg` pixels (the instance index) in each leg×leg cell of a RASTER_SIZE² target,
+// drawn with fill_fs and fill's blend. Its corners sit 0.25 pixel off the pixel grid, so no
+// pixel centre lies on an edge and each triangle has exactly leg·(leg+1)/2 fragments (the
+// centres (i, j) of its cell with i + j < leg). Two leg lengths give the cost per triangle and
+// per fragment (mod.rs, `raster_costs`).
+const RASTER_SIZE: u32 = 512u;
+
+@vertex
+fn raster_vs(
+    @builtin(vertex_index) vi: u32,
+    @builtin(instance_index) leg: u32,
+) -> @builtin(position) vec4<f32> {
+    let t = vi / 3u;
+    let k = vi % 3u;
+    let per_row = RASTER_SIZE / leg;
+    let cell = t % (per_row * per_row);
+    let corner = vec2<f32>(f32(cell % per_row), f32(cell / per_row)) * f32(leg) + 0.25;
+    var o = vec2<f32>(0.0, 0.0);
+    if k == 1u {
+        o = vec2<f32>(f32(leg), 0.0);
+    } else if k == 2u {
+        o = vec2<f32>(0.0, f32(leg));
+    }
+    let p = (corner + o) / f32(RASTER_SIZE) * 2.0 - 1.0;
+    return vec4<f32>(p.x, -p.y, 0.5, 1.0);
+}
+
 // Compute: four independent vec4 FMA chains per invocation (ILP), FMA_ITERS rounds, the result
 // stored so nothing is optimised away. FLOPs per invocation = FMA_ITERS · 4 chains · 4 lanes · 2.
 const FMA_ITERS: u32 = 256u;

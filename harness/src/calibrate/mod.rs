@@ -1,9 +1,12 @@
 //! `tetbench calibrate`: a short, fixed micro-benchmark of the backend, and the roofline every
 //! row gets from it.
 //!
-//! Eight figures, each from one kernel that stresses one resource (`calibrate.wgsl`):
+//! Nine figures, each from one kernel that stresses one resource (`calibrate.wgsl`):
 //! small-triangle setup rate (triangles covering one pixel each), fill rate (a viewport-sized
-//! triangle blended additively into the target format the algorithms use), compute throughput
+//! triangle blended additively into the target format the algorithms use), rasterisation of
+//! triangles that cover pixels (two sizes, fitted as a cost per triangle plus a cost per
+//! fragment: small triangles cost far more per fragment than one viewport-sized triangle, and a
+//! projected cell's are small), compute throughput
 //! (vec4 FMA chains), storage-copy bandwidth (a compute copy between two storage buffers), the
 //! CPU radix sort of `render_core::sort` (HAVS §5.1) in keys/s, and the work-specific ones of
 //! `work.rs`: ray steps (a walk through 144-byte cells), splat fragments (a compute pass's
@@ -16,8 +19,8 @@
 //!
 //! The roofline ([`annotate`]) reads work counters, never names: each [`Resource`] lists the
 //! counters that measure a row's work on it (`triangles`, `fragments`, `splat_fragments`,
-//! `ray_steps`, `cpu_sort_keys`, `gpu_sort_keys`) and its calibrated rate; a row's time on a
-//! resource is its counters over the rate, plus per-frame GPU bytes (scratch, k-buffers,
+//! `ray_steps`, `cpu_sort_keys`, `gpu_sort_keys`) with the calibrated cost of one unit of each;
+//! a row's time on a resource is the sum of its counters times their costs, plus per-frame GPU bytes (scratch, k-buffers,
 //! targets: each written at least once a frame) over the copy bandwidth. The largest is the
 //! bound (`roofline_ms`, `bound_by`), and `limit_fraction = roofline_ms / total_ms` says how
 //! close the row gets to it. `normalized_time = total_ms / roofline_ms` is what
@@ -39,12 +42,16 @@ use crate::results::Row;
 pub mod work;
 
 /// Bumped whenever a kernel or its size changes (old cache files are then re-measured).
-pub const CALIBRATION_VERSION: u32 = 5;
+pub const CALIBRATION_VERSION: u32 = 6;
 
 const GRID: u64 = 256; // calibrate.wgsl GRID
 const TRIANGLES: u64 = GRID * GRID * 2;
 const FILL_SIZE: u32 = 512;
 const FILL_LAYERS: u64 = 32;
+const RASTER_SIZE: u32 = 512; // calibrate.wgsl RASTER_SIZE
+const RASTER_TRIANGLES: u64 = 1 << 17;
+/// The two leg lengths (pixels) of the rasterisation benchmark's right triangles.
+const RASTER_LEGS: [u32; 2] = [4, 16];
 const FMA_ITERS: u64 = 256; // calibrate.wgsl FMA_ITERS
 const FMA_INVOCATIONS: u64 = 64 * 1024;
 const COPY_BYTES: u64 = 32 << 20;
@@ -134,7 +141,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
     let draw = |pipeline: &wgpu::RenderPipeline,
                 view: &wgpu::TextureView,
                 vertices: u32,
-                instances: u32|
+                instances: std::ops::Range<u32>|
      -> anyhow::Result<()> {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
@@ -155,7 +162,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
                 multiview_mask: None,
             });
             pass.set_pipeline(pipeline);
-            pass.draw(0..vertices, 0..instances);
+            pass.draw(0..vertices, instances);
         }
         gpu.queue.submit([enc.finish()]);
         gpu.wait()
@@ -174,7 +181,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         wgpu::ColorWrites::ALL,
     );
     let tri_view = target(tri_format, GRID as u32);
-    let tri_s = best_seconds(|| draw(&tri, &tri_view, (TRIANGLES * 3) as u32, 1))?;
+    let tri_s = best_seconds(|| draw(&tri, &tri_view, (TRIANGLES * 3) as u32, 0..1))?;
 
     // 2. Fill: the float format the algorithms composite into, when it blends here.
     let fill_format = if gpu.features.contains(wgpu::Features::FLOAT32_BLENDABLE) {
@@ -187,6 +194,10 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         dst_factor: wgpu::BlendFactor::One,
         operation: wgpu::BlendOperation::Add,
     };
+    let blend = Some(wgpu::BlendState {
+        color: add,
+        alpha: add,
+    });
     let fill = gpu.triangle_pipeline(
         "calibrate fill",
         &empty,
@@ -194,14 +205,36 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         "fill_vs",
         "fill_fs",
         fill_format,
-        Some(wgpu::BlendState {
-            color: add,
-            alpha: add,
-        }),
+        blend,
         wgpu::ColorWrites::ALL,
     );
     let fill_view = target(fill_format, FILL_SIZE);
-    let fill_s = best_seconds(|| draw(&fill, &fill_view, 3, FILL_LAYERS as u32))?;
+    let fill_s = best_seconds(|| draw(&fill, &fill_view, 3, 0..FILL_LAYERS as u32))?;
+
+    // 2b. Rasterisation of covering triangles, the same format and blend: seconds per triangle
+    // at each leg length (the instance index is the leg), then the fit.
+    let raster = gpu.triangle_pipeline(
+        "calibrate raster",
+        &empty,
+        &module,
+        "raster_vs",
+        "fill_fs",
+        fill_format,
+        blend,
+        wgpu::ColorWrites::ALL,
+    );
+    let raster_view = target(fill_format, RASTER_SIZE);
+    let mut raster_points = [(0.0, 0.0); 2];
+    for (point, leg) in raster_points.iter_mut().zip(RASTER_LEGS) {
+        let vertices = (RASTER_TRIANGLES * 3) as u32;
+        let s = best_seconds(|| draw(&raster, &raster_view, vertices, leg..leg + 1))?;
+        *point = (
+            raster_fragments_per_triangle(leg),
+            s / RASTER_TRIANGLES as f64,
+        );
+    }
+    let (raster_seconds_per_triangle, raster_seconds_per_fragment) =
+        raster_costs(raster_points[0], raster_points[1]);
 
     // 3. Compute throughput.
     let storage = |label: &str, bytes: u64| {
@@ -313,53 +346,82 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         ray_steps_per_sec,
         splat_fragments_per_sec,
         gpu_sort_keys_per_sec,
+        raster_seconds_per_triangle,
+        raster_seconds_per_fragment,
     })
+}
+
+/// Fragments of one of the rasterisation benchmark's triangles: the pixel centres `(i, j)` of
+/// its cell with `i + j < leg` (calibrate.wgsl, `raster_vs`).
+pub fn raster_fragments_per_triangle(leg: u32) -> f64 {
+    (leg as f64) * (leg as f64 + 1.0) / 2.0
+}
+
+/// The straight line `t = a + f·b` through two (fragments per triangle, seconds per triangle)
+/// points: `(a, b)`, the cost of a triangle and of each of its fragments. Each is at least 0,
+/// since timing noise can tilt a two-point fit.
+pub fn raster_costs(small: (f64, f64), large: (f64, f64)) -> (f64, f64) {
+    let per_fragment = ((large.1 - small.1) / (large.0 - small.0)).max(0.0);
+    let per_triangle = (small.1 - small.0 * per_fragment).max(0.0);
+    (per_triangle, per_fragment)
 }
 
 // ---------------------------------------------------------------------------------------------
 // Roofline
 // ---------------------------------------------------------------------------------------------
 
-/// One resource of the roofline: the work counters a row reports on it (summed) and the
-/// calibrated rate at which the backend does that work.
+/// A work counter's name and the calibrated seconds one unit of that work costs (0 where the
+/// calibration did not measure it).
+pub type CounterCost = (&'static str, fn(&Calibration) -> f64);
+
+/// One resource of the roofline: the work counters a row reports on it, each at its own cost.
 pub struct Resource {
     pub name: &'static str,
-    pub counters: &'static [&'static str],
-    pub rate: fn(&Calibration) -> f64,
+    pub costs: &'static [CounterCost],
+}
+
+/// Seconds per unit of a rate (0 for a rate not measured).
+fn per(rate: f64) -> f64 {
+    if rate > 0.0 {
+        1.0 / rate
+    } else {
+        0.0
+    }
 }
 
 /// Every counter-priced resource. A renderer opts in by reporting the counter; nothing here
 /// knows which renderer reports what.
-pub const RESOURCES: [Resource; 6] = [
+pub const RESOURCES: [Resource; 7] = [
     Resource {
         name: "triangle setup",
-        counters: &["triangles"],
-        rate: |c| c.triangles_per_sec,
+        costs: &[("triangles", |c| per(c.triangles_per_sec))],
     },
     Resource {
         name: "fill",
-        counters: &["fragments"],
-        rate: |c| c.fill_fragments_per_sec,
+        costs: &[("fragments", |c| per(c.fill_fragments_per_sec))],
+    },
+    Resource {
+        name: "rasterisation",
+        costs: &[
+            ("triangles", |c| c.raster_seconds_per_triangle),
+            ("fragments", |c| c.raster_seconds_per_fragment),
+        ],
     },
     Resource {
         name: "splat fill",
-        counters: &["splat_fragments"],
-        rate: |c| c.splat_fragments_per_sec,
+        costs: &[("splat_fragments", |c| per(c.splat_fragments_per_sec))],
     },
     Resource {
         name: "ray steps",
-        counters: &["ray_steps"],
-        rate: |c| c.ray_steps_per_sec,
+        costs: &[("ray_steps", |c| per(c.ray_steps_per_sec))],
     },
     Resource {
         name: "cpu sort",
-        counters: &["cpu_sort_keys"],
-        rate: |c| c.sort_keys_per_sec,
+        costs: &[("cpu_sort_keys", |c| per(c.sort_keys_per_sec))],
     },
     Resource {
         name: "gpu sort",
-        counters: &["gpu_sort_keys"],
-        rate: |c| c.gpu_sort_keys_per_sec,
+        costs: &[("gpu_sort_keys", |c| per(c.gpu_sort_keys_per_sec))],
     },
 ];
 
@@ -369,10 +431,15 @@ pub const RESOURCES: [Resource; 6] = [
 pub fn resource_times(row: &Row, cal: &Calibration) -> Vec<(&'static str, f64)> {
     let mut t = vec![];
     for r in &RESOURCES {
-        let work: Vec<f64> = r.counters.iter().filter_map(|c| row.counter(c)).collect();
-        let rate = (r.rate)(cal);
-        if !work.is_empty() && rate > 0.0 {
-            t.push((r.name, work.iter().sum::<f64>() / rate * 1e3));
+        let priced: Vec<f64> = r
+            .costs
+            .iter()
+            .filter_map(|(counter, cost)| Some((row.counter(counter)?, cost(cal))))
+            .filter(|&(_, cost)| cost > 0.0)
+            .map(|(work, cost)| work * cost)
+            .collect();
+        if !priced.is_empty() {
+            t.push((r.name, priced.iter().sum::<f64>() * 1e3));
         }
     }
     if let Some(b) = row.gpu_bytes_frame {
@@ -441,6 +508,24 @@ mod tests {
             ray_steps_per_sec: 2e6,
             splat_fragments_per_sec: 5e7,
             gpu_sort_keys_per_sec: 4e7,
+            raster_seconds_per_triangle: 0.5e-6,
+            raster_seconds_per_fragment: 0.8e-8,
+        }
+    }
+
+    /// Times agree to rounding (a unit's cost is the reciprocal of its rate).
+    fn assert_close(got: f64, want: f64, what: &str) {
+        assert!(
+            (got - want).abs() <= 1e-9 * want.abs(),
+            "{what}: {got} against {want}"
+        );
+    }
+
+    fn assert_times(got: &[(&str, f64)], want: &[(&str, f64)]) {
+        let names = |t: &[(&str, f64)]| t.iter().map(|(n, _)| n.to_string()).collect::<Vec<_>>();
+        assert_eq!(names(got), names(want));
+        for ((name, g), (_, w)) in got.iter().zip(want) {
+            assert_close(*g, *w, name);
         }
     }
 
@@ -464,23 +549,25 @@ mod tests {
              splat_fragments=500000;gpu_sort_keys=40000;rays=7000",
             80.0,
         )];
-        assert_eq!(
-            resource_times(&rows[0], &cal()),
-            vec![
+        assert_times(
+            &resource_times(&rows[0], &cal()),
+            &[
                 ("triangle setup", 40.0),
                 ("fill", 10.0),
+                // 40,000 triangles × 0.5 µs + 1,000,000 fragments × 8 ns.
+                ("rasterisation", 28.0),
                 ("splat fill", 10.0),
                 ("ray steps", 10.0),
                 ("cpu sort", 1.0),
                 ("gpu sort", 1.0),
                 ("memory", 0.1),
-            ]
+            ],
         );
         annotate(&mut rows, &cal());
         assert_eq!(rows[0].bound_by, "triangle setup");
-        assert_eq!(rows[0].roofline_ms, Some(40.0));
-        assert_eq!(rows[0].limit_fraction, Some(0.5));
-        assert_eq!(rows[0].normalized_time, Some(2.0));
+        assert_close(rows[0].roofline_ms.unwrap(), 40.0, "roofline_ms");
+        assert_close(rows[0].limit_fraction.unwrap(), 0.5, "limit_fraction");
+        assert_close(rows[0].normalized_time.unwrap(), 2.0, "normalized_time");
     }
 
     /// Changing one counter flips the bound: more ray steps make the row ray-step bound, more
@@ -506,12 +593,19 @@ mod tests {
                 2_500.0,
             ),
             ("fragments=20000000", "fill", 200.0),
+            // Neither count alone is the bound, their sum on the rasteriser is: 150,000
+            // triangles × 0.5 µs + 20 M fragments × 8 ns = 75 + 160 ms, against 150 and 200.
+            (
+                "triangles=150000;fragments=20000000",
+                "rasterisation",
+                235.0,
+            ),
         ] {
             let mut rows = vec![row(counters, 400.0)];
             annotate(&mut rows, &cal());
             assert_eq!(rows[0].bound_by, bound, "{counters}");
-            assert_eq!(rows[0].roofline_ms, Some(ms), "{counters}");
-            assert_eq!(rows[0].limit_fraction, Some(ms / 400.0), "{counters}");
+            assert_close(rows[0].roofline_ms.unwrap(), ms, counters);
+            assert_close(rows[0].limit_fraction.unwrap(), ms / 400.0, counters);
         }
     }
 
@@ -527,11 +621,112 @@ mod tests {
             ..cal()
         };
         let r = row("ray_steps=200000", 50.0);
-        assert_eq!(resource_times(&r, &old), vec![("memory", 0.1)]);
-        assert_eq!(
-            resource_times(&r, &cal()),
-            vec![("ray steps", 100.0), ("memory", 0.1)]
+        assert_times(&resource_times(&r, &old), &[("memory", 0.1)]);
+        assert_times(
+            &resource_times(&r, &cal()),
+            &[("ray steps", 100.0), ("memory", 0.1)],
         );
+        // A calibration from before the rasterisation benchmark prices triangles and fragments
+        // on their own resources only.
+        let before = Calibration {
+            raster_seconds_per_triangle: 0.0,
+            raster_seconds_per_fragment: 0.0,
+            ..cal()
+        };
+        let r = row("triangles=1000;fragments=1000000", 50.0);
+        assert_times(
+            &resource_times(&r, &before),
+            &[("triangle setup", 1.0), ("fill", 10.0), ("memory", 0.1)],
+        );
+    }
+
+    /// The fit goes through both points; noise that tilts it below zero is clamped, never
+    /// priced as negative work.
+    #[test]
+    fn the_raster_fit_recovers_a_line_and_clamps_noise() {
+        let line = |f: f64| 2e-7 + f * 5e-9;
+        let (small, large) = (
+            raster_fragments_per_triangle(4),
+            raster_fragments_per_triangle(16),
+        );
+        assert_eq!((small, large), (10.0, 136.0));
+        let (a, b) = raster_costs((small, line(small)), (large, line(large)));
+        assert_close(a, 2e-7, "per triangle");
+        assert_close(b, 5e-9, "per fragment");
+        // Large triangles timed faster than small ones: no per-fragment cost, all per triangle.
+        assert_eq!(raster_costs((10.0, 3e-7), (136.0, 2e-7)), (3e-7, 0.0));
+        // A per-fragment slope steeper than the small point allows: no per-triangle cost.
+        let (a, b) = raster_costs((10.0, 1e-8), (136.0, 1e-6));
+        assert_eq!(a, 0.0);
+        assert!(b > 0.0);
+    }
+
+    /// The benchmark's triangles have exactly the fragments the fit assumes: drawn once per
+    /// cell with fill's additive blend of 0.01, the target sums to 0.01 × the count.
+    #[test]
+    fn raster_triangles_have_the_counted_fragments() {
+        let gpu = Gpu::new().expect("an adapter (lavapipe)");
+        let module = gpu.shader("calibrate", include_str!("calibrate.wgsl"));
+        let layout = gpu
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: None,
+                bind_group_layouts: &[],
+                immediate_size: 0,
+            });
+        let add = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let format = wgpu::TextureFormat::Rgba32Float;
+        let pipeline = gpu.triangle_pipeline(
+            "raster test",
+            &layout,
+            &module,
+            "raster_vs",
+            "fill_fs",
+            format,
+            Some(wgpu::BlendState {
+                color: add,
+                alpha: add,
+            }),
+            wgpu::ColorWrites::ALL,
+        );
+        for leg in RASTER_LEGS {
+            let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: None,
+                size: wgpu::Extent3d {
+                    width: RASTER_SIZE,
+                    height: RASTER_SIZE,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            let view = texture.create_view(&Default::default());
+            let cells = (RASTER_SIZE / leg).pow(2);
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            {
+                let mut pass =
+                    render_core::bind::color_pass(&mut enc, "raster test", &view, true, true, None);
+                pass.set_pipeline(&pipeline);
+                pass.draw(0..cells * 3, leg..leg + 1);
+            }
+            gpu.queue.submit([enc.finish()]);
+            let image = gpu.read_rgba32f(&texture).unwrap();
+            let sum: f64 = image.pixels.iter().map(|p| p[3] as f64).sum();
+            let counted = (sum / 0.01).round();
+            assert_eq!(
+                counted,
+                cells as f64 * raster_fragments_per_triangle(leg),
+                "leg {leg}: the target sums to {sum}"
+            );
+        }
     }
 
     /// The roofline never looks at a row's algorithm or settings: this file quotes no

@@ -78,9 +78,9 @@ pub enum Command {
     /// Compare two runs: faster / slower / no change per row and group (Mann–Whitney U and a
     /// factor threshold), image and memory changes; writes compare.{md,json,html}.
     Compare(CompareArgs),
-    /// Measure the backend (triangle setup, fill, compute, storage copy, CPU and GPU radix
-    /// sort, ray steps, splat fill) in under a minute; cached per adapter and driver, recorded
-    /// in every run.
+    /// Measure the backend (triangle setup, fill, rasterisation of small triangles, compute,
+    /// storage copy, CPU and GPU radix sort, ray steps, splat fill) in under a minute; cached
+    /// per adapter and driver, recorded in every run.
     Calibrate {
         /// Where the calibration is cached (default: the reference cache directory).
         #[arg(long, value_name = "DIR")]

@@ -220,6 +220,14 @@ pub struct Calibration {
     /// render-core's GPU radix sort on 2^18 f32 keys. 0 in calibrations made before it.
     #[serde(default)]
     pub gpu_sort_keys_per_sec: f64,
+    /// Rasterising triangles that cover pixels (right triangles with 4- and 16-pixel legs,
+    /// blended into `fill_format`), fitted as a cost per triangle plus a cost per fragment:
+    /// seconds per triangle. 0 in calibrations made before it.
+    #[serde(default)]
+    pub raster_seconds_per_triangle: f64,
+    /// The fit's seconds per fragment (see `raster_seconds_per_triangle`).
+    #[serde(default)]
+    pub raster_seconds_per_fragment: f64,
 }
 
 impl Calibration {
@@ -235,6 +243,7 @@ impl Calibration {
              GPU radix sort    {:.1} M keys/s (2^18 f32 keys)\n\
              ray steps         {:.2} M steps/s (144-byte cell walk)\n\
              splat fill        {:.1} M fragments/s (compute footprint lookup, 4x4 px)\n\
+             rasterisation     {:.0} ns/triangle + {:.2} ns/fragment (covering triangles, blended)\n\
              measured in {:.1} s on {}",
             self.adapter,
             self.driver,
@@ -249,6 +258,8 @@ impl Calibration {
             self.gpu_sort_keys_per_sec * 1e-6,
             self.ray_steps_per_sec * 1e-6,
             self.splat_fragments_per_sec * 1e-6,
+            self.raster_seconds_per_triangle * 1e9,
+            self.raster_seconds_per_fragment * 1e9,
             self.seconds,
             self.date_utc
         )
