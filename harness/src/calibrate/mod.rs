@@ -400,10 +400,24 @@ pub const RESOURCES: [Resource; 7] = [
         name: "fill",
         costs: &[("fragments", |c| per(c.fill_fragments_per_sec))],
     },
+    // Every triangle costs at least its setup (the sub-pixel figure); one that yields fragments
+    // costs the fit's per-triangle figure, and each fragment the fit's per-fragment one.
+    // `covering_tets` (tets whose projection holds a pixel centre) is a lower bound of the
+    // triangles that yield fragments: each such tet draws at least one. Rows without it (and
+    // calibrations without the fit) price no triangle above its setup.
     Resource {
         name: "rasterisation",
         costs: &[
-            ("triangles", |c| c.raster_seconds_per_triangle),
+            ("triangles", |c| {
+                if c.raster_seconds_per_fragment > 0.0 || c.raster_seconds_per_triangle > 0.0 {
+                    per(c.triangles_per_sec)
+                } else {
+                    0.0
+                }
+            }),
+            ("covering_tets", |c| {
+                (c.raster_seconds_per_triangle - per(c.triangles_per_sec)).max(0.0)
+            }),
             ("fragments", |c| c.raster_seconds_per_fragment),
         ],
     },
@@ -508,7 +522,7 @@ mod tests {
             ray_steps_per_sec: 2e6,
             splat_fragments_per_sec: 5e7,
             gpu_sort_keys_per_sec: 4e7,
-            raster_seconds_per_triangle: 0.5e-6,
+            raster_seconds_per_triangle: 1.5e-6,
             raster_seconds_per_fragment: 0.8e-8,
         }
     }
@@ -554,8 +568,9 @@ mod tests {
             &[
                 ("triangle setup", 40.0),
                 ("fill", 10.0),
-                // 40,000 triangles × 0.5 µs + 1,000,000 fragments × 8 ns.
-                ("rasterisation", 28.0),
+                // 40,000 triangles × 1 µs (setup; no covering count) + 1,000,000 fragments
+                // × 8 ns.
+                ("rasterisation", 48.0),
                 ("splat fill", 10.0),
                 ("ray steps", 10.0),
                 ("cpu sort", 1.0),
@@ -564,16 +579,27 @@ mod tests {
             ],
         );
         annotate(&mut rows, &cal());
-        assert_eq!(rows[0].bound_by, "triangle setup");
-        assert_close(rows[0].roofline_ms.unwrap(), 40.0, "roofline_ms");
-        assert_close(rows[0].limit_fraction.unwrap(), 0.5, "limit_fraction");
-        assert_close(rows[0].normalized_time.unwrap(), 2.0, "normalized_time");
+        assert_eq!(rows[0].bound_by, "rasterisation");
+        assert_close(rows[0].roofline_ms.unwrap(), 48.0, "roofline_ms");
+        assert_close(rows[0].limit_fraction.unwrap(), 0.6, "limit_fraction");
+        assert_close(
+            rows[0].normalized_time.unwrap(),
+            80.0 / 48.0,
+            "normalized_time",
+        );
     }
 
     /// Changing one counter flips the bound: more ray steps make the row ray-step bound, more
     /// splat fragments splat-fill bound, more sorted keys CPU-sort bound.
     #[test]
     fn changing_a_counter_flips_the_bound() {
+        // Without the rasterisation figure (older calibrations), triangles and fragments are
+        // priced on their own.
+        let old = Calibration {
+            raster_seconds_per_triangle: 0.0,
+            raster_seconds_per_fragment: 0.0,
+            ..cal()
+        };
         for (counters, bound, ms) in [
             ("triangles=1000;ray_steps=200000", "ray steps", 100.0),
             ("triangles=150000;ray_steps=200000", "triangle setup", 150.0),
@@ -593,19 +619,38 @@ mod tests {
                 2_500.0,
             ),
             ("fragments=20000000", "fill", 200.0),
-            // Neither count alone is the bound, their sum on the rasteriser is: 150,000
-            // triangles × 0.5 µs + 20 M fragments × 8 ns = 75 + 160 ms, against 150 and 200.
+        ] {
+            let mut rows = vec![row(counters, 400.0)];
+            annotate(&mut rows, &old);
+            assert_eq!(rows[0].bound_by, bound, "{counters}");
+            assert_close(rows[0].roofline_ms.unwrap(), ms, counters);
+            assert_close(rows[0].limit_fraction.unwrap(), ms / 400.0, counters);
+        }
+        // With it, triangles and fragments add up on the rasteriser, and covering tets cost
+        // the fit's per-triangle figure above the setup (1.5 − 1 µs here).
+        for (counters, bound, ms) in [
+            // 150 ms of setup + 160 ms of fragments, against 150 and 200 alone.
             (
                 "triangles=150000;fragments=20000000",
                 "rasterisation",
-                235.0,
+                310.0,
+            ),
+            // + 100,000 covering tets × 0.5 µs.
+            (
+                "triangles=150000;covering_tets=100000;fragments=20000000",
+                "rasterisation",
+                360.0,
+            ),
+            (
+                "triangles=1000;fragments=1000;ray_steps=200000",
+                "ray steps",
+                100.0,
             ),
         ] {
             let mut rows = vec![row(counters, 400.0)];
             annotate(&mut rows, &cal());
             assert_eq!(rows[0].bound_by, bound, "{counters}");
             assert_close(rows[0].roofline_ms.unwrap(), ms, counters);
-            assert_close(rows[0].limit_fraction.unwrap(), ms / 400.0, counters);
         }
     }
 

@@ -13,9 +13,25 @@ use rayon::prelude::*;
 
 use crate::Camera;
 
+/// The rasterisation work of a projected-tetrahedra frame, counted on the CPU.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ProjectedWork {
+    /// Pixel centres inside the projections of all tets.
+    pub fragments: u64,
+    /// Tets whose projection holds at least one pixel centre: each draws at least one triangle
+    /// that yields fragments, which costs the rasteriser more than a triangle that yields none
+    /// (the roofline's `rasterisation` resource prices them apart; `covering_tets`).
+    pub covering_tets: u64,
+}
+
 /// Pixel centres inside the projections of every tet of `mesh` (tets with a vertex at or
 /// behind the eye count nothing: the shaders drop them or cannot project them).
 pub fn projected_fragments(camera: &Camera, mesh: &datasets::TetMesh) -> u64 {
+    projected_work(camera, mesh).fragments
+}
+
+/// [`projected_fragments`] and the tets that hold any of them.
+pub fn projected_work(camera: &Camera, mesh: &datasets::TetMesh) -> ProjectedWork {
     let m = camera.view_proj_f32();
     let (w, h) = (camera.width as f64, camera.height as f64);
     // Pixel coordinates (x right, y down) of every vertex, None at or behind the eye.
@@ -43,24 +59,31 @@ pub fn projected_fragments(camera: &Camera, mesh: &datasets::TetMesh) -> u64 {
             }
             hull_pixels(&q, w, h)
         })
-        .sum()
+        .map(|n| ProjectedWork {
+            fragments: n,
+            covering_tets: (n > 0) as u64,
+        })
+        .reduce(ProjectedWork::default, |a, b| ProjectedWork {
+            fragments: a.fragments + b.fragments,
+            covering_tets: a.covering_tets + b.covering_tets,
+        })
 }
 
-/// [`projected_fragments`] of the last view asked for: a renderer derives its counters once
-/// per view, not once per frame.
+/// [`projected_work`] of the last view asked for: a renderer derives its counters once per
+/// view, not once per frame.
 #[derive(Debug, Default)]
 pub struct FragmentsPerView {
-    last: Option<(Camera, u64)>,
+    last: Option<(Camera, ProjectedWork)>,
 }
 
 impl FragmentsPerView {
-    pub fn get(&mut self, camera: &Camera, mesh: &datasets::TetMesh) -> u64 {
+    pub fn get(&mut self, camera: &Camera, mesh: &datasets::TetMesh) -> ProjectedWork {
         match &self.last {
-            Some((c, n)) if c == camera => *n,
+            Some((c, w)) if c == camera => *w,
             _ => {
-                let n = projected_fragments(camera, mesh);
-                self.last = Some((camera.clone(), n));
-                n
+                let w = projected_work(camera, mesh);
+                self.last = Some((camera.clone(), w));
+                w
             }
         }
     }
@@ -127,5 +150,41 @@ mod tests {
         // A degenerate (flat) tet covers nothing.
         let flat = [[1.0, 2.0], [5.0, 2.0], [3.0, 2.0], [4.0, 2.0]];
         assert_eq!(hull_pixels(&flat, 16.0, 16.0), 0);
+    }
+
+    /// A tet counts as covering when its projection holds a pixel centre; a second tet far
+    /// smaller than a pixel adds none.
+    #[test]
+    fn covering_tets_count_the_tets_with_fragments() {
+        let points = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.5, 0.5, 0.5],
+            [0.5001, 0.5, 0.5],
+            [0.5, 0.5001, 0.5],
+            [0.5, 0.5, 0.5001],
+        ];
+        let one = |tets: Vec<[u32; 4]>| {
+            let n = points.len();
+            let mesh = datasets::TetMesh::new(
+                "two",
+                points.iter().map(|p| p.map(|c| c as f32)).collect(),
+                vec![0.0; n],
+                "s",
+                tets,
+            )
+            .unwrap();
+            let vp = crate::Viewpoint::new("+z", [0.0, 0.0, 1.0]);
+            let cam = Camera::fit(&mesh.bounds(), &vp, crate::Projection::Orthographic, 64, 64);
+            projected_work(&cam, &mesh)
+        };
+        let big = one(vec![[0, 1, 2, 3]]);
+        assert_eq!(big.covering_tets, 1);
+        assert!(big.fragments > 100, "{big:?}");
+        let both = one(vec![[0, 1, 2, 3], [4, 5, 6, 7]]);
+        assert_eq!(both.covering_tets, 1, "{both:?}");
+        assert!(both.fragments <= big.fragments + 1, "{both:?}");
     }
 }

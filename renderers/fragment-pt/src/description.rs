@@ -31,7 +31,13 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     build: |s| Ok(Box::new(FragmentPt::new(from_settings(s)?)) as Box<dyn Renderer>),
     hue: Hue::Greens,
     tolerance,
-    counters: &["triangles", "fragments", "cpu_sort_keys", "gpu_sort_keys"],
+    counters: &[
+        "triangles",
+        "fragments",
+        "covering_tets",
+        "cpu_sort_keys",
+        "gpu_sort_keys",
+    ],
 };
 
 fn grid(sorts: &[SortMode]) -> Vec<Settings> {

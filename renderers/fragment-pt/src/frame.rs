@@ -189,6 +189,7 @@ pub(crate) fn render(
         }
         None => None,
     };
+    let projected = st.fragments.get(camera, &st.mesh);
     let counters = vec![
         (
             "model_bytes_per_tet".to_string(),
@@ -205,11 +206,9 @@ pub(crate) fn render(
         // visibility order covers every tet, on the device or on the host.
         ("triangles".to_string(), 4.0 * st.tets as f64),
         // Outside the timed frame, once per view: the pixel centres of every tet's projection,
-        // which its fan covers once.
-        (
-            "fragments".to_string(),
-            st.fragments.get(camera, &st.mesh) as f64,
-        ),
+        // which its fan covers once, and the tets that hold any.
+        ("fragments".to_string(), projected.fragments as f64),
+        ("covering_tets".to_string(), projected.covering_tets as f64),
         (
             if sort_mode == SortMode::Gpu {
                 "gpu_sort_keys"

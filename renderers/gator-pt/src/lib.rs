@@ -720,6 +720,7 @@ impl Renderer for GatorPt {
         let gpu_ms = st.timer.gpu_ms(gpu)?;
         let n = st.order.len() as f64;
         let stages = gpu_ms.map(|g| ("draw".to_string(), g));
+        let projected = st.fragments.get(camera, &st.host_mesh);
         let counters = vec![
             ("tets".to_string(), n),
             ("basis_graph_vertices".to_string(), NODES as f64 * n),
@@ -729,11 +730,9 @@ impl Renderer for GatorPt {
             ("triangles".to_string(), 4.0 * n),
             ("cpu_sort_keys".to_string(), n),
             // Outside the timed frame, once per view: the pixel centres of every tet's
-            // projection, which its four triangles cover once each.
-            (
-                "fragments".to_string(),
-                st.fragments.get(camera, &st.host_mesh) as f64,
-            ),
+            // projection, which its four triangles cover once each, and the tets that hold any.
+            ("fragments".to_string(), projected.fragments as f64),
+            ("covering_tets".to_string(), projected.covering_tets as f64),
             // Tets with a vertex at or behind the eye: the vertex shader drops them (no
             // near-plane clipping, as the paper); counted outside the timed frame.
             (
