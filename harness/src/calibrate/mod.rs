@@ -18,10 +18,11 @@
 //! pays for it once (a few seconds on lavapipe).
 //!
 //! The roofline ([`annotate`]) reads work counters, never names: each [`Resource`] lists the
-//! counters that measure a row's work on it (`triangles`, `fragments`, `splat_fragments`,
-//! `ray_steps`, `cpu_sort_keys`, `gpu_sort_keys`) with the calibrated cost of one unit of each;
-//! a row's time on a resource is the sum of its counters times their costs, plus per-frame GPU bytes (scratch, k-buffers,
-//! targets: each written at least once a frame) over the copy bandwidth. The largest is the
+//! counters that measure a row's work on it (`triangles`, `fragments`, `covering_tets`,
+//! `splat_fragments`, `ray_steps`, `cpu_sort_keys`, `gpu_sort_keys`) with the calibrated cost
+//! of one unit of each; a row's time on a resource is the sum of its counters times their
+//! costs, plus per-frame GPU bytes (scratch, k-buffers, targets: each written at least once a
+//! frame) over the copy bandwidth. The largest is the
 //! bound (`roofline_ms`, `bound_by`), and `limit_fraction = roofline_ms / total_ms` says how
 //! close the row gets to it. `normalized_time = total_ms / roofline_ms` is what
 //! `compare --normalised` compares across machines. A renderer gets a meaningful bound by
@@ -109,7 +110,7 @@ pub fn cached_or_measure(
     Ok((c, false))
 }
 
-/// Runs the eight micro-benchmarks (a few seconds on lavapipe, well under one on a GPU).
+/// Runs the nine micro-benchmarks (a few seconds on lavapipe, well under one on a GPU).
 pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> {
     let started = Instant::now();
     let module = gpu.shader("calibrate", include_str!("calibrate.wgsl"));
