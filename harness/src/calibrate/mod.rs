@@ -190,40 +190,13 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
     } else {
         wgpu::TextureFormat::Rgba16Float
     };
-    let add = wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::One,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
-    };
-    let blend = Some(wgpu::BlendState {
-        color: add,
-        alpha: add,
-    });
-    let fill = gpu.triangle_pipeline(
-        "calibrate fill",
-        &empty,
-        &module,
-        "fill_vs",
-        "fill_fs",
-        fill_format,
-        blend,
-        wgpu::ColorWrites::ALL,
-    );
+    let fill = additive_pipeline(gpu, &module, "calibrate fill", "fill_vs", fill_format);
     let fill_view = target(fill_format, FILL_SIZE);
     let fill_s = best_seconds(|| draw(&fill, &fill_view, 3, 0..FILL_LAYERS as u32))?;
 
     // 2b. Rasterisation of covering triangles, the same format and blend: seconds per triangle
     // at each leg length (the instance index is the leg), then the fit.
-    let raster = gpu.triangle_pipeline(
-        "calibrate raster",
-        &empty,
-        &module,
-        "raster_vs",
-        "fill_fs",
-        fill_format,
-        blend,
-        wgpu::ColorWrites::ALL,
-    );
+    let raster = additive_pipeline(gpu, &module, "calibrate raster", "raster_vs", fill_format);
     let raster_view = target(fill_format, RASTER_SIZE);
     let mut raster_points = [(0.0, 0.0); 2];
     for (point, leg) in raster_points.iter_mut().zip(RASTER_LEGS) {
@@ -350,6 +323,43 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         raster_seconds_per_triangle,
         raster_seconds_per_fragment,
     })
+}
+
+/// `calibrate.wgsl`'s `vertex_entry` with `fill_fs`, no bindings, blended additively into
+/// `format` (as the cell-projection algorithms composite): the pipeline of the fill and
+/// rasterisation benchmarks.
+fn additive_pipeline(
+    gpu: &Gpu,
+    module: &wgpu::ShaderModule,
+    label: &str,
+    vertex_entry: &str,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    let layout = gpu
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[],
+            immediate_size: 0,
+        });
+    let add = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    gpu.triangle_pipeline(
+        label,
+        &layout,
+        module,
+        vertex_entry,
+        "fill_fs",
+        format,
+        Some(wgpu::BlendState {
+            color: add,
+            alpha: add,
+        }),
+        wgpu::ColorWrites::ALL,
+    )
 }
 
 /// Fragments of one of the rasterisation benchmark's triangles: the pixel centres `(i, j)` of
@@ -713,32 +723,8 @@ mod tests {
     fn raster_triangles_have_the_counted_fragments() {
         let gpu = Gpu::new().expect("an adapter (lavapipe)");
         let module = gpu.shader("calibrate", include_str!("calibrate.wgsl"));
-        let layout = gpu
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: None,
-                bind_group_layouts: &[],
-                immediate_size: 0,
-            });
-        let add = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
         let format = wgpu::TextureFormat::Rgba32Float;
-        let pipeline = gpu.triangle_pipeline(
-            "raster test",
-            &layout,
-            &module,
-            "raster_vs",
-            "fill_fs",
-            format,
-            Some(wgpu::BlendState {
-                color: add,
-                alpha: add,
-            }),
-            wgpu::ColorWrites::ALL,
-        );
+        let pipeline = additive_pipeline(&gpu, &module, "raster test", "raster_vs", format);
         for leg in RASTER_LEGS {
             let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: None,
