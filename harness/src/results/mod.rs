@@ -198,6 +198,11 @@ impl Row {
         value_of(&self.counters, name)?.parse().ok()
     }
 
+    /// A stage's median time in ms (`name=ms;…` in `stages`), if present and numeric.
+    pub fn stage_ms(&self, name: &str) -> Option<f64> {
+        value_of(&self.stages, name)?.parse().ok()
+    }
+
     pub fn ok(&self) -> bool {
         self.error.is_empty()
     }
