@@ -17,3 +17,4 @@ pub use regress::{compare, compare_report, compare_time, export, history};
 pub mod report;
 pub mod results;
 pub mod run;
+pub mod schemas;

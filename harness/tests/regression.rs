@@ -161,8 +161,8 @@ fn merged_shards_equal_one_run_and_compare_finds_no_change() {
     assert!(tmp.path().join("merged/samples.csv").is_file());
     assert!(tmp.path().join("merged/index.html").is_file());
 
-    // compare: identical images and memory (timings may differ on a busy machine; the gate
-    // here is on images and memory, which are exact).
+    // compare: identical images, work counters and memory (timings may differ on a busy
+    // machine; the gate here is on what is exact).
     let text = ok(&["compare", &p("full"), &p("merged"), "--out", &p("cmp")]);
     let cmp: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(tmp.path().join("cmp/compare.json")).unwrap(),
@@ -170,7 +170,7 @@ fn merged_shards_equal_one_run_and_compare_finds_no_change() {
     .unwrap();
     for row in cmp["rows"].as_array().unwrap() {
         assert_eq!(row["image"]["changed_pixels"], 0, "{text}");
-        assert!(row["memory"].as_array().unwrap().is_empty(), "{text}");
+        assert!(row["work"].as_array().unwrap().is_empty(), "{text}");
     }
 
     // Another adapter: refused unless normalised (and normalising needs a calibration).

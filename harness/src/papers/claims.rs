@@ -549,25 +549,15 @@ pub fn row_sample(metric: &str, r: &Row) -> Result<Sample, String> {
                 return exact(r.counter(name));
             }
             if let Some(name) = metric.strip_prefix("stage:") {
-                let v = crate::results::value_of(&r.stages, name).and_then(|v| v.parse().ok());
-                return timed(v, None, None).map_err(|_| no_stage(name, r));
+                return timed(r.stage_ms(name), None, None).map_err(|_| no_stage(name, r));
             }
             if let Some(name) = metric.strip_prefix("stage_share:") {
-                let stages: Vec<(&str, f64)> = r
+                let this = r.stage_ms(name).ok_or_else(|| no_stage(name, r))?;
+                let other = r
                     .stages
-                    .split(';')
-                    .filter_map(|kv| kv.split_once('='))
-                    .filter_map(|(k, v)| Some((k, v.parse::<f64>().ok()?)))
-                    .collect();
-                let this = stages
-                    .iter()
-                    .find(|(k, _)| *k == name)
-                    .map(|(_, v)| *v)
-                    .ok_or_else(|| no_stage(name, r))?;
-                let other = stages
                     .iter()
                     .filter(|(k, _)| *k != name)
-                    .map(|(_, v)| *v)
+                    .map(|(_, v)| v)
                     .fold(0.0f64, f64::max);
                 if other <= 0.0 {
                     return Err(format!("no stage besides {name} in its rows"));
@@ -580,11 +570,7 @@ pub fn row_sample(metric: &str, r: &Row) -> Result<Sample, String> {
 }
 
 fn no_stage(name: &str, r: &Row) -> String {
-    let have: Vec<&str> = r
-        .stages
-        .split(';')
-        .filter_map(|kv| kv.split_once('=').map(|(k, _)| k))
-        .collect();
+    let have: Vec<&str> = r.stages.names().collect();
     format!(
         "no stage named {name} in its rows (stages timed: {})",
         if have.is_empty() {

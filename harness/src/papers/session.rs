@@ -124,8 +124,6 @@ impl Measured {
     }
 }
 
-pub use crate::results::value_of;
-
 /// The aggregate of `algorithm` on `dataset` whose settings include every `want` pair, if
 /// exactly one does: where several variants match, none is taken (the first one found must
 /// never stand for the algorithm silently; the table's plan names the variant).

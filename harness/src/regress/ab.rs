@@ -21,10 +21,11 @@ use std::process::{Command, Stdio};
 use std::time::Instant;
 
 use anyhow::Context;
-use serde::Serialize;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 use super::build::Binary;
-use crate::regress::compare::{adapter_of, CompareOptions, Comparison, FailOn};
+use crate::regress::compare::{adapter_of, CompareOptions, Comparison, Finding};
 use crate::results::metrics::summarize;
 use crate::results::stats::median;
 use crate::results::{MergedRun, ResultsFile, Row};
@@ -81,7 +82,8 @@ pub struct AbOptions {
 
 /// What one pair saw: NEW / BASE of each row's median frame time, its median over the rows,
 /// and each side against its own first round (the machine's drift over the session).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct PairDrift {
     /// From 1.
     pub pair: u32,
@@ -95,8 +97,19 @@ pub struct PairDrift {
     pub new_vs_first_round: Option<f64>,
 }
 
-#[derive(Debug, Clone, Serialize)]
+/// The layout of `ab.json` (`docs/ab.schema.json`).
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// The JSON Schema of `ab.json`.
+pub fn json_schema() -> serde_json::Value {
+    serde_json::to_value(schemars::schema_for!(AbReport)).expect("a schema is JSON")
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct AbReport {
+    /// [`SCHEMA_VERSION`].
+    pub schema_version: u32,
     pub base: String,
     pub new: String,
     pub base_binary: String,
@@ -105,7 +118,8 @@ pub struct AbReport {
     pub run_args: Vec<String>,
     pub drift: Vec<PairDrift>,
     pub outcome: String,
-    pub regressions: Vec<String>,
+    /// compare's regressions (its `compare.json` has the improvements and other changes).
+    pub regressions: Vec<Finding>,
     pub seconds: f64,
 }
 
@@ -419,12 +433,8 @@ pub fn run_ab(base: &Binary, new: &Binary, opt: &AbOptions) -> anyhow::Result<Ab
     std::fs::create_dir_all(&opt.compare.out)
         .with_context(|| format!("cannot create {}", opt.compare.out.display()))?;
     crate::regress::compare_report::write_outputs(&comparison, &opt.compare.out)?;
-    let fail = match opt.compare.fail_on {
-        FailOn::Never => false,
-        FailOn::Regression => !comparison.regressions.is_empty(),
-        FailOn::Change => comparison.outcome() != "no change",
-    };
     let report = AbReport {
+        schema_version: SCHEMA_VERSION,
         base: base.label(),
         new: new.label(),
         base_binary: base.path.display().to_string(),
@@ -439,6 +449,7 @@ pub fn run_ab(base: &Binary, new: &Binary, opt: &AbOptions) -> anyhow::Result<Ab
     let path = opt.out.join("ab.json");
     std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")
         .with_context(|| format!("cannot write {}", path.display()))?;
+    let fail = crate::regress::compare_report::gate(&comparison, opt.compare.fail_on)?;
     Ok(AbOutcome {
         comparison,
         report,
@@ -490,7 +501,7 @@ pub fn run_command(base: &Binary, new: &Binary, opt: &AbOptions) -> anyhow::Resu
         crate::regress::compare_report::terminal(&outcome.comparison)
     );
     for r in &outcome.comparison.regressions {
-        println!("regression: {r}");
+        println!("regression: {}", r.text);
     }
     println!(
         "wrote {}/compare.{{md,json,html}} and {}",

@@ -10,7 +10,8 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use serde::Serialize;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 use super::ab::{self, AbOptions};
 use super::build::{self, BuildArgs};
@@ -60,19 +61,31 @@ pub fn first_bad(
 }
 
 /// One A/B of the search.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct Step {
     pub commit: String,
     pub subject: String,
     pub regression: bool,
     /// compare's regressions (empty: none).
-    pub regressions: Vec<String>,
+    pub regressions: Vec<crate::regress::compare::Finding>,
     /// The A/B's output directory.
     pub dir: String,
 }
 
-#[derive(Debug, Clone, Serialize)]
+/// The layout of `bisect.json` (`docs/bisect.schema.json`).
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// The JSON Schema of `bisect.json`.
+pub fn json_schema() -> serde_json::Value {
+    serde_json::to_value(schemars::schema_for!(BisectReport)).expect("a schema is JSON")
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct BisectReport {
+    /// [`SCHEMA_VERSION`].
+    pub schema_version: u32,
     pub good: String,
     pub bad: String,
     pub candidates: usize,
@@ -140,7 +153,14 @@ pub fn run_command(opt: &BisectOptions) -> anyhow::Result<BisectReport> {
             &step.commit[..12.min(step.commit.len())],
             step.subject,
             if step.regression {
-                format!("REGRESSION ({})", step.regressions.join("; "))
+                format!(
+                    "REGRESSION ({})",
+                    step.regressions
+                        .iter()
+                        .map(|f| f.text.as_str())
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                )
             } else {
                 "no regression".into()
             }
@@ -151,6 +171,7 @@ pub fn run_command(opt: &BisectOptions) -> anyhow::Result<BisectReport> {
     })?;
     let subject = |c: &str| build::git(repo, &["log", "-1", "--format=%s", c]).unwrap_or_default();
     let report = BisectReport {
+        schema_version: SCHEMA_VERSION,
         good: opt.good.clone(),
         bad: opt.bad.clone(),
         candidates: commits.len(),

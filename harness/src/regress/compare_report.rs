@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use crate::plot::ratio::{ratio_plot, Direction, Strip};
 use crate::regress::compare::{
-    CompareOptions, Comparison, FailOn, RowComparison, TimeTest, Verdict,
+    CompareOptions, Comparison, FailOn, Finding, RowComparison, RowStatus, TimeTest, Verdict,
 };
 
 fn header(c: &Comparison) -> Vec<String> {
@@ -107,7 +107,11 @@ pub fn terminal(c: &Comparison) -> String {
         let name = format!("{} {} @ {}", g.algorithm, g.settings, g.dataset);
         let _ = writeln!(s, "  {name:<w$}  {}", time_cell(Some(&g.total)));
     }
-    let notable: Vec<&RowComparison> = c.rows.iter().filter(|r| r.status != "no change").collect();
+    let notable: Vec<&RowComparison> = c
+        .rows
+        .iter()
+        .filter(|r| r.status != RowStatus::NoChange)
+        .collect();
     let _ = writeln!(
         s,
         "\nrows with a change ({} of {}):",
@@ -142,8 +146,8 @@ fn markdown(c: &Comparison) -> String {
     ] {
         if !list.is_empty() {
             let _ = writeln!(s, "\n## {title}\n");
-            for l in list {
-                let _ = writeln!(s, "- {l}");
+            for l in list.iter() {
+                let _ = writeln!(s, "- {}", l.text);
             }
         }
     }
@@ -165,7 +169,11 @@ fn markdown(c: &Comparison) -> String {
         );
     }
     // Only the rows with something to say: the page is meant for a pull-request comment.
-    let notable: Vec<&RowComparison> = c.rows.iter().filter(|r| r.status != "no change").collect();
+    let notable: Vec<&RowComparison> = c
+        .rows
+        .iter()
+        .filter(|r| r.status != RowStatus::NoChange)
+        .collect();
     let _ = write!(
         s,
         "\n## Rows with a change ({} of {})\n\n",
@@ -175,7 +183,7 @@ fn markdown(c: &Comparison) -> String {
     if notable.is_empty() {
         return s;
     }
-    s.push_str("| status | algorithm | settings | data set | view | total_ms | cpu_ms | gpu_ms | PSNR Δ dB | changed px | memory | notes |\n|---|---|---|---|---|---|---|---|---:|---:|---|---|\n");
+    s.push_str("| status | algorithm | settings | data set | view | total_ms | cpu_ms | gpu_ms | PSNR Δ dB | changed px | work and bytes | notes |\n|---|---|---|---|---|---|---|---|---:|---:|---|---|\n");
     for r in notable {
         let img = r.image.as_ref();
         let _ = writeln!(
@@ -196,11 +204,7 @@ fn markdown(c: &Comparison) -> String {
                 .pixels_changed
                 .map(|b| if b { "yes".into() } else { "0".into() })))
                 .unwrap_or_else(|| "-".into()),
-            r.memory
-                .iter()
-                .map(|m| format!("{} {}→{}", m.what, m.base, m.new))
-                .collect::<Vec<_>>()
-                .join(", "),
+            work_cell(r),
             r.notes.join("; ")
         );
     }
@@ -223,20 +227,33 @@ struct HtmlRow {
     heatmap: String,
     changed_pixels: u64,
     image_verdict: String,
-    memory: String,
+    work: String,
     notes: String,
 }
 
 #[derive(Serialize)]
-struct HtmlSection<'a> {
+struct HtmlSection {
     title: &'static str,
-    lines: &'a [String],
+    lines: Vec<String>,
+}
+
+/// The work changes of a row, one `counter base→new` each.
+fn work_cell(r: &RowComparison) -> String {
+    r.work
+        .iter()
+        .map(|w| w.describe())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn texts(findings: &[Finding]) -> Vec<String> {
+    findings.iter().map(|f| f.text.clone()).collect()
 }
 
 #[derive(Serialize)]
-struct ComparePage<'a> {
+struct ComparePage {
     header: Vec<String>,
-    sections: Vec<HtmlSection<'a>>,
+    sections: Vec<HtmlSection>,
     rows: Vec<HtmlRow>,
 }
 
@@ -249,7 +266,7 @@ fn html(c: &Comparison) -> anyhow::Result<String> {
             let img = r.image.as_ref();
             let heatmap = img.map(|i| i.heatmap.clone()).unwrap_or_default();
             HtmlRow {
-                class: r.status.replace(' ', "-"),
+                class: r.status.label().replace(' ', "-"),
                 status: r.status.to_string(),
                 algorithm: r.algorithm.clone(),
                 settings: r.settings.clone(),
@@ -263,14 +280,9 @@ fn html(c: &Comparison) -> anyhow::Result<String> {
                     .map(|d| format!("{d:+.3}"))
                     .unwrap_or_default(),
                 changed_pixels: img.and_then(|i| i.changed_pixels).unwrap_or(0),
-                image_verdict: img.map(|i| i.verdict.clone()).unwrap_or_default(),
+                image_verdict: img.map(|i| i.verdict.to_string()).unwrap_or_default(),
                 heatmap,
-                memory: r
-                    .memory
-                    .iter()
-                    .map(|m| format!("{} {}→{}", m.what, m.base, m.new))
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                work: work_cell(r),
                 notes: r.notes.join("; "),
             }
         })
@@ -282,15 +294,15 @@ fn html(c: &Comparison) -> anyhow::Result<String> {
             sections: vec![
                 HtmlSection {
                     title: "Regressions",
-                    lines: &c.regressions,
+                    lines: texts(&c.regressions),
                 },
                 HtmlSection {
                     title: "Improvements",
-                    lines: &c.improvements,
+                    lines: texts(&c.improvements),
                 },
                 HtmlSection {
                     title: "Other changes",
-                    lines: &c.changes,
+                    lines: texts(&c.changes),
                 },
             ],
             rows,
@@ -385,11 +397,28 @@ pub fn run_command(
         CompareFormat::Json => print!("{}", serde_json::to_string_pretty(&cmp)? + "\n"),
         CompareFormat::Md => print!("{}", markdown(&cmp)),
     }
-    Ok(match opt.fail_on {
-        FailOn::Never => false,
+    gate(&cmp, opt.fail_on)
+}
+
+/// Whether `--fail-on` is met (exit 3). A regression of work, image or memory is exact and
+/// gates even on a noisy machine; without one, separate runs too noisy to judge time
+/// ([`crate::regress::compare::time_noise`]) are an error (exit 1) under `--fail-on
+/// regression` or `change`: the gate could not do its job, and exit 0 would pretend it had.
+pub fn gate(cmp: &Comparison, fail_on: FailOn) -> anyhow::Result<bool> {
+    let met = match fail_on {
+        FailOn::Never => return Ok(false),
         FailOn::Regression => !cmp.regressions.is_empty(),
         FailOn::Change => cmp.outcome() != "no change",
-    })
+    };
+    if !met && cmp.too_noisy {
+        anyhow::bail!(
+            "{}",
+            cmp.time_refused
+                .as_deref()
+                .unwrap_or("the runs are too noisy to gate on time")
+        );
+    }
+    Ok(met)
 }
 
 /// The colour a verdict's strip gets in the ratio plots.
@@ -498,8 +527,11 @@ mod tests {
         let image = row.image.as_ref().unwrap();
         assert_eq!(image.changed_pixels, Some(1));
         assert_eq!(image.pixels_changed, Some(true));
-        assert_eq!(image.verdict, "changed");
-        assert_eq!(row.status, "changed");
+        assert_eq!(
+            image.verdict,
+            crate::regress::compare::ImageVerdict::Changed
+        );
+        assert_eq!(row.status, RowStatus::Changed);
         assert_eq!(diff.outcome(), "changed");
         // fail-on change gates it; the outputs name the heatmap.
         assert!(run_command(&a, &c, &opt("ac"), CompareFormat::Text).unwrap());

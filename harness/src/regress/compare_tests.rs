@@ -5,7 +5,14 @@ use super::*;
 /// A results set of one group per entry of `factors` (algorithm `alg{i}`), 3 viewpoints
 /// each, `rounds` rounds of `frames` frames around 10 ms × factor with 3 % noise; frame j
 /// of a round is further multiplied by `1 + drift·j` (the machine drifting during a round).
-fn run_dir(dir: &Path, factors: &[f64], rounds: u32, frames: u32, drift: f64, seed: u64) {
+pub(crate) fn run_dir(
+    dir: &Path,
+    factors: &[f64],
+    rounds: u32,
+    frames: u32,
+    drift: f64,
+    seed: u64,
+) {
     let machine = vec![1.0; rounds as usize];
     run_dir_with_machine(dir, factors, &machine, frames, drift, seed);
 }
@@ -109,7 +116,7 @@ fn drift_is_divided_out_and_one_slower_group_still_stands_out() {
         limited
             .regressions
             .iter()
-            .any(|r| r.starts_with("run-wide")),
+            .any(|r| r.text.starts_with("run-wide")),
         "{:?}",
         limited.regressions
     );
@@ -185,7 +192,7 @@ fn one_round_never_gates_on_time_and_five_rounds_find_a_slowdown() {
         found
             .regressions
             .iter()
-            .any(|r| r.starts_with("slower: alg5 ")),
+            .any(|r| r.text.starts_with("slower: alg5 ")),
         "{:?}",
         found.regressions
     );

@@ -10,13 +10,17 @@ use crate::results::stats::{holm_adjust, mann_whitney_p, median};
 /// the change being looked for, not the machine's.
 pub const MIN_GROUPS_FOR_DRIFT: usize = 5;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum Verdict {
     Faster,
     Slower,
     NoChange,
+    /// Fewer than `MIN_ROUNDS` rounds on a side: no verdict.
     TooFewSamples,
+    /// Separate runs whose groups scatter too much to gate on time
+    /// ([`crate::regress::compare::time_noise`]): no verdict.
+    TooNoisy,
 }
 
 impl Verdict {
@@ -26,12 +30,14 @@ impl Verdict {
             Verdict::Slower => "slower",
             Verdict::NoChange => "no change",
             Verdict::TooFewSamples => "too few independent samples",
+            Verdict::TooNoisy => "too noisy to judge",
         }
     }
 }
 
 /// One time metric of one row (or pooled over a group's viewpoints).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct TimeTest {
     pub metric: String,
     pub base_median: f64,

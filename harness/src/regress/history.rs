@@ -18,14 +18,16 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use serde::Serialize;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
-use crate::regress::compare::{adapter_of, CompareOptions, FailOn, Verdict};
+use crate::regress::compare::{adapter_of, CompareOptions, FailOn, ImageVerdict, Verdict};
 use crate::results::aggregate::GroupKey;
 use crate::results::stats::{median, quantile};
 use crate::results::{ResultsFile, Row};
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct Point {
     pub run: usize,
     pub total_ms: f64,
@@ -34,13 +36,15 @@ pub struct Point {
     pub psnr_db: Option<f64>,
     pub gpu_bytes: Option<u64>,
     /// Against the previous run, by compare's test: `slower ×r`, `faster ×r`, `psnr ±x dB`,
-    /// `memory`, `too few rounds`.
+    /// `memory`, `work: fragments, …` (counters that changed exactly), `too few rounds`,
+    /// `too noisy`.
     pub changes: Vec<String>,
     /// A step of the piecewise-constant fit starts at this run (`×r` against the level before).
     pub step: Option<f64>,
 }
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct Series {
     pub algorithm: String,
     pub settings: String,
@@ -68,7 +72,8 @@ impl Series {
     }
 }
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct Run {
     pub dir: String,
     pub commit: String,
@@ -77,11 +82,22 @@ pub struct Run {
     pub label: String,
 }
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct History {
+    /// [`SCHEMA_VERSION`].
+    pub schema_version: u32,
     pub adapter: String,
     pub runs: Vec<Run>,
     pub series: Vec<Series>,
+}
+
+/// The layout of `history.json` (`docs/history.schema.json`).
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// The JSON Schema of `history.json`.
+pub fn json_schema() -> serde_json::Value {
+    serde_json::to_value(schemars::schema_for!(History)).expect("a schema is JSON")
 }
 
 fn group_rows<'a>(f: &'a ResultsFile, g: &GroupKey) -> Vec<&'a Row> {
@@ -259,18 +275,25 @@ pub fn history(
                         Verdict::Slower => changes.push(format!("slower ×{:.3}", gc.total.ratio)),
                         Verdict::Faster => changes.push(format!("faster ×{:.3}", gc.total.ratio)),
                         Verdict::TooFewSamples => changes.push("too few rounds".into()),
+                        Verdict::TooNoisy => changes.push("too noisy".into()),
                         Verdict::NoChange => {}
                     }
                 }
                 let rows_here = cmp.rows.iter().filter(|r| r.in_group(&g));
                 let mut psnr_moved = false;
                 let mut memory = false;
+                let mut work: Vec<&str> = vec![];
                 for r in rows_here {
-                    psnr_moved |= r
-                        .image
-                        .as_ref()
-                        .is_some_and(|i| i.verdict == "worse" || i.verdict == "better");
-                    memory |= r.memory.iter().any(|m| m.what == "gpu_bytes");
+                    psnr_moved |= r.image.as_ref().is_some_and(|i| {
+                        matches!(i.verdict, ImageVerdict::Worse | ImageVerdict::Better)
+                    });
+                    for w in &r.work {
+                        if w.counter.starts_with("gpu_bytes") {
+                            memory = true;
+                        } else if !work.contains(&w.counter.as_str()) {
+                            work.push(&w.counter);
+                        }
+                    }
                 }
                 let last = points.last().expect("checked above");
                 if psnr_moved {
@@ -280,6 +303,9 @@ pub fn history(
                 }
                 if memory {
                     changes.push("memory".into());
+                }
+                if !work.is_empty() {
+                    changes.push(format!("work: {}", work.join(", ")));
                 }
             }
             points.push(Point {
@@ -320,6 +346,7 @@ pub fn history(
         });
     }
     Ok(History {
+        schema_version: SCHEMA_VERSION,
         adapter,
         runs,
         series,
@@ -534,6 +561,7 @@ mod tests {
     fn the_page_escapes_names() {
         let hostile = "<img src=x onerror=alert(1)>";
         let h = History {
+            schema_version: SCHEMA_VERSION,
             adapter: hostile.into(),
             runs: vec![Run {
                 dir: hostile.into(),

@@ -17,8 +17,12 @@ pub mod ab;
 pub mod bisect;
 pub mod build;
 pub mod compare;
+pub mod compare_findings;
+pub mod compare_image;
 pub mod compare_report;
+pub mod compare_rounds;
 pub mod compare_time;
+pub mod compare_work;
 pub mod export;
 pub mod history;
 

@@ -162,6 +162,42 @@ struct ReportPage<'a> {
     rows: Vec<RowLine>,
 }
 
+/// The 1-minute load average at the start and the end of the run, against the cores.
+fn load_line(m: &crate::results::machine::MachineInfo) -> String {
+    let f = |v: Option<f64>| v.map_or("unknown".to_string(), |v| format!("{v:.2}"));
+    format!(
+        "{} at the start, {} at the end, on {} logical cores",
+        f(m.load_average_start),
+        f(m.load_average_end),
+        m.cpu_cores
+    )
+}
+
+/// The calibration's headline figures (what the roofline columns divide by), or why there is
+/// none.
+fn calibration_line(m: &crate::results::machine::MachineInfo) -> String {
+    let Some(c) = &m.calibration else {
+        return "none (run with --no-calibrate, or a file written before calibration)".into();
+    };
+    format!(
+        "{} on {} ({}): {:.3e} triangles/s, {:.3e} fill fragments/s ({}), {:.1} GFLOP/s, \
+         {:.3e} copy bytes/s, {:.3e} sort keys/s, {:.3e} ray steps/s, {:.3e} splat \
+         fragments/s, {:.3e} GPU sort keys/s",
+        c.date_utc,
+        c.adapter,
+        c.driver,
+        c.triangles_per_sec,
+        c.fill_fragments_per_sec,
+        c.fill_format,
+        c.compute_gflops,
+        c.copy_bytes_per_sec,
+        c.sort_keys_per_sec,
+        c.ray_steps_per_sec,
+        c.splat_fragments_per_sec,
+        c.gpu_sort_keys_per_sec
+    )
+}
+
 fn machine_lines(file: &ResultsFile) -> Vec<(&'static str, String)> {
     let m = &file.machine;
     let r = &file.run;
@@ -199,6 +235,20 @@ fn machine_lines(file: &ResultsFile) -> Vec<(&'static str, String)> {
             "tetbench",
             format!("{} at commit {commit}", m.tetbench_version),
         ),
+        (
+            "build",
+            format!(
+                "{} profile, {}",
+                m.build_profile.as_deref().unwrap_or("unknown"),
+                m.rustc_version.as_deref().unwrap_or("rustc unknown")
+            ),
+        ),
+        (
+            "host",
+            m.host_name.clone().unwrap_or_else(|| "unknown".into()),
+        ),
+        ("load (1 min)", load_line(m)),
+        ("calibration", calibration_line(m)),
         ("started", m.date_utc.clone()),
         (
             "finished",
@@ -342,7 +392,7 @@ fn row_lines(file: &ResultsFile, suspect: &[bool]) -> Vec<RowLine> {
                 opt(row.max_abs_error, 4),
                 opt(row.bad_pixel_share.map(|v| v * 100.0), 2),
             ],
-            stages: row.stages.clone(),
+            stages: row.stages.to_string(),
             error: if row.suspect.is_empty() {
                 row.error.clone()
             } else {

@@ -11,6 +11,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct MachineInfo {
     pub cpu_model: String,
     /// Logical cores available to this process.
@@ -52,6 +53,7 @@ pub struct MachineInfo {
 /// schemars); `adapter_schema_mirrors_render_core` keeps the two in step.
 #[derive(JsonSchema)]
 #[allow(dead_code)]
+#[schemars(deny_unknown_fields)]
 struct AdapterSchema {
     name: String,
     backend: String,

@@ -18,10 +18,12 @@ use serde::{Deserialize, Serialize};
 use render_core::Settings;
 
 use crate::results::machine::MachineInfo;
+pub use crate::results::named::NamedValues;
 
 pub mod aggregate;
 pub mod machine;
 pub mod metrics;
+pub mod named;
 pub mod names;
 pub mod samples;
 pub mod stats;
@@ -43,6 +45,7 @@ pub const JSON_FILE: &str = "results.json";
 /// error metrics as defined in [`crate::results::metrics`]. `None` is an empty CSV cell / JSON null: no
 /// timestamp queries (gpu_ms), no reference (error metrics), or a failed row (`error` set).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct Row {
     pub algorithm: String,
     /// The variant's typed settings: a map in `results.json` (`{"k": 6, …}`; the text form
@@ -55,16 +58,27 @@ pub struct Row {
     pub viewpoint: String,
     pub width: u32,
     pub height: u32,
+    #[schemars(required)]
     pub total_ms: Option<f64>,
+    #[schemars(required)]
     pub cpu_ms: Option<f64>,
+    #[schemars(required)]
     pub gpu_ms: Option<f64>,
+    #[schemars(required)]
     pub fps: Option<f64>,
+    #[schemars(required)]
     pub tets_per_sec: Option<f64>,
+    #[schemars(required)]
     pub gpu_bytes: Option<u64>,
+    #[schemars(required)]
     pub bytes_per_tet: Option<f64>,
+    #[schemars(required)]
     pub rmse: Option<f64>,
+    #[schemars(required)]
     pub psnr_db: Option<f64>,
+    #[schemars(required)]
     pub max_abs_error: Option<f64>,
+    #[schemars(required)]
     pub bad_pixel_share: Option<f64>,
     pub adapter: String,
     pub backend: String,
@@ -83,10 +97,12 @@ pub struct Row {
     pub gpu_bytes_persistent: Option<u64>,
     /// Largest per-frame allocation seen over the timed frames.
     pub gpu_bytes_frame: Option<u64>,
-    /// Median stage timings, `name=ms;name=ms`.
-    pub stages: String,
-    /// Median counters, `name=value;…`.
-    pub counters: String,
+    /// Median stage timings (ms) by name, in pipeline order: a map in `results.json`, the text
+    /// `name=ms;…` in `results.csv` (and in `results.json` files written before it was typed).
+    pub stages: NamedValues,
+    /// Median counters by name (fragments, triangles, ray steps, sort keys …), stored as
+    /// `stages` is.
+    pub counters: NamedValues,
     pub covered_pixels: Option<u64>,
     pub transfer_function: String,
     pub projection: String,
@@ -136,15 +152,6 @@ pub struct Row {
     pub samples: FrameSamples,
 }
 
-/// The value of `key` in a `name=value;name=value` list: a row's `stages` or `counters`.
-pub fn value_of<'a>(list: &'a str, key: &str) -> Option<&'a str> {
-    list.split(';').find_map(|kv| {
-        kv.split_once('=')
-            .filter(|(k, _)| *k == key)
-            .map(|(_, v)| v)
-    })
-}
-
 /// The settings as JSON Schema sees them: a map of integers and words, or the text form of
 /// files written before settings were typed.
 #[derive(JsonSchema)]
@@ -163,27 +170,22 @@ enum SettingValueSchema {
     Text(String),
 }
 
-thread_local! {
-    /// Set while a row is written to `results.csv`, whose cells cannot hold a map.
-    static SETTINGS_AS_TEXT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
 fn settings_column<S: serde::Serializer>(s: &Settings, ser: S) -> Result<S::Ok, S::Error> {
-    if SETTINGS_AS_TEXT.get() {
+    if named::AS_TEXT.get() {
         ser.collect_str(s)
     } else {
         s.serialize(ser)
     }
 }
 
-/// Writes one row to `results.csv`: flat (no samples), settings as text.
+/// Writes one row to `results.csv`: flat (no samples), settings, stages and counters as text.
 fn serialize_csv_row<W: Write>(csv: &mut csv::Writer<W>, row: &Row) -> csv::Result<()> {
-    SETTINGS_AS_TEXT.set(true);
+    named::AS_TEXT.set(true);
     let written = csv.serialize(Row {
         samples: FrameSamples::default(),
         ..row.clone()
     });
-    SETTINGS_AS_TEXT.set(false);
+    named::AS_TEXT.set(false);
     written
 }
 
@@ -193,14 +195,14 @@ impl Row {
         self.settings.text(key)
     }
 
-    /// A counter of the row (`name=value;…` in `counters`), if present and numeric.
+    /// A counter of the row, if present.
     pub fn counter(&self, name: &str) -> Option<f64> {
-        value_of(&self.counters, name)?.parse().ok()
+        self.counters.get(name)
     }
 
-    /// A stage's median time in ms (`name=ms;…` in `stages`), if present and numeric.
+    /// A stage's median time in ms, if present.
     pub fn stage_ms(&self, name: &str) -> Option<f64> {
-        value_of(&self.stages, name)?.parse().ok()
+        self.stages.get(name)
     }
 
     pub fn ok(&self) -> bool {
@@ -210,6 +212,7 @@ impl Row {
 
 /// How the run was asked for, stored with the results so a report says what it shows.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct RunDescription {
     pub command_line: Vec<String>,
     pub algorithms: Vec<String>,
@@ -237,6 +240,7 @@ pub struct RunDescription {
 
 /// Where the rows of a merged results set came from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct MergedRun {
     pub dir: String,
     pub shard: Option<String>,
@@ -252,6 +256,7 @@ fn one_round() -> u32 {
 
 /// The whole of `results.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct ResultsFile {
     pub schema_version: u32,
     pub machine: MachineInfo,
@@ -460,6 +465,7 @@ pub const SAMPLES_CSV: &str = "samples.csv";
 /// Per-frame measurements of one row, in frame order. `gpu_ms` is empty when the adapter has no
 /// timestamp queries.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct FrameSamples {
     pub total_ms: Vec<f64>,
     pub cpu_ms: Vec<f64>,
@@ -659,28 +665,11 @@ mod tests {
         assert!(e.contains("schema_version"), "{e}");
     }
 
-    /// docs/results.schema.json is what the types generate (regenerate with
-    /// `TETBENCH_BLESS=1 cargo test -p harness --lib results::`), and a results.json written
-    /// by a real run (the committed baseline) fits it: every field known, every required one
-    /// present.
+    /// A results.json written by a real run (the committed baseline) validates against
+    /// docs/results.schema.json (generated from these types, `crate::schemas`); with
+    /// `total_ms` renamed, an unknown field, or a required field missing, it does not.
     #[test]
-    fn checked_in_schema_matches_the_types() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/results.schema.json");
-        let text = serde_json::to_string_pretty(&json_schema()).unwrap() + "\n";
-        if std::env::var_os("TETBENCH_BLESS").is_some() {
-            std::fs::write(&path, &text).unwrap();
-        }
-        let stored = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(
-            stored == text,
-            "{} is out of date: regenerate it with TETBENCH_BLESS=1 cargo test -p harness --lib \
-             results::",
-            path.display()
-        );
-        // The committed baseline against the schema: it loads, and every object in it has
-        // the schema's required fields and no field the schema lacks (a structural check of
-        // the parts a results file is made of, without a validator crate).
-        let schema = json_schema();
+    fn a_real_results_file_validates_and_a_renamed_column_does_not() {
         let baselines = Path::new(env!("CARGO_MANIFEST_DIR")).join("../reports/baselines");
         let dir = std::fs::read_dir(&baselines)
             .unwrap()
@@ -690,26 +679,30 @@ mod tests {
         ResultsFile::read(&dir).unwrap();
         let real: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join(JSON_FILE)).unwrap()).unwrap();
-        let defs = &schema["$defs"];
-        let check = |value: &serde_json::Value, def: &serde_json::Value, what: &str| {
-            let props = def["properties"].as_object().unwrap();
-            let obj = value.as_object().unwrap();
-            for k in obj.keys() {
-                assert!(
-                    props.contains_key(k),
-                    "{what}: field {k} is not in the schema"
-                );
-            }
-            for r in def["required"].as_array().into_iter().flatten() {
-                let r = r.as_str().unwrap();
-                assert!(obj.contains_key(r), "{what}: required field {r} missing");
-            }
-        };
-        check(&real, &schema, "results.json");
-        check(&real["machine"], &defs["MachineInfo"], "machine");
-        check(&real["run"], &defs["RunDescription"], "run");
-        for row in real["rows"].as_array().unwrap() {
-            check(row, &defs["Row"], "row");
+        crate::schemas::validate("results", &real).unwrap();
+        let mutations: [(&str, fn(&mut serde_json::Value)); 4] = [
+            ("total_ms renamed", |v| {
+                let row = v["rows"][0].as_object_mut().unwrap();
+                let t = row.remove("total_ms").unwrap();
+                row.insert("total_msec".into(), t);
+            }),
+            ("an unknown machine field", |v| {
+                v["machine"]["gpu_temperature"] = serde_json::json!(80);
+            }),
+            ("no algorithm", |v| {
+                v["rows"][0].as_object_mut().unwrap().remove("algorithm");
+            }),
+            ("a counter as a word", |v| {
+                v["rows"][0]["counters"] = serde_json::json!({"fragments": "many"});
+            }),
+        ];
+        for (what, mutate) in mutations {
+            let mut bad = real.clone();
+            mutate(&mut bad);
+            assert!(
+                crate::schemas::validate("results", &bad).is_err(),
+                "results.json with {what} still validates"
+            );
         }
     }
 }

@@ -3,6 +3,7 @@
 //! counters, host peak memory). The run loop in the parent module drives it.
 
 use super::*;
+use crate::results::NamedValues;
 
 pub(super) struct DatasetContext<'a> {
     config: &'a RunConfig,
@@ -57,7 +58,7 @@ fn base_row(ctx: &DatasetContext, renderer: &dyn Renderer, vp: &Viewpoint) -> Ro
 fn median_named(
     frames: &[FrameStats],
     pick: impl Fn(&FrameStats) -> &Vec<(String, f64)>,
-) -> String {
+) -> NamedValues {
     let mut names: Vec<String> = vec![];
     for f in frames {
         for (n, _) in pick(f) {
@@ -74,18 +75,9 @@ fn median_named(
                 .flat_map(|f| pick(f).iter().filter(|(m, _)| m == n).map(|(_, v)| *v))
                 .collect();
             let m = summarize(&v).map(|s| s.median).unwrap_or(f64::NAN);
-            format!("{n}={}", trim_float(m))
+            (n.clone(), m)
         })
-        .collect::<Vec<_>>()
-        .join(";")
-}
-
-fn trim_float(v: f64) -> String {
-    if v.fract() == 0.0 && v.abs() < 1e15 {
-        format!("{}", v as i64)
-    } else {
-        format!("{v:.4}")
-    }
+        .collect()
 }
 
 impl<'a> DatasetContext<'a> {
@@ -433,12 +425,7 @@ impl<'a> DatasetContext<'a> {
             match reference {
                 Ok((reference, ref_path, lost_rays)) => {
                     // Rays the reference could not follow to their end (0 on sound meshes).
-                    let lost = format!("reference_lost_rays={lost_rays}");
-                    row.counters = if row.counters.is_empty() {
-                        lost
-                    } else {
-                        format!("{};{lost}", row.counters)
-                    };
+                    row.counters.insert("reference_lost_rays", lost_rays as f64);
                     let e = metrics::compare(&image, &reference)?;
                     row.rmse = Some(e.rmse);
                     row.psnr_db = Some(e.psnr_db);

@@ -47,6 +47,7 @@ pub static PT: AlgorithmDescription = AlgorithmDescription {
         why: "8-bit framebuffer and VTK's own approximations; see tests/vtk_vs_reference.rs",
     },
     counters: &[],
+    nondeterministic_counters: render_core::description::all_counters_exact,
 };
 
 pub static RAYCAST: AlgorithmDescription = AlgorithmDescription {
@@ -91,6 +92,7 @@ pub static RAYCAST: AlgorithmDescription = AlgorithmDescription {
         why: "the displayed image blurs silhouettes (the accuracy the peer declares)",
     },
     counters: &[],
+    nondeterministic_counters: render_core::description::all_counters_exact,
 };
 
 pub static ZSWEEP: AlgorithmDescription = AlgorithmDescription {
@@ -119,6 +121,7 @@ pub static ZSWEEP: AlgorithmDescription = AlgorithmDescription {
         why: "ZSweep rounds vertices to whole pixels (the accuracy the peer declares)",
     },
     counters: &[],
+    nondeterministic_counters: render_core::description::all_counters_exact,
 };
 
 pub(crate) fn settings_of(

@@ -50,6 +50,33 @@ pub struct Tolerance {
     pub why: &'static str,
 }
 
+/// How an adapter shades the fragments that land on one pixel: one after the other in
+/// primitive order (a CPU adapter such as lavapipe: one thread per screen tile), or
+/// concurrently (a GPU). A counter that a race decides can differ between frames only where
+/// the shading is concurrent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shading {
+    InOrder,
+    Concurrent,
+}
+
+impl Shading {
+    /// The shading of an adapter by its wgpu device type (`Cpu` for a software rasteriser).
+    pub fn of_device_type(device_type: &str) -> Shading {
+        if device_type.eq_ignore_ascii_case("cpu") {
+            Shading::InOrder
+        } else {
+            Shading::Concurrent
+        }
+    }
+}
+
+/// For [`AlgorithmDescription::nondeterministic_counters`]: every counter is exact on every
+/// adapter.
+pub fn all_counters_exact(_: &Settings, _: Shading) -> &'static [&'static str] {
+    &[]
+}
+
 /// What the harness knows of one algorithm.
 pub struct AlgorithmDescription {
     /// Name on the command line and in result rows (`havs`).
@@ -69,6 +96,10 @@ pub struct AlgorithmDescription {
     pub tolerance: fn(&Settings) -> Tolerance,
     /// Names of the work counters each frame reports (`triangles`, `fragments`, `ray_steps`).
     pub counters: &'static [&'static str],
+    /// The counters (of a variant, on an adapter that shades this way) that are not the same
+    /// from frame to frame — a race decides them. `tetbench compare` tests these
+    /// statistically; every other counter must match exactly.
+    pub nondeterministic_counters: fn(&Settings, Shading) -> &'static [&'static str],
 }
 
 impl std::fmt::Debug for AlgorithmDescription {

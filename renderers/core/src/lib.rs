@@ -20,7 +20,7 @@ pub mod transfer;
 pub mod visibility;
 
 pub use bind::ChunkedBuffer;
-pub use description::{AlgorithmDescription, Hue, Origin, Param, Tolerance};
+pub use description::{AlgorithmDescription, Hue, Origin, Param, Shading, Tolerance};
 pub use frame::{FrameClock, FrameTimes};
 pub use gpu::{AdapterDescription, DeviceRequest, FrameTimer, Gpu, Lifetime, MemoryLedger};
 pub use image::Image;

@@ -38,6 +38,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
         "cpu_sort_keys",
         "gpu_sort_keys",
     ],
+    nondeterministic_counters: render_core::description::all_counters_exact,
 };
 
 fn grid(sorts: &[SortMode]) -> Vec<Settings> {

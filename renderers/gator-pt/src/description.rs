@@ -33,6 +33,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     hue: Hue::Blues,
     tolerance,
     counters: &["triangles", "fragments", "covering_tets", "cpu_sort_keys"],
+    nondeterministic_counters: render_core::description::all_counters_exact,
 };
 
 /// Both cell models with each order (constant first), the order [`crate::variants`] runs.

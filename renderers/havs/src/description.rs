@@ -1,7 +1,7 @@
 //! What the harness knows of HAVS without building it (see [`render_core::description`]).
 
 use render_core::{
-    AlgorithmDescription, Hue, Origin, Param, Renderer, Settings, Tolerance, ValueKind,
+    AlgorithmDescription, Hue, Origin, Param, Renderer, Settings, Shading, Tolerance, ValueKind,
 };
 
 use crate::{Havs, HavsSettings, Mode, SortMode, TagScheme};
@@ -85,7 +85,28 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     hue: Hue::Oranges,
     tolerance,
     counters: &["triangles", "fragments", "cpu_sort_keys", "gpu_sort_keys"],
+    nondeterministic_counters,
 };
+
+/// The racy single pass (`mode=fragment-race`, §4) on an adapter that shades a pixel's
+/// fragments concurrently: which read-modify-writes of a pixel's k-buffer another fragment
+/// overwrote is decided by the race, and with them the fragments counted, the out-of-order
+/// pops, the early-terminated fragments and the lost updates. On an in-order adapter
+/// (lavapipe) the racy pass is its CPU twin exactly (`tests/racy_twin.rs`), so every counter is
+/// exact there.
+fn nondeterministic_counters(s: &Settings, shading: Shading) -> &'static [&'static str] {
+    let racy = s.text("mode").as_deref() == Some(Mode::FragmentRace.name());
+    if racy && shading == Shading::Concurrent {
+        &[
+            "fragments",
+            "kbuffer_out_of_order",
+            "et_culled_fragments",
+            "race_lost_updates",
+        ]
+    } else {
+        &[]
+    }
+}
 
 pub(crate) fn settings_of(s: &HavsSettings) -> Settings {
     Settings::new()

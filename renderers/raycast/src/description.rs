@@ -51,6 +51,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     hue: Hue::Purples,
     tolerance,
     counters: &["ray_steps", "triangles"],
+    nondeterministic_counters: render_core::description::all_counters_exact,
 };
 
 /// Measured on the check scene (`tests/vs_reference.rs`, lavapipe): the 3D table 96.5 dB, the

@@ -1,0 +1,242 @@
+//! What a comparison found, as objects a machine reads: each regression, improvement and other
+//! change names its group (and row), the metric, the ratio, the p-values and the verdict, with
+//! the sentence the reports print beside them.
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::regress::compare::{Comparison, ImageVerdict, RowComparison, RowStatus};
+use crate::regress::compare_time::{TimeTest, Verdict};
+use crate::regress::compare_work::WorkVerdict;
+
+/// Which way a finding goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum FindingVerdict {
+    /// Time: the group (or row, or the whole run) got slower / faster.
+    Slower,
+    Faster,
+    /// Work: a counter or byte figure grew / shrank (exact).
+    More,
+    Less,
+    /// A counter only one side reports.
+    Added,
+    Removed,
+    /// Image: PSNR dropped / rose beyond the tolerance, or the pixels changed.
+    Worse,
+    Better,
+    Changed,
+    /// The row failed in NEW only / in BASE only.
+    FailsNow,
+    NoLongerFails,
+    /// The row exists on one side only.
+    OnlyInBase,
+    OnlyInNew,
+}
+
+/// One regression, improvement or other change.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Finding {
+    /// `algorithm settings on dataset` (the group), or `run-wide` for the run as a whole.
+    pub group: String,
+    /// The row's viewpoint; `None` for a group's pooled test or the run-wide factor.
+    pub viewpoint: Option<String>,
+    /// What moved: `total_ms`, a counter (`fragments`), a byte figure (`gpu_bytes`), `image`,
+    /// `error`, `row`.
+    pub metric: String,
+    /// NEW / BASE, where there is one.
+    pub ratio: Option<f64>,
+    /// The test's p-value (time only) and the Holm-adjusted one that decided.
+    pub p: Option<f64>,
+    pub p_holm: Option<f64>,
+    pub verdict: FindingVerdict,
+    /// The finding as the reports print it.
+    pub text: String,
+}
+
+fn group_label(algorithm: &str, settings: &str, dataset: &str) -> String {
+    format!("{algorithm} {settings} on {dataset}")
+}
+
+impl Finding {
+    fn of_row(r: &RowComparison, metric: &str, verdict: FindingVerdict, text: String) -> Finding {
+        Finding {
+            group: group_label(&r.algorithm, &r.settings, &r.dataset),
+            viewpoint: Some(r.viewpoint.clone()),
+            metric: metric.into(),
+            ratio: None,
+            p: None,
+            p_holm: None,
+            verdict,
+            text: format!(
+                "{} {} {} {}: {text}",
+                r.algorithm, r.settings, r.dataset, r.viewpoint
+            ),
+        }
+    }
+
+    fn with_time(mut self, t: &TimeTest) -> Finding {
+        self.ratio = Some(t.ratio);
+        self.p = t.p_value;
+        self.p_holm = t.p_adjusted;
+        self
+    }
+}
+
+/// Fills the comparison's regressions, improvements and changes from its run-wide factor,
+/// groups and rows.
+pub fn collect(cmp: &mut Comparison, drift_limit: f64) {
+    let (mut worse, mut better, mut other) = (vec![], vec![], vec![]);
+    if let Some(f) = cmp.run_factor {
+        let finding = |verdict| Finding {
+            group: "run-wide".into(),
+            viewpoint: None,
+            metric: "total_ms".into(),
+            ratio: Some(f),
+            p: None,
+            p_holm: None,
+            verdict,
+            text: format!(
+                "run-wide: every group's total_ms ×{f:.3} (median over {} groups; machine drift \
+                 or a change common to all algorithms, beyond --drift-limit {drift_limit})",
+                cmp.groups.len(),
+            ),
+        };
+        if f >= drift_limit {
+            worse.push(finding(FindingVerdict::Slower));
+        } else if f <= 1.0 / drift_limit {
+            better.push(finding(FindingVerdict::Faster));
+        }
+    }
+    for g in &cmp.groups {
+        let verdict = match g.total.verdict {
+            Verdict::Slower => FindingVerdict::Slower,
+            Verdict::Faster => FindingVerdict::Faster,
+            _ => continue,
+        };
+        let f = Finding {
+            group: group_label(&g.algorithm, &g.settings, &g.dataset),
+            viewpoint: None,
+            metric: "total_ms".into(),
+            ratio: None,
+            p: None,
+            p_holm: None,
+            verdict,
+            text: format!(
+                "{}: {} {} on {}: total_ms ×{:.3} (p = {})",
+                g.total.verdict.label(),
+                g.algorithm,
+                g.settings,
+                g.dataset,
+                g.total.ratio,
+                g.total.p_label()
+            ),
+        }
+        .with_time(&g.total);
+        if verdict == FindingVerdict::Slower {
+            worse.push(f);
+        } else {
+            better.push(f);
+        }
+    }
+    for r in &cmp.rows {
+        for f in row_findings(r) {
+            match f.verdict {
+                FindingVerdict::Slower
+                | FindingVerdict::More
+                | FindingVerdict::Worse
+                | FindingVerdict::FailsNow => worse.push(f),
+                FindingVerdict::Faster
+                | FindingVerdict::Less
+                | FindingVerdict::Better
+                | FindingVerdict::NoLongerFails => better.push(f),
+                _ => other.push(f),
+            }
+        }
+    }
+    cmp.regressions = worse;
+    cmp.improvements = better;
+    cmp.changes = other;
+}
+
+/// The findings of one row: its error, each work change, its `total_ms` verdict, its image.
+fn row_findings(r: &RowComparison) -> Vec<Finding> {
+    let mut out = vec![];
+    match r.status {
+        RowStatus::OnlyInBase => {
+            return vec![Finding::of_row(
+                r,
+                "row",
+                FindingVerdict::OnlyInBase,
+                "only in base".into(),
+            )]
+        }
+        RowStatus::OnlyInNew => {
+            return vec![Finding::of_row(
+                r,
+                "row",
+                FindingVerdict::OnlyInNew,
+                "only in new".into(),
+            )]
+        }
+        _ => {}
+    }
+    for note in &r.notes {
+        if note.starts_with("failed now") {
+            out.push(Finding::of_row(
+                r,
+                "error",
+                FindingVerdict::FailsNow,
+                note.clone(),
+            ));
+        } else if note == "no longer fails" {
+            out.push(Finding::of_row(
+                r,
+                "error",
+                FindingVerdict::NoLongerFails,
+                note.clone(),
+            ));
+        }
+    }
+    for w in &r.work {
+        let verdict = match w.verdict {
+            WorkVerdict::More => FindingVerdict::More,
+            WorkVerdict::Less => FindingVerdict::Less,
+            WorkVerdict::Added => FindingVerdict::Added,
+            WorkVerdict::Removed => FindingVerdict::Removed,
+        };
+        let mut f = Finding::of_row(r, &w.counter, verdict, w.describe());
+        f.ratio = w.ratio;
+        out.push(f);
+    }
+    if let Some(t) = r.times.iter().find(|t| t.metric == "total_ms") {
+        let verdict = match t.verdict {
+            Verdict::Slower => Some(FindingVerdict::Slower),
+            Verdict::Faster => Some(FindingVerdict::Faster),
+            _ => None,
+        };
+        if let Some(v) = verdict {
+            let text = format!(
+                "{} ×{:.3} (p = {})",
+                t.verdict.label(),
+                t.ratio,
+                t.p_label()
+            );
+            out.push(Finding::of_row(r, "total_ms", v, text).with_time(t));
+        }
+    }
+    if let Some(img) = &r.image {
+        let verdict = match img.verdict {
+            ImageVerdict::Worse => Some(FindingVerdict::Worse),
+            ImageVerdict::Better => Some(FindingVerdict::Better),
+            ImageVerdict::Changed => Some(FindingVerdict::Changed),
+            ImageVerdict::Same => None,
+        };
+        if let Some(v) = verdict {
+            let text = crate::regress::compare_image::image_note(img);
+            out.push(Finding::of_row(r, "image", v, text));
+        }
+    }
+    out
+}
