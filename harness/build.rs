@@ -21,6 +21,19 @@ fn git(root: &Path, args: &[&str]) -> Option<String> {
         .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
 }
 
+/// What the binary is built from: a change here (tracked or not) makes the tree dirty and
+/// reruns this script.
+const SOURCE_PATHS: [&str; 8] = [
+    "harness",
+    "datasets",
+    "renderers",
+    "peers",
+    "tests",
+    "scripts",
+    "Cargo.toml",
+    "Cargo.lock",
+];
+
 fn main() {
     let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo"));
     let root = manifest
@@ -29,8 +42,14 @@ fn main() {
         .to_path_buf();
 
     let commit = git(&root, &["rev-parse", "HEAD"]);
+    // Dirty: a tracked file differs from the commit, or a source folder holds a file git
+    // does not track (a new module the commit lacks; ignored build outputs do not count).
     let dirty = commit.as_ref().and_then(|_| {
-        git(&root, &["status", "--porcelain", "--untracked-files=no"]).map(|s| !s.is_empty())
+        let tracked = git(&root, &["status", "--porcelain", "--untracked-files=no"])?;
+        let mut untracked_args = vec!["status", "--porcelain", "--untracked-files=all", "--"];
+        untracked_args.extend(SOURCE_PATHS);
+        let untracked = git(&root, &untracked_args)?;
+        Some(!tracked.is_empty() || !untracked.is_empty())
     });
     println!(
         "cargo:rustc-env=TETBENCH_GIT_COMMIT={}",
@@ -52,6 +71,18 @@ fn main() {
         .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
         .unwrap_or_default();
     println!("cargo:rustc-env=TETBENCH_RUSTC_VERSION={version}");
+    // What `tetbench --version` prints after the package version.
+    let state = match dirty {
+        Some(true) => "dirty: uncommitted changes",
+        Some(false) => "clean",
+        None => "dirty flag unknown",
+    };
+    println!(
+        "cargo:rustc-env=TETBENCH_VERSION_LINE={} (commit {}, {state}; {} build, {version})",
+        std::env::var("CARGO_PKG_VERSION").unwrap_or_default(),
+        commit.as_deref().unwrap_or("unknown"),
+        std::env::var("PROFILE").unwrap_or_default(),
+    );
 
     // Rerun when HEAD moves (a checkout: HEAD; a commit: the branch's ref, or packed-refs
     // after a gc), when the index changes, and when a tracked source changes (the dirty flag).
@@ -67,18 +98,8 @@ fn main() {
                 println!("cargo:rerun-if-changed={}", root.join(p).display());
             }
         }
-        for dir in [
-            "harness",
-            "datasets",
-            "renderers",
-            "peers",
-            "tests",
-            "scripts",
-        ] {
-            println!("cargo:rerun-if-changed={}", root.join(dir).display());
-        }
-        for file in ["Cargo.toml", "Cargo.lock"] {
-            println!("cargo:rerun-if-changed={}", root.join(file).display());
+        for path in SOURCE_PATHS {
+            println!("cargo:rerun-if-changed={}", root.join(path).display());
         }
     } else {
         println!("cargo:rerun-if-changed=build.rs");

@@ -20,7 +20,7 @@ use crate::run::{self, RunConfig};
 #[derive(Debug, Parser)]
 #[command(
     name = "tetbench",
-    version,
+    version = env!("TETBENCH_VERSION_LINE"),
     about = "Benchmarks GPU volume renderers for tetrahedral meshes against an exact CPU reference",
     long_about = None
 )]
@@ -217,6 +217,20 @@ impl RunArgs {
     }
 }
 
+/// The exit status of a bad option or argument: 1, as every other error (docs/regression.md,
+/// "Exit codes"), so that 3 alone means a regression. clap's own is 2.
+pub const EXIT_USAGE: i32 = 1;
+
+/// `--help` and `--version` print and exit 0; a bad option prints clap's message and exits
+/// [`EXIT_USAGE`].
+fn exit_on_parse_error(e: clap::Error) -> ! {
+    if !e.use_stderr() {
+        e.exit();
+    }
+    let _ = e.print();
+    std::process::exit(EXIT_USAGE)
+}
+
 /// Parses `args` (program name first) and runs the command.
 pub fn main_with_args<I, T>(args: I) -> anyhow::Result<()>
 where
@@ -224,7 +238,7 @@ where
     T: Into<std::ffi::OsString> + Clone,
 {
     let args: Vec<std::ffi::OsString> = args.into_iter().map(Into::into).collect();
-    let cli = Cli::try_parse_from(&args).unwrap_or_else(|e| e.exit());
+    let cli = Cli::try_parse_from(&args).unwrap_or_else(|e| exit_on_parse_error(e));
     let command_line = args
         .iter()
         .map(|a| a.to_string_lossy().into_owned())
