@@ -323,7 +323,118 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     let variants_total: usize = plan.iter().map(|(_, n)| n).sum();
     // Held until the run returns: a second run into this directory refuses (lock.rs).
     let _lock = lock::acquire(&config.out, &config.command_line)?;
+    let (gpu, machine) = open_machine(config)?;
+    let description = run_description(config);
+    let kept = if config.resume {
+        resume::finished_rows(&config.out, &description, &machine, config.viewpoints.len())?
+    } else {
+        vec![]
+    };
+    let scope = Scope {
+        shard: match config.shard {
+            Some(shard) => Some(shard::select(shard, &matrix_units(config, factory)?)),
+            None => None,
+        },
+        done: kept
+            .iter()
+            .map(|r| (r.dataset.clone(), r.algorithm.clone(), r.settings.clone()))
+            .collect(),
+        variants_total,
+    };
+    let mut writer = ResultsWriter::create(&config.out, machine, description)?;
+    writer.push_restored(kept)?;
+    let mut progress = start_progress(config, &gpu, &scope, &writer);
+    let mut outcome = RunOutcome::default();
+    let registry = datasets::registry::Registry::new(config.data_dir.clone());
+    for spec in &config.datasets {
+        let label = dataset_label(spec);
+        if scope.units_of(&label) == 0 || scope.finished(&label) {
+            continue; // nothing of it in this shard, or all of it kept by --resume
+        }
+        let Some(dataset) =
+            load_dataset(config, &registry, spec, &scope, &mut progress).or_else(|msg| {
+                writer.push_error(msg.clone())?;
+                outcome.errors.push(msg);
+                anyhow::Ok(None)
+            })?
+        else {
+            continue;
+        };
+        let mut renderers = vec![];
+        for (name, _) in &plan {
+            renderers.extend(
+                factory(name)?
+                    .into_iter()
+                    .filter(|r| scope.runs(config, &label, name, &r.settings())),
+            );
+        }
+        let optics =
+            Optics::for_extent(config.tf.clone(), &dataset.bounds(), dataset.scalar_range());
+        let mut ctx = DatasetContext::new(config, &gpu, &dataset, &optics, label);
+        if config.rounds <= 1 {
+            // One variant at a time: its GPU memory is freed before the next one prepares.
+            for renderer in renderers {
+                ctx.run_variants(vec![renderer], &mut writer, &mut progress, &mut outcome)?;
+            }
+        } else {
+            ctx.run_variants(renderers, &mut writer, &mut progress, &mut outcome)?;
+        }
+    }
+    progress.finish();
+    finish_run(config, &mut writer, &mut outcome)?;
+    outcome.seconds = started.elapsed().as_secs_f64();
+    Ok(outcome)
+}
 
+/// The units of the matrix this invocation runs: its shard's (all without `--shard`), less
+/// those a resumed run already finished.
+struct Scope {
+    /// The (data set, algorithm, settings) units of this shard; `None`: all.
+    shard: Option<std::collections::HashSet<shard::Unit>>,
+    /// Units whose rows `--resume` kept.
+    done: std::collections::HashSet<resume::Unit>,
+    /// Variants per data set over all algorithms (without a shard, every data set's units).
+    variants_total: usize,
+}
+
+impl Scope {
+    /// Units of data set `label` in this shard.
+    fn units_of(&self, label: &str) -> usize {
+        match &self.shard {
+            Some(u) => u.iter().filter(|(d, _, _)| d == label).count(),
+            None => self.variants_total,
+        }
+    }
+
+    fn units_total(&self, datasets: usize) -> usize {
+        match &self.shard {
+            Some(u) => u.len(),
+            None => datasets * self.variants_total,
+        }
+    }
+
+    /// Whether every unit of data set `label` was kept by `--resume`.
+    fn finished(&self, label: &str) -> bool {
+        self.done.iter().filter(|(d, _, _)| d == label).count() == self.units_of(label)
+    }
+
+    /// Whether this invocation runs the variant `settings` of `algorithm` on `label`.
+    fn runs(
+        &self,
+        config: &RunConfig,
+        label: &str,
+        algorithm: &str,
+        settings: &render_core::Settings,
+    ) -> bool {
+        let unit = (label.to_string(), algorithm.to_string(), settings.clone());
+        config.settings_filter.accepts(settings)
+            && self.shard.as_ref().is_none_or(|u| u.contains(&unit))
+            && !self.done.contains(&unit)
+    }
+}
+
+/// Opens the GPU and records the machine, calibrating the backend unless `--no-calibrate`.
+fn open_machine(config: &RunConfig) -> anyhow::Result<(Gpu, MachineInfo)> {
     let gpu = Gpu::new()?;
     let mut machine = MachineInfo::collect();
     machine.adapter = Some(gpu.adapter.clone());
@@ -340,20 +451,12 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         }
         machine.calibration = Some(cal);
     }
-    // The (data set, algorithm, settings) units this shard runs; `None`: all.
-    let shard_units = match config.shard {
-        Some(shard) => Some(crate::run::shard::select(
-            shard,
-            &matrix_units(config, factory)?,
-        )),
-        None => None,
-    };
-    let in_shard = |label: &str, alg: &str, settings: &render_core::Settings| {
-        shard_units
-            .as_ref()
-            .is_none_or(|u| u.contains(&(label.to_string(), alg.to_string(), settings.clone())))
-    };
-    let description = RunDescription {
+    Ok((gpu, machine))
+}
+
+/// How the run was asked for, as `results.json` keeps it.
+fn run_description(config: &RunConfig) -> RunDescription {
+    RunDescription {
         command_line: config.command_line.clone(),
         algorithms: config.algorithms.clone(),
         datasets: config.datasets.clone(),
@@ -369,31 +472,27 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         reference: config.reference,
         shard: config.shard.map(|s| s.to_string()),
         merged_from: vec![],
-    };
-    let kept = if config.resume {
-        resume::finished_rows(&config.out, &description, &machine, config.viewpoints.len())?
-    } else {
-        vec![]
-    };
-    let done: std::collections::HashSet<resume::Unit> = kept
-        .iter()
-        .map(|r| (r.dataset.clone(), r.algorithm.clone(), r.settings.clone()))
-        .collect();
-    let mut writer = ResultsWriter::create(&config.out, machine, description)?;
-    writer.push_restored(kept)?;
-    let units_total = match &shard_units {
-        Some(u) => u.len(),
-        None => config.datasets.len() * variants_total,
-    };
-    let mut progress = Progress::new((units_total * config.viewpoints.len()) as u64);
-    if !done.is_empty() {
+    }
+}
+
+/// The progress display over this invocation's rows, with what `--resume` kept already
+/// counted, and the run's first lines.
+fn start_progress(
+    config: &RunConfig,
+    gpu: &Gpu,
+    scope: &Scope,
+    writer: &ResultsWriter,
+) -> Progress {
+    let views = config.viewpoints.len();
+    let mut progress = Progress::new((scope.units_total(config.datasets.len()) * views) as u64);
+    if !scope.done.is_empty() {
         progress.log(&format!(
             "tetbench: --resume keeps {} finished unit(s) ({} rows) of {}",
-            done.len(),
+            scope.done.len(),
             writer.file.rows.len(),
             config.out.display()
         ));
-        progress.skip((done.len() * config.viewpoints.len()) as u64);
+        progress.skip((scope.done.len() * views) as u64);
     }
     progress.log(&format!(
         "tetbench: {} on {} ({}, {}); writing {}",
@@ -403,85 +502,58 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         gpu.adapter.device_type,
         config.out.display()
     ));
+    progress
+}
 
-    let registry = datasets::registry::Registry::new(config.data_dir.clone());
+/// Loads one data set (lazily: a voxel volume's tets are split only when a variant needs
+/// them). A data set that cannot be loaded is the error message (its rows are skipped in the
+/// progress display), not a failed run.
+fn load_dataset(
+    config: &RunConfig,
+    registry: &datasets::registry::Registry,
+    spec: &str,
+    scope: &Scope,
+    progress: &mut Progress,
+) -> Result<Option<LazyDataset>, String> {
+    let label = dataset_label(spec);
+    progress.status(&format!("loading {label}"));
+    let t0 = Instant::now();
     let load_options = datasets::LoadOptions {
         scalar: config.scalar.clone(),
         ..Default::default()
     };
-    let mut outcome = RunOutcome::default();
-
-    for spec in &config.datasets {
-        let label = dataset_label(spec);
-        if shard_units
-            .as_ref()
-            .is_some_and(|u| !u.iter().any(|(d, _, _)| *d == label))
-        {
-            continue; // nothing of this data set in this shard
-        }
-        let units_here = match &shard_units {
-            Some(u) => u.iter().filter(|(d, _, _)| *d == label).count(),
-            None => variants_total,
-        };
-        if units_here > 0 && done.iter().filter(|(d, _, _)| *d == label).count() == units_here {
-            continue; // every unit of this data set finished in the resumed run
-        }
-        progress.status(&format!("loading {label}"));
-        let t0 = Instant::now();
-        let dataset = match guarded("loading", || {
-            registry
-                .resolve_lazy(spec, &load_options)
-                .map_err(|e| anyhow!("{e}"))
-        }) {
-            Ok(d) => d,
-            Err(e) => {
-                let msg = format!("data set {spec:?} could not be loaded: {e:#}");
-                progress.log(&format!("ERROR: {msg}"));
-                writer.push_error(msg.clone())?;
-                outcome.errors.push(msg);
-                let units = match &shard_units {
-                    Some(u) => u.iter().filter(|(d, _, _)| *d == label).count(),
-                    None => variants_total,
-                };
-                progress.skip((units * config.viewpoints.len()) as u64);
-                continue;
-            }
-        };
-        // A voxel volume's tets are counted, not split: only a variant that draws tets (or the
-        // reference) splits them (measure.rs).
-        progress.log(&format!(
-            "{label}: {} points, {} tets{} (loaded in {:.2} s)",
-            dataset.num_points(),
-            dataset.num_tets(),
-            if dataset.tets_built() {
-                ""
-            } else {
-                ", not split yet"
-            },
-            t0.elapsed().as_secs_f64()
-        ));
-        let optics =
-            Optics::for_extent(config.tf.clone(), &dataset.bounds(), dataset.scalar_range());
-        let mut ctx = DatasetContext::new(config, &gpu, &dataset, &optics, label.clone());
-        let mut renderers = vec![];
-        for (name, _) in &plan {
-            renderers.extend(factory(name)?.into_iter().filter(|r| {
-                let settings = r.settings();
-                config.settings_filter.accepts(&settings)
-                    && in_shard(&label, name, &settings)
-                    && !done.contains(&(label.clone(), name.clone(), settings))
-            }));
-        }
-        if config.rounds <= 1 {
-            // One variant at a time: its GPU memory is freed before the next one prepares.
-            for renderer in renderers {
-                ctx.run_variants(vec![renderer], &mut writer, &mut progress, &mut outcome)?;
-            }
+    let dataset = guarded("loading", || {
+        registry
+            .resolve_lazy(spec, &load_options)
+            .map_err(|e| anyhow!("{e}"))
+    })
+    .map_err(|e| {
+        let msg = format!("data set {spec:?} could not be loaded: {e:#}");
+        progress.log(&format!("ERROR: {msg}"));
+        progress.skip((scope.units_of(&label) * config.viewpoints.len()) as u64);
+        msg
+    })?;
+    progress.log(&format!(
+        "{label}: {} points, {} tets{} (loaded in {:.2} s)",
+        dataset.num_points(),
+        dataset.num_tets(),
+        if dataset.tets_built() {
+            ""
         } else {
-            ctx.run_variants(renderers, &mut writer, &mut progress, &mut outcome)?;
-        }
-    }
-    progress.finish();
+            ", not split yet"
+        },
+        t0.elapsed().as_secs_f64()
+    ));
+    Ok(Some(dataset))
+}
+
+/// What needs every row: the suspect flags, the roofline columns (with a calibration), both
+/// files rewritten, the end load and time, and the report.
+fn finish_run(
+    config: &RunConfig,
+    writer: &mut ResultsWriter,
+    outcome: &mut RunOutcome,
+) -> anyhow::Result<()> {
     crate::results::suspect::mark_all(&mut writer.file.rows);
     outcome.suspect_rows = writer
         .file
@@ -506,8 +578,7 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     if config.report {
         crate::report::write(&config.out, &writer.file).context("writing the report")?;
     }
-    outcome.seconds = started.elapsed().as_secs_f64();
-    Ok(outcome)
+    Ok(())
 }
 
 /// The variants of an external renderer named `name` (one per `--external` spec with that
