@@ -12,6 +12,7 @@ out=$2
 runs=${3:-11}
 mkdir -p "$out"
 matrix=(--algorithms gator-pt,havs,fragment-pt,raycast --datasets box:10k --resolution 64
+        --viewpoints +x,+x+y+z,-x+y-z
         --frames 1 --warmup 1 --rounds 3 --no-reference --no-calibrate --no-report)
 for i in $(seq 1 "$runs"); do
     [ -f "$out/run-$i/results.json" ] && continue

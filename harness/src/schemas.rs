@@ -7,8 +7,11 @@
 
 use std::path::PathBuf;
 
+/// Generates one output's JSON Schema.
+pub type SchemaOf = fn() -> serde_json::Value;
+
 /// Each output by name (`docs/NAME.schema.json`) and the function that generates its schema.
-pub const SCHEMAS: [(&str, fn() -> serde_json::Value); 5] = [
+pub const SCHEMAS: [(&str, SchemaOf); 5] = [
     ("results", crate::results::json_schema),
     ("compare", crate::regress::compare::json_schema),
     ("history", crate::regress::history::json_schema),
@@ -41,7 +44,7 @@ pub fn validate(name: &str, value: &serde_json::Value) -> Result<(), String> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use serde_json::{json, Value};
     use std::path::Path;
@@ -67,12 +70,11 @@ mod tests {
         }
     }
 
+    /// A named change to a valid document that must make it invalid.
+    pub(crate) type Mutation = (&'static str, fn(&mut Value));
+
     /// `value` validates as `name`, and each mutation of it does not.
-    fn validates_and_mutations_fail(
-        name: &str,
-        value: &Value,
-        mutations: &[(&str, fn(&mut Value))],
-    ) {
+    fn validates_and_mutations_fail(name: &str, value: &Value, mutations: &[Mutation]) {
         validate(name, value).unwrap_or_else(|e| panic!("{name}: {e}"));
         for (what, mutate) in mutations {
             let mut bad = value.clone();

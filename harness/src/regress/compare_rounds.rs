@@ -56,9 +56,6 @@ impl Default for Rounds {
     }
 }
 
-/// `compare --fail-on` met: the exit status, distinct from 1 (an error, or a comparison
-/// refused: other adapters, unreadable results) so that CI can tell a regression from a
-
 /// The samples of `metric`, divided by the row's roofline time when normalising.
 fn metric_samples(r: &Row, metric: &str, normalised: bool) -> anyhow::Result<Vec<f64>> {
     let s = r.samples.metric(metric);

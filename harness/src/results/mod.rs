@@ -680,7 +680,7 @@ mod tests {
         let real: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join(JSON_FILE)).unwrap()).unwrap();
         crate::schemas::validate("results", &real).unwrap();
-        let mutations: [(&str, fn(&mut serde_json::Value)); 4] = [
+        let mutations: [crate::schemas::tests::Mutation; 4] = [
             ("total_ms renamed", |v| {
                 let row = v["rows"][0].as_object_mut().unwrap();
                 let t = row.remove("total_ms").unwrap();
