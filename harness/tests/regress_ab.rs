@@ -83,6 +83,20 @@ fn tetbench(args: &[&str], cwd: &Path) -> Output {
         .expect("tetbench runs")
 }
 
+/// Validates a written JSON output against its committed schema (`docs/NAME.schema.json`).
+fn assert_valid(name: &str, value: &serde_json::Value) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../docs/{name}.schema.json"));
+    let schema: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let url = format!("file:///{name}.schema.json");
+    let (mut compiler, mut schemas) = (boon::Compiler::new(), boon::Schemas::new());
+    compiler.add_resource(&url, schema).unwrap();
+    let index = compiler.compile(&url, &mut schemas).unwrap();
+    if let Err(e) = schemas.validate(value, index) {
+        panic!("{name}.json does not fit docs/{name}.schema.json: {e:#}");
+    }
+}
+
 fn text(o: &Output) -> String {
     format!(
         "status {:?}\n--- stdout\n{}\n--- stderr\n{}",
@@ -146,6 +160,7 @@ fn ab_of_two_binaries_gates_like_compare() {
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(p("same/ab.json")).unwrap()).unwrap();
     assert_eq!(report["drift"].as_array().unwrap().len(), 4);
+    assert_valid("ab", &report);
     assert!(p("same/compare/compare.html").is_file());
 
     let slow = tetbench(
@@ -355,6 +370,7 @@ fn bisect_finds_the_first_slow_commit() {
             report["first_bad"].as_str(),
             slow_from.map(|k| commits[k].as_str())
         );
+        assert_valid("bisect", &report);
         if name != "k5" {
             continue;
         }
