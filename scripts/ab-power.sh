@@ -107,7 +107,8 @@ except (OSError, ValueError):
 if regs is None:
     found, false = "error", "error"
 else:
-    found = sum(r.startswith(f"slower: {alg} ") for r in regs)
+    # Findings are objects since issue 44 (their `text` is the old sentence).
+    found = sum(r["text"].startswith(f"slower: {alg} ") for r in regs)
     false = len(regs) - found
 now = datetime.datetime.now(datetime.timezone.utc).strftime("%H:%M:%S")
 print(f"{n},{factor},{threshold},{status},{found},{false},{run_factor},{seconds},{load},{now}")

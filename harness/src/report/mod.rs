@@ -536,6 +536,33 @@ mod tests {
         assert_no_live_markup(&page);
     }
 
+    /// The page shows the provenance results.json holds: build profile, rustc, host, load
+    /// and calibration (or that there is none).
+    #[test]
+    fn the_page_shows_build_host_load_and_calibration() {
+        let mut f = file();
+        f.machine.build_profile = Some("release".into());
+        f.machine.rustc_version = Some("rustc 9.99.0 (test)".into());
+        f.machine.host_name = Some("bench-host-7".into());
+        f.machine.load_average_start = Some(4.25);
+        f.machine.load_average_end = Some(1.5);
+        let dir = tempfile::tempdir().unwrap();
+        write(dir.path(), &f).unwrap();
+        let page = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+        for shown in [
+            "release profile, rustc 9.99.0 (test)",
+            "bench-host-7",
+            "4.25 at the start, 1.50 at the end",
+            "calibration",
+        ] {
+            assert!(page.contains(shown), "{shown} missing from the page");
+        }
+        f.machine.calibration = None;
+        write(dir.path(), &f).unwrap();
+        let page = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+        assert!(page.contains("none (run with --no-calibrate"));
+    }
+
     #[test]
     fn report_has_charts_table_and_images() {
         let dir = tempfile::tempdir().unwrap();
