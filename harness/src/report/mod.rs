@@ -50,14 +50,15 @@ pub fn rewrite(out: &Path) -> anyhow::Result<()> {
 /// there): an absent image is counted and said so on the page, never linked.
 struct Images<'a> {
     dir: &'a Path,
-    absent: std::cell::Cell<usize>,
+    /// The distinct absent paths asked about.
+    absent: std::cell::RefCell<std::collections::BTreeSet<String>>,
 }
 
 impl<'a> Images<'a> {
     fn in_dir(dir: &'a Path) -> Self {
         Images {
             dir,
-            absent: std::cell::Cell::new(0),
+            absent: Default::default(),
         }
     }
 
@@ -70,7 +71,7 @@ impl<'a> Images<'a> {
         if self.dir.join(path).is_file() {
             path.to_string()
         } else {
-            self.absent.set(self.absent.get() + 1);
+            self.absent.borrow_mut().insert(path.to_string());
             String::new()
         }
     }
@@ -415,7 +416,7 @@ fn html(
             psnr_cap_db: PSNR_CAP_DB,
             one_step: format!("{ONE_STEP:.4}"),
             views,
-            images_absent: images.absent.get(),
+            images_absent: images.absent.borrow().len(),
             raw_files: [crate::results::CSV_FILE, crate::results::JSON_FILE, "samples.csv"]
                 .into_iter()
                 .filter(|f| images.dir.join(f).is_file())
