@@ -60,8 +60,8 @@ fn dependencies() -> (BTreeSet<String>, BTreeSet<String>) {
     let (mut external, mut own) = (BTreeSet::new(), BTreeSet::new());
     for f in &files {
         let text = std::fs::read_to_string(f).unwrap();
-        let doc: toml::Table = toml::from_str(&text)
-            .unwrap_or_else(|e| panic!("{} is not TOML: {e}", f.display()));
+        let doc: toml::Table =
+            toml::from_str(&text).unwrap_or_else(|e| panic!("{} is not TOML: {e}", f.display()));
         if let Some(name) = doc
             .get("package")
             .and_then(|p| p.get("name"))
@@ -72,10 +72,7 @@ fn dependencies() -> (BTreeSet<String>, BTreeSet<String>) {
         for table in dependency_tables(&doc) {
             for (name, spec) in table {
                 // A renamed dependency (`alias = { package = "real" }`) is the real crate.
-                let real = spec
-                    .get("package")
-                    .and_then(|p| p.as_str())
-                    .unwrap_or(name);
+                let real = spec.get("package").and_then(|p| p.as_str()).unwrap_or(name);
                 if spec.get("path").is_some() {
                     own.insert(real.to_string());
                 } else {

@@ -21,8 +21,7 @@ fn repo() -> PathBuf {
 fn hostile_run(dir: &Path) {
     let base = repo().join("reports/baselines/llvmpipe-llvm-15-0-6-256-bits-2026-12-03");
     let mut doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(base.join("results.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(base.join("results.json")).unwrap()).unwrap();
     doc["machine"]["date_utc"] = "2026-12-05T00:00:00Z".into();
     for row in doc["rows"].as_array_mut().unwrap() {
         if row["dataset"] == "shell:10k" {

@@ -196,9 +196,8 @@ fn copy_tree(from: &Path, to: &Path) -> anyhow::Result<()> {
         if src.is_dir() {
             copy_tree(&src, &dst)?;
         } else {
-            std::fs::copy(&src, &dst).with_context(|| {
-                format!("cannot copy {} to {}", src.display(), dst.display())
-            })?;
+            std::fs::copy(&src, &dst)
+                .with_context(|| format!("cannot copy {} to {}", src.display(), dst.display()))?;
         }
     }
     Ok(())
@@ -332,7 +331,11 @@ fn adapter_tag(file: &ResultsFile, taken: &[String]) -> String {
         .map(|a| a.name.as_str())
         .unwrap_or("unknown");
     let name = name.split(" (").next().unwrap_or(name);
-    let base = name.split_whitespace().last().unwrap_or("unknown").to_string();
+    let base = name
+        .split_whitespace()
+        .last()
+        .unwrap_or("unknown")
+        .to_string();
     let mut tag = base.clone();
     let mut n = 1;
     while taken.contains(&tag) {
@@ -584,7 +587,11 @@ pub fn publish(args: &PublishArgs) -> anyhow::Result<PathBuf> {
 /// `tetbench publish …` from the command line.
 pub fn run_command(args: &PublishArgs) -> anyhow::Result<()> {
     let index = publish(args)?;
-    println!("wrote the site {} (open {})", args.out.display(), index.display());
+    println!(
+        "wrote the site {} (open {})",
+        args.out.display(),
+        index.display()
+    );
     Ok(())
 }
 
@@ -612,7 +619,10 @@ mod tests {
         let empty = dir.path().join("empty");
         std::fs::create_dir_all(empty.join("sub")).unwrap();
         let e = Inputs::default().add(&empty).unwrap_err().to_string();
-        assert!(e.contains("empty") && e.contains("holds no results.json"), "{e}");
+        assert!(
+            e.contains("empty") && e.contains("holds no results.json"),
+            "{e}"
+        );
         let e = Inputs::default()
             .add(&dir.path().join("absent"))
             .unwrap_err();

@@ -417,10 +417,14 @@ fn html(
             one_step: format!("{ONE_STEP:.4}"),
             views,
             images_absent: images.absent.borrow().len(),
-            raw_files: [crate::results::CSV_FILE, crate::results::JSON_FILE, "samples.csv"]
-                .into_iter()
-                .filter(|f| images.dir.join(f).is_file())
-                .collect(),
+            raw_files: [
+                crate::results::CSV_FILE,
+                crate::results::JSON_FILE,
+                "samples.csv",
+            ]
+            .into_iter()
+            .filter(|f| images.dir.join(f).is_file())
+            .collect(),
             rows: row_lines(file, &suspect),
         },
     )
@@ -561,7 +565,10 @@ mod tests {
         ] {
             assert!(html.contains(needle), "index.html lacks {needle}");
         }
-        assert!(!html.contains("images/box_1k/v1/"), "an absent image is linked");
+        assert!(
+            !html.contains("images/box_1k/v1/"),
+            "an absent image is linked"
+        );
         // With every image there, the note goes.
         let d = dir.path().join("images/box_1k/v1");
         std::fs::create_dir_all(&d).unwrap();

@@ -16,8 +16,8 @@ use std::str::FromStr;
 
 use anyhow::{anyhow, Context};
 
-pub use crate::results::MergedRun;
 use crate::results::names::stable_hash;
+pub use crate::results::MergedRun;
 use crate::results::{self, ResultsFile, Row, RunDescription};
 
 /// Shard `index` (1-based) of `count`.

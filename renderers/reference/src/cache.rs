@@ -131,9 +131,8 @@ fn write_cache(path: &Path, key: &[u8; 32], r: &Reference) -> anyhow::Result<()>
         f.sync_all()?;
         tmp.persist(path).map(|_| ()).map_err(|e| e.error)
     };
-    write().map_err(|e| {
-        anyhow::anyhow!("cannot write reference cache file {}: {e}", path.display())
-    })
+    write()
+        .map_err(|e| anyhow::anyhow!("cannot write reference cache file {}: {e}", path.display()))
 }
 
 /// The reference image, from `cache_dir` when a valid file for exactly this reference code,
