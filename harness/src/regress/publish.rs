@@ -485,47 +485,64 @@ pub fn publish(args: &PublishArgs) -> anyhow::Result<PathBuf> {
     for run in &inputs.runs {
         write_run(site, run)?;
     }
-    // Adapters in order of first appearance; runs of each by the date they started.
-    let mut adapters: Vec<String> = vec![];
-    for r in &inputs.runs {
-        if !adapters.contains(&r.adapter) {
-            adapters.push(r.adapter.clone());
+    let (adapters, latest) = write_histories(site, &inputs.runs, args.threshold)?;
+    let papers = inputs
+        .papers
+        .iter()
+        .map(|p| write_paper(site, p))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let mut page = cross_adapter_charts(site, &latest)?;
+    page.adapters = adapters;
+    page.papers = papers;
+    page.runs = inputs.runs.iter().map(run_line).collect();
+    let html = crate::report::html::render("site.html", &page)?;
+    let index = site.join("index.html");
+    std::fs::write(&index, html).with_context(|| format!("cannot write {}", index.display()))?;
+    Ok(index)
+}
+
+/// Per adapter (in order of first appearance) its runs by the date they started: the front
+/// page's line and, with two runs or more, `tetbench history` over them in `history/NAME/`.
+/// Returns the lines and the latest run of each adapter.
+fn write_histories<'a>(
+    site: &Path,
+    all: &'a [RunInput],
+    threshold: f64,
+) -> anyhow::Result<(Vec<AdapterLine>, Vec<&'a RunInput>)> {
+    let mut adapters: Vec<&str> = vec![];
+    for r in all {
+        if !adapters.contains(&r.adapter.as_str()) {
+            adapters.push(&r.adapter);
         }
     }
-    let mut adapter_lines = vec![];
-    let mut latest: Vec<&RunInput> = vec![];
-    for adapter in &adapters {
-        let mut runs: Vec<&RunInput> = inputs
-            .runs
-            .iter()
-            .filter(|r| &r.adapter == adapter)
-            .collect();
+    let mut lines: Vec<AdapterLine> = vec![];
+    let mut latest = vec![];
+    for adapter in adapters {
+        let mut runs: Vec<&RunInput> = all.iter().filter(|r| r.adapter == adapter).collect();
         runs.sort_by(|a, b| a.file.machine.date_utc.cmp(&b.file.machine.date_utc));
         let last = runs[runs.len() - 1];
         latest.push(last);
         let (mut history, mut with_steps, mut series) = (String::new(), 0, 0);
         if runs.len() > 1 {
-            let mut name = url_name(
+            let base = url_name(
                 last.file
                     .machine
                     .adapter
                     .as_ref()
-                    .map_or(adapter.as_str(), |a| a.name.as_str()),
+                    .map_or(adapter, |a| a.name.as_str()),
             );
-            let base = name.clone();
-            let mut n = 1;
-            while adapter_lines
+            let (mut name, mut n) = (base.clone(), 1);
+            while lines
                 .iter()
-                .any(|a: &AdapterLine| a.history == format!("history/{name}/history.html"))
+                .any(|a| a.history == format!("history/{name}/history.html"))
             {
                 n += 1;
                 name = format!("{base}-{n}");
             }
-            let out = site.join("history").join(&name);
             let dirs: Vec<PathBuf> = runs.iter().map(|r| r.dir.clone()).collect();
-            let h = crate::regress::history::write_files(&dirs, &out, args.threshold, 0.05)
-                .with_context(|| format!("the history of {adapter}"))?
-                .0;
+            let out = site.join("history").join(&name);
+            let (h, _) = crate::regress::history::write_files(&dirs, &out, threshold, 0.05)
+                .with_context(|| format!("the history of {adapter}"))?;
             series = h.series.len();
             with_steps = h
                 .series
@@ -534,8 +551,8 @@ pub fn publish(args: &PublishArgs) -> anyhow::Result<PathBuf> {
                 .count();
             history = format!("history/{name}/history.html");
         }
-        adapter_lines.push(AdapterLine {
-            adapter: adapter.clone(),
+        lines.push(AdapterLine {
+            adapter: adapter.to_string(),
             latest: run_line(last),
             runs: runs.len(),
             history,
@@ -543,45 +560,39 @@ pub fn publish(args: &PublishArgs) -> anyhow::Result<PathBuf> {
             series,
         });
     }
-    let mut papers = vec![];
-    for p in &inputs.papers {
-        let rel = format!("papers/{}/{}", slug(&p.source), slug(&p.summary.paper));
-        let out = site.join(&rel);
-        anyhow::ensure!(
-            !out.exists(),
-            "{}: paper {} of {} given twice",
-            p.dir.display(),
-            p.summary.paper,
-            p.source
-        );
-        for f in ["report.html", "report.md", SUMMARY_FILE] {
-            if has(&p.dir, f) {
-                copy_file(&p.dir.join(f), &out.join(f))?;
-            }
+    Ok((lines, latest))
+}
+
+/// A reproduced paper's report, charts and summary in `papers/SOURCE/PAPER/`.
+fn write_paper(site: &Path, p: &PaperInput) -> anyhow::Result<PaperLine> {
+    let rel = format!("papers/{}/{}", slug(&p.source), slug(&p.summary.paper));
+    let out = site.join(&rel);
+    anyhow::ensure!(
+        !out.exists(),
+        "{}: paper {} of {} given twice",
+        p.dir.display(),
+        p.summary.paper,
+        p.source
+    );
+    for f in ["report.html", "report.md", SUMMARY_FILE] {
+        if has(&p.dir, f) {
+            copy_file(&p.dir.join(f), &out.join(f))?;
         }
-        if p.dir.join("charts").is_dir() {
-            copy_tree(&p.dir.join("charts"), &out.join("charts"))?;
-        }
-        papers.push(PaperLine {
-            paper: p.summary.paper.clone(),
-            source: p.source.clone(),
-            adapter: p.adapter.clone(),
-            mode: p.summary.mode.clone(),
-            exact_tables: p.summary.exact_tables.clone(),
-            claims: p.summary.claims.clone(),
-            // The summary's sentence is Markdown (`commit` in backticks): shown as text.
-            commit: p.summary.source.replace('`', ""),
-            link: format!("{rel}/report.html"),
-        });
     }
-    let mut page = cross_adapter_charts(site, &latest)?;
-    page.adapters = adapter_lines;
-    page.papers = papers;
-    page.runs = inputs.runs.iter().map(run_line).collect();
-    let html = crate::report::html::render("site.html", &page)?;
-    let index = site.join("index.html");
-    std::fs::write(&index, html).with_context(|| format!("cannot write {}", index.display()))?;
-    Ok(index)
+    if p.dir.join("charts").is_dir() {
+        copy_tree(&p.dir.join("charts"), &out.join("charts"))?;
+    }
+    Ok(PaperLine {
+        paper: p.summary.paper.clone(),
+        source: p.source.clone(),
+        adapter: p.adapter.clone(),
+        mode: p.summary.mode.clone(),
+        exact_tables: p.summary.exact_tables.clone(),
+        claims: p.summary.claims.clone(),
+        // The summary's sentence is Markdown (`commit` in backticks): shown as text.
+        commit: p.summary.source.replace('`', ""),
+        link: format!("{rel}/report.html"),
+    })
 }
 
 /// `tetbench publish …` from the command line.
