@@ -8,11 +8,6 @@ cd "$(dirname "$0")/.."
 . scripts/common.sh
 site="${1:?usage: scripts/check-site.sh SITE_DIR [--expect-text TEXT] [--json OUT]}"
 shift
-browser="$(command -v chromium || command -v chromium-browser || command -v google-chrome || true)"
-if [ -z "$browser" ]; then
-    echo "check-site: installing Debian's chromium" >&2
-    apt_install chromium >&2
-    browser="$(command -v chromium)"
-fi
+browser="$(ensure_chromium)" || { echo "check-site: no Chromium, and it could not be installed" >&2; exit 1; }
 command -v python3 >/dev/null 2>&1 || apt_install python3 >&2
 exec python3 scripts/check_site.py "$site" --browser "$browser" "$@"
