@@ -119,3 +119,16 @@ ensure_numpy_python() {
         "$TETBENCH_VTK_PYTHON" -m pip install --quiet --disable-pip-version-check numpy || return 1
     fi
 }
+
+# A Chromium for the browser checks (scripts/check-site.sh, scripts/screenshot-report.sh): the
+# one on the PATH, else Debian's `chromium`. Prints its path.
+ensure_chromium() {
+    local b
+    b="$(command -v chromium || command -v chromium-browser || command -v google-chrome || true)"
+    if [ -z "$b" ]; then
+        echo "tetbench: installing Debian's chromium" >&2
+        apt_install chromium >&2 || return 1
+        b="$(command -v chromium)"
+    fi
+    echo "$b"
+}

@@ -20,10 +20,12 @@
 #                     in their errors (default: the merge job refuses and names the shards)
 #   --fail-shard I    for testing: shard I fails on purpose (exit 42) instead of running
 #
-# The shared-path test: DIR and BIN must not be under /tmp, /var/tmp, /dev/shm or $TMPDIR nor
-# on tmpfs (node-local everywhere), and must be on a network or parallel file system (NFS,
-# Lustre, GPFS, BeeGFS, CephFS, …) unless every node of the cluster is this host (a one-node
-# cluster sees its own disk). Anything else is refused unless --shared-ok says otherwise.
+# The shared-path test: when every node of the cluster is this host (a one-node cluster, such as
+# CI's), every path is seen by every node and passes, /tmp included — unless Slurm gives each
+# job a private /tmp (JobContainerType=job_container/tmpfs). On any other cluster DIR and BIN
+# must not be under /tmp, /var/tmp, /dev/shm or $TMPDIR nor on tmpfs (node-local everywhere),
+# and must be on a network or parallel file system (NFS, Lustre, GPFS, BeeGFS, CephFS, …).
+# Anything else is refused unless --shared-ok says otherwise.
 set -euo pipefail
 
 die() {
@@ -76,17 +78,41 @@ bin="$(cd "$(dirname "$bin")" && pwd)/$(basename "$bin")"
 mkdir -p "$out" || die "cannot create $out"
 out="$(cd "$out" && pwd)"
 
+# Whether every node of the cluster is this host (sinfo answers and names no other node).
+only_this_host() {
+    local me others
+    me="$(hostname -s)"
+    sinfo -h -N -o '%n' >/dev/null 2>&1 || return 1
+    others="$(sinfo -h -N -o '%n %N' 2>/dev/null | tr ' ' '\n' | sort -u |
+        grep -v -x -e '' -e "$me" -e "$(hostname)" -e localhost || true)"
+    [ -z "$others" ]
+}
+# Whether Slurm mounts a private /tmp (and /dev/shm) for each job: job_container/tmpfs.
+private_job_tmp() {
+    scontrol show config 2>/dev/null | grep -q -E '^JobContainerType *= *job_container/tmpfs'
+}
+
 # Why PATH is not visible from every node, or nothing when it is (see the header).
 not_shared_because() {
-    local path="$1" tmp
+    local path="$1" tmp one_node=0
+    only_this_host && one_node=1
     for tmp in /tmp /var/tmp /dev/shm ${TMPDIR:+"${TMPDIR%/}"}; do
         [ "$tmp" = / ] && continue
         case "$path/" in "$tmp"/*)
+            if [ "$one_node" -eq 1 ]; then
+                # The one node is this host: it sees this /tmp, unless each job gets its own.
+                if private_job_tmp; then
+                    echo "it is under $tmp, and this cluster gives each job a private $tmp (job_container/tmpfs)"
+                fi
+                return 0
+            fi
             echo "it is under $tmp, which is local to each node"
             return
             ;;
         esac
     done
+    # A one-node cluster whose node is this host sees every path of this host.
+    [ "$one_node" -eq 1 ] && return 0
     local fstype
     fstype="$(findmnt -n -o FSTYPE -T "$path" 2>/dev/null || stat -f -c %T "$path" 2>/dev/null || echo unknown)"
     case "$fstype" in
@@ -94,13 +120,10 @@ not_shared_because() {
     nfs* | lustre | gpfs | beegfs | ceph | fuse.ceph* | cifs | smb* | *gluster* | panfs | wekafs | \
         fuse.sshfs | fuse.juicefs | orangefs | pvfs2 | afs | 9p | virtiofs | autofs) ;;
     *)
-        # A local file system is shared only when every node is this host.
-        local me others
-        me="$(hostname -s)"
-        others="$(sinfo -h -N -o '%n %N' 2>/dev/null | tr ' ' '\n' | sort -u |
-            grep -v -x -e "$me" -e "$(hostname)" -e localhost || true)"
-        if [ -n "$others" ] || ! sinfo -h -N -o '%n' >/dev/null 2>&1; then
-            echo "it is on a local file system ($fstype) and the cluster has other nodes than $me"
+        if sinfo -h -N -o '%n' >/dev/null 2>&1; then
+            echo "it is on a local file system ($fstype) and the cluster has other nodes than $(hostname -s)"
+        else
+            echo "it is on a local file system ($fstype) and sinfo could not list the cluster's nodes"
         fi
         ;;
     esac

@@ -11,4 +11,7 @@ ensure_prerequisites
 ensure_vtk_python || echo "tetbench: could not install VTK (see above); tests/vtk_vs_reference.rs will fail" >&2
 # The Python example of an external renderer (tests/external_renderers.rs) needs numpy.
 ensure_numpy_python || echo "tetbench: could not install numpy (see above); tests/external_renderers.rs will fail" >&2
+# The published site's browser walk (harness/tests/publish_site.rs) needs Chromium; installed
+# here so that no test waits on apt.
+ensure_chromium >/dev/null || echo "tetbench: could not install chromium (see above); harness/tests/publish_site.rs will fail" >&2
 exec cargo test --workspace "$@"

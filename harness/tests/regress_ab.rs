@@ -136,6 +136,10 @@ fn ab_of_two_binaries_gates_like_compare() {
     let out = String::from_utf8_lossy(&same.stdout);
     assert!(out.contains("pair  1 (BASE, NEW): NEW/BASE ×"), "{out}");
     assert!(out.contains("pair  4 (NEW, BASE)"), "{out}");
+    // Piped: a line per round with its count, the ETA until the last (issue 44).
+    let err = String::from_utf8_lossy(&same.stderr);
+    assert!(err.contains("tetbench ab: [1/8, ETA "), "{err}");
+    assert!(err.contains("tetbench ab: [8/8] pair 4"), "{err}");
     assert!(
         out.contains("samples: one per round (4 rounds in BASE, 4 in NEW)"),
         "{out}"
@@ -348,6 +352,15 @@ fn bisect_finds_the_first_slow_commit() {
         assert_eq!(o.status.code(), Some(0), "{name}: {}", text(&o));
         let stdout = String::from_utf8_lossy(&o.stdout);
         assert!(stdout.contains("bisect: 8 commit(s) after"), "{stdout}");
+        // A line per step on stderr, out of at most ⌈log2 8⌉ + 1 = 4, with the ETA from the
+        // second on (without a slow commit the first step, the last commit, ends the search).
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(stderr.contains("bisect: [1/4] A/B of "), "{stderr}");
+        assert_eq!(
+            stderr.contains("bisect: [2/4, ETA "),
+            slow_from.is_some(),
+            "{stderr}"
+        );
         match slow_from {
             Some(k) => {
                 let want = format!("first bad commit: {} change {k}", commits[k]);

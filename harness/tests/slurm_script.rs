@@ -112,14 +112,15 @@ fn refuses_without_sbatch() {
     assert!(o.status.success(), "{}", text(&o));
 }
 
-/// /tmp is node-local: refused (the test's own directory is under it, or under the target
-/// directory). A local disk is refused when the cluster has other nodes, accepted when this
-/// host is the only one; --shared-ok accepts anything.
+/// /tmp is node-local: refused on a cluster with other nodes than this host, accepted on a
+/// one-node cluster whose node is this host (CI's own, issue 44: a clone under /tmp). A local
+/// disk is likewise refused when the cluster has other nodes, accepted when this host is the
+/// only one; --shared-ok accepts anything.
 #[test]
 fn refuses_an_output_directory_other_nodes_cannot_see() {
     let tmp = tempfile::tempdir().unwrap();
-    std::fs::write(tmp.path().join("nodes"), this_host()).unwrap();
     let path = fake_path(tmp.path(), true);
+    let nodes = |list: &str| std::fs::write(tmp.path().join("nodes"), list).unwrap();
     let run = |out: &Path, extra: &[&str]| {
         let mut args = vec!["--shards", "2", "--out", out.to_str().unwrap()];
         args.extend(["--tetbench", TETBENCH]);
@@ -128,6 +129,7 @@ fn refuses_an_output_directory_other_nodes_cannot_see() {
         slurm_run(tmp.path(), &path, &args)
     };
     let in_tmp = Path::new("/tmp").join(format!("slurm-script-{}", std::process::id()));
+    nodes(&format!("{}\nnode2\n", this_host()));
     let o = run(&in_tmp, &[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(
@@ -137,6 +139,19 @@ fn refuses_an_output_directory_other_nodes_cannot_see() {
     );
     let o = run(&in_tmp, &["--shared-ok"]);
     assert!(o.status.success(), "{}", text(&o));
+    // The same directory when this host is the cluster's only node.
+    nodes(&this_host());
+    let o = run(&in_tmp, &[]);
+    assert!(o.status.success(), "one-node cluster, /tmp: {}", text(&o));
+    // ... unless Slurm gives each job a private /tmp.
+    write_exe(
+        &path.join("scontrol"),
+        "#!/bin/bash\necho 'JobContainerType        = job_container/tmpfs'\n",
+    );
+    let o = run(&in_tmp, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("private /tmp"), "{}", text(&o));
+    std::fs::remove_file(path.join("scontrol")).unwrap();
     std::fs::remove_dir_all(&in_tmp).unwrap();
 
     // A local disk: the target directory's scratch space, when it is one.
@@ -158,11 +173,7 @@ fn refuses_an_output_directory_other_nodes_cannot_see() {
     let out = local.path().join("out");
     let o = run(&out, &[]);
     assert!(o.status.success(), "one-node cluster: {}", text(&o));
-    std::fs::write(
-        tmp.path().join("nodes"),
-        format!("{}\nnode2\n", this_host()),
-    )
-    .unwrap();
+    nodes(&format!("{}\nnode2\n", this_host()));
     let o = run(&out, &[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(

@@ -37,6 +37,7 @@ use anyhow::Context;
 use render_core::Gpu;
 
 use crate::calibrate::work::best_seconds;
+use crate::report::progress::Progress;
 use crate::results::machine::MachineInfo;
 use crate::results::Row;
 
@@ -113,6 +114,9 @@ pub fn cached_or_measure(
 /// Runs the nine micro-benchmarks (a few seconds on lavapipe, well under one on a GPU).
 pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> {
     let started = Instant::now();
+    // One step per benchmark (the rasterisation's two legs are two).
+    let mut progress = Progress::new("tetbench calibrate", 10, "benchmarks");
+    progress.activity("triangle setup");
     let module = gpu.shader("calibrate", include_str!("calibrate.wgsl"));
     let empty = gpu
         .device
@@ -183,6 +187,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
     );
     let tri_view = target(tri_format, GRID as u32);
     let tri_s = best_seconds(|| draw(&tri, &tri_view, (TRIANGLES * 3) as u32, 0..1))?;
+    progress.step("triangle setup");
 
     // 2. Fill: the float format the algorithms composite into, when it blends here.
     let fill_format = if gpu.features.contains(wgpu::Features::FLOAT32_BLENDABLE) {
@@ -193,6 +198,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
     let fill = additive_pipeline(gpu, &module, "calibrate fill", "fill_vs", fill_format);
     let fill_view = target(fill_format, FILL_SIZE);
     let fill_s = best_seconds(|| draw(&fill, &fill_view, 3, 0..FILL_LAYERS as u32))?;
+    progress.step("fill");
 
     // 2b. Rasterisation of covering triangles, the same format and blend: seconds per triangle
     // at each leg length (the instance index is the leg), then the fit.
@@ -206,6 +212,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
             raster_fragments_per_triangle(leg),
             s / RASTER_TRIANGLES as f64,
         );
+        progress.step(&format!("rasterisation, leg {leg}"));
     }
     let (raster_seconds_per_triangle, raster_seconds_per_fragment) =
         raster_costs(raster_points[0], raster_points[1]);
@@ -244,6 +251,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         }],
     });
     let fma_s = best_seconds(|| dispatch(&fma, &fma_bind, (FMA_INVOCATIONS / 64) as u32))?;
+    progress.step("compute");
 
     // 4. Storage copy bandwidth (halved where one binding cannot hold 32 MiB).
     let copy_bytes = COPY_BYTES.min(gpu.max_storage_binding()) & !1023;
@@ -272,6 +280,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         "calibration copy needs {copy_groups} workgroups, more than the adapter allows"
     );
     let copy_s = best_seconds(|| dispatch(&copy, &copy_bind, copy_groups as u32))?;
+    progress.step("storage copy");
 
     // 5. CPU radix sort (what HAVS' and the PT algorithms' CPU orders run on).
     let mut state = 0x9E37_79B9_7F4A_7C15u64;
@@ -297,11 +306,16 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
             .all(|w| keys[w[0] as usize] <= keys[w[1] as usize]),
         "the calibration's radix sort did not sort"
     );
+    progress.step("CPU radix sort");
 
     // 6–8. The work of the counters no generic figure prices (work.rs).
     let ray_steps_per_sec = crate::calibrate::work::ray_steps_per_sec(gpu, &module)?;
+    progress.step("ray steps");
     let splat_fragments_per_sec = crate::calibrate::work::splat_fragments_per_sec(gpu, &module)?;
+    progress.step("splat fill");
     let gpu_sort_keys_per_sec = crate::calibrate::work::gpu_sort_keys_per_sec(gpu)?;
+    progress.step("GPU radix sort");
+    progress.finish();
 
     Ok(Calibration {
         version: CALIBRATION_VERSION,

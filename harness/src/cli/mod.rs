@@ -125,6 +125,9 @@ pub enum Command {
     Ab(crate::regress::AbArgs),
     /// Find the first commit between GOOD and BAD that an A/B against GOOD calls a regression.
     Bisect(crate::regress::BisectArgs),
+    /// Write one static site over baselines, runs and reproduced papers (docs/commands.md,
+    /// "publish"): per adapter the latest run, histories, verdicts, speed vs error.
+    Publish(crate::regress::publish::PublishArgs),
 }
 
 #[derive(Debug, Clone, clap::Args)]
@@ -375,6 +378,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Bisect(args) => crate::regress::run_bisect_command(args, cli.data_dir),
+        Command::Publish(args) => crate::regress::publish::run_command(&args),
     }
 }
 

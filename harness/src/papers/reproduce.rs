@@ -23,6 +23,7 @@ use super::session::{
     QUICK_RESOLUTION_DIVISOR, QUICK_VIEWPOINTS, QUICK_WARMUP,
 };
 use super::{table, Paper, PaperModule, PAPERS};
+use crate::report::progress::Progress;
 use crate::results::machine::MachineInfo;
 
 #[derive(Debug, Clone, clap::Args)]
@@ -85,6 +86,9 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
     let mut source = SourceState::read();
     source.check(args.allow_dirty)?;
     let started = Instant::now();
+    // Lines only (each run shows its own bar); the ETA counts runs, which differ in size.
+    let runs: usize = chosen.iter().map(|m| m.plan().len()).sum();
+    let mut progress = Progress::lines("tetbench reproduce", runs as u64);
     for module in chosen {
         let p = module.paper();
         let t0 = Instant::now();
@@ -109,7 +113,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             from_run: None,
         };
         eprintln!("tetbench reproduce: {} ({})", p.id, p.title);
-        let report = measure_and_tabulate(module, &mut session)?;
+        let report = measure_and_tabulate(module, &mut session, &mut progress)?;
         let seconds = t0.elapsed().as_secs_f64();
         write_report(p, &session, &report, seconds)?;
         let exact: Vec<String> = report
@@ -156,11 +160,17 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
 }
 
 /// A paper's CPU analyses, then its plan's runs, then its tables from what they measured.
-fn measure_and_tabulate(paper: &dyn PaperModule, session: &mut Session) -> anyhow::Result<Report> {
+fn measure_and_tabulate(
+    paper: &dyn PaperModule,
+    session: &mut Session,
+    progress: &mut Progress,
+) -> anyhow::Result<Report> {
     let mut measured = Measured::default();
     let extra = paper.analyses(session, &mut measured)?;
     for spec in paper.plan() {
+        progress.begin(&format!("{}: run {}", paper.paper().id, spec.name));
         session.run(&spec, &mut measured)?;
+        progress.skip(1);
     }
     Ok(paper.tables(&measured, &extra))
 }

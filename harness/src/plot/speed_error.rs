@@ -95,6 +95,8 @@ struct SpeedError<'a> {
     records: Vec<Record>,
     book: &'a StyleBook,
     viewpoints: usize,
+    /// What the x axis measures.
+    x_desc: &'a str,
     /// Every variant of every algorithm on one chart, one legend line and one style per
     /// algorithm, no whiskers: drawn when the per-variant legend is too long for one chart, so
     /// that tetbench's algorithms and the peers (VTK's, `--external` ones) still share a chart.
@@ -253,7 +255,7 @@ impl Chart for SpeedError<'_> {
             .bold_line_style(WHITE.mix(0.0))
             .x_labels(0)
             .y_labels(0)
-            .x_desc("tets per second (log scale)")
+            .x_desc(self.x_desc)
             .y_desc("PSNR against the exact reference (dB)")
             .axis_desc_style((FONT, 15))
             .draw()
@@ -334,9 +336,42 @@ pub fn sort_by_style(points: &mut [&Point], book: &StyleBook) {
     points.sort_by_key(|p| super::style::order_key(book, &p.algorithm, &p.settings));
 }
 
+/// What the x axis of a set of speed–error charts measures, and how the charts are named.
+#[derive(Debug, Clone)]
+pub struct SpeedAxis {
+    /// The axis title.
+    pub desc: String,
+    /// The start of every chart's file stem.
+    pub stem: String,
+    /// The start of every chart's title.
+    pub title: String,
+}
+
+impl Default for SpeedAxis {
+    /// tets per second, as a run's report draws it.
+    fn default() -> Self {
+        SpeedAxis {
+            desc: "tets per second (log scale)".into(),
+            stem: "speed_error".into(),
+            title: "Speed vs error".into(),
+        }
+    }
+}
+
 /// Draws one chart per data set × viewport (split per algorithm when the legend would not
 /// fit) into `dir`, each with its CSV.
 pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<Vec<ChartFile>> {
+    write_with(dir, points, book, &SpeedAxis::default())
+}
+
+/// [`write`] with another x axis: the points' `tets_per_sec` holds what `axis` names (`tetbench
+/// publish` draws calibration-normalised speeds across adapters this way).
+pub fn write_with(
+    dir: &Path,
+    points: &[Point],
+    book: &StyleBook,
+    axis: &SpeedAxis,
+) -> anyhow::Result<Vec<ChartFile>> {
     let mut files = vec![];
     let groups = distinct(
         points
@@ -361,7 +396,7 @@ pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<V
         } else {
             vec![(String::new(), pts.clone())]
         };
-        let mut stem_base = format!("speed_error_{}", crate::results::names::slug(&dataset));
+        let mut stem_base = format!("{}_{}", axis.stem, crate::results::names::slug(&dataset));
         if many_sizes {
             stem_base.push_str(&format!("_{width}x{height}"));
         }
@@ -371,7 +406,8 @@ pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<V
             // algorithm, so every algorithm and peer is compared on one chart.
             let stem = format!("{stem_base}_overview");
             let title = format!(
-                "Speed vs error — {dataset} ({} tets, {width}×{height}), every algorithm",
+                "{} — {dataset} ({} tets, {width}×{height}), every algorithm",
+                axis.title,
                 draw::si(tets as f64)
             );
             let chart = SpeedError {
@@ -379,6 +415,7 @@ pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<V
                 records: records(&pts, book),
                 book,
                 viewpoints: pts.iter().map(|p| p.rows).max().unwrap_or(0),
+                x_desc: &axis.desc,
                 overview: true,
             };
             draw::save(&chart, dir, &stem)?;
@@ -400,7 +437,8 @@ pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<V
                 stem.push_str(&format!("_{}", crate::results::names::slug(&alg)));
             }
             let title = format!(
-                "Speed vs error — {dataset}{} ({} tets, {width}×{height})",
+                "{} — {dataset}{} ({} tets, {width}×{height})",
+                axis.title,
                 if alg.is_empty() {
                     String::new()
                 } else {
@@ -413,6 +451,7 @@ pub fn write(dir: &Path, points: &[Point], book: &StyleBook) -> anyhow::Result<V
                 records: records.clone(),
                 book,
                 viewpoints,
+                x_desc: &axis.desc,
                 overview: false,
             };
             draw::save(&chart, dir, &stem)?;
@@ -515,6 +554,7 @@ mod tests {
             records: recs,
             book: &book,
             viewpoints: 2,
+            x_desc: "",
             overview: true,
         };
         let legend: Vec<String> = chart.entries().iter().map(|e| e.text()).collect();

@@ -12,6 +12,8 @@ use std::collections::BTreeMap;
 
 use plotters::style::RGBColor;
 
+use crate::results::names::stable_hash;
+
 /// Shades per colour family and marker shapes: 4 × 8 = 32 distinct styles per algorithm.
 pub const SHADES: usize = 4;
 pub const SLOTS: usize = SHADES * Marker::ALL.len();
@@ -177,7 +179,7 @@ fn peer_slot_offset(algorithm: &str) -> usize {
     let index = peers
         .iter()
         .position(|p| *p == algorithm)
-        .unwrap_or((fnv1a(algorithm) % 8) as usize);
+        .unwrap_or((stable_hash(algorithm) % 8) as usize);
     4 * index
 }
 
@@ -200,16 +202,6 @@ pub fn order_key(
     )
 }
 
-/// 64-bit FNV-1a: a hash that does not change between Rust releases or runs.
-fn fnv1a(s: &str) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in s.bytes() {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
-}
-
 fn family(algorithm: &str) -> Family {
     if is_peer(algorithm) {
         return GREYS;
@@ -217,7 +209,7 @@ fn family(algorithm: &str) -> Family {
     crate::algorithms::describe(algorithm)
         .map(|d| hue_family(d.hue))
         .unwrap_or_else(|| {
-            SPARE_FAMILIES[(fnv1a(algorithm) % SPARE_FAMILIES.len() as u64) as usize]
+            SPARE_FAMILIES[(stable_hash(algorithm) % SPARE_FAMILIES.len() as u64) as usize]
         })
 }
 
@@ -276,7 +268,7 @@ fn preferred(settings: &str, defaults: &[String], all: &[String]) -> (usize, usi
     if let Some(i) = all.iter().position(|s| s == settings) {
         return (1, (defaults.len() + i) % SLOTS);
     }
-    (2, (fnv1a(settings) % SLOTS as u64) as usize)
+    (2, (stable_hash(settings) % SLOTS as u64) as usize)
 }
 
 /// `k=2` for numbers, the bare value otherwise.

@@ -26,6 +26,7 @@ use serde::{Deserialize, Serialize};
 
 use super::build::Binary;
 use crate::regress::compare::{adapter_of, CompareOptions, Comparison, Finding};
+use crate::report::progress::Progress;
 use crate::results::metrics::summarize;
 use crate::results::stats::median;
 use crate::results::{MergedRun, ResultsFile, Row};
@@ -393,22 +394,19 @@ pub fn run_ab(base: &Binary, new: &Binary, opt: &AbOptions) -> anyhow::Result<Ab
     let logs = opt.out.join("logs");
     std::fs::create_dir_all(&logs).with_context(|| format!("cannot create {}", logs.display()))?;
     let order = schedule(opt.pairs);
-    for (i, (pair, side)) in order.iter().enumerate() {
+    // A bar with the ETA on a terminal, a line per round otherwise (rounds are of equal size).
+    let mut progress = Progress::new("tetbench ab", order.len() as u64, "rounds");
+    for (pair, side) in &order {
         let bin = if *side == Side::Base { base } else { new };
         let dir = round_dir(&opt.out, *side, *pair);
         let log = logs.join(format!("{}-round-{:02}.log", side.dir_name(), pair + 1));
+        let what = format!("pair {} {} ({})", pair + 1, side.label(), bin.label());
+        progress.activity(&what);
         let t = Instant::now();
         invoke(bin, &dir, &log, opt)?;
-        eprintln!(
-            "tetbench ab: [{}/{}] pair {} {} ({}) {:.1} s",
-            i + 1,
-            order.len(),
-            pair + 1,
-            side.label(),
-            bin.label(),
-            t.elapsed().as_secs_f64()
-        );
+        progress.step(&format!("{what} {:.1} s", t.elapsed().as_secs_f64()));
     }
+    progress.finish();
     let mut rounds = vec![];
     for side in [Side::Base, Side::New] {
         let side_dir = opt.out.join(side.dir_name());

@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use super::ab::{self, AbOptions};
 use super::build::{self, BuildArgs};
+use crate::report::progress::Progress;
 
 /// The first-parent commits after `good` up to and including `bad`, oldest first.
 pub fn candidates(repo: &std::path::Path, good: &str, bad: &str) -> anyhow::Result<Vec<String>> {
@@ -35,6 +36,15 @@ pub fn candidates(repo: &std::path::Path, good: &str, bad: &str) -> anyhow::Resu
          {good}?)"
     );
     Ok(commits)
+}
+
+/// The most candidates [`first_bad`] asks about among `n`: the last, then ⌈log2 n⌉.
+pub fn max_steps(n: usize) -> usize {
+    if n == 0 {
+        0
+    } else {
+        1 + (usize::BITS - (n - 1).leading_zeros()) as usize
+    }
 }
 
 /// The binary search: index of the first of `n` candidates for which `is_bad` holds, given
@@ -118,9 +128,17 @@ pub fn run_command(opt: &BisectOptions) -> anyhow::Result<BisectReport> {
     );
     let good = build::resolve(&opt.good, &opt.build)?;
     let mut steps: Vec<Step> = vec![];
+    // Lines only: each step's A/B shows its own bar. The total is the search's bound (the last
+    // commit, then a binary search), so the ETA is an upper bound too.
+    let mut progress = Progress::lines("bisect", max_steps(commits.len()) as u64);
     let found = first_bad(commits.len(), |i| {
         let commit = &commits[i];
         let subject = build::git(repo, &["log", "-1", "--format=%s", commit]).unwrap_or_default();
+        progress.begin(&format!(
+            "A/B of {} against {}: {subject}",
+            &commit[..12.min(commit.len())],
+            opt.good
+        ));
         let candidate = build::resolve(commit, &opt.build)?;
         let dir = opt.ab.out.join(format!(
             "step-{:02}-{}",
@@ -167,6 +185,7 @@ pub fn run_command(opt: &BisectOptions) -> anyhow::Result<BisectReport> {
         );
         let bad = step.regression;
         steps.push(step);
+        progress.skip(1);
         Ok(bad)
     })?;
     let subject = |c: &str| build::git(repo, &["log", "-1", "--format=%s", c]).unwrap_or_default();
@@ -214,6 +233,7 @@ mod tests {
                 assert_eq!(got, Some(k), "n={n} k={k}");
                 let bound = (n as f64).log2().ceil() as usize + 1;
                 assert!(asked <= bound, "n={n} k={k}: asked {asked} > {bound}");
+                assert_eq!(max_steps(n), bound, "n={n}");
             }
             assert_eq!(first_bad(n, |_| Ok(false)).unwrap(), None);
         }

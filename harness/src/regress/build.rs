@@ -123,13 +123,6 @@ pub fn resolve(spec: &str, args: &BuildArgs) -> anyhow::Result<Binary> {
     })
 }
 
-/// FNV-1a: a stable short name for a repository's worktree in a shared cache.
-fn fnv(text: &str) -> u64 {
-    text.bytes().fold(0xcbf29ce484222325, |h, b| {
-        (h ^ b as u64).wrapping_mul(0x100000001b3)
-    })
-}
-
 /// Builds `commit` (or finds it built before) and returns the binary's path in the cache.
 pub fn build_commit(commit: &str, args: &BuildArgs) -> anyhow::Result<PathBuf> {
     let cache = std::path::absolute(args.cache()).context("cannot resolve the build cache")?;
@@ -170,7 +163,10 @@ pub fn build_commit(commit: &str, args: &BuildArgs) -> anyhow::Result<PathBuf> {
         &repo,
         &["rev-parse", "--path-format=absolute", "--git-common-dir"],
     )?;
-    let tree = cache.join(format!("src-{:016x}", fnv(&common)));
+    let tree = cache.join(format!(
+        "src-{:016x}",
+        crate::results::names::stable_hash(&common)
+    ));
     if tree.join(".git").exists() {
         git(
             &tree,

@@ -463,6 +463,20 @@ pub fn page(h: &History, charts: &[(String, String)]) -> anyhow::Result<String> 
 /// `tetbench history`: history.json, history.md, history.html and one chart per algorithm ×
 /// data set in `out`.
 pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> anyhow::Result<()> {
+    let (_, md) = write_files(dirs, out, threshold, alpha)?;
+    print!("{md}");
+    println!("wrote {}/history.{{md,html,json}}", out.display());
+    Ok(())
+}
+
+/// Writes what `tetbench history` writes (also for `tetbench publish`); returns the history and
+/// its Markdown.
+pub fn write_files(
+    dirs: &[PathBuf],
+    out: &Path,
+    threshold: f64,
+    alpha: f64,
+) -> anyhow::Result<(History, String)> {
     let h = history(dirs, out, threshold, alpha)?;
     let charts_dir = out.join("charts");
     std::fs::create_dir_all(&charts_dir)
@@ -522,9 +536,7 @@ pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> 
     std::fs::write(out.join("history.html"), page(&h, &charts)?).context("writing history.html")?;
     std::fs::write(out.join("history.json"), serde_json::to_string_pretty(&h)?)
         .context("writing history.json")?;
-    print!("{md}");
-    println!("wrote {}/history.{{md,html,json}}", out.display());
-    Ok(())
+    Ok((h, md))
 }
 
 #[cfg(test)]

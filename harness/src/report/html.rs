@@ -16,6 +16,7 @@ const TEMPLATES: &[(&str, &str)] = &[
     ("report.html", include_str!("../../templates/report.html")),
     ("history.html", include_str!("../../templates/history.html")),
     ("compare.html", include_str!("../../templates/compare.html")),
+    ("site.html", include_str!("../../templates/site.html")),
     (
         "markdown.html",
         include_str!("../../templates/markdown.html"),

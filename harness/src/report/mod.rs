@@ -15,6 +15,7 @@ use crate::results::metrics::{HEATMAP_MAX_ERROR, ONE_STEP, PSNR_CAP_DB};
 use crate::results::{ResultsFile, Row};
 
 pub mod html;
+pub mod progress;
 
 pub use crate::results::names::series_label;
 pub use crate::results::stats::{spread, Spread};
@@ -32,6 +33,7 @@ pub fn write(out: &Path, file: &ResultsFile) -> anyhow::Result<()> {
         file,
         &aggs,
         &crate::plot::ChartsPage::new(&charts, "charts"),
+        &Images::in_dir(out),
     )?;
     let path = out.join("index.html");
     std::fs::write(&path, html).with_context(|| format!("cannot write {}", path.display()))
@@ -41,6 +43,38 @@ pub fn write(out: &Path, file: &ResultsFile) -> anyhow::Result<()> {
 pub fn rewrite(out: &Path) -> anyhow::Result<()> {
     let file = ResultsFile::read(out)?;
     write(out, &file)
+}
+
+/// Which of the images a run's rows name are in the report's directory. A baseline keeps its
+/// results but not its images (a report re-rendered from one named 198 files that were not
+/// there): an absent image is counted and said so on the page, never linked.
+struct Images<'a> {
+    dir: &'a Path,
+    /// The distinct absent paths asked about.
+    absent: std::cell::RefCell<std::collections::BTreeSet<String>>,
+}
+
+impl<'a> Images<'a> {
+    fn in_dir(dir: &'a Path) -> Self {
+        Images {
+            dir,
+            absent: Default::default(),
+        }
+    }
+
+    /// `path` when it names a file in the directory; empty (and counted) when it names one that
+    /// is not there; empty when it names none.
+    fn present(&self, path: &str) -> String {
+        if path.is_empty() {
+            return String::new();
+        }
+        if self.dir.join(path).is_file() {
+            path.to_string()
+        } else {
+            self.absent.borrow_mut().insert(path.to_string());
+            String::new()
+        }
+    }
 }
 
 /// CSS classes of a table row: failed, suspect (issue 15's rule) and peer rows are marked.
@@ -159,6 +193,10 @@ struct ReportPage<'a> {
     psnr_cap_db: f64,
     one_step: String,
     views: Vec<View>,
+    /// Images the rows name that are not in the report's directory (not linked).
+    images_absent: usize,
+    /// The run's data files that are in the report's directory (linked).
+    raw_files: Vec<&'static str>,
     rows: Vec<RowLine>,
 }
 
@@ -303,7 +341,7 @@ fn summary_lines(aggs: &[Aggregate]) -> Vec<SummaryLine> {
 
 /// Rows flagged by [`crate::results::suspect`], each with its heatmap first, then the rendering and the
 /// reference, so a broken renderer is the first picture a reader sees after the charts.
-fn suspect_figures(file: &ResultsFile) -> Vec<SuspectFigure> {
+fn suspect_figures(file: &ResultsFile, images: &Images) -> Vec<SuspectFigure> {
     file.rows
         .iter()
         .filter(|r| !r.suspect.is_empty())
@@ -314,11 +352,11 @@ fn suspect_figures(file: &ResultsFile) -> Vec<SuspectFigure> {
                 (&row.reference_image, "reference"),
             ]
             .into_iter()
-            .filter(|(path, _)| !path.is_empty())
             .map(|(path, alt)| Picture {
-                path: path.clone(),
+                path: images.present(path),
                 alt,
             })
+            .filter(|p| !p.path.is_empty())
             .collect(),
             algorithm: row.algorithm.clone(),
             settings: row.settings.to_string(),
@@ -329,7 +367,7 @@ fn suspect_figures(file: &ResultsFile) -> Vec<SuspectFigure> {
         .collect()
 }
 
-fn views(file: &ResultsFile) -> Vec<View> {
+fn views(file: &ResultsFile, images: &Images) -> Vec<View> {
     let mut keys: Vec<(&str, &str)> = vec![];
     for row in &file.rows {
         let k = (row.dataset.as_str(), row.viewpoint.as_str());
@@ -350,21 +388,25 @@ fn views(file: &ResultsFile) -> Vec<View> {
                 reference: rows
                     .iter()
                     .find(|r| !r.reference_image.is_empty())
-                    .map(|r| r.reference_image.clone())
+                    .map(|r| images.present(&r.reference_image))
                     .unwrap_or_default(),
                 figures: rows
                     .iter()
-                    .filter(|r| !r.image.is_empty())
-                    .map(|row| ViewFigure {
-                        image: row.image.clone(),
-                        heatmap: row.heatmap.clone(),
-                        label: series_label(&row.algorithm, &row.settings.to_string()),
-                        psnr: opt(row.psnr_db, 2),
-                        mtets: opt(row.tets_per_sec.map(|v| v * 1e-6), 3),
+                    .filter_map(|row| {
+                        let image = images.present(&row.image);
+                        let heatmap = images.present(&row.heatmap);
+                        (!image.is_empty()).then(|| ViewFigure {
+                            image,
+                            heatmap,
+                            label: series_label(&row.algorithm, &row.settings.to_string()),
+                            psnr: opt(row.psnr_db, 2),
+                            mtets: opt(row.tets_per_sec.map(|v| v * 1e-6), 3),
+                        })
                     })
                     .collect(),
             }
         })
+        .filter(|v| !v.reference.is_empty() || !v.figures.is_empty())
         .collect()
 }
 
@@ -406,21 +448,33 @@ fn html(
     file: &ResultsFile,
     aggs: &[Aggregate],
     charts: &crate::plot::ChartsPage,
+    images: &Images,
 ) -> anyhow::Result<String> {
     let suspect = crate::results::suspect::flags(&file.rows);
+    let suspects = suspect_figures(file, images);
+    let views = views(file, images);
     crate::report::html::render(
         "report.html",
         ReportPage {
             machine: machine_lines(file),
             errors: &file.errors,
             charts,
-            suspects: suspect_figures(file),
+            suspects,
             any_peer: file.rows.iter().any(|r| is_peer(&r.algorithm)),
             summary: summary_lines(aggs),
             heatmap_max_error: HEATMAP_MAX_ERROR,
             psnr_cap_db: PSNR_CAP_DB,
             one_step: format!("{ONE_STEP:.4}"),
-            views: views(file),
+            views,
+            images_absent: images.absent.borrow().len(),
+            raw_files: [
+                crate::results::CSV_FILE,
+                crate::results::JSON_FILE,
+                "samples.csv",
+            ]
+            .into_iter()
+            .filter(|f| images.dir.join(f).is_file())
+            .collect(),
             rows: row_lines(file, &suspect),
         },
     )
@@ -566,6 +620,15 @@ mod tests {
     #[test]
     fn report_has_charts_table_and_images() {
         let dir = tempfile::tempdir().unwrap();
+        // The images of views 0 and 2 are there, view 1's are not (as in a baseline, which
+        // keeps no images): those are counted and said, never linked.
+        for v in [0, 2] {
+            let d = dir.path().join(format!("images/box_1k/v{v}"));
+            std::fs::create_dir_all(&d).unwrap();
+            for f in ["test.png", "test.error.png", "reference.png"] {
+                std::fs::write(d.join(f), b"png").unwrap();
+            }
+        }
         write(dir.path(), &file()).unwrap();
         let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
         for needle in [
@@ -575,9 +638,24 @@ mod tests {
             "images/box_1k/v2/test.error.png",
             "images/box_1k/v0/reference.png",
             "out of memory &lt;boom&gt;",
+            "3 image(s) named in results.json are not in this\ndirectory",
         ] {
             assert!(html.contains(needle), "index.html lacks {needle}");
         }
+        assert!(
+            !html.contains("images/box_1k/v1/"),
+            "an absent image is linked"
+        );
+        // With every image there, the note goes.
+        let d = dir.path().join("images/box_1k/v1");
+        std::fs::create_dir_all(&d).unwrap();
+        for f in ["test.png", "test.error.png", "reference.png"] {
+            std::fs::write(d.join(f), b"png").unwrap();
+        }
+        write(dir.path(), &file()).unwrap();
+        let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+        assert!(html.contains("images/box_1k/v1/test.png"));
+        assert!(!html.contains("images-absent"));
         for f in [
             "tets_per_sec.png",
             "tets_per_sec.svg",

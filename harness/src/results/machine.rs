@@ -163,29 +163,10 @@ fn os_name() -> String {
     std::env::consts::OS.to_string()
 }
 
-/// `YYYY-MM-DDTHH:MM:SSZ` without a date crate: days since the epoch to a civil date by
-/// Howard Hinnant's `civil_from_days` (proleptic Gregorian calendar).
+/// `YYYY-MM-DDTHH:MM:SSZ` (RFC 3339 in UTC, whole seconds; `humantime`). Times before 1970
+/// (a clock set wrong) are written as the epoch.
 pub fn iso8601_utc(t: SystemTime) -> String {
-    let secs = t
-        .duration_since(UNIX_EPOCH)
-        .map(|d| d.as_secs() as i64)
-        .unwrap_or(0);
-    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    format!(
-        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
-        rem / 3600,
-        rem / 60 % 60,
-        rem % 60
-    )
+    humantime::format_rfc3339_seconds(t.max(UNIX_EPOCH)).to_string()
 }
 
 /// The backend's figures, stored in every run's machine record.
@@ -276,6 +257,10 @@ mod tests {
     #[test]
     fn iso_dates() {
         assert_eq!(iso8601_utc(UNIX_EPOCH), "1970-01-01T00:00:00Z");
+        assert_eq!(
+            iso8601_utc(UNIX_EPOCH - Duration::from_secs(5)),
+            "1970-01-01T00:00:00Z"
+        );
         // 2000-02-29T12:34:56Z (a leap day in a century leap year).
         assert_eq!(
             iso8601_utc(UNIX_EPOCH + Duration::from_secs(951_827_696)),

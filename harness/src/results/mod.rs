@@ -408,13 +408,35 @@ pub fn write_csv(dir: &Path, rows: &[Row]) -> anyhow::Result<()> {
 
 /// Writes `results.json` atomically.
 pub fn write_json(dir: &Path, file: &ResultsFile) -> anyhow::Result<()> {
-    let path = dir.join(JSON_FILE);
-    let tmp = dir.join(format!(".{JSON_FILE}.tmp"));
-    let mut f = File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
-    serde_json::to_writer_pretty(&mut f, file)?;
-    f.write_all(b"\n")?;
-    f.sync_all().ok();
-    std::fs::rename(&tmp, &path).with_context(|| format!("cannot write {}", path.display()))
+    write_atomic(&dir.join(JSON_FILE), |f| {
+        serde_json::to_writer_pretty(&mut *f, file)?;
+        f.write_all(b"\n")
+    })
+}
+
+/// Writes `path` atomically: into a temporary file beside it, then renamed over it
+/// (`tempfile`'s `persist`), so a reader never sees half a file and an interrupted write
+/// leaves the old one. The file gets the usual 0644 permissions (a temporary file's are 0600).
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut File) -> std::io::Result<()>,
+) -> anyhow::Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".tetbench-")
+        .suffix(".tmp")
+        .permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644))
+        .tempfile_in(dir)
+        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+    write(tmp.as_file_mut()).with_context(|| format!("cannot write {}", path.display()))?;
+    tmp.as_file().sync_all().ok();
+    tmp.persist(path)
+        .map_err(|e| e.error)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
 }
 
 /// The CSV header: [`Row`]'s field names in order (taken from serde so they cannot drift).

@@ -202,7 +202,7 @@ impl<'a> DatasetContext<'a> {
                         let mut row = base_row(self, renderer.as_ref(), vp);
                         row.error = format!("prepare failed: {e:#}");
                         row.host_peak_bytes = prepare_peak;
-                        progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
+                        progress.step(&format!("FAILED {what} {}: {}", vp.name, row.error));
                         writer.push(row)?;
                         outcome.failed_rows += 1;
                     }
@@ -318,11 +318,11 @@ impl<'a> DatasetContext<'a> {
         if let Err(e) = measured {
             row.error = format!("{e:#}");
             outcome.failed_rows += 1;
-            progress.row(&format!("FAILED {what} {}: {}", vp.name, row.error));
+            progress.step(&format!("FAILED {what} {}: {}", vp.name, row.error));
         } else if !row.error.is_empty() {
             // Measured, but without error metrics (the reference failed).
             outcome.failed_rows += 1;
-            progress.row(&format!(
+            progress.step(&format!(
                 "{what} {}: {:.2} ms, no reference: {}",
                 vp.name,
                 row.total_ms.unwrap_or(f64::NAN),
@@ -331,7 +331,7 @@ impl<'a> DatasetContext<'a> {
         } else {
             // Against the rows so far; the final flags are set once every row is in.
             row.suspect = crate::results::suspect::reason(&row, rows_so_far).unwrap_or_default();
-            progress.row(&format!(
+            progress.step(&format!(
                 "{what} {}: {:.2} ms, {:.3} M tets/s, PSNR {}{}",
                 vp.name,
                 row.total_ms.unwrap_or(f64::NAN),

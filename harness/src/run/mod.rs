@@ -8,14 +8,12 @@
 //! on; finished rows are never lost.
 
 use std::collections::HashMap;
-use std::io::IsTerminal;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{anyhow, Context};
 use datasets::LazyDataset;
-use indicatif::{ProgressBar, ProgressStyle};
 use render_core::{
     Camera, FrameStats, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint,
 };
@@ -23,6 +21,7 @@ use render_core::{
 pub use crate::results::names::{dataset_label, slug, viewpoint_slug};
 
 use crate::algorithms::SettingsFilter;
+use crate::report::progress::Progress;
 use crate::results::machine::MachineInfo;
 use crate::results::metrics::{self, summarize};
 use crate::results::{ResultsWriter, Row, RunDescription};
@@ -118,79 +117,6 @@ fn guarded<T>(what: &str, f: impl FnOnce() -> anyhow::Result<T>) -> anyhow::Resu
     match catch_unwind(AssertUnwindSafe(f)) {
         Ok(r) => r,
         Err(p) => Err(anyhow!("{what} panicked: {}", panic_message(p))),
-    }
-}
-
-/// Progress bar on a terminal, plain log lines otherwise (CI logs, pipes).
-struct Progress {
-    bar: Option<ProgressBar>,
-    done: u64,
-    total: u64,
-}
-
-impl Progress {
-    fn new(total: u64) -> Progress {
-        let bar = std::io::stderr().is_terminal().then(|| {
-            let b = ProgressBar::new(total);
-            b.set_style(
-                ProgressStyle::with_template(
-                    "{elapsed_precise} [{bar:30}] {pos}/{len} rows  {msg}",
-                )
-                .expect("valid template")
-                .progress_chars("=> "),
-            );
-            b
-        });
-        Progress {
-            bar,
-            done: 0,
-            total,
-        }
-    }
-
-    fn status(&self, msg: &str) {
-        match &self.bar {
-            Some(b) => b.set_message(msg.to_string()),
-            None => eprintln!("tetbench: {msg}"),
-        }
-    }
-
-    /// Shows what is being measured on the bar only (log mode prints one line per row).
-    fn activity(&self, msg: &str) {
-        if let Some(b) = &self.bar {
-            b.set_message(msg.to_string());
-        }
-    }
-
-    fn log(&self, line: &str) {
-        match &self.bar {
-            Some(b) => b.println(line),
-            None => eprintln!("{line}"),
-        }
-    }
-
-    fn row(&mut self, line: &str) {
-        self.done += 1;
-        match &self.bar {
-            Some(b) => {
-                b.println(line);
-                b.inc(1);
-            }
-            None => eprintln!("[{}/{}] {line}", self.done, self.total),
-        }
-    }
-
-    fn skip(&mut self, n: u64) {
-        self.done += n;
-        if let Some(b) = &self.bar {
-            b.inc(n);
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(b) = &self.bar {
-            b.finish_and_clear();
-        }
     }
 }
 
@@ -484,7 +410,11 @@ fn start_progress(
     writer: &ResultsWriter,
 ) -> Progress {
     let views = config.viewpoints.len();
-    let mut progress = Progress::new((scope.units_total(config.datasets.len()) * views) as u64);
+    let mut progress = Progress::new(
+        "",
+        (scope.units_total(config.datasets.len()) * views) as u64,
+        "rows",
+    );
     if !scope.done.is_empty() {
         progress.log(&format!(
             "tetbench: --resume keeps {} finished unit(s) ({} rows) of {}",

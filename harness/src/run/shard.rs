@@ -16,6 +16,7 @@ use std::str::FromStr;
 
 use anyhow::{anyhow, Context};
 
+use crate::results::names::stable_hash;
 pub use crate::results::MergedRun;
 use crate::results::{self, ResultsFile, Row, RunDescription};
 
@@ -49,22 +50,13 @@ impl fmt::Display for Shard {
 /// One unit of the run matrix: (data set label, algorithm, settings).
 pub type Unit = (String, String, render_core::Settings);
 
-fn fnv1a(s: &str) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    for b in s.bytes() {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    h
-}
-
 /// The shard (1-based) of every unit, in the order given.
 pub fn assign(units: &[Unit], count: usize) -> Vec<usize> {
     let key = |u: &Unit| format!("{}\u{1f}{}\u{1f}{}", u.0, u.1, u.2);
     let mut ranked: Vec<(u64, String, usize)> = units
         .iter()
         .enumerate()
-        .map(|(i, u)| (fnv1a(&key(u)), key(u), i))
+        .map(|(i, u)| (stable_hash(&key(u)), key(u), i))
         .collect();
     ranked.sort();
     let mut out = vec![0; units.len()];

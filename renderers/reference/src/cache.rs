@@ -114,9 +114,14 @@ fn write_cache(path: &Path, key: &[u8; 32], r: &Reference) -> anyhow::Result<()>
             checked.extend_from_slice(&v.to_le_bytes());
         }
     }
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+    // A temporary file beside it, renamed over it (tempfile's persist): a reader sees the old
+    // file or the whole new one; the temporary file is removed if anything fails.
     let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
+        let mut tmp = tempfile::Builder::new()
+            .prefix(".reference-")
+            .suffix(".tmp")
+            .tempfile_in(dir)?;
+        let f = tmp.as_file_mut();
         f.write_all(CACHE_MAGIC)?;
         f.write_all(key)?;
         f.write_all(&img.width.to_le_bytes())?;
@@ -124,12 +129,10 @@ fn write_cache(path: &Path, key: &[u8; 32], r: &Reference) -> anyhow::Result<()>
         f.write_all(&checked)?;
         f.write_all(blake3::hash(&checked).as_bytes())?;
         f.sync_all()?;
-        std::fs::rename(&tmp, path)
+        tmp.persist(path).map(|_| ()).map_err(|e| e.error)
     };
-    write().map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        anyhow::anyhow!("cannot write reference cache file {}: {e}", path.display())
-    })
+    write()
+        .map_err(|e| anyhow::anyhow!("cannot write reference cache file {}: {e}", path.display()))
 }
 
 /// The reference image, from `cache_dir` when a valid file for exactly this reference code,
