@@ -21,7 +21,7 @@
 //! [`GpuRadixSort::encode`] writes its pass parameters through the queue, so encode at most
 //! one sort per instance per submission.
 
-use anyhow::{bail, ensure};
+use anyhow::ensure;
 
 use crate::gpu::{Gpu, Lifetime, MemoryLedger};
 
