@@ -456,9 +456,15 @@ pub const RESOURCES: [Resource; 8] = [
             ("fragments", |c| c.raster_seconds_per_fragment),
         ],
     },
+    // `splat_fragments` counts every footprint pixel; early splat elimination skips the
+    // lookups and atomics of those behind an opaque pixel (`ese_dropped_fragments`, the GPU's
+    // exact count), so they are taken back: a bound must not price work the frame skipped.
     Resource {
         name: "splat fill",
-        costs: &[("splat_fragments", |c| per(c.splat_fragments_per_sec))],
+        costs: &[
+            ("splat_fragments", |c| per(c.splat_fragments_per_sec)),
+            ("ese_dropped_fragments", |c| -per(c.splat_fragments_per_sec)),
+        ],
     },
     Resource {
         name: "ray steps",
@@ -490,15 +496,17 @@ pub const RESOURCES: [Resource; 8] = [
 pub fn resource_times(row: &Row, cal: &Calibration) -> Vec<(&'static str, f64)> {
     let mut t = vec![];
     for r in &RESOURCES {
-        let priced: Vec<f64> = r
+        let priced: Vec<(f64, f64)> = r
             .costs
             .iter()
             .filter_map(|(counter, cost)| Some((row.counter(counter)?, cost(cal))))
-            .filter(|&(_, cost)| cost > 0.0)
-            .map(|(work, cost)| work * cost)
+            .filter(|&(_, cost)| cost != 0.0)
             .collect();
-        if !priced.is_empty() {
-            t.push((r.name, priced.iter().sum::<f64>() * 1e3));
+        // A negative cost takes back work a positive one counted but the frame skipped; the
+        // resource is priced only where some work is counted, and never below 0.
+        if priced.iter().any(|&(_, cost)| cost > 0.0) {
+            let seconds: f64 = priced.iter().map(|(work, cost)| work * cost).sum();
+            t.push((r.name, seconds.max(0.0) * 1e3));
         }
     }
     if let Some(b) = row.gpu_bytes_frame {
@@ -674,6 +682,12 @@ mod tests {
                 2_500.0,
             ),
             ("fragments=20000000", "fill", 200.0),
+            // Splat fragments early splat elimination dropped are not priced.
+            (
+                "triangles=1000;splat_fragments=10000000;ese_dropped_fragments=4000000",
+                "splat fill",
+                120.0,
+            ),
             (
                 "triangles=1000;tet_classifications=3000000",
                 "classification",
