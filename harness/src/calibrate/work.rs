@@ -159,13 +159,16 @@ pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Resu
 }
 
 /// The two tables of the splat benchmark: 8 slices of 32² texels, one with no zero (every
-/// term adds), one shaped like the splatter's kernel (slice k the section of the unit ball at
-/// height z_k, 1 − r² inside and 0 outside, so its zero terms skip their atomics as the
-/// splatter's do).
+/// term adds), one shaped like the splatter's kernel (kernel.rs: radius R = 2 grid spacings,
+/// slabs 1 spacing thick, a ring of 5 slabs): slice k lies z_k = (k + ½)·5/8 − 2.5 slabs from
+/// the voxel, its texels span ±R, and it holds 1 − r²/R² inside the ball of radius R and 0
+/// outside, so the outermost slices are all zero and the zero terms skip their atomics as the
+/// splatter's do.
 pub fn splat_tables() -> [Vec<f32>; 2] {
     let mut fill = Filler(0x9E37_79B9_7F4A_7C15);
     let texels = (SPLAT_SLICES * SPLAT_SLICE * SPLAT_SLICE) as usize;
     let dense: Vec<f32> = (0..texels).map(|_| 0.05 + fill.unit()).collect();
+    // Texel centres in units of R: across a slice −1 … 1; along the ring ±2.5 slabs, ±1.25 R.
     let centre = |i: u64, n: u64| (i as f32 + 0.5) / n as f32 * 2.0 - 1.0;
     let ball: Vec<f32> = (0..texels as u64)
         .map(|t| {
@@ -175,7 +178,7 @@ pub fn splat_tables() -> [Vec<f32>; 2] {
                 t % SPLAT_SLICE,
             );
             let (z, y, x) = (
-                centre(k, SPLAT_SLICES),
+                centre(k, SPLAT_SLICES) * 1.25,
                 centre(y, SPLAT_SLICE),
                 centre(x, SPLAT_SLICE),
             );
