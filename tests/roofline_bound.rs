@@ -148,9 +148,12 @@ fn no_row_of_the_default_suite_beats_its_roofline() {
         eprintln!(
             "roofline_bound: NOT JUDGED: the 1-minute load average reached {busiest:.1} on {cores} \
              cores (over {MAX_LOAD_PER_CORE} a core), so a frame in a quiet minute can beat \
-             calibrations taken in busy ones; {} row(s) beat the bound here:\n  {}",
+             calibrations taken in busy ones; {} row(s) beat the bound here{}",
             beaten.len(),
-            beaten.join("\n  ")
+            beaten
+                .iter()
+                .map(|b| format!("\n  {b}"))
+                .collect::<String>()
         );
     } else {
         assert!(
