@@ -155,23 +155,32 @@ fn walk_main(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Splat fill: what the splatter's compute pass does per voxel (Grau & Tost 2007 §3.6, our
-// splat.wgsl): walk the pixel centres of a SPLAT_PX-pixel square; per centre and per slab of
-// the voxel's SPLAT_RING (2r + 1 for the default r = 2), a bilinear lookup in two footprint
-// slices of a storage table, added to that slab's two-u32 fixed-point sums with atomics. A
-// splat fragment is one (voxel, slab, pixel), as the row's `splat_fragments` counts them.
-// Squares half a square apart, so each pixel is hit several times, as overlapping splats are.
-// SPLAT_PX = 4 is a typical footprint of the paper's volumes at 256²-512², so the rate per
-// fragment carries its share of the per-voxel set-up. The table holds no zeros: the
-// splatter's skipped zero terms (the footprint square's corners) are the row's saving.
-const SPLAT_PX: f32 = 4.0;
+// splat.wgsl): walk the pixel centres of a square of `splat_params.px` pixels; per centre and
+// per slab of the voxel's SPLAT_RING (2r + 1 for the default r = 2), a bilinear lookup in two
+// footprint slices of a storage table, added to that slab's two-u32 fixed-point sums with
+// atomics, a term that rounds to 0 skipping its atomic as the splatter's does. A splat
+// fragment is one (voxel, slab, pixel), as the row's `splat_fragments` counts them. Squares
+// half a square apart, so each pixel is hit several times, as overlapping splats are. work.rs
+// runs it at several square sizes (the per-voxel set-up is spread over more fragments in a
+// larger square) and with two tables: one without zeros, and one shaped like the splatter's
+// kernel (each slice the section of a ball, zero outside it, so the terms outside the ball
+// skip their atomics as the splatter's do); the calibration keeps the fastest.
 const SPLAT_RING: u32 = 5u;
-const SPLAT_GRID: u32 = 128u;
 const SPLAT_TARGET: u32 = 512u;
 const SPLAT_SLICE: u32 = 32u;
 const SPLAT_ONE: f32 = 16777216.0;
 
+// x: square side in pixels (even); y: squares per row of the grid.
+struct SplatParams {
+    px: u32,
+    grid: u32,
+    pad0: u32,
+    pad1: u32,
+}
+
 @group(0) @binding(7) var<storage, read> splat_table: array<f32>;
 @group(0) @binding(8) var<storage, read_write> splat_sheet: array<atomic<u32>>;
+@group(0) @binding(9) var<storage, read> splat_params: SplatParams;
 
 fn splat_texel(q: u32, x: i32, y: i32) -> f32 {
     let n = i32(SPLAT_SLICE);
@@ -191,21 +200,81 @@ fn splat_bilinear(q: u32, uv: vec2<f32>) -> f32 {
 
 @compute @workgroup_size(256)
 fn splat_cs(@builtin(global_invocation_id) id: vec3<u32>) {
-    let cell = id.x % (SPLAT_GRID * SPLAT_GRID);
-    let origin = vec2<f32>(f32(cell % SPLAT_GRID), f32(cell / SPLAT_GRID)) * (SPLAT_PX * 0.5) + 0.25;
+    let px = f32(splat_params.px);
+    let grid = splat_params.grid;
+    let cell = id.x % (grid * grid);
+    let origin = vec2<f32>(f32(cell % grid), f32(cell / grid)) * (px * 0.5) + 0.25;
     let q = id.x % 3u;
     let lo = vec2<u32>(ceil(origin - 0.5));
-    let hi = vec2<u32>(ceil(origin + SPLAT_PX - 0.5));
+    let hi = vec2<u32>(ceil(origin + px - 0.5));
     for (var y = lo.y; y < hi.y; y++) {
         for (var x = lo.x; x < hi.x; x++) {
-            let uv = (vec2<f32>(f32(x) + 0.5, f32(y) + 0.5) - origin) / SPLAT_PX * f32(SPLAT_SLICE) - 0.5;
+            let uv = (vec2<f32>(f32(x) + 0.5, f32(y) + 0.5) - origin) / px * f32(SPLAT_SLICE) - 0.5;
             let pixel = (y * SPLAT_TARGET + x) * SPLAT_RING;
             for (var o = 0u; o < SPLAT_RING; o++) {
                 let w = mix(splat_bilinear(q + o, uv), splat_bilinear(q + o + 1u, uv), 0.5);
                 let p = 2u * (pixel + o);
-                atomicAdd(&splat_sheet[p], u32(w * 0.5 * SPLAT_ONE + 0.5));
-                atomicAdd(&splat_sheet[p + 1u], u32(w * SPLAT_ONE + 0.5));
+                let wv = u32(w * 0.5 * SPLAT_ONE + 0.5);
+                let ww = u32(w * SPLAT_ONE + 0.5);
+                if wv != 0u {
+                    atomicAdd(&splat_sheet[p], wv);
+                }
+                if ww != 0u {
+                    atomicAdd(&splat_sheet[p + 1u], ww);
+                }
             }
         }
     }
+}
+
+// Tet classification: the part of a projected tetrahedron's classification that GATOR's vertex
+// program (Wylie et al. 2002 §3, gator.wgsl) and fragment PT's first pass (Marroquim et al.
+// 2006 §3.2, pass1.wgsl) both do: gather the tet's four vertex indices and positions, project
+// them (a 4×4 matrix and the perspective divide), the three orientation tests of the projected
+// vertices, and the intersection of the two diagonals (the thick vertex of a class-2
+// projection). One invocation per tet; the result is stored so nothing is optimised away.
+@group(0) @binding(10) var<storage, read> classify_tets: array<vec4<u32>>;
+@group(0) @binding(11) var<storage, read> classify_points: array<vec4<f32>>;
+@group(0) @binding(12) var<storage, read> classify_matrix: mat4x4<f32>;
+@group(0) @binding(13) var<storage, read_write> classify_out: array<vec4<f32>>;
+
+fn classify_cross(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+@compute @workgroup_size(64)
+fn classify_cs(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= arrayLength(&classify_tets) {
+        return;
+    }
+    let t = classify_tets[id.x];
+    let c0 = classify_matrix * vec4<f32>(classify_points[t.x].xyz, 1.0);
+    let c1 = classify_matrix * vec4<f32>(classify_points[t.y].xyz, 1.0);
+    let c2 = classify_matrix * vec4<f32>(classify_points[t.z].xyz, 1.0);
+    let c3 = classify_matrix * vec4<f32>(classify_points[t.w].xyz, 1.0);
+    let q0 = c0.xy / c0.w;
+    let q1 = c1.xy / c1.w;
+    let q2 = c2.xy / c2.w;
+    let q3 = c3.xy / c3.w;
+    let a = classify_cross(q1 - q0, q2 - q0);
+    let b = classify_cross(q1 - q0, q3 - q0);
+    let c = classify_cross(q3 - q0, q2 - q0);
+    let t1 = (a >= 0.0) != (b >= 0.0);
+    let t2 = (a >= 0.0) != (c >= 0.0);
+    // The diagonals of the quad the tests pick: v0v1 against v2v3 or v0v2 against v1v3.
+    var d0 = q1 - q0;
+    var e0 = q2;
+    var e1 = q3;
+    if t2 {
+        d0 = q2 - q0;
+        e0 = q1;
+    }
+    let bv = e1 - e0;
+    let den = classify_cross(d0, bv);
+    var alpha = 0.0;
+    if den != 0.0 {
+        alpha = clamp(classify_cross(bv, q0 - e0) / den, 0.0, 1.0);
+    }
+    let thick = q0 + alpha * d0;
+    classify_out[id.x] = vec4<f32>(thick, alpha, select(0.0, 1.0, t1));
 }

@@ -91,6 +91,13 @@ pub enum Command {
         /// Print JSON instead of the table.
         #[arg(long)]
         json: bool,
+        /// Measure the per-frame floor instead (submit, wait, an empty frame's clear,
+        /// readbacks, timestamps; docs/gpu.md), not cached.
+        #[arg(long)]
+        floor: bool,
+        /// The floor's square viewport in pixels.
+        #[arg(long, value_name = "PIXELS", default_value_t = 512, requires = "floor")]
+        resolution: u32,
     },
     /// Metrics over a series of runs of one adapter (ordered by date, e.g. the baselines) per
     /// algorithm × data set: compare's test for each adjacent pair and the steps of the whole
@@ -273,6 +280,17 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
                     eprintln!("  {s}");
                 }
             }
+            if !outcome.beaten_bounds.is_empty() {
+                eprintln!(
+                    "{} row(s) beat their roofline bound — a defect of the bound (a calibrated \
+                     figure that is not the backend's peak, or a counter of work not done; \
+                     docs/roofline.md):",
+                    outcome.beaten_bounds.len()
+                );
+                for s in &outcome.beaten_bounds {
+                    eprintln!("  {s}");
+                }
+            }
             if outcome.rows == 0 && !outcome.errors.is_empty() {
                 anyhow::bail!("nothing was measured:\n  {}", outcome.errors.join("\n  "));
             }
@@ -353,9 +371,20 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Calibrate {
+            floor: true,
+            resolution,
+            json,
+            ..
+        } => crate::calibrate::floor::run_command(
+            resolution,
+            crate::calibrate::floor::FLOOR_REPS,
+            json,
+        ),
+        Command::Calibrate {
             cache_dir,
             force,
             json,
+            ..
         } => {
             let cache = cache_dir.unwrap_or_else(|| default_cache_dir(std::path::Path::new(".")));
             crate::calibrate::run_command(&cache, force, json)

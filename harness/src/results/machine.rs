@@ -189,20 +189,26 @@ pub struct Calibration {
     pub compute_gflops: f64,
     /// Storage-to-storage copy, bytes read + bytes written per second.
     pub copy_bytes_per_sec: f64,
-    /// `render_core::sort::radix_sort_indices` on 2^20 f32 keys.
+    /// `render_core::sort::radix_sort_indices`: the fastest of 2^14, 2^17 and 2^20 f32 keys.
     pub sort_keys_per_sec: f64,
     /// Steps of a walk through 144-byte cells (a dependent gather, four plane tests, one
     /// table lookup each), the ray caster's unit of work. 0 in calibrations made before it.
     #[serde(default)]
     pub ray_steps_per_sec: f64,
     /// Footprint pixels of the splatter's compute fill: a two-slice bilinear footprint lookup
-    /// added with atomics into a fixed-point sheet (4×4-pixel footprints); 0 in calibrations
+    /// added with atomics into a fixed-point sheet, zero terms skipped: the fastest of square
+    /// footprints of 4–32 pixels a side with a dense and a ball-shaped table; 0 in calibrations
     /// made before it.
     #[serde(default)]
     pub splat_fragments_per_sec: f64,
-    /// render-core's GPU radix sort on 2^18 f32 keys. 0 in calibrations made before it.
+    /// render-core's GPU radix sort: the fastest of 2^16 and 2^18 f32 keys. 0 in calibrations made before it.
     #[serde(default)]
     pub gpu_sort_keys_per_sec: f64,
+    /// Tet classifications (projection, orientation tests, diagonal intersection: the part of
+    /// a projected-tetrahedra classification every variant does) per second, one compute
+    /// invocation per tet. 0 in calibrations made before it.
+    #[serde(default)]
+    pub tet_classifications_per_sec: f64,
     /// Rasterising triangles that cover pixels (right triangles with 4- and 16-pixel legs,
     /// blended into `fill_format`), fitted as a cost per triangle plus a cost per fragment:
     /// seconds per triangle. 0 in calibrations made before it.
@@ -214,6 +220,44 @@ pub struct Calibration {
 }
 
 impl Calibration {
+    /// Figure by figure the faster of `self` and `other` (two measurements of the same
+    /// backend): the larger rate, the smaller cost where both were measured (0 = not
+    /// measured). The rest (date, seconds) is `self`'s.
+    pub fn peak_with(&self, other: &Calibration) -> Calibration {
+        let cost = |a: f64, b: f64| match (a > 0.0, b > 0.0) {
+            (true, true) => a.min(b),
+            (true, false) => a,
+            _ => b,
+        };
+        Calibration {
+            triangles_per_sec: self.triangles_per_sec.max(other.triangles_per_sec),
+            fill_fragments_per_sec: self
+                .fill_fragments_per_sec
+                .max(other.fill_fragments_per_sec),
+            compute_gflops: self.compute_gflops.max(other.compute_gflops),
+            copy_bytes_per_sec: self.copy_bytes_per_sec.max(other.copy_bytes_per_sec),
+            sort_keys_per_sec: self.sort_keys_per_sec.max(other.sort_keys_per_sec),
+            ray_steps_per_sec: self.ray_steps_per_sec.max(other.ray_steps_per_sec),
+            splat_fragments_per_sec: self
+                .splat_fragments_per_sec
+                .max(other.splat_fragments_per_sec),
+            gpu_sort_keys_per_sec: self.gpu_sort_keys_per_sec.max(other.gpu_sort_keys_per_sec),
+            tet_classifications_per_sec: self
+                .tet_classifications_per_sec
+                .max(other.tet_classifications_per_sec),
+            // Each the smaller: the bound at any triangle size is then at most either fit's.
+            raster_seconds_per_triangle: cost(
+                self.raster_seconds_per_triangle,
+                other.raster_seconds_per_triangle,
+            ),
+            raster_seconds_per_fragment: cost(
+                self.raster_seconds_per_fragment,
+                other.raster_seconds_per_fragment,
+            ),
+            ..self.clone()
+        }
+    }
+
     /// The lines `tetbench calibrate` prints.
     pub fn describe(&self) -> String {
         format!(
@@ -222,10 +266,11 @@ impl Calibration {
              fill rate         {:.1} M fragments/s (blended, {})\n\
              compute           {:.2} GFLOP/s (f32 FMA)\n\
              storage copy      {:.2} GB/s (read + write)\n\
-             CPU radix sort    {:.1} M keys/s (2^20 f32 keys)\n\
-             GPU radix sort    {:.1} M keys/s (2^18 f32 keys)\n\
+             CPU radix sort    {:.1} M keys/s (best of 2^14, 2^17, 2^20 f32 keys)\n\
+             GPU radix sort    {:.1} M keys/s (best of 2^16, 2^18 f32 keys)\n\
              ray steps         {:.2} M steps/s (144-byte cell walk)\n\
-             splat fill        {:.1} M fragments/s (compute footprint lookup, 4x4 px)\n\
+             splat fill        {:.1} M fragments/s (compute footprint lookup, best of 4-32 px)\n\
+             classification    {:.1} M tets/s (projection, orientation tests, diagonals)\n\
              rasterisation     {:.0} ns/triangle + {:.2} ns/fragment (covering triangles, blended)\n\
              measured in {:.1} s on {}",
             self.adapter,
@@ -241,6 +286,7 @@ impl Calibration {
             self.gpu_sort_keys_per_sec * 1e-6,
             self.ray_steps_per_sec * 1e-6,
             self.splat_fragments_per_sec * 1e-6,
+            self.tet_classifications_per_sec * 1e-6,
             self.raster_seconds_per_triangle * 1e9,
             self.raster_seconds_per_fragment * 1e9,
             self.seconds,

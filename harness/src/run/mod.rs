@@ -91,6 +91,9 @@ pub struct RunOutcome {
     /// Rows whose image error is out of line with the others on the same image
     /// ([`crate::results::suspect`]): measured, but probably a renderer defect.
     pub suspect_rows: Vec<String>,
+    /// Rows whose fastest frame beat their roofline bound ([`crate::calibrate::beats_bound`]):
+    /// a defect of the bound, listed so that it is seen.
+    pub beaten_bounds: Vec<String>,
     /// Failures that are not one row (a data set that did not load, a missing reference).
     pub errors: Vec<String>,
     pub seconds: f64,
@@ -500,6 +503,7 @@ fn finish_run(
     if let Some(cal) = writer.file.machine.calibration.clone() {
         crate::calibrate::annotate(&mut writer.file.rows, &cal);
     }
+    outcome.beaten_bounds = beaten_bounds(&writer.file.rows);
     // Columns only known once every row is in (suspect flags, roofline): both files again.
     writer.rewrite_all()?;
     writer.file.machine.load_average_end = crate::results::machine::load_average();
@@ -509,6 +513,26 @@ fn finish_run(
         crate::report::write(&config.out, &writer.file).context("writing the report")?;
     }
     Ok(())
+}
+
+/// One line per row whose fastest frame beat its roofline ([`crate::calibrate::beats_bound`]).
+pub fn beaten_bounds(rows: &[Row]) -> Vec<String> {
+    rows.iter()
+        .filter(|r| crate::calibrate::beats_bound(r))
+        .map(|r| {
+            format!(
+                "{} {} on {} {}: {} bound {:.3} ms, fastest frame {:.3} ms (limit fraction {:.2})",
+                r.algorithm,
+                r.settings,
+                r.dataset,
+                r.viewpoint,
+                r.bound_by,
+                r.roofline_ms.unwrap_or(f64::NAN),
+                r.total_ms_min.unwrap_or(f64::NAN),
+                r.limit_fraction.unwrap_or(f64::NAN)
+            )
+        })
+        .collect()
 }
 
 /// The variants of an external renderer named `name` (one per `--external` spec with that

@@ -215,6 +215,93 @@ pub fn check_storage_bindings(gpu: &Gpu, label: &str, needed: u32) -> anyhow::Re
     Ok(())
 }
 
+/// WGSL declaring `chunks` storage arrays `NAME_0 …` of `TY` at `@group(group) @binding(first
+/// ..)`, `per_chunk` elements each (the last may hold fewer), and `fn NAME_at(i: u32) -> TY`
+/// (and `fn NAME_set(i: u32, v: TY)` when writable) that index them as one array: what
+/// [`ChunkedBuffer::wgsl`] writes, for arrays bound in any chunks (e.g. [`range_entries`]).
+pub fn chunked_wgsl(
+    name: &str,
+    ty: &str,
+    group: u32,
+    first: u32,
+    chunks: u32,
+    per_chunk: u64,
+    read_only: bool,
+) -> String {
+    let access = if read_only { "read" } else { "read_write" };
+    let n = chunks.max(1);
+    let mut s = String::new();
+    for i in 0..n {
+        s += &format!(
+            "@group({group}) @binding({}) var<storage, {access}> {name}_{i}: array<{ty}>;\n",
+            first + i
+        );
+    }
+    let per = per_chunk.min(u32::MAX as u64);
+    let mut get = format!("fn {name}_at(i: u32) -> {ty} {{\n");
+    let mut set = format!("fn {name}_set(i: u32, v: {ty}) {{\n");
+    if n == 1 {
+        get += &format!("    return {name}_0[i];\n}}\n");
+        set += &format!("    {name}_0[i] = v;\n}}\n");
+    } else {
+        let head =
+            format!("    let c = i / {per}u;\n    let j = i - c * {per}u;\n    switch c {{\n");
+        get += &head;
+        set += &head;
+        for i in 0..n {
+            let case = if i + 1 == n {
+                "default".to_string()
+            } else {
+                format!("case {i}u")
+            };
+            get += &format!("        {case}: {{ return {name}_{i}[j]; }}\n");
+            set += &format!("        {case}: {{ {name}_{i}[j] = v; }}\n");
+        }
+        get += "    }\n}\n";
+        set += "    }\n}\n";
+    }
+    s += &get;
+    if !read_only {
+        s += &set;
+    }
+    s
+}
+
+/// Bind-group entries `first ..` that bind one buffer as `chunks` arrays of `per_chunk`
+/// elements of `elem_bytes` each (the chunks [`chunked_wgsl`] declares), covering its first
+/// `len` elements: a buffer larger than one storage binding, sorted or written whole by a
+/// shader through `NAME_at` / `NAME_set`. A chunk past `len` binds the first element (its
+/// binding must exist; no index reaches it). `per_chunk × elem_bytes` must be a multiple of
+/// the storage offset alignment (256 bytes), as [`crate::Gpu::max_storage_binding`] is.
+pub fn range_entries(
+    first: u32,
+    buffer: &wgpu::Buffer,
+    elem_bytes: u64,
+    per_chunk: u64,
+    chunks: u32,
+    len: u64,
+) -> Vec<wgpu::BindGroupEntry<'_>> {
+    (0..chunks.max(1))
+        .map(|c| {
+            let start = c as u64 * per_chunk;
+            let end = ((c as u64 + 1) * per_chunk).min(len);
+            let (offset, elements) = if end > start {
+                (start * elem_bytes, end - start)
+            } else {
+                (0, 1)
+            };
+            wgpu::BindGroupEntry {
+                binding: first + c,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer,
+                    offset,
+                    size: wgpu::BufferSize::new(elements * elem_bytes),
+                }),
+            }
+        })
+        .collect()
+}
+
 /// An array of fixed-size elements split across buffers of at most one storage binding each.
 pub struct ChunkedBuffer {
     pub buffers: Vec<wgpu::Buffer>,
@@ -314,43 +401,15 @@ impl ChunkedBuffer {
     /// WGSL declaring the chunks as `NAME_0 …` at `@group(group) @binding(first ..)` and
     /// `fn NAME_at(i: u32) -> TY` (and `fn NAME_set(i: u32, v: TY)` when writable).
     pub fn wgsl(&self, name: &str, ty: &str, group: u32, first: u32, read_only: bool) -> String {
-        let access = if read_only { "read" } else { "read_write" };
-        let n = self.bindings();
-        let mut s = String::new();
-        for i in 0..n {
-            s += &format!(
-                "@group({group}) @binding({}) var<storage, {access}> {name}_{i}: array<{ty}>;\n",
-                first + i
-            );
-        }
-        let per = self.per_chunk.min(u32::MAX as u64);
-        let mut get = format!("fn {name}_at(i: u32) -> {ty} {{\n");
-        let mut set = format!("fn {name}_set(i: u32, v: {ty}) {{\n");
-        if n == 1 {
-            get += &format!("    return {name}_0[i];\n}}\n");
-            set += &format!("    {name}_0[i] = v;\n}}\n");
-        } else {
-            let head =
-                format!("    let c = i / {per}u;\n    let j = i - c * {per}u;\n    switch c {{\n");
-            get += &head;
-            set += &head;
-            for i in 0..n {
-                let case = if i + 1 == n {
-                    "default".to_string()
-                } else {
-                    format!("case {i}u")
-                };
-                get += &format!("        {case}: {{ return {name}_{i}[j]; }}\n");
-                set += &format!("        {case}: {{ {name}_{i}[j] = v; }}\n");
-            }
-            get += "    }\n}\n";
-            set += "    }\n}\n";
-        }
-        s += &get;
-        if !read_only {
-            s += &set;
-        }
-        s
+        chunked_wgsl(
+            name,
+            ty,
+            group,
+            first,
+            self.bindings(),
+            self.per_chunk,
+            read_only,
+        )
     }
 
     /// Writes host data starting at element `first` (may span chunks).

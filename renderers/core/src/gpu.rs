@@ -32,7 +32,16 @@ pub struct Gpu {
     /// Triangles per render pass when a whole mesh is drawn
     /// ([`MAX_TRIANGLES_PER_PASS`] unless the request asked for fewer).
     pub triangles_per_pass: u32,
+    /// Mappable buffers of earlier readbacks, reused by the next ([`Gpu::read_buffer`]): a
+    /// frame that reads its counters back would otherwise allocate one every frame, which a
+    /// real application keeps (issue 43, the per-frame floor).
+    staging: std::sync::Mutex<Vec<wgpu::Buffer>>,
+    /// Mappable buffers created for readbacks so far (what the reuse saves; tests read it).
+    staging_created: std::sync::atomic::AtomicU64,
 }
+
+/// Readback buffers kept for reuse at most (the rest are dropped when returned).
+const STAGING_KEPT: usize = 8;
 
 /// Features used when present; none is required, each algorithm checks what it needs.
 fn wanted_features() -> wgpu::Features {
@@ -213,6 +222,8 @@ impl Gpu {
             triangles_per_pass: request
                 .max_triangles_per_pass
                 .map_or(MAX_TRIANGLES_PER_PASS, DeviceRequest::pass_size),
+            staging: Default::default(),
+            staging_created: Default::default(),
         })
     }
 
@@ -394,28 +405,67 @@ impl Gpu {
         size: u64,
         waited: &mut Duration,
     ) -> anyhow::Result<Vec<u8>> {
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let staging = self.take_staging(size);
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
         // The submit counts as waiting (see FrameClock::submit).
         let t = Instant::now();
         self.queue.submit([enc.finish()]);
         *waited += t.elapsed();
-        self.map_and_copy(&staging, waited)
+        let data = self.map_and_copy(&staging, size, waited);
+        self.return_staging(staging);
+        data
     }
 
-    fn map_and_copy(
+    /// A mappable buffer of at least `size` bytes: the smallest kept one that fits, else a new
+    /// one (sizes rounded up to 4 KiB, so that a frame's readbacks of slightly different
+    /// sizes share one).
+    pub fn take_staging(&self, size: u64) -> wgpu::Buffer {
+        let mut kept = self.staging.lock().unwrap_or_else(|e| e.into_inner());
+        let fit = kept
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.size() >= size)
+            .min_by_key(|(_, b)| b.size())
+            .map(|(i, _)| i);
+        if let Some(i) = fit {
+            return kept.swap_remove(i);
+        }
+        drop(kept);
+        self.staging_created
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: size.max(1).next_multiple_of(4096),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// Gives an unmapped readback buffer back for reuse.
+    pub fn return_staging(&self, buffer: wgpu::Buffer) {
+        let mut kept = self.staging.lock().unwrap_or_else(|e| e.into_inner());
+        if kept.len() < STAGING_KEPT {
+            kept.push(buffer);
+        }
+    }
+
+    /// Mappable buffers created for readbacks since the device was opened.
+    pub fn staging_buffers_created(&self) -> u64 {
+        self.staging_created
+            .load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Maps the first `size` bytes of `staging` (after the work that fills it was submitted),
+    /// copies them out and unmaps it; the wait for the map is added to `waited`.
+    pub fn map_and_copy(
         &self,
         staging: &wgpu::Buffer,
+        size: u64,
         waited: &mut Duration,
     ) -> anyhow::Result<Vec<u8>> {
         let (tx, rx) = mpsc::channel();
-        staging.map_async(wgpu::MapMode::Read, .., move |r| {
+        staging.map_async(wgpu::MapMode::Read, ..size, move |r| {
             let _ = tx.send(r);
         });
         let t = Instant::now();
@@ -426,7 +476,7 @@ impl Gpu {
             .map_err(|_| anyhow!("readback callback dropped"))?
             .map_err(|e| anyhow!("mapping readback buffer: {e}"))?;
         let data = staging
-            .get_mapped_range(..)
+            .get_mapped_range(..size)
             .map_err(|e| anyhow!("mapped range: {e:?}"))?
             .to_vec();
         staging.unmap();
@@ -485,7 +535,7 @@ impl Gpu {
         );
         self.queue.submit([enc.finish()]);
         let mut waited = Duration::ZERO;
-        let bytes = self.map_and_copy(&staging, &mut waited)?;
+        let bytes = self.map_and_copy(&staging, staging.size(), &mut waited)?;
         let mut out = Vec::with_capacity((unpadded * h as u64) as usize);
         for y in 0..h as usize {
             out.extend_from_slice(
@@ -622,16 +672,20 @@ pub fn chunk_ranges(count: u64, element_bytes: u64, max_binding: u64) -> Vec<std
         .collect()
 }
 
-/// GPU time of a frame from two timestamps (wall and host time: [`crate::FrameClock`]).
+/// GPU time of a frame from two timestamps (wall and host time: [`crate::FrameClock`]). The
+/// timestamps are resolved and copied into a mappable buffer by the frame's own last command
+/// buffer ([`FrameTimer::end`]), so reading them ([`FrameTimer::gpu_ms`]) is one map: no
+/// further submission and no buffer created per frame (issue 43, the per-frame floor).
 pub struct FrameTimer {
     query_set: Option<wgpu::QuerySet>,
     resolve: Option<wgpu::Buffer>,
+    readback: Option<wgpu::Buffer>,
     period_ns: f32,
 }
 
 impl FrameTimer {
     pub fn new(gpu: &Gpu) -> FrameTimer {
-        let (query_set, resolve) = if gpu.has_timestamps() {
+        let (query_set, resolve, readback) = if gpu.has_timestamps() {
             let qs = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("frame timestamps"),
                 ty: wgpu::QueryType::Timestamp,
@@ -643,13 +697,20 @@ impl FrameTimer {
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            (Some(qs), Some(buf))
+            let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamp readback"),
+                size: 16,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            (Some(qs), Some(buf), Some(readback))
         } else {
-            (None, None)
+            (None, None, None)
         };
         FrameTimer {
             query_set,
             resolve,
+            readback,
             period_ns: gpu.queue.get_timestamp_period(),
         }
     }
@@ -661,20 +722,24 @@ impl FrameTimer {
         }
     }
 
-    /// Writes the "end" timestamp and resolves both (last commands of the frame's GPU work).
+    /// Writes the "end" timestamp, resolves both and copies them where [`FrameTimer::gpu_ms`]
+    /// maps them (last commands of the frame's GPU work).
     pub fn end(&self, encoder: &mut wgpu::CommandEncoder) {
-        if let (Some(qs), Some(buf)) = (&self.query_set, &self.resolve) {
+        if let (Some(qs), Some(buf), Some(readback)) =
+            (&self.query_set, &self.resolve, &self.readback)
+        {
             encoder.write_timestamp(qs, 1);
             encoder.resolve_query_set(qs, 0..2, buf, 0);
+            encoder.copy_buffer_to_buffer(buf, 0, readback, 0, 16);
         }
     }
 
     /// GPU milliseconds between begin and end (after the work was submitted; blocks).
     pub fn gpu_ms(&self, gpu: &Gpu) -> anyhow::Result<Option<f64>> {
-        let Some(buf) = &self.resolve else {
+        let Some(readback) = &self.readback else {
             return Ok(None);
         };
-        let bytes = gpu.read_buffer(buf, 0, 16)?;
+        let bytes = gpu.map_and_copy(readback, 16, &mut Duration::default())?;
         let t: &[u64] = bytemuck::cast_slice(&bytes);
         Ok(Some(
             t[1].saturating_sub(t[0]) as f64 * self.period_ns as f64 * 1e-6,
@@ -810,5 +875,55 @@ mod device_tests {
             gpu.has_timestamps(),
             gpu.limits
         );
+    }
+
+    /// Readbacks reuse their mappable buffers (issue 43: none created per frame) and still
+    /// return exactly the bytes asked for: a smaller read after a larger one, an offset read,
+    /// and a larger one that needs a new buffer.
+    #[test]
+    fn readbacks_reuse_their_buffers_and_return_the_same_bytes() {
+        let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
+        let mut ledger = MemoryLedger::default();
+        let data: Vec<u32> = (0..4096).map(|i| i * 7 + 1).collect();
+        let buf = ledger
+            .buffer_init(
+                &gpu,
+                "test",
+                Lifetime::Persistent,
+                bytemuck::cast_slice(&data),
+                wgpu::BufferUsages::COPY_SRC,
+            )
+            .unwrap();
+        let created = gpu.staging_buffers_created();
+        let read = |offset: u64, size: u64| -> Vec<u32> {
+            bytemuck::cast_slice(&gpu.read_buffer(&buf, offset, size).unwrap()).to_vec()
+        };
+        assert_eq!(read(0, 4000), &data[..1000]);
+        assert_eq!(read(0, 32), &data[..8]);
+        assert_eq!(read(400, 64), &data[100..116]);
+        assert_eq!(
+            gpu.staging_buffers_created() - created,
+            1,
+            "one 4 KiB buffer serves all three"
+        );
+        assert_eq!(read(0, 16384), &data[..]);
+        assert_eq!(gpu.staging_buffers_created() - created, 2);
+        for _ in 0..10 {
+            assert_eq!(read(4, 8), &data[1..3]);
+        }
+        assert_eq!(gpu.staging_buffers_created() - created, 2);
+        // The frame timer maps its own buffer: no readback buffer per frame either.
+        let timer = FrameTimer::new(&gpu);
+        for _ in 0..3 {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            timer.begin(&mut enc);
+            timer.end(&mut enc);
+            gpu.queue.submit([enc.finish()]);
+            gpu.wait().unwrap();
+            let ms = timer.gpu_ms(&gpu).unwrap();
+            assert_eq!(ms.is_some(), gpu.has_timestamps());
+            assert!(ms.is_none_or(|m| m >= 0.0));
+        }
+        assert_eq!(gpu.staging_buffers_created() - created, 2);
     }
 }

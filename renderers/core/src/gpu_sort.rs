@@ -13,12 +13,15 @@
 //! the centroid's sort distance as key and the primitive id as value, so a frame is "key pass,
 //! sort, draw" in one encoder with nothing read back.
 //!
-//! Limits: `n` ≤ `max_len`, and `max_len` keys must fit one storage binding
-//! (`Gpu::max_storage_binding() / 4`: 32 Mi keys at 128 MiB on lavapipe); larger arrays are not
-//! sorted in one piece (no chunking). Each [`GpuRadixSort::encode`] writes its pass parameters
-//! through the queue, so encode at most one sort per instance per submission.
+//! Limits: `n` ≤ `max_len`. Arrays larger than one storage binding
+//! (`Gpu::max_storage_binding() / 4` keys: 32 Mi at 128 MiB on lavapipe) are sorted in one
+//! piece all the same: the shader sees each of its four arrays as `chunks` bindings of one
+//! buffer ([`crate::bind::chunked_wgsl`], [`crate::bind::range_entries`]), so HAVS's 20 M-tet
+//! meshes (about 40 M faces, 160 MB of keys) sort on the device. Each
+//! [`GpuRadixSort::encode`] writes its pass parameters through the queue, so encode at most
+//! one sort per instance per submission.
 
-use anyhow::{bail, ensure};
+use anyhow::ensure;
 
 use crate::gpu::{Gpu, Lifetime, MemoryLedger};
 
@@ -44,11 +47,36 @@ struct Params {
     flags: u32,
 }
 
+/// First binding of the four sorted arrays (`keys_in`, `vals_in`, `keys_out`, `vals_out`,
+/// `chunks` bindings each, in that order).
+const ARRAYS_BINDING: u32 = 10;
+
+/// The sort shader for arrays of `chunks` bindings of `per_chunk` keys each.
+fn sort_source(chunks: u32, per_chunk: u64) -> String {
+    let mut s = String::new();
+    for (a, (name, read_only)) in [
+        ("keys_in", true),
+        ("vals_in", true),
+        ("keys_out", false),
+        ("vals_out", false),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let first = ARRAYS_BINDING + a as u32 * chunks;
+        s += &crate::bind::chunked_wgsl(name, "u32", 0, first, chunks, per_chunk, read_only);
+    }
+    s + include_str!("gpu_sort.wgsl")
+}
+
 /// A reusable GPU radix sorter for up to `max_len` pairs.
 pub struct GpuRadixSort {
     device: wgpu::Device,
     queue: wgpu::Queue,
     max_len: u32,
+    /// Keys per storage binding, and bindings per array.
+    per_chunk: u64,
+    chunks: u32,
     layout: wgpu::BindGroupLayout,
     histogram: wgpu::ComputePipeline,
     scan_tiles: wgpu::ComputePipeline,
@@ -74,33 +102,29 @@ impl GpuRadixSort {
     /// buffers: 8 bytes per key of ping-pong copies plus 1 KiB of histogram per tile).
     pub fn new(gpu: &Gpu, max_len: u32, ledger: &mut MemoryLedger) -> anyhow::Result<GpuRadixSort> {
         let max_len = max_len.max(1);
-        let binding = gpu.max_storage_binding();
-        if max_len as u64 * 4 > binding {
-            bail!(
-                "GPU radix sort of {max_len} keys: {} bytes exceed one storage binding ({binding} bytes); \
-                 at most {} keys",
-                max_len as u64 * 4,
-                binding / 4
-            );
-        }
+        let per_chunk = gpu.max_storage_binding() / 4;
+        let chunks = (max_len as u64).div_ceil(per_chunk) as u32;
+        crate::bind::check_storage_bindings(gpu, "GPU radix sort", 4 * chunks + 3)?;
         let tiles = max_len.div_ceil(TILE);
         ensure!(
             tiles <= gpu.limits.max_compute_workgroups_per_dimension,
             "too many tiles for one dispatch"
         );
         let device = &gpu.device;
-        let module = gpu.shader("gpu_sort.wgsl", include_str!("gpu_sort.wgsl"));
+        let module = gpu.shader("gpu_sort.wgsl", &sort_source(chunks, per_chunk));
+        let mut entries = vec![
+            params_entry(0),
+            storage_entry(5, false),
+            storage_entry(6, false),
+        ];
+        for a in 0..4 {
+            for c in 0..chunks {
+                entries.push(storage_entry(ARRAYS_BINDING + a * chunks + c, a < 2));
+            }
+        }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("radix sort"),
-            entries: &[
-                params_entry(0),
-                storage_entry(1, true),
-                storage_entry(2, true),
-                storage_entry(3, false),
-                storage_entry(4, false),
-                storage_entry(5, false),
-                storage_entry(6, false),
-            ],
+            entries: &entries,
         });
         let pipeline_layout = crate::bind::pipeline_layout(gpu, "radix sort", &[Some(&layout)]);
         let pipeline = |entry: &str| {
@@ -118,6 +142,8 @@ impl GpuRadixSort {
             device: gpu.device.clone(),
             queue: gpu.queue.clone(),
             max_len,
+            per_chunk,
+            chunks,
             histogram: pipeline("histogram"),
             scan_tiles: pipeline("scan_tiles"),
             scatter: pipeline("scatter"),
@@ -165,6 +191,11 @@ impl GpuRadixSort {
         self.max_len
     }
 
+    /// Storage bindings each of its four arrays is split over (1 where `max_len` keys fit one).
+    pub fn bindings_per_array(&self) -> u32 {
+        self.chunks
+    }
+
     /// Records the sort of the first `n` pairs of `keys` (f32) and `values` (u32) into `encoder`,
     /// ascending or descending by key, stable (equal keys keep their order). Both buffers need
     /// [`REQUIRED_USAGE`] and at least `4 n` bytes; callers normally fill them with their own
@@ -210,14 +241,6 @@ impl GpuRadixSort {
             .collect();
         self.queue
             .write_buffer(&self.params, 0, &crate::bind::strided_uniforms(&params));
-        let bytes = wgpu::BufferSize::new(n as u64 * 4);
-        fn range(b: &wgpu::Buffer, size: Option<wgpu::BufferSize>) -> wgpu::BindingResource<'_> {
-            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: b,
-                offset: 0,
-                size,
-            })
-        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("radix sort"),
             timestamp_writes: None,
@@ -229,43 +252,38 @@ impl GpuRadixSort {
             } else {
                 (&self.tmp_keys, &self.tmp_vals, keys, values)
             };
+            let mut entries = vec![
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.params,
+                        offset: p as u64 * PARAM_STRIDE,
+                        size: wgpu::BufferSize::new(16),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: self.tile_hist.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: self.digit_total.as_entire_binding(),
+                },
+            ];
+            for (a, buffer) in [ki, vi, ko, vo].into_iter().enumerate() {
+                entries.extend(crate::bind::range_entries(
+                    ARRAYS_BINDING + a as u32 * self.chunks,
+                    buffer,
+                    4,
+                    self.per_chunk,
+                    self.chunks,
+                    n as u64,
+                ));
+            }
             let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("radix sort pass"),
                 layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &self.params,
-                            offset: p as u64 * PARAM_STRIDE,
-                            size: wgpu::BufferSize::new(16),
-                        }),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: range(ki, bytes),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: range(vi, bytes),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: range(ko, bytes),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: range(vo, bytes),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 5,
-                        resource: self.tile_hist.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 6,
-                        resource: self.digit_total.as_entire_binding(),
-                    },
-                ],
+                entries: &entries,
             });
             pass.set_bind_group(0, &bind, &[]);
             pass.set_pipeline(&self.histogram);
@@ -359,7 +377,11 @@ pub struct GpuCentroidKeys {
 impl GpuCentroidKeys {
     pub fn new(gpu: &Gpu, ledger: &mut MemoryLedger) -> anyhow::Result<GpuCentroidKeys> {
         let device = &gpu.device;
-        let module = gpu.shader("gpu_sort.wgsl", include_str!("gpu_sort.wgsl"));
+        // The module's sort entry points need their arrays declared; one binding each.
+        let module = gpu.shader(
+            "gpu_sort.wgsl",
+            &sort_source(1, gpu.max_storage_binding() / 4),
+        );
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("centroid keys"),
             entries: &[
@@ -647,10 +669,38 @@ mod tests {
         Ok(())
     }
 
+    /// Arrays larger than one storage binding sort in one piece (issue 43: HAVS's 20 M-tet
+    /// faces): with the binding limited to 256 KiB (65,536 keys), 65,537 and 150,000 keys span
+    /// two and three bindings, and the order equals the CPU radix sort's exactly, ascending
+    /// and descending; a sort of fewer keys than the sorter holds binds its unused chunks
+    /// harmlessly.
     #[test]
-    fn oversized_sort_is_an_error() {
-        let gpu = Gpu::new().expect("a wgpu adapter");
-        let too_many = (gpu.max_storage_binding() / 4 + 1).min(u32::MAX as u64) as u32;
-        assert!(GpuRadixSort::new(&gpu, too_many, &mut MemoryLedger::default()).is_err());
+    fn a_sort_larger_than_one_binding_agrees_with_cpu() {
+        let gpu = Gpu::with_request(&crate::DeviceRequest {
+            max_storage_binding: Some(256 << 10),
+            ..Default::default()
+        })
+        .expect("a wgpu adapter");
+        assert_eq!(gpu.max_storage_binding(), 256 << 10);
+        let sorter = GpuRadixSort::new(&gpu, 150_000, &mut MemoryLedger::default()).unwrap();
+        assert_eq!(sorter.bindings_per_array(), 3);
+        let mut scratch = RadixScratch::default();
+        for (n, seed) in [(1000usize, 8u64), (65_537, 9), (150_000, 10)] {
+            let keys = xorshift_keys(n, seed);
+            for descending in [false, true] {
+                let (sorted, perm) = sorter.sort_pairs_blocking(&gpu, &keys, descending).unwrap();
+                let mut want = Vec::new();
+                if descending {
+                    radix_sort_indices_descending(&keys, &mut want, &mut scratch);
+                } else {
+                    radix_sort_indices(&keys, &mut want, &mut scratch);
+                }
+                assert_eq!(perm, want, "n = {n}, descending = {descending}");
+                let want_keys: Vec<u32> =
+                    want.iter().map(|&i| keys[i as usize].to_bits()).collect();
+                let got_keys: Vec<u32> = sorted.iter().map(|k| k.to_bits()).collect();
+                assert_eq!(got_keys, want_keys, "n = {n}: keys come back sorted");
+            }
+        }
     }
 }

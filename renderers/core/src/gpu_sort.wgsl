@@ -27,10 +27,9 @@ const DESCENDING: u32 = 2u;
 const UNMAP_OUT: u32 = 4u;
 
 @group(0) @binding(0) var<storage, read> params: Params;
-@group(0) @binding(1) var<storage, read> keys_in: array<u32>;
-@group(0) @binding(2) var<storage, read> vals_in: array<u32>;
-@group(0) @binding(3) var<storage, read_write> keys_out: array<u32>;
-@group(0) @binding(4) var<storage, read_write> vals_out: array<u32>;
+// keys_in, vals_in, keys_out, vals_out: declared by the Rust (gpu_sort.rs, `sort_source`) at
+// bindings 10.., each split over as many storage bindings as the sorter's capacity needs, and
+// read and written through keys_in_at(i), keys_out_set(i, v), ...
 // tile_hist[digit * num_tiles + tile]: counts, then (after scan_tiles) exclusive prefixes.
 @group(0) @binding(5) var<storage, read_write> tile_hist: array<u32>;
 @group(0) @binding(6) var<storage, read_write> digit_total: array<u32>;
@@ -50,7 +49,7 @@ fn unordered(u: u32) -> u32 {
 }
 
 fn load_key(i: u32) -> u32 {
-    var k = keys_in[i];
+    var k = keys_in_at(i);
     if (params.flags & MAP_IN) != 0u {
         k = ordered(k);
         if (params.flags & DESCENDING) != 0u {
@@ -166,8 +165,8 @@ fn scatter(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid
                 rank = rank + countOneBits(atomicLoad(&match_mask[d][w]));
             }
             let dst = running[d] + rank;
-            keys_out[dst] = store_key(key);
-            vals_out[dst] = vals_in[i];
+            keys_out_set(dst, store_key(key));
+            vals_out_set(dst, vals_in_at(i));
         }
         workgroupBarrier();
         var count = 0u;

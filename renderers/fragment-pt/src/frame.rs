@@ -209,6 +209,8 @@ pub(crate) fn render(
         // which its fan covers once, and the tets that hold any.
         ("fragments".to_string(), projected.fragments as f64),
         ("covering_tets".to_string(), projected.covering_tets as f64),
+        // Pass 1 classifies every tet once (one invocation per tet).
+        ("tet_classifications".to_string(), st.tets as f64),
         (
             if sort_mode == SortMode::Gpu {
                 "gpu_sort_keys"

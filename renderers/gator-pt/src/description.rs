@@ -32,7 +32,13 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     build,
     hue: Hue::Blues,
     tolerance,
-    counters: &["triangles", "fragments", "covering_tets", "cpu_sort_keys"],
+    counters: &[
+        "triangles",
+        "fragments",
+        "covering_tets",
+        "tet_classifications",
+        "cpu_sort_keys",
+    ],
     nondeterministic_counters: render_core::description::all_counters_exact,
 };
 

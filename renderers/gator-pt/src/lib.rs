@@ -733,6 +733,10 @@ impl Renderer for GatorPt {
             // projection, which its four triangles cover once each, and the tets that hold any.
             ("fragments".to_string(), projected.fragments as f64),
             ("covering_tets".to_string(), projected.covering_tets as f64),
+            // The vertex program classifies the tet once per basis-graph node it shades
+            // (§3: every node's invocation repeats the tests): at least 5 per tet, since an
+            // indexed draw shades each of its 5 indices at least once.
+            ("tet_classifications".to_string(), NODES as f64 * n),
             // Tets with a vertex at or behind the eye: the vertex shader drops them (no
             // near-plane clipping, as the paper); counted outside the timed frame.
             (

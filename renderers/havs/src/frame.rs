@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::bail;
 use rayon::prelude::*;
-use render_core::bind::whole;
+use render_core::bind::{chunked_wgsl, range_entries, whole};
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::sort::radix_sort_indices;
 use render_core::{Camera, ChunkedBuffer, FrameClock, FrameStats, Gpu};
@@ -24,15 +24,10 @@ impl GpuSortState {
         faces: &ChunkedBuffer,
         num_faces: u64,
     ) -> anyhow::Result<GpuSortState> {
-        let max = gpu.max_storage_binding();
-        if num_faces * 4 > max {
-            bail!(
-                "HAVS GPU sort: {num_faces} face keys need {} bytes in one storage binding, the \
-                 adapter allows {max} bytes (max_storage_buffer_binding_size; the device radix \
-                 sort is not split); use sort=cpu-radix",
-                num_faces * 4
-            );
-        }
+        // Keys and ids larger than one storage binding are written and sorted as chunks of
+        // one buffer each (render_core::bind::range_entries; the sort does the same).
+        let per_chunk = gpu.max_storage_binding() / 4;
+        let chunks = num_faces.max(1).div_ceil(per_chunk) as u32;
         let usage = wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_SRC
             | wgpu::BufferUsages::COPY_DST;
@@ -57,16 +52,28 @@ impl GpuSortState {
             std::mem::size_of::<KeyUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         )?;
-        let source = mesh_decls(verts, faces, KEY_MESH_BINDING) + include_str!("keys.wgsl");
+        let keys_binding = KEY_MESH_BINDING + verts.bindings() + faces.bindings();
+        let ids_binding = keys_binding + chunks;
+        let source = mesh_decls(verts, faces, KEY_MESH_BINDING)
+            + &chunked_wgsl("keys", "f32", 0, keys_binding, chunks, per_chunk, false)
+            + &chunked_wgsl("ids", "u32", 0, ids_binding, chunks, per_chunk, false)
+            + include_str!("keys.wgsl");
+        render_core::bind::check_storage_bindings(
+            gpu,
+            "HAVS face keys",
+            verts.bindings() + faces.bindings() + 2 * chunks,
+        )?;
         let module = gpu.shader("havs keys", &source);
         let key_pipeline = gpu.compute_pipeline("havs face keys", None, &module, "face_keys");
         let key_bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("havs keys"),
             layout: &key_pipeline.get_bind_group_layout(0),
             entries: &[
-                vec![whole(0, &key_uniforms), whole(3, &keys), whole(4, &ids)],
+                vec![whole(0, &key_uniforms)],
                 verts.bind_entries(KEY_MESH_BINDING),
                 faces.bind_entries(KEY_MESH_BINDING + verts.bindings()),
+                range_entries(keys_binding, &keys, 4, per_chunk, chunks, num_faces),
+                range_entries(ids_binding, &ids, 4, per_chunk, chunks, num_faces),
             ]
             .concat(),
         });

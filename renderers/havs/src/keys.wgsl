@@ -13,9 +13,9 @@ struct KeyUniforms {
 }
 
 @group(0) @binding(0) var<uniform> ku: KeyUniforms;
-// verts_at / faces_at: declared by the Rust (render_core::ChunkedBuffer) at bindings 5..
-@group(0) @binding(3) var<storage, read_write> keys: array<f32>;
-@group(0) @binding(4) var<storage, read_write> ids: array<u32>;
+// verts_at / faces_at: declared by the Rust (render_core::ChunkedBuffer) at bindings 5..;
+// keys_set / ids_set after them, each array split over as many storage bindings as the
+// faces need (render_core::bind::chunked_wgsl), as the GPU radix sort reads them.
 
 @compute @workgroup_size(256)
 fn face_keys(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
@@ -29,6 +29,6 @@ fn face_keys(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroup
     if ku.eye.w > 0.5 {
         d = length(rel);
     }
-    keys[f] = d;
-    ids[f] = f;
+    keys_set(f, d);
+    ids_set(f, f);
 }

@@ -1,0 +1,217 @@
+//! `tetbench calibrate --floor`: what one frame costs before any algorithm does any work, step
+//! by step (issue 43). On a GPU a frame of a small mesh is mostly this floor: a submission,
+//! the wait for the device, the readbacks of a frame's counters and timestamps. Each step is
+//! timed on its own, `FLOOR_REPS` times after warming up, and reported as the median and the
+//! fastest; the report stands beside the rows (`scripts/gpu.sh`), never subtracted from them.
+//!
+//! The steps, each what the frame loop (`harness/src/run/measure.rs`, `render_core::FrameClock`)
+//! does or did:
+//!
+//! - `submit`: an empty command buffer handed to the queue (no wait);
+//! - `submit + wait`: the same, then the device wait every frame ends with;
+//! - `clear + wait`: a render pass that only clears a viewport-sized `Rgba32Float` target (the
+//!   frame of an empty mesh: every renderer clears its target), submitted and waited for;
+//! - `readback, new buffer`: 32 bytes copied into a mappable buffer created for it, submitted,
+//!   mapped (what every counter and timestamp readback cost before the reuse);
+//! - `readback, reused buffer`: the same into a buffer kept from the last readback (what
+//!   `Gpu::read_buffer` does now);
+//! - `timestamps`: a frame's two timestamps written, resolved and copied in one command buffer,
+//!   submitted, waited for and mapped (`FrameTimer`); absent without timestamp queries.
+
+use std::time::{Duration, Instant};
+
+use render_core::{FrameTimer, Gpu};
+use serde::{Deserialize, Serialize};
+
+/// Timed repetitions of each step (after `FLOOR_REPS / 10` warm-ups).
+pub const FLOOR_REPS: usize = 200;
+
+/// One step's times (microseconds).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FloorStep {
+    pub step: String,
+    pub median_us: f64,
+    pub min_us: f64,
+}
+
+/// The floor of one adapter at one viewport.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Floor {
+    pub adapter: String,
+    pub width: u32,
+    pub reps: usize,
+    pub steps: Vec<FloorStep>,
+}
+
+fn step(
+    name: &str,
+    reps: usize,
+    mut f: impl FnMut() -> anyhow::Result<()>,
+) -> anyhow::Result<FloorStep> {
+    for _ in 0..(reps / 10).max(1) {
+        f()?;
+    }
+    let mut t = Vec::with_capacity(reps);
+    for _ in 0..reps {
+        let t0 = Instant::now();
+        f()?;
+        t.push(t0.elapsed().as_secs_f64() * 1e6);
+    }
+    t.sort_by(f64::total_cmp);
+    Ok(FloorStep {
+        step: name.to_string(),
+        median_us: t[t.len() / 2],
+        min_us: t[0],
+    })
+}
+
+/// Measures every step at a `width`² viewport, `reps` times each.
+pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
+    anyhow::ensure!(reps >= 1, "the floor needs at least one repetition");
+    let empty = || {
+        gpu.device
+            .create_command_encoder(&Default::default())
+            .finish()
+    };
+    let mut steps = vec![];
+    steps.push(step("submit", reps, || {
+        gpu.queue.submit([empty()]);
+        Ok(())
+    })?);
+    gpu.wait()?;
+    steps.push(step("submit + wait", reps, || {
+        gpu.queue.submit([empty()]);
+        gpu.wait()
+    })?);
+    let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("floor target"),
+        size: wgpu::Extent3d {
+            width,
+            height: width,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba32Float,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let view = target.create_view(&Default::default());
+    steps.push(step("clear + wait", reps, || {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        drop(render_core::bind::color_pass(
+            &mut enc, "floor", &view, true, true, None,
+        ));
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait()
+    })?);
+    let counters = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("floor counters"),
+        size: 32,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    steps.push(step("readback, new buffer", reps, || {
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("floor readback"),
+            size: 32,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&counters, 0, &staging, 0, 32);
+        gpu.queue.submit([enc.finish()]);
+        gpu.map_and_copy(&staging, 32, &mut Duration::default())
+            .map(|_| ())
+    })?);
+    steps.push(step("readback, reused buffer", reps, || {
+        gpu.read_buffer(&counters, 0, 32).map(|_| ())
+    })?);
+    if gpu.has_timestamps() {
+        let timer = FrameTimer::new(gpu);
+        steps.push(step("timestamps", reps, || {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            timer.begin(&mut enc);
+            timer.end(&mut enc);
+            gpu.queue.submit([enc.finish()]);
+            gpu.wait()?;
+            timer.gpu_ms(gpu).map(|_| ())
+        })?);
+    }
+    Ok(Floor {
+        adapter: gpu.adapter.name.clone(),
+        width,
+        reps,
+        steps,
+    })
+}
+
+impl Floor {
+    /// A Markdown table of the steps.
+    pub fn markdown(&self) -> String {
+        let mut s = format!(
+            "Per-frame floor on {} at {w}×{w}, {} repetitions a step \
+             (`tetbench calibrate --floor`; never subtracted from a row):\n\n\
+             | step | median (µs) | fastest (µs) |\n|---|---:|---:|\n",
+            self.adapter,
+            self.reps,
+            w = self.width
+        );
+        for st in &self.steps {
+            s.push_str(&format!(
+                "| {} | {:.1} | {:.1} |\n",
+                st.step, st.median_us, st.min_us
+            ));
+        }
+        s
+    }
+}
+
+/// `tetbench calibrate --floor`.
+pub fn run_command(width: u32, reps: usize, json: bool) -> anyhow::Result<()> {
+    let gpu = Gpu::new()?;
+    let floor = measure(&gpu, width, reps)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&floor)?);
+    } else {
+        print!("{}", floor.markdown());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every step is measured (timestamps where the adapter has them), in the table's order,
+    /// with positive, ordered times; the reused readback creates at most one buffer however
+    /// often it runs.
+    #[test]
+    fn the_floor_has_every_step() {
+        let gpu = Gpu::new().expect("an adapter (lavapipe)");
+        let before = gpu.staging_buffers_created();
+        let floor = measure(&gpu, 16, 5).unwrap();
+        let names: Vec<&str> = floor.steps.iter().map(|s| s.step.as_str()).collect();
+        let mut want = vec![
+            "submit",
+            "submit + wait",
+            "clear + wait",
+            "readback, new buffer",
+            "readback, reused buffer",
+        ];
+        if gpu.has_timestamps() {
+            want.push("timestamps");
+        }
+        assert_eq!(names, want);
+        for s in &floor.steps {
+            assert!(s.min_us > 0.0 && s.min_us <= s.median_us, "{s:?}");
+        }
+        assert!(gpu.staging_buffers_created() - before <= 1);
+        let table = floor.markdown();
+        assert_eq!(
+            table.lines().filter(|l| l.starts_with("| ")).count(),
+            want.len() + 1
+        );
+    }
+}

@@ -1,0 +1,185 @@
+//! The roofline is a lower bound: no row of the default suite beats it (docs/roofline.md, "A
+//! bound that is never beaten").
+//!
+//! The default suite (every algorithm's default variants on box:10k and shell:10k, 3
+//! viewpoints, 128², 3 rounds) runs as two runs, one a data set, with the backend calibrated
+//! three times: before the first (the run's own calibration), between them and after the
+//! second. Each figure is the fastest of the three ([`Calibration::peak_with`]). Then no row's
+//! fastest timed frame may be faster than its roofline.
+//!
+//! What this can honestly assert on a busy machine: other work only ever slows a repetition
+//! down, of the calibration and of the frames alike. A frame slowed down hides a defect, so a
+//! pass on a busy machine is weak evidence; `tetbench run` lists every beaten bound on any
+//! machine, and an idle run of `scripts/bench.sh` is where a pass counts. A failure needs a
+//! frame faster than the best of fifteen calibration repetitions taken at three moments
+//! minutes apart: either the bound is wrong (a figure that is not the backend's peak for the
+//! work the rows do, or a counter of work not done), or every one of those repetitions was
+//! disturbed while that frame was not. The second happened on the development VM with four
+//! engineers' builds on its 2 cores (load average 8–10): the splat fill's best repetition came
+//! out 15 times slower than idle, and three splat rows that ran in a quieter minute beat it. So
+//! the verdict is only given where the machine was not oversubscribed: the 1-minute load
+//! average, at each calibration, at most [`MAX_LOAD_PER_CORE`] a core (this test's own two
+//! lavapipe threads included). On a machine busier than that the test prints the beaten
+//! bounds and the load, and passes without a verdict, saying so. No timing gates a
+//! performance target here: the frames may be as slow as they like.
+//!
+//! The check itself can fail: the same rows against a calibration slowed down until the row
+//! closest to its bound reads 1.5 are listed as beating it.
+
+use clap::Parser;
+use harness::cli::{Cli, Command};
+use harness::results::machine::{Calibration, MachineInfo};
+use harness::results::{ResultsFile, Row};
+
+fn config(args: &[String]) -> harness::run::RunConfig {
+    let cli = Cli::try_parse_from(args).unwrap();
+    let Command::Run(run) = cli.command else {
+        panic!("not a run")
+    };
+    run.to_config(cli.data_dir, args.to_vec()).unwrap()
+}
+
+/// Every figure `factor` times slower (every cost `factor` times larger).
+fn slowed(c: &Calibration, factor: f64) -> Calibration {
+    Calibration {
+        triangles_per_sec: c.triangles_per_sec / factor,
+        fill_fragments_per_sec: c.fill_fragments_per_sec / factor,
+        compute_gflops: c.compute_gflops / factor,
+        copy_bytes_per_sec: c.copy_bytes_per_sec / factor,
+        sort_keys_per_sec: c.sort_keys_per_sec / factor,
+        ray_steps_per_sec: c.ray_steps_per_sec / factor,
+        splat_fragments_per_sec: c.splat_fragments_per_sec / factor,
+        gpu_sort_keys_per_sec: c.gpu_sort_keys_per_sec / factor,
+        tet_classifications_per_sec: c.tet_classifications_per_sec / factor,
+        raster_seconds_per_triangle: c.raster_seconds_per_triangle * factor,
+        raster_seconds_per_fragment: c.raster_seconds_per_fragment * factor,
+        ..c.clone()
+    }
+}
+
+fn fastest_fraction(r: &Row) -> f64 {
+    r.roofline_ms.unwrap_or(0.0) / r.total_ms_min.unwrap_or(f64::INFINITY)
+}
+
+/// The busiest the machine may be, per core (1-minute load average), for the test to judge.
+const MAX_LOAD_PER_CORE: f64 = 1.5;
+
+/// `tetbench run` of the default suite's settings on one data set into `out`.
+fn run_one(dataset: &str, out: &std::path::Path, cache: &std::path::Path) -> Vec<Row> {
+    let suite = &harness::run::suite::DEFAULT_SUITE;
+    let args: Vec<String> = [
+        "tetbench",
+        "run",
+        "--datasets",
+        dataset,
+        "--viewpoints",
+        suite.viewpoints,
+        "--resolution",
+        &suite.resolution.to_string(),
+        "--frames",
+        &suite.frames.to_string(),
+        "--warmup",
+        &suite.warmup.to_string(),
+        "--rounds",
+        &suite.rounds.to_string(),
+        "--no-report",
+        "--no-reference",
+        "--out",
+        out.to_str().unwrap(),
+        "--cache-dir",
+        cache.to_str().unwrap(),
+    ]
+    .map(String::from)
+    .to_vec();
+    let cfg = config(&args);
+    let filter = cfg.settings_filter.clone();
+    let outcome = harness::run::run(&cfg, &|name: &str| {
+        harness::algorithms::selected_variants(name, &filter)
+    })
+    .unwrap();
+    assert!(outcome.all_ok(), "{outcome:?}");
+    ResultsFile::read(out).unwrap().rows
+}
+
+#[test]
+fn no_row_of_the_default_suite_beats_its_roofline() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("cache");
+    let gpu = render_core::Gpu::new().unwrap();
+    let machine = MachineInfo::collect();
+    let cores = machine.cpu_cores.max(1) as f64;
+    let mut loads = vec![];
+    let mut calibrations = vec![];
+    let mut rows = vec![];
+    for (i, dataset) in harness::run::suite::DEFAULT_SUITE
+        .datasets
+        .iter()
+        .enumerate()
+    {
+        let out = dir.path().join(format!("out{i}"));
+        rows.extend(run_one(dataset, &out, &cache));
+        if i == 0 {
+            // The first run calibrated the backend before it (an empty cache).
+            let file = ResultsFile::read(&out).unwrap();
+            calibrations.push(file.machine.calibration.expect("the run calibrated"));
+            loads.push(file.machine.load_average_start);
+        }
+        loads.push(harness::results::machine::load_average());
+        calibrations.push(harness::calibrate::measure(&gpu, &machine).unwrap());
+    }
+    let peak = calibrations
+        .iter()
+        .skip(1)
+        .fold(calibrations[0].clone(), |p, c| p.peak_with(c));
+    assert_eq!(rows.len(), 96, "the default suite's rows");
+    harness::calibrate::annotate(&mut rows, &peak);
+    let priced = rows.iter().filter(|r| r.roofline_ms.is_some()).count();
+    assert_eq!(
+        priced,
+        rows.len(),
+        "every row of the default suite is priced"
+    );
+    let beaten = harness::run::beaten_bounds(&rows);
+    let busiest = loads
+        .iter()
+        .map(|l| l.unwrap_or(f64::INFINITY))
+        .fold(0.0, f64::max);
+    if busiest > MAX_LOAD_PER_CORE * cores {
+        eprintln!(
+            "roofline_bound: NOT JUDGED: the 1-minute load average reached {busiest:.1} on {cores} \
+             cores (over {MAX_LOAD_PER_CORE} a core), so a frame in a quiet minute can beat \
+             calibrations taken in busy ones; {} row(s) beat the bound here{}",
+            beaten.len(),
+            beaten
+                .iter()
+                .map(|b| format!("\n  {b}"))
+                .collect::<String>()
+        );
+    } else {
+        assert!(
+            beaten.is_empty(),
+            "{} row(s) beat the roofline (load averages {loads:?} on {cores} cores; \
+             calibrations {calibrations:?}):\n  {}",
+            beaten.len(),
+            beaten.join("\n  ")
+        );
+    }
+
+    // The check can fail: slowed until the closest row reads 1.5, that row is listed.
+    let closest = rows
+        .iter()
+        .max_by(|a, b| fastest_fraction(a).total_cmp(&fastest_fraction(b)))
+        .unwrap()
+        .clone();
+    let factor = 1.5 / fastest_fraction(&closest);
+    harness::calibrate::annotate(&mut rows, &slowed(&peak, factor));
+    let beaten = harness::run::beaten_bounds(&rows);
+    let name = format!(
+        "{} {} on {} {}:",
+        closest.algorithm, closest.settings, closest.dataset, closest.viewpoint
+    );
+    assert!(
+        beaten.iter().any(|b| b.starts_with(&name)),
+        "{name} not listed among {beaten:?}"
+    );
+}
