@@ -18,6 +18,7 @@ use std::time::Instant;
 use anyhow::Context as _;
 
 use super::claims::{self, ClaimResult};
+pub use super::session::SourceState;
 use super::session::{
     not_built_reason, Measured, Report, Session, FULL_FRAMES, FULL_WARMUP, QUICK_FRAMES,
     QUICK_RESOLUTION_DIVISOR, QUICK_VIEWPOINTS, QUICK_WARMUP,
@@ -115,10 +116,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
         let exact: Vec<String> = report
             .comparisons
             .iter()
-            .filter_map(|c| {
-                c.verdict()
-                    .map(|v| format!("{}: {}", c.key, if v { "match" } else { "differ" }))
-            })
+            .filter_map(|c| c.summary())
             .collect();
         let summary = PaperSummary {
             paper: p.id.to_string(),
@@ -131,6 +129,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
                 exact.join(", ")
             },
             claims: tally_text(&report.claims),
+            not_measured: tally_apart_text(&report.claims),
         };
         write_file(
             &dir.join(SUMMARY_FILE),
@@ -174,14 +173,18 @@ pub struct PaperSummary {
     /// The commit sentence of [`SourceState::describe`].
     pub source: String,
     pub exact_tables: String,
+    /// The measured claims' verdicts (the headline).
     pub claims: String,
+    /// The claims by construction and the derived ones, with their own words.
+    #[serde(default)]
+    pub not_measured: String,
 }
 
 pub const SUMMARY_FILE: &str = "summary.json";
 
 /// The index of every paper reproduced under `out`, from their summaries.
 pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
-    let mut md = String::from("# Papers reproduced\n\nWritten by `tetbench reproduce` from each paper's `summary.json`; nothing here is edited by hand.\n\n| paper | mode | seconds | commit | exact tables | claims (verdicts per data set) | report |\n|---|---|---:|---|---|---|---|\n");
+    let mut md = String::from("# Papers reproduced\n\nWritten by `tetbench reproduce` from each paper's `summary.json`; nothing here is edited by hand.\n\n| paper | mode | seconds | commit | exact tables (columns compared) | measured claims (verdicts per data set) | by construction, derived | report |\n|---|---|---:|---|---|---|---|---|\n");
     let mut total = 0.0;
     let mut sources = vec![];
     for p in PAPERS.iter().map(|p| p.paper()) {
@@ -199,7 +202,7 @@ pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
         }
         let _ = writeln!(
             md,
-            "| {} | {} | {:.0} | {} | {} | {} | [{0}/report.md]({0}/report.md) |",
+            "| {} | {} | {:.0} | {} | {} | {} | {} | [{0}/report.md]({0}/report.md) |",
             s.paper,
             s.mode,
             s.seconds,
@@ -208,7 +211,12 @@ pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
                 .position(|x| *x == s.source)
                 .map_or(0, |i| i + 1),
             s.exact_tables,
-            s.claims
+            s.claims,
+            if s.not_measured.is_empty() {
+                "–"
+            } else {
+                &s.not_measured
+            }
         );
     }
     let _ = writeln!(md, "\nTotal: {total:.0} s.\n");
@@ -250,7 +258,7 @@ fn our_conditions(machine: Option<&MachineInfo>) -> String {
     )
 }
 
-/// Counts of each verdict, as one line.
+/// Counts of each verdict of the measured claims, as one line (the headline).
 pub fn tally_text(results: &[ClaimResult]) -> String {
     let parts: Vec<String> = claims::tally(results)
         .into_iter()
@@ -264,47 +272,19 @@ pub fn tally_text(results: &[ClaimResult]) -> String {
     }
 }
 
-/// The commit `reproduce` runs from and whether the tree has uncommitted changes (read the
-/// way the run's machine record reads it, [`MachineInfo::collect`]).
-#[derive(Debug, Clone, Default)]
-pub struct SourceState {
-    pub commit: Option<String>,
-    pub dirty: Option<bool>,
-    /// `--allow-dirty` was given.
-    pub allowed_dirty: bool,
-}
-
-impl SourceState {
-    pub fn read() -> SourceState {
-        let m = MachineInfo::collect();
-        SourceState {
-            commit: m.git_commit,
-            dirty: m.git_dirty,
-            allowed_dirty: false,
-        }
-    }
-
-    /// Refuses a tree with uncommitted changes unless allowed.
-    pub fn check(&mut self, allow_dirty: bool) -> anyhow::Result<()> {
-        if self.dirty == Some(true) && !allow_dirty {
-            anyhow::bail!(
-                "the working tree has uncommitted changes: commit them so the reports name one commit, or pass --allow-dirty (the reports will say so)"
-            );
-        }
-        self.allowed_dirty = allow_dirty && self.dirty == Some(true);
-        Ok(())
-    }
-
-    /// One sentence for the reports.
-    pub fn describe(&self) -> String {
-        let commit = self.commit.as_deref().unwrap_or("unknown (no git)");
-        match self.dirty {
-            Some(true) => format!(
-                "Built from commit `{commit}` **with uncommitted changes** (`--allow-dirty`): these figures are not reproducible from the commit alone."
-            ),
-            Some(false) => format!("Built from commit `{commit}`, clean tree."),
-            None => format!("Commit `{commit}`; whether the tree was clean is unknown."),
-        }
+/// Counts of the claims that are not measured, by kind, as one line (`–` when none).
+pub fn tally_apart_text(results: &[ClaimResult]) -> String {
+    let parts: Vec<String> = claims::tally_apart(results)
+        .into_iter()
+        .map(|(kind, words)| {
+            let w: Vec<String> = words.iter().map(|(w, n)| format!("{n} {w}")).collect();
+            format!("{kind}: {}", w.join(", "))
+        })
+        .collect();
+    if parts.is_empty() {
+        "–".into()
+    } else {
+        parts.join("; ")
     }
 }
 
@@ -361,8 +341,9 @@ pub(crate) fn write_report(
     } else {
         let _ = writeln!(
             md,
-            "From `reports/papers/claims.csv`; one verdict per data set: {}. The rule (`harness/src/papers/verdict.rs`): a difference inside the samples' spread (frames' range) or the claim's tolerance is *within noise*, and one frame per side never orders two sides; a claim about GPU speed measured on a software rasteriser is *not testable on this adapter* (its numbers are still shown), and on a real GPU a band of absolute GPU rates (the paper's GPU's) is tested by its lower end only; *not checkable* says what is missing.\n",
-            tally_text(&report.claims)
+            "From `reports/papers/claims.csv`; one verdict per data set. Measured claims: {}. Not measured, and so never counted as holds: {} (*by construction*: an input chosen to equal the paper's, read *as constructed*; *derived*: arithmetic on other claims' numbers, read *follows*). Each claim's rule (expectation, tolerance, normalisation) is written in the file before the run; an earlier rule is shown beside the verdict with the verdict it gives. The rule (`harness/src/papers/verdict.rs`): a difference inside the samples' spread (frames' range) or the claim's tolerance is *within noise*, and one frame per side never orders two sides; a claim about GPU speed measured on a software rasteriser is *not testable on this adapter* (its numbers are still shown), *not checkable* says what is missing.\n",
+            tally_text(&report.claims),
+            tally_apart_text(&report.claims)
         );
         md.push_str(&claims::markdown(&report.claims));
         md.push('\n');
