@@ -131,6 +131,7 @@ pub fn run(cmd: PaperAnalysis) -> anyhow::Result<()> {
         cache_dir: None,
         substitutes: vec![],
         resolution: None,
+        rounds: None,
         machine: files.first().map(|f| f.machine.clone()),
         log: vec![format!(
             "analysed {} run(s) under {} ({} rows), measured by commit(s) {}",

@@ -52,6 +52,12 @@ pub struct Args {
     /// `tetbench run --external`).
     #[command(flatten)]
     pub external: crate::run::matrix::ExternalArgs,
+    /// Rounds per row: each variant's frames are taken this many times, seconds apart, so a
+    /// timing claim compares samples from separate moments (default: 5 in the full mode, the
+    /// rounds a GPU timing claim needs; 1 in the quick mode). `scripts/gpu.sh` runs the quick
+    /// mode with 5.
+    #[arg(long, value_name = "N")]
+    pub rounds: Option<u32>,
     /// Run although the working tree has uncommitted changes (the reports then say so; by
     /// default `reproduce` refuses, so every report names the one commit it came from).
     #[arg(long)]
@@ -83,6 +89,9 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             .ok_or_else(|| anyhow::anyhow!("--substitute {s:?}: expected NAME=SPEC"))?;
         substitutes.push((a.trim().to_string(), b.trim().to_string()));
     }
+    if args.rounds == Some(0) {
+        anyhow::bail!("--rounds 0: need at least one round");
+    }
     let mut source = SourceState::read();
     source.check(args.allow_dirty)?;
     let started = Instant::now();
@@ -103,6 +112,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             cache_dir: args.cache_dir.clone(),
             substitutes: substitutes.clone(),
             resolution: args.resolution,
+            rounds: args.rounds,
             machine: None,
             log: vec![],
             external: args.external.clone(),
@@ -304,11 +314,13 @@ pub(crate) fn write_report(
         )
     } else if session.quick {
         format!(
-            "**Quick mode**: viewpoint(s) {QUICK_VIEWPOINTS} instead of the paper's, the viewport side divided by {QUICK_RESOLUTION_DIVISOR} (e.g. 256² for the papers' 512²), {QUICK_FRAMES} timed frame after {QUICK_WARMUP} warm-up, no reference images (no PSNR); data sets at the papers' sizes; only the variants the paper's tables and claims compare where a plan adds others (each run's settings are under Runs). Figures are indicative only."
+            "**Quick mode**: viewpoint(s) {QUICK_VIEWPOINTS} instead of the paper's, the viewport side divided by {QUICK_RESOLUTION_DIVISOR} (e.g. 256² for the papers' 512²), {QUICK_FRAMES} timed frame after {QUICK_WARMUP} warm-up, no reference images (no PSNR); data sets at the papers' sizes; only the variants the paper's tables and claims compare where a plan adds others (each run's settings are under Runs); {} round(s) per row. Counts that do not depend on the GPU (HAVS Table 2, GATOR's classifier, the ray caster's passes, fragment PT's device bytes on Brain) are measured at the paper's size in this mode too. Figures of time are indicative only.",
+            session.rounds()
         )
     } else {
         format!(
-            "**Full mode**: the paper's viewpoints and viewport, {FULL_FRAMES} timed frames after {FULL_WARMUP} warm-up, reference images and PSNR."
+            "**Full mode**: the paper's viewpoints and viewport, {FULL_FRAMES} timed frames after {FULL_WARMUP} warm-up in each of {} rounds per row (seconds apart), reference images and PSNR.",
+            session.rounds()
         )
     };
     if session.from_run.is_some() {

@@ -85,6 +85,9 @@ pub const QUICK_WARMUP: u32 = 1;
 /// The full mode's frames and warm-up (tetbench's standard).
 pub const FULL_FRAMES: u32 = crate::run::suite::STANDARD_FRAMES;
 pub const FULL_WARMUP: u32 = crate::run::suite::STANDARD_WARMUP;
+/// The full mode's rounds per row: each row's frames are taken at five moments, seconds
+/// apart, so that a GPU timing claim reads holds, does not hold or a real within noise.
+pub const FULL_ROUNDS: u32 = 5;
 
 /// Measured rows of one paper plus what could not be measured.
 #[derive(Debug, Clone, Default)]
@@ -179,6 +182,8 @@ pub struct Session {
     pub cache_dir: Option<PathBuf>,
     pub substitutes: Vec<(String, String)>,
     pub resolution: Option<u32>,
+    /// `--rounds`: rounds per row (`None`: [`FULL_ROUNDS`] in the full mode, 1 in quick).
+    pub rounds: Option<u32>,
     /// The machine of the first run (adapter included), for the conditions.
     pub machine: Option<MachineInfo>,
     /// The equivalent `tetbench run` command of every run, and its outcome.
@@ -199,6 +204,12 @@ impl Session {
             .find(|(n, _)| n == name)
             .map(|(_, s)| s.clone())
             .unwrap_or_else(|| name.to_string())
+    }
+
+    /// Rounds per row in this mode.
+    pub fn rounds(&self) -> u32 {
+        self.rounds
+            .unwrap_or(if self.quick { 1 } else { FULL_ROUNDS })
     }
 
     /// The viewport of a plan entry: as [`Session::resolution`], never halved where the entry
@@ -263,6 +274,7 @@ impl Session {
                 FULL_WARMUP
             }),
             settings: spec.settings_for(self.quick).cloned(),
+            rounds: Some(self.rounds()),
             no_reference: self.quick,
             cache_dir: self.cache_dir.clone(),
             external: self.external.clone(),
@@ -283,7 +295,11 @@ impl Session {
             } else {
                 String::new()
             }
-        );
+        ) + &if self.rounds() > 1 {
+            format!(" --rounds {}", self.rounds())
+        } else {
+            String::new()
+        };
         let config = args.to_config(self.data_dir.clone(), vec![command.clone()])?;
         let filter = config.settings_filter.clone();
         let t0 = Instant::now();
