@@ -31,7 +31,7 @@ const TILINGS: [&str; 6] = ["1x1", "2x2", "3x3", "4x4", "5x5", "6x6"];
 const PAPER_BYTES_PER_TET: f64 = 144.0;
 
 /// The variant Table 4's passes are counted with in quick mode (see the plan).
-const PASSES_SETTINGS: &str = "tiles=1x1;table=2d;mode=passes;et=on;layers=32";
+const PASSES_SETTINGS: &str = "tiles=1x1;table=2d;mode=loop;et=on;layers=32";
 const PASSES_LAYERS: &str = "32";
 
 /// The tiled ray casting paper.
@@ -181,7 +181,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         .iter()
         .map(|(paper, d)| {
             let runs = passes_rows(d);
-            let (lo, hi) = min_max(runs.iter().filter_map(|r| r.counter("passes_max")));
+            let (lo, hi) = min_max(runs.iter().filter_map(|r| r.counter("steps_max")));
             if let Some(note) = passes_note(paper, &runs, t4.value(paper, "min_ray_casting_passes"))
             {
                 notes.push(note);
@@ -206,7 +206,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     report.comparisons.push(Comparison {
         key: "table4".into(),
         title: "Table 4 — number of ray-casting passes (2D table)".into(),
-        conditions: format!("A pass (the paper, §2.3 and §3.2): one GPU pass advances every active ray by one tet (one intersection); the count is checked every k passes with an occlusion query. Paper: min/max passes per data set over its camera positions at 512² (GPU and tiling not stated). Ours: the `passes_max` counter (the passes the busiest tile ran; with one tile, every ray's) of `{PASSES_SETTINGS}` at 512² over the 14 viewpoints in every mode, min and max over the viewpoints; our count is read every {} passes, so it is a multiple of {}. Ours continues a ray that leaves the mesh at its next peeled entry within the same passes; the paper peels a layer and then runs passes until that layer's rays have left, so its count adds up the layers' longest walks. A count, not a time: it does not depend on the GPU.", raycast::COUNT_EVERY, raycast::COUNT_EVERY),
+        conditions: format!("A pass (the paper, §2.3 and §3.2): one GPU pass advances every active ray by one tet (one intersection); the count is checked every k passes with an occlusion query. Paper: min/max passes per data set over its camera positions at 512² (GPU and tiling not stated). Ours: the passes one step per pass needs, i.e. the longest walk of any ray in tets (the `steps_max` counter; `mode=passes` runs exactly that many passes, rounded up to the {} after which it counts the active rays), of `{PASSES_SETTINGS}` at 512² over the 14 viewpoints in every mode, min and max over the viewpoints. Ours continues a ray that leaves the mesh at its next peeled entry within the same passes; the paper peels a layer and then runs passes until that layer's rays have left, so its count adds up the layers' longest walks. A count, not a time: it does not depend on the GPU.", raycast::COUNT_EVERY),
         metrics: vec![Metric::exact("min passes", 0), Metric::exact("max passes", 0)],
         rows,
         notes,
