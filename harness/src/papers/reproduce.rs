@@ -136,7 +136,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             exact_tables: if exact.is_empty() {
                 "–".into()
             } else {
-                exact.join(", ")
+                exact.join("; ")
             },
             claims: tally_text(&report.claims),
             not_measured: tally_apart_text(&report.claims),

@@ -203,7 +203,7 @@ impl Comparison {
     }
 
     /// The table's one-line verdict for the index, naming the columns it compared and those
-    /// it did not: `table1: tets match; fps, tets/s not compared` (`None`: no exact column).
+    /// it did not: `table1: tets match (fps, tets/s not compared)` (`None`: no exact column).
     pub fn summary(&self) -> Option<String> {
         let v = self.verdict()?;
         let mut s = format!(
@@ -214,7 +214,7 @@ impl Comparison {
         );
         let not = self.not_compared_columns();
         if !not.is_empty() {
-            s.push_str(&format!("; {} not compared", not.join(", ")));
+            s.push_str(&format!(" ({} not compared)", not.join(", ")));
         }
         Some(s)
     }

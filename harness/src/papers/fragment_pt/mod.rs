@@ -256,20 +256,33 @@ fn brain_bytes_note(m: &Measured) -> Option<String> {
         .find(|r| r.algorithm == "fragment-pt" && r.dataset == "brain" && r.ok())?;
     let total = r.gpu_bytes? as f64;
     let tets = r.tets as f64;
-    let per = |name: &str| r.counter(name).unwrap_or(0.0);
-    let (model, records, sort) = (
-        per("model_bytes_per_tet"),
-        per("records_bytes_per_tet"),
-        per("sort_bytes_per_tet"),
-    );
-    let rest = total / tets - model - records - sort;
     const MIB: f64 = 1048576.0;
-    Some(format!(
-        "Brain (claim F7, §5's 5.5 M tets on a 256 MB board), as allocated at {}²: {:.1} MiB in all for {} tets, {:.1} B/tet: the model {model:.1} B/tet (§4's 20), pass 1's per-tet records {records:.1} B/tet, the sort's depths and order {sort:.1} B/tet, tables, parameters and the target {rest:.1} B/tet. The paper keeps pass 1's output in two RGBA32F render targets, one texel per tet (§3.1): 32 B/tet beside the 20 of §4, which for this mesh alone is {:.1} MiB.",
+    let paper = format!(
+        "The paper keeps pass 1's output in two RGBA32F render targets, one texel per tet (§3.1): 32 B/tet beside the 20 of §4, which for this mesh alone is {:.1} MiB.",
+        52.0 * tets / MIB
+    );
+    let head = format!(
+        "Brain (claim F7, §5's 5.5 M tets on a 256 MB board), as allocated at {}²: {:.1} MiB in all for {} tets, {:.1} B/tet",
         r.width,
         total / MIB,
         r.tets,
-        total / tets,
-        52.0 * tets / MIB
-    ))
+        total / tets
+    );
+    let per = |name: &str| r.counter(name);
+    Some(match (
+        per("model_bytes_per_tet"),
+        per("records_bytes_per_tet"),
+        per("sort_bytes_per_tet"),
+    ) {
+        (Some(model), Some(records), Some(sort)) => format!(
+            "{head}: the model {model:.1} B/tet (§4's 20), pass 1's per-tet records {records:.1} B/tet, the sort's depths and order {sort:.1} B/tet, tables, parameters and the target {:.1} B/tet. {paper}",
+            total / tets - model - records - sort
+        ),
+        // Rows without the per-buffer counters: the split the row itself records.
+        _ => format!(
+            "{head}: {:.1} B/tet live as long as the mesh (the model and the tables), {:.1} B/tet are per-frame buffers (pass 1's per-tet records, the sort's buffers, the target). {paper}",
+            r.gpu_bytes_persistent.unwrap_or(0) as f64 / tets,
+            r.gpu_bytes_frame.unwrap_or(0) as f64 / tets
+        ),
+    })
 }
