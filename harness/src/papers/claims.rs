@@ -10,9 +10,11 @@
 //! what the paper states and `ours` for a reading of its numbers that its text does not make.
 //!
 //! Metrics read from a run's rows: `total_ms`, `gpu_ms`, `cpu_ms`, `fps`, `tets_per_sec`,
-//! `gpu_tets_per_sec`, `bytes_per_tet`, `psnr_db`, `counter:NAME`, `stage:NAME`,
-//! `stage_share:NAME` (the stage over the most expensive other stage) and `view_range:METRIC`
-//! (range over the viewpoints divided by their mean). Other metrics (the CPU analyses: sorts,
+//! `gpu_tets_per_sec`, `bytes_per_tet`, `gpu_bytes`, `psnr_db`, `counter:NAME`,
+//! `counter_per_tet:NAME`, `stage:NAME`,
+//! `stage_share:NAME` (the stage over the most expensive other stage), `view_range:METRIC`
+//! (range over the viewpoints divided by their mean) and `view_max:METRIC` / `view_min:METRIC`
+//! (the largest / smallest over the viewpoints). Other metrics (the CPU analyses: sorts,
 //! the k-buffer, the classifier, data set sizes) come from the paper's own measurements.
 
 use anyhow::{bail, Context as _};
@@ -24,6 +26,195 @@ use crate::results::Row;
 /// The claims file, compiled in like the tables.
 pub const CLAIMS_CSV: &str = include_str!("../../../reports/papers/claims.csv");
 const FILE: &str = "reports/papers/claims.csv";
+
+/// The rule history (`reports/papers/rule_history.csv`), compiled in like the claims.
+pub const RULE_HISTORY_CSV: &str = include_str!("../../../reports/papers/rule_history.csv");
+const HISTORY_FILE: &str = "reports/papers/rule_history.csv";
+
+/// What a claim's evidence is: only a measurement can make a claim hold.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Evidence {
+    /// An outcome the code produces and could get wrong.
+    Measured,
+    /// An input chosen to equal the paper's (a stand-in's counts, a fixed layout constant):
+    /// checked, but it cannot fail unless the construction is broken.
+    ByConstruction,
+    /// Arithmetic on other claims' numbers (their ids).
+    Derived(Vec<String>),
+}
+
+impl Evidence {
+    pub fn parse(text: &str) -> Result<Evidence, String> {
+        match text.trim() {
+            "measured" => Ok(Evidence::Measured),
+            "construction" => Ok(Evidence::ByConstruction),
+            t => match t.strip_prefix("derived:") {
+                Some(ids) if !ids.trim().is_empty() => Ok(Evidence::Derived(
+                    ids.split('+').map(|s| s.trim().to_string()).collect(),
+                )),
+                _ => Err(format!(
+                    "evidence {t:?} is not measured, construction or derived:ID[+ID…]"
+                )),
+            },
+        }
+    }
+
+    /// The word of the kind, as reports list it.
+    pub fn label(&self) -> String {
+        match self {
+            Evidence::Measured => "measured".into(),
+            Evidence::ByConstruction => "by construction".into(),
+            Evidence::Derived(ids) => format!("derived from {}", ids.join(", ")),
+        }
+    }
+
+    /// The word a verdict takes for this kind: a measured claim *holds*; one by construction
+    /// is *as constructed*; a derived one *follows*. Verdicts that decide nothing (noise, not
+    /// testable, not checkable) keep their word.
+    pub fn word(&self, v: verdict::Verdict) -> &'static str {
+        use verdict::Verdict::*;
+        match (self, v) {
+            (Evidence::Measured, v) => v.label(),
+            (Evidence::ByConstruction, Holds) => "as constructed",
+            (Evidence::ByConstruction, DoesNotHold) => "not as constructed",
+            (Evidence::Derived(_), Holds) => "follows",
+            (Evidence::Derived(_), DoesNotHold) => "does not follow",
+            (_, v) => v.label(),
+        }
+    }
+}
+
+/// How a rate measured on the paper's GPU is compared across hardware (see
+/// docs/reproduction.md, "Across hardware").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Normalise {
+    /// Compared as measured.
+    None,
+    /// A rate of the paper's GPU judged relative to the fill rate: the paper's figure is
+    /// scaled by our calibrated fill rate over its GPU's published one
+    /// (`reports/papers/hardware.csv`). A GPU claim so normalised is judged on any adapter,
+    /// a software rasteriser included: its calibration measures the same cores it renders on.
+    Fill,
+}
+
+impl Normalise {
+    pub fn parse(text: &str) -> Result<Normalise, String> {
+        match text.trim() {
+            "none" | "" => Ok(Normalise::None),
+            "fill" => Ok(Normalise::Fill),
+            t => Err(format!("normalise {t:?} is not none or fill")),
+        }
+    }
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Normalise::None => "none",
+            Normalise::Fill => "fill rate",
+        }
+    }
+}
+
+/// A claim's rule: what it expects, its tolerance and its normalisation, as written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rule {
+    pub expect: ExpectSpec,
+    pub expect_text: String,
+    pub tolerance: f64,
+    pub normalise: Normalise,
+}
+
+impl Rule {
+    pub fn describe(&self) -> String {
+        let mut s = format!("`{}`", self.expect_text);
+        if self.tolerance > 0.0 {
+            s.push_str(&format!(", tolerance {}", self.tolerance));
+        }
+        if self.normalise != Normalise::None {
+            s.push_str(&format!(", normalised by {}", self.normalise.label()));
+        }
+        s
+    }
+}
+
+/// An earlier rule of a claim, replaced on `date` at `commit` for `reason`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RuleChange {
+    pub paper: String,
+    pub id: String,
+    pub date: String,
+    pub commit: String,
+    pub reason: String,
+    pub old: Rule,
+}
+
+/// Parses a rule history; errors name the file, the line and what is wrong.
+pub fn parse_history(text: &str, file: &str) -> anyhow::Result<Vec<RuleChange>> {
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = reader
+        .headers()
+        .with_context(|| format!("{file}: header"))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let expected = [
+        "paper",
+        "id",
+        "date",
+        "commit",
+        "reason",
+        "old_expect",
+        "old_tolerance",
+        "old_normalise",
+    ];
+    if header != expected {
+        bail!(
+            "{file}: header is {header:?}, expected {}",
+            expected.join(",")
+        );
+    }
+    let mut out = vec![];
+    for (i, rec) in reader.records().enumerate() {
+        let line = i + 2;
+        let rec = rec.with_context(|| format!("{file}: line {line}"))?;
+        let f = |j: usize| rec.get(j).unwrap_or("").trim().to_string();
+        let err = |what: String| anyhow::anyhow!("{file}: line {line}: {what}");
+        for (name, j) in [
+            ("paper", 0),
+            ("id", 1),
+            ("date", 2),
+            ("commit", 3),
+            ("reason", 4),
+        ] {
+            if f(j).is_empty() {
+                return Err(err(format!("{name} is empty")));
+            }
+        }
+        let tolerance: f64 = f(6)
+            .parse()
+            .map_err(|_| err(format!("old_tolerance {:?} is not a number", f(6))))?;
+        out.push(RuleChange {
+            paper: f(0),
+            id: f(1),
+            date: f(2),
+            commit: f(3),
+            reason: f(4),
+            old: Rule {
+                expect: ExpectSpec::parse(&f(5)).map_err(err)?,
+                expect_text: f(5),
+                tolerance,
+                normalise: Normalise::parse(&f(7)).map_err(err)?,
+            },
+        });
+    }
+    Ok(out)
+}
+
+/// Every rule change of the compiled-in history.
+pub fn history() -> anyhow::Result<Vec<RuleChange>> {
+    parse_history(RULE_HISTORY_CSV, HISTORY_FILE)
+}
 
 /// Whether the paper states the claim or we read it off its numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -177,6 +368,34 @@ pub struct Claim {
     pub hardware: Hardware,
     /// The expectation as written in the file.
     pub expect_text: String,
+    pub evidence: Evidence,
+    pub normalise: Normalise,
+    /// Earlier rules of this claim, oldest first (`reports/papers/rule_history.csv`).
+    pub history: Vec<RuleChange>,
+}
+
+impl Claim {
+    /// The claim's rule as it stands.
+    pub fn rule(&self) -> Rule {
+        Rule {
+            expect: self.expect.clone(),
+            expect_text: self.expect_text.clone(),
+            tolerance: self.tolerance,
+            normalise: self.normalise,
+        }
+    }
+
+    /// The claim under another rule (an earlier one of its history).
+    pub fn with_rule(&self, rule: &Rule) -> Claim {
+        Claim {
+            expect: rule.expect.clone(),
+            expect_text: rule.expect_text.clone(),
+            tolerance: rule.tolerance,
+            normalise: rule.normalise,
+            history: vec![],
+            ..self.clone()
+        }
+    }
 }
 
 /// Parses a claims file; errors name the file, the line and what is wrong.
@@ -203,6 +422,8 @@ pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
         "expect",
         "tolerance",
         "hardware",
+        "evidence",
+        "normalise",
     ];
     if header != expected {
         bail!(
@@ -239,6 +460,8 @@ pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
             s => Some(VariantSpec::parse(&s).map_err(err)?),
         };
         let expect = ExpectSpec::parse(&f(9)).map_err(err)?;
+        let evidence = Evidence::parse(&f(12)).map_err(err)?;
+        let normalise = Normalise::parse(&f(13)).map_err(err)?;
         let needs_b = expect.needs_b() || f(9).replace(' ', "").starts_with("a/b");
         if needs_b != b.is_some() {
             return Err(err(format!(
@@ -277,6 +500,9 @@ pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
             tolerance,
             hardware,
             expect_text: f(9),
+            evidence,
+            normalise,
+            history: vec![],
         };
         if claims
             .iter()
@@ -289,9 +515,44 @@ pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
     Ok(claims)
 }
 
-/// Every claim of the compiled-in file.
+/// Every claim of the compiled-in file, each with its rule history.
 pub fn all() -> anyhow::Result<Vec<Claim>> {
-    parse(CLAIMS_CSV, FILE)
+    let mut claims = parse(CLAIMS_CSV, FILE)?;
+    attach_history(&mut claims, history()?, HISTORY_FILE)?;
+    Ok(claims)
+}
+
+/// Gives each claim its earlier rules; a change naming no claim is an error, and a derived
+/// claim must name claims that exist.
+pub fn attach_history(
+    claims: &mut [Claim],
+    history: Vec<RuleChange>,
+    file: &str,
+) -> anyhow::Result<()> {
+    for h in history {
+        let Some(c) = claims
+            .iter_mut()
+            .find(|c| c.paper == h.paper && c.id == h.id)
+        else {
+            bail!("{file}: {} {} is not a claim of {FILE}", h.paper, h.id);
+        };
+        c.history.push(h);
+    }
+    for c in claims.iter() {
+        if let Evidence::Derived(ids) = &c.evidence {
+            for id in ids {
+                if !claims.iter().any(|o| o.paper == c.paper && &o.id == id) {
+                    bail!(
+                        "{FILE}: {} {} is derived from {id}, which is not a claim of {}",
+                        c.paper,
+                        c.id,
+                        c.paper
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The claims of one paper, in the file's order.
@@ -309,6 +570,15 @@ pub struct ClaimResult {
     pub claim: Claim,
     pub dataset: Option<String>,
     pub evaluation: Evaluation,
+    /// The same numbers under each earlier rule of the claim's history.
+    pub earlier: Vec<(RuleChange, Evaluation)>,
+}
+
+impl ClaimResult {
+    /// The verdict in the word of the claim's evidence kind.
+    pub fn word(&self) -> &'static str {
+        self.claim.evidence.word(self.evaluation.verdict)
+    }
 }
 
 /// Where the numbers come from: the run's rows, the paper's own analyses, and why an
@@ -326,6 +596,8 @@ pub struct Inputs<'a> {
     pub why_missing: &'a dyn Fn(&str, &str) -> String,
     /// Whether the GPU numbers came from a software rasteriser.
     pub software_adapter: bool,
+    /// Our adapter's calibrated peaks (`None`: the runs were not calibrated).
+    pub our_peaks: Option<super::hardware::OurPeaks>,
 }
 
 /// Whether rows were measured on a software rasteriser (lavapipe, WARP, SwiftShader report a
@@ -354,10 +626,21 @@ pub fn evaluate(claim: &Claim, inputs: &Inputs) -> Vec<ClaimResult> {
         .into_iter()
         .map(|d| {
             let evaluation = evaluate_one(claim, d.as_deref(), inputs);
+            let earlier = claim
+                .history
+                .iter()
+                .map(|h| {
+                    (
+                        h.clone(),
+                        evaluate_one(&claim.with_rule(&h.old), d.as_deref(), inputs),
+                    )
+                })
+                .collect();
             ClaimResult {
                 claim: claim.clone(),
                 dataset: d,
                 evaluation,
+                earlier,
             }
         })
         .collect()
@@ -387,6 +670,10 @@ fn evaluate_one(claim: &Claim, dataset: Option<&str>, inputs: &Inputs) -> Evalua
             }
         }
     };
+    let (expect, normalised) = match normalise(claim, expect, inputs) {
+        Ok(x) => x,
+        Err(why) => return Evaluation::not_checkable(why),
+    };
     let check = Check {
         expect,
         tolerance: claim.tolerance,
@@ -394,12 +681,68 @@ fn evaluate_one(claim: &Claim, dataset: Option<&str>, inputs: &Inputs) -> Evalua
     };
     let a = side(claim, &claim.a, dataset, inputs);
     let b = claim.b.as_ref().map(|b| side(claim, b, dataset, inputs));
-    verdict::evaluate(
+    let mut e = verdict::evaluate(
         &check,
         a.as_ref().map_err(Clone::clone),
         b.as_ref().map(|r| r.as_ref().map_err(Clone::clone)),
-        inputs.software_adapter,
-    )
+        // A normalised rate is judged against the adapter's own calibrated peak.
+        inputs.software_adapter && claim.normalise == Normalise::None,
+    );
+    if let Some(n) = normalised {
+        if e.verdict != verdict::Verdict::NotCheckable {
+            e.numbers.push_str("; ");
+            e.numbers.push_str(&n);
+        }
+    }
+    e
+}
+
+/// The expectation scaled to our adapter by the claim's normalisation, and the sentence that
+/// says how (`None`: not normalised).
+fn normalise(
+    claim: &Claim,
+    expect: Expect,
+    inputs: &Inputs,
+) -> Result<(Expect, Option<String>), String> {
+    match claim.normalise {
+        Normalise::None => Ok((expect, None)),
+        Normalise::Fill => {
+            let paper = super::hardware::paper_gpu(&claim.paper)
+                .and_then(|g| Some((g.fill_pixels_per_sec?, g)))
+                .ok_or_else(|| {
+                    format!(
+                        "{} {}: normalised by the fill rate, but reports/papers/hardware.csv gives no fill rate for the {} paper's GPU",
+                        claim.paper, claim.id, claim.paper
+                    )
+                })?;
+            let ours = inputs.our_peaks.as_ref().ok_or_else(|| {
+                format!(
+                    "{} {}: normalised by the fill rate, but the runs carry no calibration (run without --no-calibrate)",
+                    claim.paper, claim.id
+                )
+            })?;
+            let f = ours.fill_fragments_per_sec / paper.0;
+            let scaled = match expect {
+                Expect::Above(t) => Expect::Above(t * f),
+                Expect::Below(t) => Expect::Below(t * f),
+                Expect::Equals(t) => Expect::Equals(t * f),
+                Expect::Band(lo, hi) if claim.b.is_none() => Expect::Band(lo * f, hi * f),
+                _ => {
+                    return Err(format!(
+                        "{} {}: a comparison of two sides measured here needs no normalisation",
+                        claim.paper, claim.id
+                    ))
+                }
+            };
+            Ok((
+                scaled,
+                Some(format!(
+                    "normalised by the fill rate: the paper's figure ({}) × our calibrated {:.3e} blended fragments/s ({}) / the {}'s published {:.3e} pixels/s = ×{:.3}",
+                    claim.expect_text, ours.fill_fragments_per_sec, ours.adapter, paper.1.gpu, paper.0, f
+                )),
+            ))
+        }
+    }
 }
 
 /// The samples of one side on one data set.
@@ -458,6 +801,30 @@ pub fn side_from_rows(
         ));
     }
     let label = format!("{} {} on {dataset}", spec.algorithm, variants[0]);
+    for (prefix, largest) in [("view_max:", true), ("view_min:", false)] {
+        let Some(inner) = metric.strip_prefix(prefix) else {
+            continue;
+        };
+        let values: Vec<(String, f64)> = rows
+            .iter()
+            .filter_map(|r| Some((r.viewpoint.clone(), row_sample(inner, r).ok()?.value)))
+            .collect();
+        let pick = values
+            .iter()
+            .cloned()
+            .reduce(|a, b| if (b.1 > a.1) == largest { b } else { a });
+        let Some((view, v)) = pick else {
+            return Err(format!("{label}: no {inner} in its rows"));
+        };
+        return Ok(Side::new(
+            format!(
+                "{label}, {inner} {} over {} viewpoint(s) (at {view})",
+                if largest { "largest" } else { "smallest" },
+                values.len()
+            ),
+            vec![Sample::exact(view, v)],
+        ));
+    }
     if let Some(inner) = metric.strip_prefix("view_range:") {
         let values: Vec<f64> = rows
             .iter()
@@ -543,10 +910,18 @@ pub fn row_sample(metric: &str, r: &Row) -> Result<Sample, String> {
             timed(r.gpu_ms, r.gpu_ms_min, r.gpu_ms_max)?,
         )),
         "bytes_per_tet" => exact(r.bytes_per_tet),
+        // Every device byte the row's renderer allocated (persistent and per frame).
+        "gpu_bytes" => exact(r.gpu_bytes.map(|b| b as f64)),
         "psnr_db" => exact(r.psnr_db),
         _ => {
             if let Some(name) = metric.strip_prefix("counter:") {
                 return exact(r.counter(name));
+            }
+            if let Some(name) = metric.strip_prefix("counter_per_tet:") {
+                if r.tets == 0 {
+                    return Err(format!("{metric}: the row has no tets"));
+                }
+                return exact(r.counter(name).map(|v| v / r.tets as f64));
             }
             if let Some(name) = metric.strip_prefix("stage:") {
                 return timed(r.stage_ms(name), None, None).map_err(|_| no_stage(name, r));
@@ -581,7 +956,8 @@ fn no_stage(name: &str, r: &Row) -> String {
     )
 }
 
-/// Counts of each verdict, in [`verdict::Verdict::ALL`]'s order.
+/// Counts of each verdict of the measured claims, in [`verdict::Verdict::ALL`]'s order:
+/// the headline. Claims by construction and derived ones are counted apart ([`tally_apart`]).
 pub fn tally(results: &[ClaimResult]) -> Vec<(verdict::Verdict, usize)> {
     verdict::Verdict::ALL
         .iter()
@@ -590,18 +966,47 @@ pub fn tally(results: &[ClaimResult]) -> Vec<(verdict::Verdict, usize)> {
                 *v,
                 results
                     .iter()
-                    .filter(|r| r.evaluation.verdict == *v)
+                    .filter(|r| {
+                        r.claim.evidence == Evidence::Measured && r.evaluation.verdict == *v
+                    })
                     .count(),
             )
         })
         .collect()
 }
 
-/// The verdicts as a Markdown table: claim, where, verdict, the numbers and variants used.
+/// Counts of the claims that are not measured, by kind and word: (`by construction`,
+/// [(`as constructed`, 6)]), (`derived`, [(`follows`, 5)]).
+pub fn tally_apart(results: &[ClaimResult]) -> Vec<(&'static str, Vec<(&'static str, usize)>)> {
+    let mut out = vec![];
+    for (kind, is) in [
+        (
+            "by construction",
+            (|e: &Evidence| *e == Evidence::ByConstruction) as fn(&Evidence) -> bool,
+        ),
+        ("derived", |e: &Evidence| matches!(e, Evidence::Derived(_))),
+    ] {
+        let mut words: Vec<(&'static str, usize)> = vec![];
+        for r in results.iter().filter(|r| is(&r.claim.evidence)) {
+            let w = r.word();
+            match words.iter_mut().find(|(x, _)| *x == w) {
+                Some((_, n)) => *n += 1,
+                None => words.push((w, 1)),
+            }
+        }
+        if !words.is_empty() {
+            out.push((kind, words));
+        }
+    }
+    out
+}
+
+/// The verdicts as a Markdown table: claim, where, evidence, rule, verdict (in the word of its
+/// evidence kind), the numbers and variants used, and each earlier rule with its verdict.
 pub fn markdown(results: &[ClaimResult]) -> String {
     use std::fmt::Write as _;
     let mut md = String::from(
-        "| claim | cites | data set | verdict | numbers (variants named) |\n|---|---|---|---|---|\n",
+        "| claim | cites | evidence | rule | data set | verdict | numbers (variants named) |\n|---|---|---|---|---|---|---|\n",
     );
     for r in results {
         let c = &r.claim;
@@ -609,15 +1014,58 @@ pub fn markdown(results: &[ClaimResult]) -> String {
             Source::Paper => format!("**{}** {}", c.id, c.text),
             Source::Ours => format!("**{}** (ours, not the paper's) {}", c.id, c.text),
         };
+        let mut rule = c.rule().describe();
+        let mut verdict = r.word().to_string();
+        for (h, e) in &r.earlier {
+            let _ = write!(
+                rule,
+                "; until {} ({}): {}",
+                h.date,
+                h.commit,
+                h.old.describe()
+            );
+            let _ = write!(
+                verdict,
+                "; by the rule before {}: {}",
+                h.commit,
+                c.evidence.word(e.verdict)
+            );
+        }
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} |",
             cell(&label),
             cell(&c.cites),
+            cell(&c.evidence.label()),
+            cell(&rule),
             r.dataset.as_deref().unwrap_or("–"),
-            r.evaluation.verdict.label(),
+            cell(&verdict),
             cell(&r.evaluation.numbers)
         );
+    }
+    let changes: Vec<&RuleChange> = {
+        let mut v: Vec<&RuleChange> = vec![];
+        for (h, _) in results.iter().flat_map(|r| &r.earlier) {
+            if !v.contains(&h) {
+                v.push(h);
+            }
+        }
+        v
+    };
+    if !changes.is_empty() {
+        md.push_str("\nRule history (`reports/papers/rule_history.csv`):\n\n");
+        for h in changes {
+            let _ = writeln!(
+                md,
+                "- {} {}: until {} (commit {}) the rule was {}. Why it changed: {}",
+                h.paper,
+                h.id,
+                h.date,
+                h.commit,
+                h.old.describe(),
+                h.reason
+            );
+        }
     }
     md
 }
@@ -658,22 +1106,48 @@ mod tests {
 
     #[test]
     fn a_bad_claims_file_is_refused_with_file_and_line() {
-        let head = "paper,id,source,cites,claim,metric,datasets,a,b,expect,tolerance,hardware\n";
-        let bad = format!("{head}havs,H1,paper,§5.1,x,total_ms,spx2,havs:k=2,,a<b,0,gpu\n");
+        let head = "paper,id,source,cites,claim,metric,datasets,a,b,expect,tolerance,hardware,evidence,normalise\n";
+        let bad =
+            format!("{head}havs,H1,paper,§5.1,x,total_ms,spx2,havs:k=2,,a<b,0,gpu,measured,none\n");
         let e = parse(&bad, "claims.csv").unwrap_err().to_string();
         assert!(
             e.contains("claims.csv: line 2") && e.contains("second side"),
             "{e}"
         );
-        let bad = format!("{head}havs,H1,maybe,§5.1,x,total_ms,spx2,havs,,a>1,0,gpu\n");
+        let bad =
+            format!("{head}havs,H1,maybe,§5.1,x,total_ms,spx2,havs,,a>1,0,gpu,measured,none\n");
         assert!(parse(&bad, "c").unwrap_err().to_string().contains("source"));
+        let bad =
+            format!("{head}havs,H1,paper,§5.1,x,total_ms,spx2,havs,,a>1,0,gpu,guessed,none\n");
+        assert!(parse(&bad, "c")
+            .unwrap_err()
+            .to_string()
+            .contains("evidence"));
         let twice = format!(
-            "{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu\nhavs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu\n"
+            "{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none\nhavs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none\n"
         );
         assert!(parse(&twice, "c")
             .unwrap_err()
             .to_string()
             .contains("twice"));
+        // A derived claim must name claims that exist; a rule change must name a claim.
+        let derived =
+            format!("{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,derived:H9,none\n");
+        let mut c = parse(&derived, "c").unwrap();
+        let e = attach_history(&mut c, vec![], "h").unwrap_err().to_string();
+        assert!(e.contains("derived from H9"), "{e}");
+        let h = parse_history(
+            "paper,id,date,commit,reason,old_expect,old_tolerance,old_normalise\nhavs,H2,2026-12-04,abc,why,a>2,0,none\n",
+            "h.csv",
+        )
+        .unwrap();
+        let mut c = parse(
+            &format!("{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none\n"),
+            "c",
+        )
+        .unwrap();
+        let e = attach_history(&mut c, h, "h.csv").unwrap_err().to_string();
+        assert!(e.contains("havs H2 is not a claim"), "{e}");
     }
 
     fn row(settings: &str, viewpoint: &str, total: f64, frames: u32) -> Row {
@@ -698,6 +1172,7 @@ mod tests {
             analysis: &|_, _, _| None,
             why_missing: &|a, d| format!("{a} not measured on {d}"),
             software_adapter: software_adapter(rows),
+            our_peaks: None,
         }
     }
 
@@ -730,6 +1205,9 @@ mod tests {
             tolerance: 0.0,
             hardware: Hardware::Gpu,
             expect_text: "a<b".into(),
+            evidence: Evidence::Measured,
+            normalise: Normalise::None,
+            history: vec![],
         };
         let v = |a: &str| evaluate(&claim(a), &inputs(&rows))[0].evaluation.verdict;
         assert_eq!(v("raycast:tiles=5x5;mode=passes"), verdict::Verdict::Holds);

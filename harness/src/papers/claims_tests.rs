@@ -90,6 +90,20 @@ fn every_claim_names_a_paper_section_data_sets_and_variants_that_exist() {
     }
 }
 
+/// Every claim of `paper` on `m` and `x`, with the papers' own analyses as `reproduce` reads them.
+fn eval(paper: &str, m: &Measured, x: &Extra) -> Vec<ClaimResult> {
+    evaluate_claims(paper, m, x, &|metric, spec, d| {
+        havs::claim_side(x, metric, spec, d).or_else(|| gator::claim_side(x, metric, spec, d))
+    })
+}
+
+fn truth_table(observed: Vec<gator::ObservedCase>) -> Extra {
+    Extra::with_own(gator::GatorAnalyses {
+        truth_table: Some(observed),
+        geometry: vec![],
+    })
+}
+
 fn verdict_of(results: &[ClaimResult], id: &str, dataset: Option<&str>) -> Verdict {
     results
         .iter()
@@ -103,24 +117,18 @@ fn verdict_of(results: &[ClaimResult], id: &str, dataset: Option<&str>) -> Verdi
 fn gator_table1_fails_when_two_cases_are_swapped() {
     let observed = gator::observed_truth_table(50_000);
     assert_eq!(observed.len(), 14, "{observed:?}");
-    let x = Extra {
-        truth_table: Some(observed.clone()),
-        ..Default::default()
-    };
+    let x = truth_table(observed.clone());
     let m = Measured::default();
-    let ok = evaluate_claims("gator", &m, &x);
-    assert_eq!(verdict_of(&ok, "G1", None), Verdict::Holds);
+    let ok = eval("gator", &m, &x);
+    assert_eq!(verdict_of(&ok, "G8", None), Verdict::Holds);
     // Swap the case numbers of two outcomes.
     let mut swapped = observed.clone();
     let (a, b) = (swapped[0].case, swapped[5].case);
     swapped[0].case = b;
     swapped[5].case = a;
-    let x2 = Extra {
-        truth_table: Some(swapped),
-        ..Default::default()
-    };
+    let x2 = truth_table(swapped);
     assert_eq!(
-        verdict_of(&evaluate_claims("gator", &m, &x2), "G1", None),
+        verdict_of(&eval("gator", &m, &x2), "G8", None),
         Verdict::DoesNotHold
     );
     // A wrong triangle count alone fails too.
@@ -133,8 +141,8 @@ fn gator_table1_fails_when_two_cases_are_swapped() {
     let report = gator::tables(&m, &x2);
     assert_eq!(report.comparisons[0].verdict(), Some(false));
     // Not run: not checkable, with why.
-    let none = evaluate_claims("gator", &m, &Extra::default());
-    assert_eq!(verdict_of(&none, "G1", None), Verdict::NotCheckable);
+    let none = eval("gator", &m, &Extra::default());
+    assert_eq!(verdict_of(&none, "G8", None), Verdict::NotCheckable);
 }
 
 #[test]
@@ -147,10 +155,10 @@ fn gator_sizes_fail_when_a_tet_is_lost() {
         ],
         ..Default::default()
     };
-    let ok = evaluate_claims("gator", &m, &sizes(187_395));
+    let ok = eval("gator", &m, &sizes(187_395));
     assert_eq!(verdict_of(&ok, "G2", Some("bluntfin")), Verdict::Holds);
     assert_eq!(verdict_of(&ok, "G3", Some("post")), Verdict::Holds);
-    let lost = evaluate_claims("gator", &m, &sizes(187_317));
+    let lost = eval("gator", &m, &sizes(187_317));
     assert_eq!(
         verdict_of(&lost, "G2", Some("bluntfin")),
         Verdict::DoesNotHold
@@ -195,15 +203,15 @@ fn havs_k_gt2_pixels_fail_past_two_percent() {
     let edge = (paper as f64 * 0.98).ceil() as u64;
     let x = |pixels: u64| spx2_kbuffer(6_615_778, pixels);
     let m = Measured::default();
-    let at = evaluate_claims("havs", &m, &x(edge));
+    let at = eval("havs", &m, &x(edge));
     assert_eq!(verdict_of(&at, "H5", Some("spx2")), Verdict::Holds);
-    let below = evaluate_claims("havs", &m, &x(edge - 1));
+    let below = eval("havs", &m, &x(edge - 1));
     assert_eq!(verdict_of(&below, "H5", Some("spx2")), Verdict::DoesNotHold);
 }
 
 /// spx2's k-buffer analysis (512², 14 viewpoints) with the given fragments and k > 2 pixels.
 fn spx2_kbuffer(fragments: u64, pixels_k_gt2: u64) -> Extra {
-    Extra {
+    Extra::with_own(crate::papers::havs::analysis::HavsAnalyses {
         kbuffer: vec![crate::papers::havs::analysis::KbufferRow {
             dataset: "spx2".into(),
             fragments,
@@ -214,7 +222,7 @@ fn spx2_kbuffer(fragments: u64, pixels_k_gt2: u64) -> Extra {
         kbuffer_views: 14,
         kbuffer_resolution: 512,
         ..Default::default()
-    }
+    })
 }
 
 fn counter_row(algorithm: &str, settings: &str, dataset: &str, counters: &str) -> Row {
@@ -242,12 +250,13 @@ fn memory_claims_fail_with_four_more_bytes_per_tet() {
             &format!("model_bytes_per_tet={b}"),
         )],
         errors: vec![],
+        calibration: None,
     };
     let x = Extra::default();
-    let ok = evaluate_claims("fragment-pt", &frag(19.5), &x);
+    let ok = eval("fragment-pt", &frag(19.5), &x);
     assert_eq!(verdict_of(&ok, "F2", Some("bluntfin")), Verdict::Holds);
     assert_eq!(verdict_of(&ok, "F3", Some("bluntfin")), Verdict::Holds);
-    let fat = evaluate_claims("fragment-pt", &frag(23.5), &x);
+    let fat = eval("fragment-pt", &frag(23.5), &x);
     assert_eq!(
         verdict_of(&fat, "F2", Some("bluntfin")),
         Verdict::DoesNotHold
@@ -263,11 +272,12 @@ fn memory_claims_fail_with_four_more_bytes_per_tet() {
             &format!("mesh_bytes_per_tet={b}"),
         )],
         errors: vec![],
+        calibration: None,
     };
-    let ok = evaluate_claims("raycast", &ray(144.0), &x);
+    let ok = eval("raycast", &ray(144.0), &x);
     assert_eq!(verdict_of(&ok, "R4", Some("spx1")), Verdict::Holds);
     assert_eq!(verdict_of(&ok, "R5", Some("spx1")), Verdict::Holds);
-    let fat = evaluate_claims("raycast", &ray(148.0), &x);
+    let fat = eval("raycast", &ray(148.0), &x);
     assert_eq!(verdict_of(&fat, "R4", Some("spx1")), Verdict::DoesNotHold);
     // The memory table compares with the paper's own 144, exactly.
     assert_eq!(
@@ -295,12 +305,12 @@ fn havs_table2_fails_when_a_fragment_is_dropped_past_the_tolerance() {
     let edge = (paper as f64 * 0.98).ceil() as u64;
     let x = |fragments: u64| spx2_kbuffer(fragments, 10_626);
     let m = Measured::default();
-    let at = evaluate_claims("havs", &m, &x(edge));
+    let at = eval("havs", &m, &x(edge));
     assert_eq!(verdict_of(&at, "H4", Some("spx2")), Verdict::Holds);
     assert_eq!(verdict_of(&at, "H5", Some("spx2")), Verdict::Holds);
     // 512 of 512² pixels is 0.2 %: a small k suffices.
     assert_eq!(verdict_of(&at, "H3", Some("spx2")), Verdict::Holds);
-    let dropped = evaluate_claims("havs", &m, &x(edge - 1));
+    let dropped = eval("havs", &m, &x(edge - 1));
     assert_eq!(
         verdict_of(&dropped, "H4", Some("spx2")),
         Verdict::DoesNotHold
@@ -335,8 +345,9 @@ fn gpu_speed_claims_on_lavapipe_are_not_testable_and_name_their_variants() {
             ),
         ],
         errors: vec![],
+        calibration: None,
     };
-    let r = evaluate_claims("havs", &m, &Extra::default());
+    let r = eval("havs", &m, &Extra::default());
     let h6 = r
         .iter()
         .find(|r| r.claim.id == "H6" && r.dataset.as_deref() == Some("spx2"))
@@ -353,7 +364,7 @@ fn gpu_speed_claims_on_lavapipe_are_not_testable_and_name_their_variants() {
     for r in &mut hw.rows {
         r.device_type = "DiscreteGpu".into();
     }
-    let r = evaluate_claims("havs", &hw, &Extra::default());
+    let r = eval("havs", &hw, &Extra::default());
     assert_eq!(verdict_of(&r, "H6", Some("spx2")), Verdict::Holds);
 }
 
@@ -374,6 +385,7 @@ fn peers_have_no_cpu_gpu_split_in_havs_table5() {
     let m = Measured {
         rows: vec![row],
         errors: vec![],
+        calibration: None,
     };
     let report = havs::tables(&m, &Extra::default());
     let t5 = report
@@ -430,4 +442,236 @@ fn quick_plans_run_a_subset_of_the_full_variants_and_every_variant_a_claim_names
         }
     }
     assert!(narrowed > 0, "no plan narrows its quick run");
+}
+
+#[test]
+fn g1_fails_when_a_geometric_test_of_the_classifier_is_broken_though_its_labels_pass() {
+    use gator::geometry::check_mesh;
+    let mesh = datasets::registry::Registry::new(None)
+        .resolve("box:2k", &datasets::LoadOptions::default())
+        .expect("generated mesh")
+        .mesh;
+    let views = render_core::fixed_viewpoints();
+    let broken = gator_pt::GeometricTests {
+        test4_alpha_limit: 0.5,
+    };
+    let broken_classifier = |p| gator_pt::classify_cpu_with(p, &broken);
+    let with = |classify: &(dyn Fn([[f64; 3]; 4]) -> gator_pt::Classification + Sync)| {
+        let geometry = ["bluntfin", "post", "deltawing"]
+            .map(|d| check_mesh(d, &mesh, &views, 512, classify))
+            .to_vec();
+        Extra::with_own(gator::GatorAnalyses {
+            truth_table: Some(gator::observed_truth_table_with(50_000, classify)),
+            geometry,
+        })
+    };
+    let m = Measured::default();
+    let ok = eval("gator", &m, &with(&gator_pt::classify_cpu));
+    assert_eq!(verdict_of(&ok, "G1", Some("post")), Verdict::Holds);
+    assert_eq!(verdict_of(&ok, "G8", None), Verdict::Holds);
+    let bad = eval("gator", &m, &with(&broken_classifier));
+    assert_eq!(verdict_of(&bad, "G1", Some("post")), Verdict::DoesNotHold);
+    // The truth table compares labels only: the broken classifier still passes it.
+    assert_eq!(verdict_of(&bad, "G8", None), Verdict::Holds);
+    // Not run: not checkable.
+    let none = eval("gator", &m, &Extra::default());
+    assert_eq!(verdict_of(&none, "G1", Some("post")), Verdict::NotCheckable);
+}
+
+#[test]
+fn claims_by_construction_and_derived_ones_are_counted_apart_with_their_own_words() {
+    let row = |alg: &str, settings: &str, d: &str, counters: &str| {
+        let mut r = counter_row(alg, settings, d, counters);
+        r.tets = 233_000;
+        r
+    };
+    let m = Measured {
+        rows: vec![row(
+            "splat",
+            "buckets=cpu;sort=cpu-radix",
+            "lobster",
+            "effective_voxels=233000",
+        )],
+        errors: vec![],
+        calibration: None,
+    };
+    let r = eval("splat", &m, &Extra::default());
+    let s3 = r
+        .iter()
+        .find(|r| r.claim.id == "S3" && r.dataset.as_deref() == Some("lobster"))
+        .unwrap();
+    assert_eq!(s3.evaluation.verdict, Verdict::Holds);
+    assert_eq!(s3.word(), "as constructed");
+    // The headline counts measured claims only.
+    let holds = claims::tally(&r)
+        .into_iter()
+        .find(|(v, _)| *v == Verdict::Holds)
+        .unwrap()
+        .1;
+    assert_eq!(holds, 0, "S3 is not a measurement");
+    let apart = crate::papers::reproduce::tally_apart_text(&r);
+    assert!(
+        apart.contains("by construction: 1 as constructed"),
+        "{apart}"
+    );
+    assert!(claims::markdown(&r).contains("| by construction |"));
+    // A changed construction flips it to its own negative word.
+    let mut m2 = m.clone();
+    m2.rows[0].counters = "effective_voxels=232000".into();
+    let r2 = eval("splat", &m2, &Extra::default());
+    let s3 = r2
+        .iter()
+        .find(|r| r.claim.id == "S3" && r.dataset.as_deref() == Some("lobster"))
+        .unwrap();
+    assert_eq!(s3.word(), "not as constructed");
+    // R5 is derived from R4: "follows".
+    let ray = Measured {
+        rows: vec![counter_row(
+            "raycast",
+            "tiles=5x5;table=2d;mode=passes;et=on;layers=8",
+            "spx1",
+            "mesh_bytes_per_tet=144",
+        )],
+        errors: vec![],
+        calibration: None,
+    };
+    let r = eval("raycast", &ray, &Extra::default());
+    let r5 = r
+        .iter()
+        .find(|r| r.claim.id == "R5" && r.dataset.as_deref() == Some("spx1"))
+        .unwrap();
+    assert_eq!(r5.word(), "follows");
+    assert_eq!(verdict_of(&r, "R4", Some("spx1")), Verdict::Holds);
+}
+
+/// The committed H200 rows of one paper's reproduction (`reports/baselines/…/reproduce`).
+fn h200(paper: &str) -> Measured {
+    let runs = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../reports/baselines/nvidia-h200-2026-12-04/reproduce")
+        .join(paper)
+        .join("runs");
+    let mut m = Measured::default();
+    let mut dirs: Vec<_> = std::fs::read_dir(&runs)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    dirs.sort();
+    for dir in dirs {
+        let f = crate::results::ResultsFile::read(&dir).unwrap();
+        m.rows.extend(f.rows);
+        if m.calibration.is_none() {
+            m.calibration = f.machine.calibration;
+        }
+    }
+    m
+}
+
+#[test]
+fn h7_and_f1_rejudged_from_the_committed_h200_rows_show_their_old_rules_beside() {
+    let m = h200("havs");
+    assert!(
+        m.calibration.is_some(),
+        "the H200 runs carry their calibration"
+    );
+    let r = eval("havs", &m, &Extra::default());
+    for d in ["f117", "kew", "spx2", "torso", "fighter"] {
+        let h7 = r
+            .iter()
+            .find(|r| r.claim.id == "H7" && r.dataset.as_deref() == Some(d))
+            .unwrap();
+        assert_eq!(
+            h7.evaluation.verdict,
+            Verdict::Holds,
+            "{}",
+            h7.evaluation.numbers
+        );
+        assert!(h7
+            .evaluation
+            .numbers
+            .contains("normalised by the fill rate"));
+        // The whole band (until 16f45b8) read "does not hold" on the H200; the lower end
+        // alone, unnormalised, "holds".
+        let old: Vec<(&str, Verdict)> = h7
+            .earlier
+            .iter()
+            .map(|(h, e)| (h.commit.as_str(), e.verdict))
+            .collect();
+        assert_eq!(old[0], ("16f45b8", Verdict::DoesNotHold), "{d}: {old:?}");
+        assert_eq!(old[1].1, Verdict::Holds, "{d}: {old:?}");
+    }
+    let md = claims::markdown(&r);
+    assert!(
+        md.contains("by the rule before 16f45b8: does not hold") && md.contains("Rule history"),
+        "{md}"
+    );
+    // A GPU 1000 times slower than the H200 measured: below the normalised threshold.
+    let mut slow = m.clone();
+    for row in &mut slow.rows {
+        row.gpu_ms = row.gpu_ms.map(|g| g * 1000.0);
+        row.gpu_ms_min = row.gpu_ms_min.map(|g| g * 1000.0);
+        row.gpu_ms_max = row.gpu_ms_max.map(|g| g * 1000.0);
+    }
+    let r = eval("havs", &slow, &Extra::default());
+    assert_eq!(verdict_of(&r, "H7", Some("f117")), Verdict::DoesNotHold);
+    // The same rows against a calibrated fill rate 1000 times higher: also below.
+    let mut fast_peak = m.clone();
+    if let Some(c) = &mut fast_peak.calibration {
+        c.fill_fragments_per_sec *= 1000.0;
+    }
+    let r = eval("havs", &fast_peak, &Extra::default());
+    assert_eq!(verdict_of(&r, "H7", Some("f117")), Verdict::DoesNotHold);
+    // Without a calibration the normalised claim is not checkable, with why.
+    let mut uncalibrated = m.clone();
+    uncalibrated.calibration = None;
+    let r = eval("havs", &uncalibrated, &Extra::default());
+    assert_eq!(verdict_of(&r, "H7", Some("f117")), Verdict::NotCheckable);
+
+    // F1 on the H200: whole frames of fragment PT against 2.0 M tets/s, normalised.
+    let f = h200("fragment-pt");
+    let r = eval("fragment-pt", &f, &Extra::default());
+    for d in ["bluntfin", "comb", "post", "spx2"] {
+        assert_eq!(verdict_of(&r, "F1", Some(d)), Verdict::Holds, "{d}");
+    }
+}
+
+#[test]
+fn hardware_independent_counts_of_gator_and_fragment_pt_flip_on_a_changed_measurement() {
+    let gator_row = |variant: &str, d: &str, triangles: f64, bytes_per_tet: f64| {
+        let mut r = counter_row(
+            "gator-pt",
+            &format!("variant={variant};sort=radix"),
+            d,
+            &format!("triangles_drawn={triangles}"),
+        );
+        r.bytes_per_tet = Some(bytes_per_tet);
+        r
+    };
+    let m = |tri: f64, linear_bytes: f64| Measured {
+        rows: vec![
+            gator_row("linear", "post", tri, linear_bytes),
+            gator_row("constant", "post", tri, 10.0),
+        ],
+        errors: vec![],
+        calibration: None,
+    };
+    let ok = eval("gator", &m(4000.0, 40.0), &Extra::default());
+    assert_eq!(verdict_of(&ok, "G9", Some("post")), Verdict::Holds);
+    assert_eq!(verdict_of(&ok, "G10", Some("post")), Verdict::Holds);
+    let bad = eval("gator", &m(3000.0, 10.0), &Extra::default());
+    assert_eq!(verdict_of(&bad, "G9", Some("post")), Verdict::DoesNotHold);
+    assert_eq!(verdict_of(&bad, "G10", Some("post")), Verdict::DoesNotHold);
+
+    let brain = |bytes: u64| {
+        let mut r = counter_row("fragment-pt", "shading=average;sort=bucket", "brain", "");
+        r.gpu_bytes = Some(bytes);
+        Measured {
+            rows: vec![r],
+            errors: vec![],
+            calibration: None,
+        }
+    };
+    let fits = eval("fragment-pt", &brain(200 << 20), &Extra::default());
+    assert_eq!(verdict_of(&fits, "F7", Some("brain")), Verdict::Holds);
+    let over = eval("fragment-pt", &brain(300 << 20), &Extra::default());
+    assert_eq!(verdict_of(&over, "F7", Some("brain")), Verdict::DoesNotHold);
 }

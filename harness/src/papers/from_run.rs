@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 
-use super::reproduce::{write_report, SourceState};
-use super::session::{Extra, Measured, Session};
+use super::reproduce::write_report;
+use super::session::{Extra, Measured, Session, SourceState};
 use crate::results::ResultsFile;
 
 /// `tetbench analyze PAPER RUN_DIR`: one subcommand per paper of [`super::PAPERS`] (flattened
@@ -101,6 +101,9 @@ pub fn run(cmd: PaperAnalysis) -> anyhow::Result<()> {
     let mut measured = Measured::default();
     for f in &files {
         measured.rows.extend(f.rows.iter().cloned());
+        if measured.calibration.is_none() {
+            measured.calibration = f.machine.calibration.clone();
+        }
     }
     let report = paper.tables(&measured, &Extra::default());
     let out = args
@@ -128,6 +131,7 @@ pub fn run(cmd: PaperAnalysis) -> anyhow::Result<()> {
         cache_dir: None,
         substitutes: vec![],
         resolution: None,
+        rounds: None,
         machine: files.first().map(|f| f.machine.clone()),
         log: vec![format!(
             "analysed {} run(s) under {} ({} rows), measured by commit(s) {}",

@@ -16,6 +16,7 @@
 pub mod claims;
 pub mod evidence;
 pub mod from_run;
+pub mod hardware;
 pub mod reproduce;
 pub mod session;
 pub mod table;

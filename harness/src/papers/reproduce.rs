@@ -18,6 +18,7 @@ use std::time::Instant;
 use anyhow::Context as _;
 
 use super::claims::{self, ClaimResult};
+pub use super::session::SourceState;
 use super::session::{
     not_built_reason, Measured, Report, Session, FULL_FRAMES, FULL_WARMUP, QUICK_FRAMES,
     QUICK_RESOLUTION_DIVISOR, QUICK_VIEWPOINTS, QUICK_WARMUP,
@@ -52,6 +53,12 @@ pub struct Args {
     /// `tetbench run --external`).
     #[command(flatten)]
     pub external: crate::run::matrix::ExternalArgs,
+    /// Rounds per row: each variant's frames are taken this many times, seconds apart, so a
+    /// timing claim compares samples from separate moments (default: 5 in the full mode, the
+    /// rounds a GPU timing claim needs; 1 in the quick mode). `scripts/gpu.sh` runs the quick
+    /// mode with 5.
+    #[arg(long, value_name = "N")]
+    pub rounds: Option<u32>,
     /// Run although the working tree has uncommitted changes (the reports then say so; by
     /// default `reproduce` refuses, so every report names the one commit it came from).
     #[arg(long)]
@@ -83,6 +90,9 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             .ok_or_else(|| anyhow::anyhow!("--substitute {s:?}: expected NAME=SPEC"))?;
         substitutes.push((a.trim().to_string(), b.trim().to_string()));
     }
+    if args.rounds == Some(0) {
+        anyhow::bail!("--rounds 0: need at least one round");
+    }
     let mut source = SourceState::read();
     source.check(args.allow_dirty)?;
     let started = Instant::now();
@@ -106,6 +116,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             cache_dir: args.cache_dir.clone(),
             substitutes: substitutes.clone(),
             resolution: args.resolution,
+            rounds: args.rounds,
             machine: None,
             log: vec![],
             external: args.external.clone(),
@@ -119,10 +130,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
         let exact: Vec<String> = report
             .comparisons
             .iter()
-            .filter_map(|c| {
-                c.verdict()
-                    .map(|v| format!("{}: {}", c.key, if v { "match" } else { "differ" }))
-            })
+            .filter_map(|c| c.summary())
             .collect();
         let summary = PaperSummary {
             paper: p.id.to_string(),
@@ -132,9 +140,10 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
             exact_tables: if exact.is_empty() {
                 "–".into()
             } else {
-                exact.join(", ")
+                exact.join("; ")
             },
             claims: tally_text(&report.claims),
+            not_measured: tally_apart_text(&report.claims),
         };
         write_file(
             &dir.join(SUMMARY_FILE),
@@ -184,14 +193,18 @@ pub struct PaperSummary {
     /// The commit sentence of [`SourceState::describe`].
     pub source: String,
     pub exact_tables: String,
+    /// The measured claims' verdicts (the headline).
     pub claims: String,
+    /// The claims by construction and the derived ones, with their own words.
+    #[serde(default)]
+    pub not_measured: String,
 }
 
 pub const SUMMARY_FILE: &str = "summary.json";
 
 /// The index of every paper reproduced under `out`, from their summaries.
 pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
-    let mut md = String::from("# Papers reproduced\n\nWritten by `tetbench reproduce` from each paper's `summary.json`; nothing here is edited by hand.\n\n| paper | mode | seconds | commit | exact tables | claims (verdicts per data set) | report |\n|---|---|---:|---|---|---|---|\n");
+    let mut md = String::from("# Papers reproduced\n\nWritten by `tetbench reproduce` from each paper's `summary.json`; nothing here is edited by hand.\n\n| paper | mode | seconds | commit | exact tables (columns compared) | measured claims (verdicts per data set) | by construction, derived | report |\n|---|---|---:|---|---|---|---|---|\n");
     let mut total = 0.0;
     let mut sources = vec![];
     for p in PAPERS.iter().map(|p| p.paper()) {
@@ -209,7 +222,7 @@ pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
         }
         let _ = writeln!(
             md,
-            "| {} | {} | {:.0} | {} | {} | {} | [{0}/report.md]({0}/report.md) |",
+            "| {} | {} | {:.0} | {} | {} | {} | {} | [{0}/report.md]({0}/report.md) |",
             s.paper,
             s.mode,
             s.seconds,
@@ -218,7 +231,12 @@ pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
                 .position(|x| *x == s.source)
                 .map_or(0, |i| i + 1),
             s.exact_tables,
-            s.claims
+            s.claims,
+            if s.not_measured.is_empty() {
+                "–"
+            } else {
+                &s.not_measured
+            }
         );
     }
     let _ = writeln!(md, "\nTotal: {total:.0} s.\n");
@@ -260,7 +278,7 @@ fn our_conditions(machine: Option<&MachineInfo>) -> String {
     )
 }
 
-/// Counts of each verdict, as one line.
+/// Counts of each verdict of the measured claims, as one line (the headline).
 pub fn tally_text(results: &[ClaimResult]) -> String {
     let parts: Vec<String> = claims::tally(results)
         .into_iter()
@@ -274,47 +292,19 @@ pub fn tally_text(results: &[ClaimResult]) -> String {
     }
 }
 
-/// The commit `reproduce` runs from and whether the tree has uncommitted changes (read the
-/// way the run's machine record reads it, [`MachineInfo::collect`]).
-#[derive(Debug, Clone, Default)]
-pub struct SourceState {
-    pub commit: Option<String>,
-    pub dirty: Option<bool>,
-    /// `--allow-dirty` was given.
-    pub allowed_dirty: bool,
-}
-
-impl SourceState {
-    pub fn read() -> SourceState {
-        let m = MachineInfo::collect();
-        SourceState {
-            commit: m.git_commit,
-            dirty: m.git_dirty,
-            allowed_dirty: false,
-        }
-    }
-
-    /// Refuses a tree with uncommitted changes unless allowed.
-    pub fn check(&mut self, allow_dirty: bool) -> anyhow::Result<()> {
-        if self.dirty == Some(true) && !allow_dirty {
-            anyhow::bail!(
-                "the working tree has uncommitted changes: commit them so the reports name one commit, or pass --allow-dirty (the reports will say so)"
-            );
-        }
-        self.allowed_dirty = allow_dirty && self.dirty == Some(true);
-        Ok(())
-    }
-
-    /// One sentence for the reports.
-    pub fn describe(&self) -> String {
-        let commit = self.commit.as_deref().unwrap_or("unknown (no git)");
-        match self.dirty {
-            Some(true) => format!(
-                "Built from commit `{commit}` **with uncommitted changes** (`--allow-dirty`): these figures are not reproducible from the commit alone."
-            ),
-            Some(false) => format!("Built from commit `{commit}`, clean tree."),
-            None => format!("Commit `{commit}`; whether the tree was clean is unknown."),
-        }
+/// Counts of the claims that are not measured, by kind, as one line (`–` when none).
+pub fn tally_apart_text(results: &[ClaimResult]) -> String {
+    let parts: Vec<String> = claims::tally_apart(results)
+        .into_iter()
+        .map(|(kind, words)| {
+            let w: Vec<String> = words.iter().map(|(w, n)| format!("{n} {w}")).collect();
+            format!("{kind}: {}", w.join(", "))
+        })
+        .collect();
+    if parts.is_empty() {
+        "–".into()
+    } else {
+        parts.join("; ")
     }
 }
 
@@ -334,11 +324,13 @@ pub(crate) fn write_report(
         )
     } else if session.quick {
         format!(
-            "**Quick mode**: viewpoint(s) {QUICK_VIEWPOINTS} instead of the paper's, the viewport side divided by {QUICK_RESOLUTION_DIVISOR} (e.g. 256² for the papers' 512²), {QUICK_FRAMES} timed frame after {QUICK_WARMUP} warm-up, no reference images (no PSNR); data sets at the papers' sizes; only the variants the paper's tables and claims compare where a plan adds others (each run's settings are under Runs). Figures are indicative only."
+            "**Quick mode**: viewpoint(s) {QUICK_VIEWPOINTS} instead of the paper's, the viewport side divided by {QUICK_RESOLUTION_DIVISOR} (e.g. 256² for the papers' 512²), {QUICK_FRAMES} timed frame after {QUICK_WARMUP} warm-up, no reference images (no PSNR); data sets at the papers' sizes; only the variants the paper's tables and claims compare where a plan adds others (each run's settings are under Runs); {} round(s) per row. Counts that do not depend on the GPU (HAVS Table 2, GATOR's classifier, the ray caster's passes, fragment PT's device bytes on Brain) are measured at the paper's size in this mode too. Figures of time are indicative only.",
+            session.rounds()
         )
     } else {
         format!(
-            "**Full mode**: the paper's viewpoints and viewport, {FULL_FRAMES} timed frames after {FULL_WARMUP} warm-up, reference images and PSNR."
+            "**Full mode**: the paper's viewpoints and viewport, {FULL_FRAMES} timed frames after {FULL_WARMUP} warm-up in each of {} rounds per row (seconds apart), reference images and PSNR.",
+            session.rounds()
         )
     };
     if session.from_run.is_some() {
@@ -371,8 +363,9 @@ pub(crate) fn write_report(
     } else {
         let _ = writeln!(
             md,
-            "From `reports/papers/claims.csv`; one verdict per data set: {}. The rule (`harness/src/papers/verdict.rs`): a difference inside the samples' spread (frames' range) or the claim's tolerance is *within noise*, and one frame per side never orders two sides; a claim about GPU speed measured on a software rasteriser is *not testable on this adapter* (its numbers are still shown), and on a real GPU a band of absolute GPU rates (the paper's GPU's) is tested by its lower end only; *not checkable* says what is missing.\n",
-            tally_text(&report.claims)
+            "From `reports/papers/claims.csv`; one verdict per data set. Measured claims: {}. Not measured, and so never counted as holds: {} (*by construction*: an input chosen to equal the paper's, read *as constructed*; *derived*: arithmetic on other claims' numbers, read *follows*). Each claim's rule (expectation, tolerance, normalisation) is written in the file before the run; an earlier rule is shown beside the verdict with the verdict it gives. The rule (`harness/src/papers/verdict.rs`): a difference inside the samples' spread (frames' range) or the claim's tolerance is *within noise*, and one frame per side never orders two sides; a claim about GPU speed measured on a software rasteriser is *not testable on this adapter* (its numbers are still shown), *not checkable* says what is missing.\n",
+            tally_text(&report.claims),
+            tally_apart_text(&report.claims)
         );
         md.push_str(&claims::markdown(&report.claims));
         md.push('\n');

@@ -2,7 +2,9 @@
 //! runs it made), a plan's [`RunSpec`], what was [`Measured`] and the CPU analyses' [`Extra`],
 //! the [`Report`] a paper's table writer returns, and the lookups the writers share.
 
+use std::any::Any;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context as _;
@@ -13,7 +15,6 @@ use crate::results::{ResultsFile, Row};
 use crate::run::matrix::{MatrixArgs, DEFAULT_TF};
 
 use super::claims::ClaimResult;
-use super::reproduce::SourceState;
 use super::table::Comparison;
 
 /// What a paper module's table writer returns.
@@ -56,6 +57,12 @@ pub struct RunSpec {
     /// The quick run's settings where they differ from `settings`: only the variants the
     /// paper's tables and claims compare; the others beside them run in the full mode.
     pub quick_settings: Option<String>,
+    /// The paper's viewport in every mode: a claim on what the run measures depends on the
+    /// viewport (fragment PT's device bytes at 512²), so the quick mode does not halve it.
+    pub full_viewport: bool,
+    /// The paper's viewpoints in every mode (hardware-independent counts over the views,
+    /// such as the ray caster's passes).
+    pub full_views: bool,
 }
 
 impl RunSpec {
@@ -78,6 +85,9 @@ pub const QUICK_WARMUP: u32 = 1;
 /// The full mode's frames and warm-up (tetbench's standard).
 pub const FULL_FRAMES: u32 = crate::run::suite::STANDARD_FRAMES;
 pub const FULL_WARMUP: u32 = crate::run::suite::STANDARD_WARMUP;
+/// The full mode's rounds per row: each row's frames are taken at five moments, seconds
+/// apart, so that a GPU timing claim reads holds, does not hold or a real within noise.
+pub const FULL_ROUNDS: u32 = 5;
 
 /// Measured rows of one paper plus what could not be measured.
 #[derive(Debug, Clone, Default)]
@@ -85,6 +95,9 @@ pub struct Measured {
     pub rows: Vec<Row>,
     /// Per run, the failures that are not one row (a data set that did not load).
     pub errors: Vec<String>,
+    /// The adapter's calibration from the first run's machine record that has one (claims
+    /// normalised by a peak read it).
+    pub calibration: Option<crate::results::machine::Calibration>,
 }
 
 impl Measured {
@@ -167,6 +180,8 @@ pub struct Session {
     pub cache_dir: Option<PathBuf>,
     pub substitutes: Vec<(String, String)>,
     pub resolution: Option<u32>,
+    /// `--rounds`: rounds per row (`None`: [`FULL_ROUNDS`] in the full mode, 1 in quick).
+    pub rounds: Option<u32>,
     /// The machine of the first run (adapter included), for the conditions.
     pub machine: Option<MachineInfo>,
     /// The equivalent `tetbench run` command of every run, and its outcome.
@@ -187,6 +202,22 @@ impl Session {
             .find(|(n, _)| n == name)
             .map(|(_, s)| s.clone())
             .unwrap_or_else(|| name.to_string())
+    }
+
+    /// Rounds per row in this mode.
+    pub fn rounds(&self) -> u32 {
+        self.rounds
+            .unwrap_or(if self.quick { 1 } else { FULL_ROUNDS })
+    }
+
+    /// The viewport of a plan entry: as [`Session::resolution`], never halved where the entry
+    /// needs the paper's viewport.
+    pub fn resolution_of(&self, spec: &RunSpec) -> u32 {
+        if spec.full_viewport {
+            self.resolution.unwrap_or(spec.resolution)
+        } else {
+            self.resolution(spec.resolution)
+        }
     }
 
     /// The viewport of a run: `--resolution`, else the paper's (halved in quick mode).
@@ -217,7 +248,7 @@ impl Session {
         if algorithms.is_empty() {
             return Ok(());
         }
-        let viewpoints = if self.quick {
+        let viewpoints = if self.quick && !spec.full_views {
             QUICK_VIEWPOINTS.to_string()
         } else {
             spec.viewpoints.clone()
@@ -228,7 +259,7 @@ impl Session {
             algorithms: algorithms.clone(),
             datasets: datasets.clone(),
             viewpoints: Some(viewpoints.clone()),
-            resolution: Some(self.resolution(spec.resolution)),
+            resolution: Some(self.resolution_of(spec)),
             tf: Some(spec.tf.unwrap_or(DEFAULT_TF).into()),
             frames: Some(if self.quick {
                 QUICK_FRAMES
@@ -241,6 +272,7 @@ impl Session {
                 FULL_WARMUP
             }),
             settings: spec.settings_for(self.quick).cloned(),
+            rounds: Some(self.rounds()),
             no_reference: self.quick,
             cache_dir: self.cache_dir.clone(),
             external: self.external.clone(),
@@ -251,7 +283,7 @@ impl Session {
             "tetbench run --algorithms {} --datasets {} --viewpoints {viewpoints} --resolution {}{}{}{}",
             algorithms.join(","),
             datasets.join(","),
-            self.resolution(spec.resolution),
+            self.resolution_of(spec),
             spec.tf.map(|t| format!(" --tf {t}")).unwrap_or_default(),
             spec.settings_for(self.quick)
                 .map(|s| format!(" --settings '{s}'"))
@@ -261,7 +293,11 @@ impl Session {
             } else {
                 String::new()
             }
-        );
+        ) + &if self.rounds() > 1 {
+            format!(" --rounds {}", self.rounds())
+        } else {
+            String::new()
+        };
         let config = args.to_config(self.data_dir.clone(), vec![command.clone()])?;
         let filter = config.settings_filter.clone();
         let t0 = Instant::now();
@@ -270,6 +306,9 @@ impl Session {
         let file = ResultsFile::read(&out)?;
         if self.machine.is_none() {
             self.machine = Some(file.machine.clone());
+        }
+        if measured.calibration.is_none() {
+            measured.calibration = file.machine.calibration.clone();
         }
         self.log.push(format!(
             "run {}: `{command}` — {} rows, {} failed, {:.0} s",
@@ -297,31 +336,93 @@ pub fn is_standin(name: &str) -> bool {
     datasets::standins::is_generated(name)
 }
 
-/// What a paper measured besides run rows (CPU analyses), shared shape so the tests can call
-/// every table writer alike.
-#[derive(Debug, Clone, Default)]
+/// What a paper measured besides run rows: the data set sizes every paper may need, and the
+/// paper's own CPU analyses as its module's type (sorts and the k-buffer for HAVS, the
+/// classifier for GATOR), which only that module reads back ([`Extra::own`]). The shape is
+/// shared so the tests can call every table writer alike; it names no paper's types.
+#[derive(Clone, Default)]
 pub struct Extra {
-    /// HAVS Table 1: each sort's median, fastest and slowest run.
-    pub sorts: Vec<super::havs::analysis::SortRow>,
-    /// HAVS Table 2 rows.
-    pub kbuffer: Vec<super::havs::analysis::KbufferRow>,
-    /// GATOR Table 1: the classifier's distinct outcomes (`None`: not run).
-    pub truth_table: Option<Vec<super::gator::ObservedCase>>,
     /// Data set sizes: (plan name, points, tets).
     pub sizes: Vec<(String, u64, u64)>,
     /// Zero-volume tets the loader dropped, per data set (plan name, count).
     pub dropped: Vec<(String, u64)>,
-    /// How many viewpoints and what viewport the k analysis used.
-    pub kbuffer_views: usize,
-    pub kbuffer_resolution: u32,
+    /// The paper's own analyses (`None`: not run).
+    pub own: Option<Arc<dyn Any + Send + Sync>>,
+}
+
+impl std::fmt::Debug for Extra {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Extra")
+            .field("sizes", &self.sizes)
+            .field("dropped", &self.dropped)
+            .field("own", &self.own.as_ref().map(|_| "…"))
+            .finish()
+    }
 }
 
 impl Extra {
+    /// An `Extra` holding a paper's own analyses.
+    pub fn with_own<T: Any + Send + Sync>(own: T) -> Extra {
+        Extra {
+            own: Some(Arc::new(own)),
+            ..Extra::default()
+        }
+    }
+
+    /// The paper's own analyses, if they are of type `T`.
+    pub fn own<T: Any>(&self) -> Option<&T> {
+        self.own.as_deref()?.downcast_ref::<T>()
+    }
+
     /// Tets of zero volume the loader dropped from data set `d` (0 when none or not loaded).
     pub fn dropped_by_loader(&self, d: &str) -> u64 {
         self.dropped
             .iter()
             .find(|(n, _)| n == d)
             .map_or(0, |(_, n)| *n)
+    }
+}
+
+/// The commit `reproduce` runs from and whether the tree has uncommitted changes (read the
+/// way the run's machine record reads it, [`MachineInfo::collect`]).
+#[derive(Debug, Clone, Default)]
+pub struct SourceState {
+    pub commit: Option<String>,
+    pub dirty: Option<bool>,
+    /// `--allow-dirty` was given.
+    pub allowed_dirty: bool,
+}
+
+impl SourceState {
+    pub fn read() -> SourceState {
+        let m = MachineInfo::collect();
+        SourceState {
+            commit: m.git_commit,
+            dirty: m.git_dirty,
+            allowed_dirty: false,
+        }
+    }
+
+    /// Refuses a tree with uncommitted changes unless allowed.
+    pub fn check(&mut self, allow_dirty: bool) -> anyhow::Result<()> {
+        if self.dirty == Some(true) && !allow_dirty {
+            anyhow::bail!(
+                "the working tree has uncommitted changes: commit them so the reports name one commit, or pass --allow-dirty (the reports will say so)"
+            );
+        }
+        self.allowed_dirty = allow_dirty && self.dirty == Some(true);
+        Ok(())
+    }
+
+    /// One sentence for the reports.
+    pub fn describe(&self) -> String {
+        let commit = self.commit.as_deref().unwrap_or("unknown (no git)");
+        match self.dirty {
+            Some(true) => format!(
+                "Built from commit `{commit}` **with uncommitted changes** (`--allow-dirty`): these figures are not reproducible from the commit alone."
+            ),
+            Some(false) => format!("Built from commit `{commit}`, clean tree."),
+            None => format!("Commit `{commit}`; whether the tree was clean is unknown."),
+        }
     }
 }

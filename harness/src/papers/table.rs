@@ -170,6 +170,56 @@ impl Comparison {
     }
 }
 
+impl Comparison {
+    /// The columns the exact verdict compares (exact metrics).
+    pub fn compared_columns(&self) -> Vec<&str> {
+        self.metrics
+            .iter()
+            .filter(|m| m.compared_exactly())
+            .map(|m| m.name.as_str())
+            .collect()
+    }
+
+    /// The columns that depend on the hardware: shown as ours/paper, never part of a match.
+    pub fn not_compared_columns(&self) -> Vec<&str> {
+        self.metrics
+            .iter()
+            .filter(|m| !m.compared_exactly())
+            .map(|m| m.name.as_str())
+            .collect()
+    }
+
+    /// "Compared: tets. Not compared (they depend on the hardware): fps, tets/s."
+    pub fn columns_sentence(&self) -> String {
+        let mut s = format!("Compared: {}.", self.compared_columns().join(", "));
+        let not = self.not_compared_columns();
+        if !not.is_empty() {
+            s.push_str(&format!(
+                " Not compared (they depend on the hardware; ours/paper shown): {}.",
+                not.join(", ")
+            ));
+        }
+        s
+    }
+
+    /// The table's one-line verdict for the index, naming the columns it compared and those
+    /// it did not: `table1: tets match (fps, tets/s not compared)` (`None`: no exact column).
+    pub fn summary(&self) -> Option<String> {
+        let v = self.verdict()?;
+        let mut s = format!(
+            "{}: {} {}",
+            self.key,
+            self.compared_columns().join(", "),
+            if v { "match" } else { "differ" }
+        );
+        let not = self.not_compared_columns();
+        if !not.is_empty() {
+            s.push_str(&format!(" ({} not compared)", not.join(", ")));
+        }
+        Some(s)
+    }
+}
+
 /// A number as printed in tables: fixed digits, `–` for none.
 pub fn num(v: Option<f64>, digits: usize) -> String {
     match v {
@@ -256,14 +306,14 @@ pub fn markdown(c: &Comparison) -> String {
     if c.metrics.iter().any(|m| m.compared_exactly()) {
         let v = match c.verdict() {
             Some(true) => {
-                "**ours matches the paper** in every cell both have (stand-in rows excluded)"
+                "**ours matches the paper** in every cell of the compared columns both have (stand-in rows excluded)"
             }
             Some(false) => {
-                "**ours does not match the paper** in at least one cell (stand-in rows excluded)"
+                "**ours does not match the paper** in at least one cell of the compared columns (stand-in rows excluded)"
             }
             None => "no cell could be compared",
         };
-        let _ = writeln!(md, "\nVerdict: {v}.");
+        let _ = writeln!(md, "\nVerdict: {v}. {}", c.columns_sentence());
     }
     if !footnotes.is_empty() {
         md.push('\n');

@@ -661,6 +661,16 @@ impl MemoryLedger {
     pub fn total(&self) -> u64 {
         self.persistent + self.per_frame
     }
+
+    /// Bytes of the buffers and textures whose label starts with `prefix`: what one kind of
+    /// data takes on the device, as allocated.
+    pub fn bytes_labelled(&self, prefix: &str) -> u64 {
+        self.entries
+            .iter()
+            .filter(|(label, _, _)| label.starts_with(prefix))
+            .map(|(_, _, bytes)| bytes)
+            .sum()
+    }
 }
 
 /// Splits `count` elements of `element_bytes` each into ranges that fit one storage binding.

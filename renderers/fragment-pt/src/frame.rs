@@ -201,6 +201,18 @@ pub(crate) fn render(
             "tets_behind_eye".to_string(),
             camera.tets_behind_eye(&st.mesh) as f64,
         ),
+        // Where the device bytes go (from the ledger, as allocated): the paper's 5.5 M tets on
+        // a 256 MB board (§5) is judged on the total; these say which buffers take it.
+        (
+            "records_bytes_per_tet".to_string(),
+            st.ledger.bytes_labelled("fragment-pt pass-1 records") as f64 / st.tets.max(1) as f64,
+        ),
+        (
+            "sort_bytes_per_tet".to_string(),
+            (st.ledger.bytes_labelled("fragment-pt centroid depths")
+                + st.ledger.bytes_labelled("fragment-pt order")) as f64
+                / st.tets.max(1) as f64,
+        ),
         ("mesh_bindings".to_string(), st.mesh_bindings as f64),
         // The roofline's work: pass 2 draws 12 vertices (4 triangles) per tet, and the
         // visibility order covers every tet, on the device or on the host.

@@ -115,6 +115,28 @@ fn sub2(a: [f64; 3], b: [f64; 3]) -> [f64; 2] {
 /// vertex and thickness. `projected[i]` = (x, y, z) of vertex i in a space where eye rays are
 /// parallel to z (see the module documentation). Same arithmetic as the vertex shader.
 pub fn classify_cpu(projected: [[f64; 3]; 4]) -> Classification {
+    classify_cpu_with(projected, &GeometricTests::PAPER)
+}
+
+/// The constants of the classifier's geometric tests. [`GeometricTests::PAPER`] is the paper's
+/// (and the shader's); any other value exists so that a check of the classifier against
+/// geometry (`tetbench reproduce gator`, claim G1) can be shown to fail on a classifier whose
+/// geometric test is wrong while every label and truth-table outcome stays the same.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GeometricTests {
+    /// Test 4: the diagonals cross inside v0'v1' when α < this (the paper: 1, the end of the
+    /// segment).
+    pub test4_alpha_limit: f64,
+}
+
+impl GeometricTests {
+    pub const PAPER: GeometricTests = GeometricTests {
+        test4_alpha_limit: 1.0,
+    };
+}
+
+/// [`classify_cpu`] with the geometric tests' constants given (see [`GeometricTests`]).
+pub fn classify_cpu_with(projected: [[f64; 3]; 4], geometry: &GeometricTests) -> Classification {
     let p = projected;
     // Tests 1-3 (gator.cg tests123): z of three cross products about v0.
     let e1 = sub2(p[1], p[0]);
@@ -143,7 +165,7 @@ pub fn classify_cpu(projected: [[f64; 3]; 4]) -> Classification {
     // Test 4: α < 1 (class 2). Impossible for idx 6, 7 (v0 inside the triangle).
     let t4 = idx < 6 && den != 0.0 && {
         let alpha = alpha_num / den;
-        alpha < 1.0
+        alpha < geometry.test4_alpha_limit
     };
     let beta = if den != 0.0 {
         (beta_num / den).clamp(0.0, 1.0)

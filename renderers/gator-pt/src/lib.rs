@@ -46,8 +46,8 @@ use render_core::{
 };
 
 pub use classify::{
-    classify_cpu, classify_tet, world_segment, Classification, ThickSegment, FAN_TRIANGLES,
-    MAPPING_TABLE,
+    classify_cpu, classify_cpu_with, classify_tet, world_segment, Classification, GeometricTests,
+    ThickSegment, FAN_TRIANGLES, MAPPING_TABLE,
 };
 
 /// Entries of the transfer-function table (rgb, κ over the normalised scalar).
@@ -674,6 +674,9 @@ impl Renderer for GatorPt {
         let mut pass: Option<wgpu::RenderPass<'static>> = None;
         let mut in_pass = 0u64;
         let mut first = true;
+        // Indices issued by the draws below: the triangles the frame actually draws (§3.4:
+        // four per tet, class-1 cases with a degenerate fourth).
+        let mut indices_drawn = 0u64;
         let open_pass = |enc: &mut wgpu::CommandEncoder, first: bool| {
             let mut p =
                 render_core::bind::color_pass(enc, "gator fans", &target.view, first, true, None)
@@ -704,6 +707,7 @@ impl Renderer for GatorPt {
                     .min(tets_per_pass - in_pass);
                 // Vertex index = fan index + base_vertex = 5·(sorted position) + node.
                 p.draw_indexed(0..(12 * len) as u32, (start * NODES as u64) as i32, 0..1);
+                indices_drawn += 12 * len;
                 start += len;
                 in_pass += len;
             }
@@ -728,6 +732,8 @@ impl Renderer for GatorPt {
             // The roofline's work: the basis graph's 4 triangles per tet (12 indices), every
             // tet ordered on the CPU.
             ("triangles".to_string(), 4.0 * n),
+            // Counted from the draw calls issued (indices / 3), not from the formula above.
+            ("triangles_drawn".to_string(), (indices_drawn / 3) as f64),
             ("cpu_sort_keys".to_string(), n),
             // Outside the timed frame, once per view: the pixel centres of every tet's
             // projection, which its four triangles cover once each, and the tets that hold any.

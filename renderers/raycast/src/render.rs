@@ -273,7 +273,6 @@ impl Renderer for Raycast {
         });
         let mut layout = MeshLayout::build(mesh, optics, max_binding)?;
         let slots = layout.chunks.len();
-        let mesh_bytes = layout.bytes();
         render_core::bind::check_storage_bindings(
             gpu,
             &format!("raycast on {} ({} mesh bindings)", gpu.adapter.name, slots),
@@ -290,13 +289,17 @@ impl Renderer for Raycast {
             .map(|(c, data)| {
                 ledger.buffer_init(
                     gpu,
-                    &format!("raycast mesh binding {c}"),
+                    &format!("{MESH_BINDING_LABEL} {c}"),
                     Lifetime::Persistent,
                     bytemuck::cast_slice(&data),
                     storage,
                 )
             })
             .collect::<anyhow::Result<_>>()?;
+        // The mesh's bytes as allocated: the buffers just created for its bindings, read from
+        // the ledger (not from the layout's texel count), so `mesh_bytes_per_tet` measures
+        // what the device holds (§3.1's 144 B/tet is a claim about it).
+        let mesh_bytes = ledger.bytes_labelled(MESH_BINDING_LABEL);
         // Boundary faces as geometry (phase 1): position (OCS) and the tet's (binding, index).
         let o = layout.origin;
         let mut verts: Vec<u32> = Vec::with_capacity(mesh.boundary_faces().len() * 15);
@@ -434,6 +437,9 @@ impl Renderer for Raycast {
         )))
     }
 }
+
+/// Label of the buffers that hold the mesh (one per storage binding).
+const MESH_BINDING_LABEL: &str = "raycast mesh binding";
 
 fn frame(
     gpu: &Gpu,

@@ -66,16 +66,28 @@ impl PaperModule for FragmentPt {
     }
 
     fn plan(&self) -> Vec<RunSpec> {
-        let mut plan = vec![RunSpec {
-            name: "fragment-pt".into(),
+        let table1 = |name: &str, datasets: Vec<String>, full_viewport: bool| RunSpec {
+            name: name.into(),
             algorithms: vec!["fragment-pt".into()],
-            datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
+            datasets,
             viewpoints: "orbit:14".into(),
             resolution: 512,
             tf: None,
             settings: Some(FRAGMENT_SETTINGS.into()),
             quick_settings: None,
-        }];
+            full_viewport,
+            full_views: false,
+        };
+        let (brain, others): (Vec<String>, Vec<String>) = DATASETS
+            .map(|(_, d)| d.to_string())
+            .into_iter()
+            .partition(|d| d == "brain");
+        let mut plan = vec![
+            table1("fragment-pt", others, false),
+            // §5's 5.5 M tets on a 256 MB board (claim F7) is judged on the device bytes of
+            // the Brain row, which depend on the viewport: 512² in every mode.
+            table1("fragment-pt-brain", brain, true),
+        ];
         for (label, alg, settings) in TABLE2.iter().skip(1) {
             let Some(alg) = alg else { continue };
             plan.push(RunSpec {
@@ -87,6 +99,8 @@ impl PaperModule for FragmentPt {
                 tf: None,
                 settings: (!settings.is_empty()).then(|| settings.to_string()),
                 quick_settings: None,
+                full_viewport: false,
+                full_views: false,
             });
         }
         plan
@@ -183,7 +197,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         conditions: "Paper (§4): 16 B per tet texel + 16 B per vertex texel, about 20 B/tet at about four tets per vertex. Ours: the renderer's `model_bytes_per_tet` counter (tet indices + vertices), which does not depend on the GPU. Claims F2 (about 20) and F3 (under the ray casters' 96 and 144) give the verdicts.".into(),
         metrics: vec![Metric::new("B/tet", 1)],
         rows: bytes_rows,
-        notes: vec![],
+        notes: brain_bytes_note(m).into_iter().collect(),
     });
 
     // Table 2.
@@ -224,6 +238,51 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         rows,
         notes: vec![],
     });
-    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x);
+    report.claims = crate::papers::evidence::evaluate_claims(
+        PAPER.id,
+        m,
+        x,
+        &crate::papers::evidence::no_analyses,
+    );
     report
+}
+
+/// §5's 5.5 M tets on a 256 MB board (claim F7): where the Brain row's device bytes go, from
+/// the renderer's ledger counters, beside what the paper's own textures would take.
+fn brain_bytes_note(m: &Measured) -> Option<String> {
+    let r = m
+        .rows
+        .iter()
+        .find(|r| r.algorithm == "fragment-pt" && r.dataset == "brain" && r.ok())?;
+    let total = r.gpu_bytes? as f64;
+    let tets = r.tets as f64;
+    const MIB: f64 = 1048576.0;
+    let paper = format!(
+        "The paper keeps pass 1's output in two RGBA32F render targets, one texel per tet (§3.1): 32 B/tet beside the 20 of §4, which for this mesh alone is {:.1} MiB.",
+        52.0 * tets / MIB
+    );
+    let head = format!(
+        "Brain (claim F7, §5's 5.5 M tets on a 256 MB board), as allocated at {}²: {:.1} MiB in all for {} tets, {:.1} B/tet",
+        r.width,
+        total / MIB,
+        r.tets,
+        total / tets
+    );
+    let per = |name: &str| r.counter(name);
+    Some(match (
+        per("model_bytes_per_tet"),
+        per("records_bytes_per_tet"),
+        per("sort_bytes_per_tet"),
+    ) {
+        (Some(model), Some(records), Some(sort)) => format!(
+            "{head}: the model {model:.1} B/tet (§4's 20), pass 1's per-tet records {records:.1} B/tet, the sort's depths and order {sort:.1} B/tet, tables, parameters and the target {:.1} B/tet. {paper}",
+            total / tets - model - records - sort
+        ),
+        // Rows without the per-buffer counters: the split the row itself records.
+        _ => format!(
+            "{head}: {:.1} B/tet live as long as the mesh (the model and the tables), {:.1} B/tet are per-frame buffers (pass 1's per-tet records, the sort's buffers, the target). {paper}",
+            r.gpu_bytes_persistent.unwrap_or(0) as f64 / tets,
+            r.gpu_bytes_frame.unwrap_or(0) as f64 / tets
+        ),
+    })
 }

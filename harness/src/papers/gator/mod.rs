@@ -6,9 +6,14 @@
 //! Fin, Oxygen Post and Delta Wing, sort excluded, averaged over many viewpoints (we use the 14;
 //! the paper's viewport is not stated, we use 512²).
 
+pub mod geometry;
+
+use crate::papers::claims::VariantSpec;
+use crate::papers::evidence::exact_side;
 use crate::papers::session::{find, is_standin, Extra, Measured, Report, RunSpec, Session};
 use crate::papers::table::{Cell, CompRow, Comparison, Metric};
 use crate::papers::transcription;
+use crate::papers::verdict::Side;
 use crate::papers::{Paper, PaperModule};
 
 pub const PAPER: Paper = Paper {
@@ -49,6 +54,14 @@ pub const OUR_CASE_OF_PAPER_ROW: [u8; 14] = [14, 13, 9, 11, 7, 5, 3, 1, 10, 12, 
 /// the paper's order (the paper's test 3, |V0→middle| > |V0→I|, is our t4; its test 4,
 /// cross1.z > 0, is our t3).
 pub fn observed_truth_table(samples: usize) -> Vec<ObservedCase> {
+    observed_truth_table_with(samples, &gator_pt::classify_cpu)
+}
+
+/// [`observed_truth_table`] of another classifier (a test's broken one).
+pub fn observed_truth_table_with(
+    samples: usize,
+    classify: &dyn Fn([[f64; 3]; 4]) -> gator_pt::Classification,
+) -> Vec<ObservedCase> {
     let mut x = 0x9e37_79b9_7f4a_7c15u64;
     let mut rnd = || {
         x ^= x << 13;
@@ -59,7 +72,7 @@ pub fn observed_truth_table(samples: usize) -> Vec<ObservedCase> {
     let mut seen: Vec<ObservedCase> = vec![];
     for _ in 0..samples {
         let p: [[f64; 3]; 4] = std::array::from_fn(|_| [rnd(), rnd(), rnd()]);
-        let c = gator_pt::classify_cpu(p);
+        let c = classify(p);
         let [t1, t2, t3, t4] = c.tests;
         let o = ObservedCase {
             case: c.case,
@@ -140,6 +153,84 @@ pub fn table1_mismatches(observed: &[ObservedCase], rows: &[[Option<bool>; 4]]) 
     out
 }
 
+/// GATOR's CPU analyses besides the runs, kept in [`Extra::own`].
+#[derive(Debug, Clone, Default)]
+pub struct GatorAnalyses {
+    /// Table 1: the classifier's distinct outcomes on random tets (`None`: not run).
+    pub truth_table: Option<Vec<ObservedCase>>,
+    /// G1: the classifier against the projected hull on the paper's meshes and views.
+    pub geometry: Vec<geometry::GeometryCheck>,
+}
+
+/// The analyses `x` holds (empty when GATOR's were not run).
+pub fn analyses_of(x: &Extra) -> &GatorAnalyses {
+    static NONE: GatorAnalyses = GatorAnalyses {
+        truth_table: None,
+        geometry: Vec::new(),
+    };
+    x.own::<GatorAnalyses>().unwrap_or(&NONE)
+}
+
+/// The viewport of the geometric check (the plan's; only its aspect matters).
+const GEOMETRY_RESOLUTION: u32 = 512;
+
+/// A claim's side from GATOR's CPU analyses (`classifier-twin`); `None`: not one of them.
+pub fn claim_side(
+    x: &Extra,
+    metric: &str,
+    spec: &VariantSpec,
+    dataset: Option<&str>,
+) -> Option<Result<Side, String>> {
+    if spec.algorithm != "classifier-twin" {
+        return None;
+    }
+    let a = analyses_of(x);
+    Some(match metric {
+        "classifier_mismatches" => match &a.truth_table {
+            None => Err("the classifier was not run (`tetbench reproduce gator` runs it)".into()),
+            Some(observed) => {
+                let mismatches = table1_mismatches(observed, &paper_rows());
+                exact_side(
+                    format!(
+                        "gator-pt classifier (CPU twin), {} distinct outcomes, mismatches{}{}",
+                        observed.len(),
+                        if mismatches.is_empty() { "" } else { ": " },
+                        mismatches.join("; ")
+                    ),
+                    "table1",
+                    mismatches.len() as f64,
+                )
+            }
+        },
+        "classifier_geometry_mismatches" => {
+            let Some(d) = dataset else {
+                return Some(Err(format!("{metric} needs a data set")));
+            };
+            match a.geometry.iter().find(|g| g.dataset == d) {
+                None => Err(format!(
+                    "the classifier was not checked against geometry on {d} (`tetbench reproduce gator` does)"
+                )),
+                Some(g) => exact_side(
+                    format!(
+                        "gator-pt classifier (CPU twin) against the projected hull on {d}, {} viewpoints: {} projected tets compared ({} too close to degenerate to call, {} behind the eye), {} class and {} thick-vertex mismatches{}{}",
+                        g.viewpoints,
+                        g.compared,
+                        g.ambiguous,
+                        g.behind_eye,
+                        g.class_mismatches,
+                        g.thick_vertex_mismatches,
+                        if g.examples.is_empty() { "" } else { ", e.g. " },
+                        g.examples.join("; ")
+                    ),
+                    d,
+                    g.mismatches() as f64,
+                ),
+            }
+        }
+        _ => Err(format!("classifier-twin has no metric {metric}")),
+    })
+}
+
 /// The GATOR paper.
 pub struct Gator;
 
@@ -158,17 +249,21 @@ impl PaperModule for Gator {
             tf: None,
             settings: Some("variant=constant|linear".into()),
             quick_settings: None,
+            full_viewport: false,
+            full_views: false,
         }]
     }
 
     fn analyses(&self, s: &mut Session, m: &mut Measured) -> anyhow::Result<Extra> {
-        let mut x = Extra {
+        let mut own = GatorAnalyses {
             truth_table: Some(observed_truth_table(200_000)),
-            ..Default::default()
+            geometry: vec![],
         };
         s.log.push(
             "Table 1: 200,000 random projected tets through the classifier's CPU twin".into(),
         );
+        let views = render_core::fixed_viewpoints();
+        let mut x = Extra::default();
         let registry = datasets::registry::Registry::new(s.data_dir.clone());
         for (_, d) in DATASETS {
             match registry.resolve(&s.dataset(d), &datasets::LoadOptions::default()) {
@@ -180,12 +275,30 @@ impl PaperModule for Gator {
                     ));
                     x.dropped
                         .push((d.to_string(), ds.mesh.repair.degenerate_dropped as u64));
+                    // G1: every tet from the paper's views (the 14; it averages "many"), at
+                    // full size in every mode: no GPU, a few seconds.
+                    let t0 = std::time::Instant::now();
+                    let g = geometry::check_mesh(
+                        d,
+                        &ds.mesh,
+                        &views,
+                        GEOMETRY_RESOLUTION,
+                        &gator_pt::classify_cpu,
+                    );
+                    s.log.push(format!(
+                        "G1: the classifier against the projected hull on {d}, {} viewpoints, {} tets compared, {:.0} s",
+                        views.len(),
+                        g.compared,
+                        t0.elapsed().as_secs_f64()
+                    ));
+                    own.geometry.push(g);
                 }
                 Err(e) => m
                     .errors
                     .push(format!("data set \"{d}\" could not be loaded: {e}")),
             }
         }
+        x.own = Some(std::sync::Arc::new(own));
         Ok(x)
     }
 
@@ -203,7 +316,8 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     let t = load("gator_table1");
     let cols = ["test1_bool", "test2_bool", "test3_bool", "test4_bool"];
     let rows_p = paper_rows();
-    let observed = x.truth_table.as_deref().unwrap_or(&[]);
+    let own = analyses_of(x);
+    let observed = own.truth_table.as_deref().unwrap_or(&[]);
     let rows: Vec<CompRow> = t
         .keys()
         .iter()
@@ -212,7 +326,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
             let ours_case = OUR_CASE_OF_PAPER_ROW[i];
             let hits: Vec<&ObservedCase> =
                 observed.iter().filter(|o| o.case == ours_case).collect();
-            let why = if x.truth_table.is_none() {
+            let why = if own.truth_table.is_none() {
                 Some("not run (`tetbench reproduce gator` classifies random tets)".to_string())
             } else if hits.is_empty() {
                 Some(format!("our case {ours_case} was never observed"))
@@ -259,7 +373,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         "{} distinct (case, class, outcome) triples observed; X (don't care) cells accept either value and are left out of the comparison. The paper prints no triangle counts: a row's count follows from its test 3, the class-2 test (four triangles; otherwise three).",
         observed.len()
     )];
-    if x.truth_table.is_some() {
+    if own.truth_table.is_some() {
         notes.push(if mismatches.is_empty() {
             "Every observed outcome fits exactly one paper row, with that row's case number and triangle count, and every row is observed.".into()
         } else {
@@ -376,8 +490,26 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
             Metric::new("linear tets/s", 0),
         ],
         rows,
-        notes: vec![],
+        notes: linear_data_note(m).into_iter().collect(),
     });
-    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x);
+    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x, &|metric, spec, d| {
+        claim_side(x, metric, spec, d)
+    });
     report
+}
+
+/// Claim G10 (§4: linear cells carry four times the data per cell): the device bytes per tet
+/// of both variants as measured, and why they are equal here.
+fn linear_data_note(m: &Measured) -> Option<String> {
+    let bytes = |variant: &str| {
+        m.rows
+            .iter()
+            .filter(|r| r.algorithm == "gator-pt" && r.ok() && r.settings.is("variant", variant))
+            .find_map(|r| Some((r.dataset.clone(), r.bytes_per_tet?)))
+    };
+    let ((d, linear), (_, constant)) = (bytes("linear")?, bytes("constant")?);
+    Some(format!(
+        "Data per cell (claim G10): on {d} the linear variant holds {linear:.1} device bytes per tet, the constant one {constant:.1} (ratio {:.2}). Both read the same per-vertex scalars and look colour and extinction up in the shader from one transfer-function table; the paper's linear cells send colour and extinction for each of the four vertices over AGP instead of once per cell (§4), which is what it counts four times. Ours does not reproduce that cost.",
+        linear / constant
+    ))
 }

@@ -42,6 +42,29 @@ pub struct SortArgs {
     pub out: PathBuf,
 }
 
+/// HAVS's CPU analyses besides the runs (Tables 1 and 2), kept in [`Extra::own`].
+#[derive(Debug, Clone, Default)]
+pub struct HavsAnalyses {
+    /// Table 1: each sort's median, fastest and slowest run.
+    pub sorts: Vec<SortRow>,
+    /// Table 2 rows.
+    pub kbuffer: Vec<KbufferRow>,
+    /// How many viewpoints and what viewport the k analysis used.
+    pub kbuffer_views: usize,
+    pub kbuffer_resolution: u32,
+}
+
+/// The analyses `x` holds (empty when HAVS's were not run).
+pub fn of(x: &Extra) -> &HavsAnalyses {
+    static NONE: HavsAnalyses = HavsAnalyses {
+        sorts: Vec::new(),
+        kbuffer: Vec::new(),
+        kbuffer_views: 0,
+        kbuffer_resolution: 0,
+    };
+    x.own::<HavsAnalyses>().unwrap_or(&NONE)
+}
+
 /// One row of Table 1.
 #[derive(Debug, Clone)]
 pub struct SortRow {
@@ -153,10 +176,10 @@ pub fn run_sort(args: SortArgs) -> anyhow::Result<()> {
         )?;
     }
     md.push('\n');
-    let extra = Extra {
+    let extra = Extra::with_own(HavsAnalyses {
         sorts: rows,
-        ..Extra::default()
-    };
+        ..HavsAnalyses::default()
+    });
     md.push_str(&markdown(&super::table1(&extra)));
     let md_path = args.out.join("havs_table1.md");
     std::fs::write(&md_path, &md).with_context(|| format!("cannot write {}", md_path.display()))?;
@@ -375,12 +398,12 @@ pub fn table2_markdown(rows: &[KbufferRow], resolution: u32, viewpoints: usize) 
         );
     }
     md.push('\n');
-    let extra = Extra {
+    let extra = Extra::with_own(HavsAnalyses {
         kbuffer: rows.to_vec(),
         kbuffer_views: viewpoints,
         kbuffer_resolution: resolution,
-        ..Extra::default()
-    };
+        ..HavsAnalyses::default()
+    });
     let table = super::table2(&Measured::default(), &extra);
     let papers_own: Vec<&str> = table.rows.iter().map(|r| r.label.as_str()).collect();
     if rows

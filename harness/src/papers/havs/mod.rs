@@ -11,11 +11,14 @@ use render_core::TransferFunction;
 
 pub mod analysis;
 
+use crate::papers::claims::VariantSpec;
+use crate::papers::evidence::exact_side;
 use crate::papers::session::{
     find, find_including, is_standin, Extra, Measured, Report, RunSpec, Session,
 };
 use crate::papers::table::{Cell, CompRow, Comparison, Metric};
 use crate::papers::transcription::{self, PaperTable};
+use crate::papers::verdict::{Sample, Side};
 use crate::papers::{Paper, PaperModule};
 
 pub const PAPER: Paper = Paper {
@@ -71,6 +74,8 @@ impl PaperModule for Havs {
             tf: None,
             settings: Some(HAVS_SETTINGS.into()),
             quick_settings: None,
+            full_viewport: false,
+            full_views: false,
         }];
         // Table 5's other rows.
         for (label, alg, settings) in TABLE5_ALGORITHMS.iter().skip(1) {
@@ -83,6 +88,8 @@ impl PaperModule for Havs {
                 tf: None,
                 settings: settings.map(String::from),
                 quick_settings: None,
+                full_viewport: false,
+                full_views: false,
             });
         }
         plan
@@ -92,9 +99,9 @@ impl PaperModule for Havs {
         // Table 1: CPU sorts of 1 M floats, median of 5 runs. Not shrunk in quick mode: five
         // sorts of 1 M floats take seconds, and one run per sort would leave the orderings of
         // Table 1 without a spread.
-        let mut x = Extra {
+        let mut x = analysis::HavsAnalyses {
             sorts: analysis::sort_times(1_000_000, 5)?,
-            ..Extra::default()
+            ..Default::default()
         };
         s.log
             .push("Table 1: `tetbench analyze sort` (1 M floats)".into());
@@ -129,7 +136,7 @@ impl PaperModule for Havs {
                     .push(format!("data set \"{d}\" could not be loaded: {e}")),
             }
         }
-        Ok(x)
+        Ok(Extra::with_own(x))
     }
 
     fn tables(&self, m: &Measured, x: &Extra) -> Report {
@@ -327,7 +334,9 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     report.notes.push(
         "Rows on f117, kew, torso and fighter are measured on generated stand-ins with the papers' tet counts (non-convex cavities where the originals are; `tetbench datasets list`); spx2 is spx split 1:8 twice, the paper's own mesh. Timings on stand-ins compare sizes, not images.".into(),
     );
-    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x);
+    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x, &|metric, spec, d| {
+        claim_side(x, metric, spec, d)
+    });
     report
 }
 
@@ -341,7 +350,8 @@ pub fn table1(x: &Extra) -> Comparison {
             "radixsort" => "radix sort (HAVS §5.1, one core)",
             other => other,
         };
-        x.sorts
+        analysis::of(x)
+            .sorts
             .iter()
             .find(|r| r.name.starts_with(prefix))
             .map(|r| r.ms)
@@ -386,7 +396,7 @@ pub fn table2(m: &Measured, x: &Extra) -> Comparison {
         .keys()
         .iter()
         .map(|k| {
-            let ours = x.kbuffer.iter().find(|r| r.dataset == *k);
+            let ours = analysis::of(x).kbuffer.iter().find(|r| r.dataset == *k);
             let val = |c: &str| {
                 ours.map(|r| match c {
                     "fragments_count" => r.fragments as f64,
@@ -416,13 +426,13 @@ pub fn table2(m: &Measured, x: &Extra) -> Comparison {
         title: "Table 2 — k-buffer analysis (exact A-buffer, maxima over the viewpoints)".into(),
         conditions: format!(
             "Paper: software A-buffer, 512², maximum over 14 viewpoints; k is the deepest insertion of a fragment into its pixel's ordered A-buffer, plus one for compositing (§5.2). Ours: the CPU model of `tetbench analyze kbuffer`, {}², over {} viewpoint(s), k measured the same way. Counts are geometric (no GPU); they can equal the paper's only on the same mesh, camera, viewport, rasterisation rule and face order, so the cells are compared exactly here and claims H3–H5 compare spx2 (the paper's own mesh) within a stated tolerance.",
-            x.kbuffer_resolution, x.kbuffer_views
+            analysis::of(x).kbuffer_resolution, analysis::of(x).kbuffer_views
         ),
         metrics: cols.iter().map(|(_, n)| Metric::exact(*n, 0)).collect(),
         rows,
         notes: rows_differ_why(&t, x)
             .into_iter()
-            .chain(x
+            .chain(analysis::of(x)
             .kbuffer
             .iter()
             .filter(|r| r.exact_max_k < r.max_k || r.exact_pixels_k_gt2 < r.pixels_k_gt2)
@@ -447,7 +457,8 @@ pub fn table2(m: &Measured, x: &Extra) -> Comparison {
 /// fill rule, the order of faces with equal keys). Bulk counts move little with them; the tail
 /// (k > 6) and the maxima (longest list, largest k) move most.
 fn rows_differ_why(t: &transcription::PaperTable, x: &Extra) -> Vec<String> {
-    x.kbuffer
+    analysis::of(x)
+        .kbuffer
         .iter()
         .filter(|r| !is_standin(&r.dataset))
         .filter_map(|r| {
@@ -466,4 +477,91 @@ fn rows_differ_why(t: &transcription::PaperTable, x: &Extra) -> Vec<String> {
             ))
         })
         .collect()
+}
+
+/// A claim's side from HAVS's CPU analyses (the sorts of Table 1, the k-buffer model of
+/// Table 2); `None`: not one of them.
+pub fn claim_side(
+    x: &Extra,
+    metric: &str,
+    spec: &VariantSpec,
+    dataset: Option<&str>,
+) -> Option<Result<Side, String>> {
+    let exact = exact_side;
+    let need = |d: Option<&str>| {
+        d.map(String::from)
+            .ok_or_else(|| format!("{metric} needs a data set"))
+    };
+    Some(match spec.algorithm.as_str() {
+        "sort-analysis" => {
+            let name = spec.setting("sort").unwrap_or_default();
+            // Table 1's radix sort is §5.1's one-core LSD sort.
+            let prefix = if name == "radixsort" {
+                "radix sort (HAVS §5.1, one core)"
+            } else {
+                name.as_str()
+            };
+            let Some(r) = analysis::of(x)
+                .sorts
+                .iter()
+                .find(|r| r.name.starts_with(prefix))
+            else {
+                return Some(Err(format!(
+                    "sort {name}: not measured (`tetbench reproduce havs` times the sorts)"
+                )));
+            };
+            let keys = r.keys_per_sec * r.ms * 1e-3;
+            let (value, min, max) = match metric {
+                "sort_ms" => (r.ms, r.min_ms, r.max_ms),
+                "sort_keys_per_sec" => (
+                    r.keys_per_sec,
+                    keys / (r.max_ms * 1e-3),
+                    keys / (r.min_ms * 1e-3),
+                ),
+                _ => return Some(Err(format!("sort-analysis has no metric {metric}"))),
+            };
+            Ok(Side::new(
+                format!(
+                    "{} ({keys:.0} floats, median of {} runs)",
+                    r.name, r.repeats
+                ),
+                vec![Sample {
+                    key: "sort".into(),
+                    value,
+                    min,
+                    max,
+                    frames: r.repeats,
+                }],
+            ))
+        }
+        "kbuffer-analysis" => (|| {
+            let d = need(dataset)?;
+            let r = analysis::of(x)
+                .kbuffer
+                .iter()
+                .find(|r| r.dataset == d)
+                .ok_or_else(|| {
+                    format!("k-buffer analysis of {d}: not run (`tetbench reproduce havs` runs it)")
+                })?;
+            let pixels = f64::from(analysis::of(x).kbuffer_resolution).powi(2);
+            let v = match metric {
+                "kbuffer_fragments" => r.fragments as f64,
+                "kbuffer_pixels_k_gt2" => r.pixels_k_gt2 as f64,
+                "kbuffer_pixels_k_gt6" => r.pixels_k_gt6 as f64,
+                "kbuffer_share_k_gt6" => r.pixels_k_gt6 as f64 / pixels.max(1.0),
+                "kbuffer_max_k" => r.max_k as f64,
+                _ => return Err(format!("kbuffer-analysis has no metric {metric}")),
+            };
+            exact(
+                format!(
+                    "k-buffer analysis of {d}, {} viewpoints at {}²",
+                    analysis::of(x).kbuffer_views,
+                    analysis::of(x).kbuffer_resolution
+                ),
+                &d,
+                v,
+            )
+        })(),
+        _ => return None,
+    })
 }

@@ -65,6 +65,8 @@ impl PaperModule for Splat {
             tf: Some(TABLE1_TF),
             settings: Some(TABLE1_SETTINGS.into()),
             quick_settings: Some(TABLE1_QUICK_SETTINGS.into()),
+            full_viewport: false,
+            full_views: false,
         }]
     }
 
@@ -152,6 +154,11 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         rows,
         notes: radix_notes,
     });
-    report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x);
+    report.claims = crate::papers::evidence::evaluate_claims(
+        PAPER.id,
+        m,
+        x,
+        &crate::papers::evidence::no_analyses,
+    );
     report
 }
