@@ -44,7 +44,7 @@ pub fn validate(name: &str, value: &serde_json::Value) -> Result<(), String> {
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::*;
     use serde_json::{json, Value};
     use std::path::Path;
@@ -71,7 +71,7 @@ pub(crate) mod tests {
     }
 
     /// A named change to a valid document that must make it invalid.
-    pub(crate) type Mutation = (&'static str, fn(&mut Value));
+    type Mutation = (&'static str, fn(&mut Value));
 
     /// `value` validates as `name`, and each mutation of it does not.
     fn validates_and_mutations_fail(name: &str, value: &Value, mutations: &[Mutation]) {
@@ -82,6 +82,49 @@ pub(crate) mod tests {
             assert!(
                 validate(name, &bad).is_err(),
                 "{name} with {what} still validates"
+            );
+        }
+    }
+
+    /// A results.json written by a real run (the committed baseline) validates against
+    /// docs/results.schema.json (generated from the types); with
+    /// `total_ms` renamed, an unknown field, or a required field missing, it does not.
+    #[test]
+    fn a_real_results_file_validates_and_a_renamed_column_does_not() {
+        let baselines = Path::new(env!("CARGO_MANIFEST_DIR")).join("../reports/baselines");
+        let dir = std::fs::read_dir(&baselines)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.join(crate::results::JSON_FILE).is_file())
+            .expect("a committed baseline");
+        crate::results::ResultsFile::read(&dir).unwrap();
+        let real: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.join(crate::results::JSON_FILE)).unwrap(),
+        )
+        .unwrap();
+        validate("results", &real).unwrap();
+        let mutations: [Mutation; 4] = [
+            ("total_ms renamed", |v| {
+                let row = v["rows"][0].as_object_mut().unwrap();
+                let t = row.remove("total_ms").unwrap();
+                row.insert("total_msec".into(), t);
+            }),
+            ("an unknown machine field", |v| {
+                v["machine"]["gpu_temperature"] = serde_json::json!(80);
+            }),
+            ("no algorithm", |v| {
+                v["rows"][0].as_object_mut().unwrap().remove("algorithm");
+            }),
+            ("a counter as a word", |v| {
+                v["rows"][0]["counters"] = serde_json::json!({"fragments": "many"});
+            }),
+        ];
+        for (what, mutate) in mutations {
+            let mut bad = real.clone();
+            mutate(&mut bad);
+            assert!(
+                validate("results", &bad).is_err(),
+                "results.json with {what} still validates"
             );
         }
     }
