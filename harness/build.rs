@@ -6,33 +6,12 @@
 //! `rustc-env` lines, and it must also rerun when a tracked source changes (for the dirty
 //! flag), which those crates leave to the caller anyway.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
 
-fn git(root: &Path, args: &[&str]) -> Option<String> {
-    let out = Command::new("git")
-        .arg("-C")
-        .arg(root)
-        .args(args)
-        .output()
-        .ok()?;
-    out.status
-        .success()
-        .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
-}
-
-/// What the binary is built from: a change here (tracked or not) makes the tree dirty and
-/// reruns this script.
-const SOURCE_PATHS: [&str; 8] = [
-    "harness",
-    "datasets",
-    "renderers",
-    "peers",
-    "tests",
-    "scripts",
-    "Cargo.toml",
-    "Cargo.lock",
-];
+#[path = "src/results/git_state.rs"]
+mod git_state;
+use git_state::{git, SOURCE_PATHS};
 
 fn main() {
     let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo"));
@@ -43,14 +22,8 @@ fn main() {
 
     let commit = git(&root, &["rev-parse", "HEAD"]);
     // Dirty: a tracked file differs from the commit, or a source folder holds a file git
-    // does not track (a new module the commit lacks; ignored build outputs do not count).
-    let dirty = commit.as_ref().and_then(|_| {
-        let tracked = git(&root, &["status", "--porcelain", "--untracked-files=no"])?;
-        let mut untracked_args = vec!["status", "--porcelain", "--untracked-files=all", "--"];
-        untracked_args.extend(SOURCE_PATHS);
-        let untracked = git(&root, &untracked_args)?;
-        Some(!tracked.is_empty() || !untracked.is_empty())
-    });
+    // does not track (`git_state::dirty`, tested there).
+    let dirty = git_state::dirty(&root);
     println!(
         "cargo:rustc-env=TETBENCH_GIT_COMMIT={}",
         commit.clone().unwrap_or_default()

@@ -69,6 +69,19 @@ pub fn retype(algorithm: &str, settings: Settings) -> Settings {
     }
 }
 
+/// The counters `algorithm` declares nondeterministic for `settings` on an adapter of
+/// `device_type` (`AlgorithmDescription::nondeterministic_counters`); none for an algorithm
+/// this build does not know.
+pub fn nondeterministic_counters(
+    algorithm: &str,
+    settings: &Settings,
+    device_type: &str,
+) -> &'static [&'static str] {
+    describe(algorithm).map_or(&[], |d| {
+        (d.nondeterministic_counters)(settings, render_core::Shading::of_device_type(device_type))
+    })
+}
+
 fn build_all(
     d: &AlgorithmDescription,
     grid: &[Settings],

@@ -132,8 +132,24 @@ fn the_published_site_passes_a_real_browser_and_a_broken_one_does_not() {
     ] {
         assert!(site.join(page).is_file(), "the site lacks {page}");
     }
+    // Every page below the front page links back to it, however deep it lies.
+    for (page, up) in [
+        ("runs/hostile-run/index.html", "../../"),
+        ("papers/reproduced/havs/report.html", "../../../"),
+    ] {
+        let html = std::fs::read_to_string(site.join(page)).unwrap();
+        let back = format!("<a href=\"{up}index.html\">");
+        assert!(
+            html.contains(&back),
+            "{page} has no link {back} to the front page"
+        );
+    }
     let front = std::fs::read_to_string(site.join("index.html")).unwrap();
     harness::report::html::assert_no_live_markup(&front);
+    assert!(
+        !front.contains("all results</a></nav>"),
+        "the front page links to itself"
+    );
     assert!(
         front.contains("group(s) with a step"),
         "no history on the front page"

@@ -24,6 +24,7 @@ fn row(alg: &str, vp: &str, frames: &[f64]) -> Row {
             total_ms: frames.to_vec(),
             cpu_ms: frames.iter().map(|f| f / 2.0).collect(),
             gpu_ms: vec![],
+            ..Default::default()
         },
         total_ms: Some(frames[0]),
         ..Default::default()

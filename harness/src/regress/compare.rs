@@ -537,7 +537,15 @@ fn compare_rows(
         (false, false) => out.notes.push("fails in both".into()),
         (true, true) => {}
     }
-    for change in crate::regress::compare_work::work_changes(b, n, opt.threshold) {
+    for change in crate::regress::compare_work::work_changes(
+        b,
+        n,
+        &crate::regress::compare_work::WorkJudge {
+            threshold: opt.threshold,
+            alpha: opt.alpha,
+            rounds,
+        },
+    ) {
         match change.verdict {
             WorkVerdict::More => d.worse = true,
             WorkVerdict::Less => d.better = true,

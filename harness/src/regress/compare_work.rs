@@ -11,15 +11,18 @@
 //! The exception is declared, not guessed: a counter the algorithm's description
 //! ([`render_core::AlgorithmDescription::nondeterministic_counters`]) names for the row's
 //! variant on the row's kind of adapter (HAVS's racy single pass on a GPU) is decided by a race
-//! and differs between frames. Rows keep only its median over the frames, so it is judged by
-//! compare's factor threshold instead (a change needs NEW/BASE ≥ `--threshold` or
-//! ≤ 1/`--threshold`), and the change names that rule.
+//! and differs between frames. Such a counter is compared **statistically**, as time is: the
+//! row keeps its per-frame values (`samples.counters`), one value per round is their median,
+//! and asv's rule decides (Mann–Whitney p < α and a ratio of medians beyond `--threshold`,
+//! [`crate::regress::compare_time::time_test`]). Where either side has fewer than
+//! [`MIN_ROUNDS`] rounds of such values (rows written before they were kept, or a one-round
+//! run), only the factor threshold decides, and the change says which rule judged it.
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use render_core::Shading;
-
+use crate::regress::compare_rounds::{round_values, Rounds, MIN_ROUNDS};
+use crate::regress::compare_time::{time_test, Verdict};
 use crate::results::Row;
 
 /// How a work figure was judged.
@@ -28,8 +31,12 @@ use crate::results::Row;
 pub enum WorkRule {
     /// Any difference is a change.
     Exact,
-    /// Declared nondeterministic on this adapter: a change needs the factor threshold.
+    /// Declared nondeterministic on this adapter, with too few rounds of per-frame values to
+    /// test: a change needs the factor threshold.
     Threshold,
+    /// Declared nondeterministic on this adapter: asv's rule on one value per round (p < α
+    /// and the factor threshold), as for time.
+    Statistical,
 }
 
 /// Which way a work figure moved.
@@ -70,6 +77,9 @@ pub struct WorkChange {
     /// NEW / BASE (`None` where a side lacks it or BASE is 0).
     pub ratio: Option<f64>,
     pub rule: WorkRule,
+    /// [`WorkRule::Statistical`]: the Mann–Whitney p of the per-round values.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub p_value: Option<f64>,
     pub verdict: WorkVerdict,
 }
 
@@ -81,8 +91,15 @@ impl WorkChange {
         if let Some(r) = self.ratio {
             s.push_str(&format!(" (×{r:.4})"));
         }
-        if self.rule == WorkRule::Threshold {
-            s.push_str(" [nondeterministic on this adapter: judged by the threshold]");
+        match (self.rule, self.p_value) {
+            (WorkRule::Exact, _) => {}
+            (WorkRule::Threshold, _) => {
+                s.push_str(" [nondeterministic on this adapter: judged by the threshold]")
+            }
+            (WorkRule::Statistical, p) => s.push_str(&format!(
+                " [nondeterministic on this adapter: per-round values, p = {}]",
+                p.map_or("-".into(), |p| format!("{p:.3}"))
+            )),
         }
         s
     }
@@ -97,20 +114,57 @@ fn byte_figures(r: &Row) -> [(&'static str, Option<u64>); 3] {
     ]
 }
 
-/// The counters the row's algorithm declares nondeterministic for its variant on its adapter.
-fn nondeterministic(r: &Row) -> &'static [&'static str] {
-    crate::algorithms::describe(&r.algorithm).map_or(&[], |d| {
-        (d.nondeterministic_counters)(&r.settings, Shading::of_device_type(&r.device_type))
-    })
+/// How compare judges the work of two matched rows: its factor threshold and α, and the
+/// rounds each side holds (a nondeterministic counter's samples split into them).
+#[derive(Debug, Clone, Copy)]
+pub struct WorkJudge {
+    pub threshold: f64,
+    pub alpha: f64,
+    pub rounds: Rounds,
+}
+
+/// A nondeterministic counter's rule, p and direction (`None`: no change; `Some(true)`: NEW
+/// counts more): asv's rule on per-round values where both sides hold enough rounds of them,
+/// else the factor threshold on the rows' medians `(base, new)`.
+fn judge_nondeterministic(
+    (b, n): (&Row, &Row),
+    counter: &str,
+    (base, new): (f64, f64),
+    judge: &WorkJudge,
+) -> (WorkRule, Option<f64>, Option<bool>) {
+    let per_round =
+        |r: &Row, rounds: u32| round_values(r, counter, rounds, false).unwrap_or_default();
+    let (bs, ns) = (
+        per_round(b, judge.rounds.base),
+        per_round(n, judge.rounds.new),
+    );
+    let enough = MIN_ROUNDS as usize;
+    if judge.rounds.enough() && bs.len() >= enough && ns.len() >= enough {
+        let t = time_test(counter, &bs, &ns, judge.threshold, judge.alpha);
+        let more = match t.verdict {
+            Verdict::Slower => Some(true),
+            Verdict::Faster => Some(false),
+            _ => None,
+        };
+        return (WorkRule::Statistical, t.p_value, more);
+    }
+    let beyond =
+        base == 0.0 || new / base >= judge.threshold || new / base <= 1.0 / judge.threshold;
+    (
+        WorkRule::Threshold,
+        None,
+        (beyond && base != new).then_some(new > base),
+    )
 }
 
 /// Every work figure of two matched rows that differs (in BASE's order, then those only NEW
 /// reports). Rows where either side failed compare nothing: a failed row counted nothing.
-pub fn work_changes(b: &Row, n: &Row, threshold: f64) -> Vec<WorkChange> {
+pub fn work_changes(b: &Row, n: &Row, judge: &WorkJudge) -> Vec<WorkChange> {
     if !b.ok() || !n.ok() {
         return vec![];
     }
-    let racy = nondeterministic(n);
+    let racy =
+        crate::algorithms::nondeterministic_counters(&n.algorithm, &n.settings, &n.device_type);
     let mut figures: Vec<(String, Option<f64>, Option<f64>)> = vec![];
     for ((name, bv), (_, nv)) in byte_figures(b).into_iter().zip(byte_figures(n)) {
         figures.push((name.into(), bv.map(|v| v as f64), nv.map(|v| v as f64)));
@@ -126,29 +180,30 @@ pub fn work_changes(b: &Row, n: &Row, threshold: f64) -> Vec<WorkChange> {
     figures
         .into_iter()
         .filter_map(|(counter, base, new)| {
-            let rule = if racy.contains(&counter.as_str()) {
-                WorkRule::Threshold
-            } else {
-                WorkRule::Exact
-            };
             let ratio = base.zip(new).filter(|(b, _)| *b != 0.0).map(|(b, n)| n / b);
-            let verdict = match (base, new) {
+            let (rule, p_value, verdict) = match (base, new) {
                 (None, None) => return None,
-                (Some(_), None) => WorkVerdict::Removed,
-                (None, Some(_)) => WorkVerdict::Added,
+                (Some(_), None) => (WorkRule::Exact, None, WorkVerdict::Removed),
+                (None, Some(_)) => (WorkRule::Exact, None, WorkVerdict::Added),
                 // NaN (a median that could not be taken) equals nothing: left alone.
-                (Some(b), Some(n)) if b.is_nan() || n.is_nan() || b == n => return None,
-                (Some(b), Some(n)) => {
-                    if rule == WorkRule::Threshold
-                        && ratio.is_some_and(|r| r < threshold && r > 1.0 / threshold)
-                    {
-                        return None;
-                    }
-                    if n > b {
+                (Some(b), Some(n)) if b.is_nan() || n.is_nan() => return None,
+                (Some(bv), Some(nv)) if racy.contains(&counter.as_str()) => {
+                    let (rule, p, more) = judge_nondeterministic((b, n), &counter, (bv, nv), judge);
+                    let verdict = if more? {
                         WorkVerdict::More
                     } else {
                         WorkVerdict::Less
-                    }
+                    };
+                    (rule, p, verdict)
+                }
+                (Some(b), Some(n)) if b == n => return None,
+                (Some(b), Some(n)) => {
+                    let verdict = if n > b {
+                        WorkVerdict::More
+                    } else {
+                        WorkVerdict::Less
+                    };
+                    (WorkRule::Exact, None, verdict)
                 }
             };
             Some(WorkChange {
@@ -157,6 +212,7 @@ pub fn work_changes(b: &Row, n: &Row, threshold: f64) -> Vec<WorkChange> {
                 new,
                 ratio,
                 rule,
+                p_value,
                 verdict,
             })
         })
@@ -166,6 +222,13 @@ pub fn work_changes(b: &Row, n: &Row, threshold: f64) -> Vec<WorkChange> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// compare's defaults on one-round runs: nondeterministic counters by the threshold.
+    const ONE_ROUND: WorkJudge = WorkJudge {
+        threshold: 1.10,
+        alpha: 0.01,
+        rounds: Rounds { base: 1, new: 1 },
+    };
 
     fn row(counters: &str, bytes: u64) -> Row {
         Row {
@@ -188,21 +251,21 @@ mod tests {
     #[test]
     fn a_count_one_higher_is_a_change_and_equal_counts_are_not() {
         let base = row("fragments=1000;triangles=50", 4096);
-        assert!(work_changes(&base, &base.clone(), 1.10).is_empty());
+        assert!(work_changes(&base, &base.clone(), &ONE_ROUND).is_empty());
         let more = row("fragments=1001;triangles=50", 4096);
-        let c = work_changes(&base, &more, 1.10);
+        let c = work_changes(&base, &more, &ONE_ROUND);
         assert_eq!(c.len(), 1, "{c:?}");
         assert_eq!(c[0].counter, "fragments");
         assert_eq!(c[0].verdict, WorkVerdict::More);
         assert_eq!(c[0].rule, WorkRule::Exact);
         assert_eq!(c[0].ratio, Some(1.001));
         let smaller = row("fragments=1000;triangles=50", 4000);
-        let c = work_changes(&base, &smaller, 1.10);
+        let c = work_changes(&base, &smaller, &ONE_ROUND);
         assert_eq!(c.len(), 2, "{c:?}");
         assert!(c.iter().all(|c| c.verdict == WorkVerdict::Less));
         let added = row("fragments=1000;triangles=50;passes=3", 4096);
         assert_eq!(
-            work_changes(&base, &added, 1.10)[0].verdict,
+            work_changes(&base, &added, &ONE_ROUND)[0].verdict,
             WorkVerdict::Added
         );
     }
@@ -211,26 +274,82 @@ mod tests {
     /// small change of `fragments` is noise, a change beyond the threshold still counts, and
     /// on lavapipe (in-order shading) the same +1 is exact.
     #[test]
-    fn declared_racy_counters_are_judged_by_the_threshold_on_a_gpu_only() {
+    fn declared_racy_counters_of_one_round_runs_are_judged_by_the_threshold_on_a_gpu_only() {
         let on = |device: &str, counters: &str| Row {
             device_type: device.into(),
             ..row(counters, 4096)
         };
         let base = on("DiscreteGpu", "fragments=1000;triangles=50");
         let plus_one = on("DiscreteGpu", "fragments=1001;triangles=50");
-        assert!(work_changes(&base, &plus_one, 1.10).is_empty());
+        assert!(work_changes(&base, &plus_one, &ONE_ROUND).is_empty());
         let far = on("DiscreteGpu", "fragments=1200;triangles=50");
-        let c = work_changes(&base, &far, 1.10);
+        let c = work_changes(&base, &far, &ONE_ROUND);
         assert_eq!(c[0].rule, WorkRule::Threshold);
         assert_eq!(c[0].verdict, WorkVerdict::More);
         // triangles are not racy: exact on a GPU too.
         let tri = on("DiscreteGpu", "fragments=1000;triangles=51");
-        assert_eq!(work_changes(&base, &tri, 1.10)[0].rule, WorkRule::Exact);
+        assert_eq!(
+            work_changes(&base, &tri, &ONE_ROUND)[0].rule,
+            WorkRule::Exact
+        );
         let cpu = work_changes(
             &on("Cpu", "fragments=1000;triangles=50"),
             &on("Cpu", "fragments=1001;triangles=50"),
             1.10,
         );
         assert_eq!(cpu[0].rule, WorkRule::Exact);
+    }
+
+    /// A racy row of `rounds` rounds of 3 frames whose per-frame `fragments` are `per_frame`
+    /// (its median the row's counter), on a GPU.
+    fn racy_on_gpu(per_frame: &[f64]) -> Row {
+        let mut r = Row {
+            device_type: "DiscreteGpu".into(),
+            ..row("triangles=50", 4096)
+        };
+        r.counters
+            .insert("fragments", crate::results::stats::median(per_frame));
+        r.samples
+            .counters
+            .insert("fragments".into(), per_frame.to_vec());
+        r
+    }
+
+    /// With five rounds a side of per-frame values, asv's rule judges a racy counter: the
+    /// same scatter is no change, the same scatter 20 % higher is a regression with its p, and
+    /// 20 % higher on only one round of five is not (the rows' medians alone moved ×1.2 in
+    /// none of them: the test needs the rounds to agree).
+    #[test]
+    fn racy_counters_with_rounds_are_judged_statistically() {
+        let judge = WorkJudge {
+            rounds: Rounds { base: 5, new: 5 },
+            ..ONE_ROUND
+        };
+        // 5 rounds × 3 frames, a race's scatter of a few per cent.
+        let scatter: Vec<f64> = (0..15).map(|i| 1000.0 + ((i * 37) % 50) as f64).collect();
+        let base = racy_on_gpu(&scatter);
+        let same: Vec<f64> = scatter.iter().rev().copied().collect();
+        assert!(work_changes(&base, &racy_on_gpu(&same), &judge).is_empty());
+        let more: Vec<f64> = scatter.iter().map(|v| v * 1.2).collect();
+        let c = work_changes(&base, &racy_on_gpu(&more), &judge);
+        assert_eq!(c.len(), 1, "{c:?}");
+        assert_eq!(c[0].rule, WorkRule::Statistical);
+        assert_eq!(c[0].verdict, WorkVerdict::More);
+        assert!(c[0].p_value.is_some_and(|p| p < 0.01), "{c:?}");
+        assert!(c[0].describe().contains("p = "), "{}", c[0].describe());
+        let less: Vec<f64> = scatter.iter().map(|v| v / 1.2).collect();
+        assert_eq!(
+            work_changes(&base, &racy_on_gpu(&less), &judge)[0].verdict,
+            WorkVerdict::Less
+        );
+        // One round of five 20 % higher: its median is one sample of five, not a change.
+        let mut one_round = scatter.clone();
+        for v in &mut one_round[..3] {
+            *v *= 1.2;
+        }
+        assert!(work_changes(&base, &racy_on_gpu(&one_round), &judge).is_empty());
+        // The same pair judged as one-round runs falls back to the threshold.
+        let c = work_changes(&base, &racy_on_gpu(&more), &ONE_ROUND);
+        assert_eq!(c[0].rule, WorkRule::Threshold);
     }
 }

@@ -498,7 +498,47 @@ pub fn publish(args: &PublishArgs) -> anyhow::Result<PathBuf> {
     let html = crate::report::html::render("site.html", &page)?;
     let index = site.join("index.html");
     std::fs::write(&index, html).with_context(|| format!("cannot write {}", index.display()))?;
+    link_pages_to_front(site, site)?;
     Ok(index)
+}
+
+/// The line every page below the front page gets after its `<body>`: a link back to
+/// `index.html`, `depth` folders up. Made of constants only (no data set or file name).
+fn front_link(depth: usize) -> String {
+    format!(
+        "<nav class=site><a href=\"{}index.html\">\u{2190} all results</a></nav>",
+        "../".repeat(depth)
+    )
+}
+
+/// Gives every page under `dir` (runs, histories, papers; not the front page itself) a link
+/// back to the site's front page, so that a reader who arrived from a search or a shared link
+/// can reach the rest. The pages' own templates serve stand-alone reports too, where no front
+/// page exists, so the link is added here rather than in them.
+fn link_pages_to_front(site: &Path, dir: &Path) -> anyhow::Result<()> {
+    for e in std::fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))? {
+        let path = e?.path();
+        if path.is_dir() {
+            link_pages_to_front(site, &path)?;
+            continue;
+        }
+        let rel = path
+            .strip_prefix(site)
+            .expect("walked from the site's root");
+        if path.extension().is_none_or(|x| x != "html") || rel == Path::new("index.html") {
+            continue;
+        }
+        let html = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let Some(at) = html.find("<body>").map(|i| i + "<body>".len()) else {
+            continue;
+        };
+        let depth = rel.components().count() - 1;
+        let linked = format!("{}\n{}{}", &html[..at], front_link(depth), &html[at..]);
+        std::fs::write(&path, linked)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
 }
 
 /// Per adapter (in order of first appearance) its runs by the date they started: the front

@@ -7,6 +7,7 @@
 //! The CSV columns are the fields of [`Row`] in order. The first twenty are fixed by the
 //! measurement-core issue and are never renamed; later algorithms add columns at the end.
 
+use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -21,6 +22,7 @@ use crate::results::machine::MachineInfo;
 pub use crate::results::named::NamedValues;
 
 pub mod aggregate;
+pub mod git_state;
 pub mod machine;
 pub mod metrics;
 pub mod named;
@@ -493,6 +495,12 @@ pub struct FrameSamples {
     pub cpu_ms: Vec<f64>,
     #[serde(default)]
     pub gpu_ms: Vec<f64>,
+    /// Per frame, each counter the row's algorithm declares nondeterministic on the row's
+    /// adapter (`AlgorithmDescription::nondeterministic_counters`: HAVS's racy pass on a GPU),
+    /// so that `compare` tests it across rounds as it tests time. Exact counters are not kept
+    /// here: every frame counts them alike.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub counters: BTreeMap<String, Vec<f64>>,
 }
 
 impl FrameSamples {
@@ -500,22 +508,39 @@ impl FrameSamples {
         self.total_ms.is_empty() && self.cpu_ms.is_empty() && self.gpu_ms.is_empty()
     }
 
-    pub fn from_frames(frames: &[render_core::FrameStats]) -> FrameSamples {
+    /// The samples of `frames`, with the per-frame values of the counters named in
+    /// `nondeterministic` (a frame that lacks one leaves it out).
+    pub fn from_frames(
+        frames: &[render_core::FrameStats],
+        nondeterministic: &[&str],
+    ) -> FrameSamples {
         let gpu: Option<Vec<f64>> = frames.iter().map(|f| f.gpu_ms).collect();
+        let counters = nondeterministic
+            .iter()
+            .map(|name| {
+                let per_frame = frames
+                    .iter()
+                    .filter_map(|f| f.counters.iter().find(|(n, _)| n == name).map(|(_, v)| *v));
+                (name.to_string(), per_frame.collect::<Vec<f64>>())
+            })
+            .filter(|(_, v)| !v.is_empty())
+            .collect();
         FrameSamples {
             total_ms: frames.iter().map(|f| f.total_ms).collect(),
             cpu_ms: frames.iter().map(|f| f.cpu_ms).collect(),
             gpu_ms: gpu.unwrap_or_default(),
+            counters,
         }
     }
 
-    /// The samples of a time metric by its column name (`total_ms`, `cpu_ms`, `gpu_ms`).
+    /// The samples of a time metric by its column name (`total_ms`, `cpu_ms`, `gpu_ms`), or of
+    /// a nondeterministic counter by its name (empty for any other name).
     pub fn metric(&self, name: &str) -> &[f64] {
         match name {
             "total_ms" => &self.total_ms,
             "cpu_ms" => &self.cpu_ms,
             "gpu_ms" => &self.gpu_ms,
-            _ => &[],
+            counter => self.counters.get(counter).map_or(&[], Vec::as_slice),
         }
     }
 }

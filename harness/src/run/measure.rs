@@ -397,7 +397,12 @@ impl<'a> DatasetContext<'a> {
         }
         row.stages = median_named(&frames, |f| &f.stages);
         row.counters = median_named(&frames, |f| &f.counters);
-        row.samples = crate::results::samples::FrameSamples::from_frames(&frames);
+        let racy = crate::algorithms::nondeterministic_counters(
+            &row.algorithm,
+            &row.settings,
+            &row.device_type,
+        );
+        row.samples = crate::results::samples::FrameSamples::from_frames(&frames, racy);
 
         let (dir, rel) = self.images_dir(vp);
         std::fs::create_dir_all(&dir)
