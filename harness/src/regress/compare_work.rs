@@ -295,7 +295,7 @@ mod tests {
         let cpu = work_changes(
             &on("Cpu", "fragments=1000;triangles=50"),
             &on("Cpu", "fragments=1001;triangles=50"),
-            1.10,
+            &ONE_ROUND,
         );
         assert_eq!(cpu[0].rule, WorkRule::Exact);
     }
