@@ -10,6 +10,7 @@
 use render_core::TransferFunction;
 
 pub mod analysis;
+mod memory;
 
 use crate::papers::claims::VariantSpec;
 use crate::papers::evidence::exact_side;
@@ -334,6 +335,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     report.notes.push(
         "Rows on f117, kew, torso and fighter are measured on generated stand-ins with the papers' tet counts (non-convex cavities where the originals are; `tetbench datasets list`); spx2 is spx split 1:8 twice, the paper's own mesh. Timings on stand-ins compare sizes, not images.".into(),
     );
+    report.notes.extend(memory::memory_note(m));
     report.claims = crate::papers::evidence::evaluate_claims(PAPER.id, m, x, &|metric, spec, d| {
         claim_side(x, metric, spec, d)
     });
