@@ -92,20 +92,35 @@ pub fn acquire(dir: &Path, command_line: &[String]) -> anyhow::Result<OutputLock
 mod tests {
     use super::*;
 
+    /// `acquire`, retried for up to two seconds. flock's lock belongs to the open file, and a
+    /// test running beside this one that starts a process (git, a browser) copies every
+    /// descriptor into its child between fork and exec (close-on-exec drops them at exec): for
+    /// that moment a released lock is still held. A run never forks while it takes its lock;
+    /// the tests do.
+    fn acquire_soon(dir: &Path, command_line: &[String]) -> OutputLock {
+        for _ in 0..200 {
+            if let Ok(lock) = acquire(dir, command_line) {
+                return lock;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        acquire(dir, command_line).unwrap()
+    }
+
     /// A second lock on a held directory is refused with the holder named; once released, and
     /// over a stale file left by a crashed run (a dead pid, no lock held), it is granted.
     #[test]
     fn a_held_directory_refuses_and_a_stale_file_does_not_block() {
         let tmp = tempfile::tempdir().unwrap();
         let dir = tmp.path().join("out");
-        let first = acquire(&dir, &["tetbench".into(), "run".into()]).unwrap();
+        let first = acquire_soon(&dir, &["tetbench".into(), "run".into()]);
         let e = acquire(&dir, &[]).unwrap_err().to_string();
         let pid = format!("pid {}", std::process::id());
         assert!(e.contains(&pid), "{e}");
         assert!(e.contains(&crate::results::machine::host_name()), "{e}");
         assert!(e.contains("tetbench run"), "{e}");
         drop(first);
-        let again = acquire(&dir, &[]).unwrap();
+        let again = acquire_soon(&dir, &[]);
         drop(again);
         // What a crashed run leaves: its record, but no lock.
         let stale = Holder {
@@ -115,7 +130,7 @@ mod tests {
             command_line: vec!["tetbench".into()],
         };
         std::fs::write(dir.join(LOCK_FILE), serde_json::to_string(&stale).unwrap()).unwrap();
-        let taken = acquire(&dir, &["new".into()]).unwrap();
+        let taken = acquire_soon(&dir, &["new".into()]);
         let now: Holder =
             serde_json::from_str(&std::fs::read_to_string(&taken.path).unwrap()).unwrap();
         assert_eq!(now.pid, std::process::id());
