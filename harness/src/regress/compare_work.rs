@@ -7,6 +7,8 @@
 //! of the data), however busy the machine was — where a 2 % change of time is lost in the
 //! scatter of a shared 2-core VM (docs/regression.md, "Power"). A count that grew is a
 //! regression, one that shrank an improvement; a counter only one side reports is a change.
+//! Fractions (means, bytes per tet) are compared as the row's text form writes them (4
+//! decimals), and rates among the counters (`…_per_sec`) are time, so not compared here.
 //!
 //! The exception is declared, not guessed: a counter the algorithm's description
 //! ([`render_core::AlgorithmDescription::nondeterministic_counters`]) names for the row's
@@ -105,6 +107,21 @@ impl WorkChange {
     }
 }
 
+/// Counters that are rates (`voxels_per_sec`: the splatter's work over its frame time) are
+/// time, not work: the time tests judge them, the exact gate does not.
+fn is_rate(counter: &str) -> bool {
+    counter.ends_with("_per_sec")
+}
+
+/// Whether two values of a work figure are the same: equal as the row's text form writes them
+/// (integers exactly, fractions such as `steps_mean` to 4 decimals,
+/// [`crate::results::named::trim_float`]). Results written in that form before the rows kept
+/// full precision would otherwise differ from their own recomputation in the last bits.
+fn same_figure(a: f64, b: f64) -> bool {
+    use crate::results::named::trim_float;
+    a == b || trim_float(a) == trim_float(b)
+}
+
 /// The byte figures of a row, by column name.
 fn byte_figures(r: &Row) -> [(&'static str, Option<u64>); 3] {
     [
@@ -179,6 +196,7 @@ pub fn work_changes(b: &Row, n: &Row, judge: &WorkJudge) -> Vec<WorkChange> {
     }
     figures
         .into_iter()
+        .filter(|(counter, ..)| !is_rate(counter))
         .filter_map(|(counter, base, new)| {
             let ratio = base.zip(new).filter(|(b, _)| *b != 0.0).map(|(b, n)| n / b);
             let (rule, p_value, verdict) = match (base, new) {
@@ -196,7 +214,7 @@ pub fn work_changes(b: &Row, n: &Row, judge: &WorkJudge) -> Vec<WorkChange> {
                     };
                     (rule, p, verdict)
                 }
-                (Some(b), Some(n)) if b == n => return None,
+                (Some(b), Some(n)) if same_figure(b, n) => return None,
                 (Some(b), Some(n)) => {
                     let verdict = if n > b {
                         WorkVerdict::More
@@ -351,5 +369,19 @@ mod tests {
         // The same pair judged as one-round runs falls back to the threshold.
         let c = work_changes(&base, &racy_on_gpu(&more), &ONE_ROUND);
         assert_eq!(c[0].rule, WorkRule::Threshold);
+    }
+
+    /// A rate among the counters is time, not work; a mean written at the text form's four
+    /// decimals equals its full-precision recomputation, and one that moved past them does not.
+    #[test]
+    fn rates_are_not_work_and_fractions_compare_at_the_written_precision() {
+        let base = row("steps_mean=32.4484;voxels_per_sec=154530.7", 4096);
+        let same = row("steps_mean=32.448431;voxels_per_sec=26367.1", 4096);
+        assert!(work_changes(&base, &same, &ONE_ROUND).is_empty());
+        let moved = row("steps_mean=32.4491;voxels_per_sec=154530.7", 4096);
+        let c = work_changes(&base, &moved, &ONE_ROUND);
+        assert_eq!(c.len(), 1, "{c:?}");
+        assert_eq!(c[0].counter, "steps_mean");
+        assert_eq!(c[0].verdict, WorkVerdict::More);
     }
 }

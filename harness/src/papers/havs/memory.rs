@@ -9,7 +9,7 @@ use crate::papers::session::Measured;
 const SIDES: [(&str, &str, &[(&str, &str)]); 2] = [
     ("HAVS (k = 2)", "havs", &[("k", "2")]),
     (
-        "the ray caster (5×5 tiles, 2D table)",
+        "The ray caster (5×5 tiles, 2D table)",
         "raycast",
         &[("tiles", "5x5"), ("table", "2d")],
     ),
