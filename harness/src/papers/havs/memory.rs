@@ -5,8 +5,15 @@
 
 use crate::papers::session::Measured;
 
-/// The two renderers H11 compares: (label, algorithm, settings that pick the variant).
-const SIDES: [(&str, &str, &[(&str, &str)]); 2] = [
+/// One renderer H11 compares: (label, algorithm, settings that pick the variant).
+type Side = (
+    &'static str,
+    &'static str,
+    &'static [(&'static str, &'static str)],
+);
+
+/// The two renderers H11 compares.
+const SIDES: [Side; 2] = [
     ("HAVS (k = 2)", "havs", &[("k", "2")]),
     (
         "The ray caster (5×5 tiles, 2D table)",
