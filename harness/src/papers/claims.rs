@@ -14,13 +14,17 @@
 //! `counter_per_tet:NAME`, `stage:NAME`,
 //! `stage_share:NAME` (the stage over the most expensive other stage), `view_range:METRIC`
 //! (range over the viewpoints divided by their mean) and `view_max:METRIC` / `view_min:METRIC`
-//! (the largest / smallest over the viewpoints). Other metrics (the CPU analyses: sorts,
+//! (the largest / smallest over the viewpoints); from two sides' images, `pair_psnr_db` and
+//! `pair_bad_pixel_share` (side `a`'s image against side `b`'s, [`super::sides::pair_side`]).
+//! Other metrics (the CPU analyses: sorts,
 //! the k-buffer, the classifier, data set sizes) come from the paper's own measurements.
 
 use anyhow::{bail, Context as _};
 use render_core::Settings;
 
-use super::verdict::{self, Check, Evaluation, Expect, Hardware, Sample, Side};
+use super::sides::{is_pair_metric, pair_side};
+pub use super::sides::{row_sample, side_from_rows};
+use super::verdict::{self, Check, Evaluation, Expect, Hardware, Side};
 use crate::results::Row;
 
 /// The claims file, compiled in like the tables.
@@ -280,7 +284,7 @@ impl VariantSpec {
         self.settings.text(key)
     }
 
-    fn matches(&self, row: &Row) -> bool {
+    pub(crate) fn matches(&self, row: &Row) -> bool {
         row.algorithm == self.algorithm
             && self
                 .settings
@@ -462,7 +466,16 @@ pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
         let expect = ExpectSpec::parse(&f(9)).map_err(err)?;
         let evidence = Evidence::parse(&f(12)).map_err(err)?;
         let normalise = Normalise::parse(&f(13)).map_err(err)?;
-        let needs_b = expect.needs_b() || f(9).replace(' ', "").starts_with("a/b");
+        let ratio = f(9).replace(' ', "").starts_with("a/b");
+        let pair = is_pair_metric(&f(5));
+        if pair && (expect.needs_b() || ratio) {
+            return Err(err(format!(
+                "metric {} compares a's image with b's: expect a>N, a<N, a=N or a in LO..HI, not {:?}",
+                f(5),
+                f(9)
+            )));
+        }
+        let needs_b = expect.needs_b() || ratio || pair;
         if needs_b != b.is_some() {
             return Err(err(format!(
                 "expect {:?} {} a second side (column b)",
@@ -598,6 +611,9 @@ pub struct Inputs<'a> {
     pub software_adapter: bool,
     /// Our adapter's calibrated peaks (`None`: the runs were not calibrated).
     pub our_peaks: Option<super::hardware::OurPeaks>,
+    /// The run folder each row's image paths are relative to, by the row's index in `rows`
+    /// (`None` or missing: its images cannot be read).
+    pub row_dirs: &'a [Option<std::path::PathBuf>],
 }
 
 /// Whether rows were measured on a software rasteriser (lavapipe, WARP, SwiftShader report a
@@ -679,8 +695,16 @@ fn evaluate_one(claim: &Claim, dataset: Option<&str>, inputs: &Inputs) -> Evalua
         tolerance: claim.tolerance,
         hardware: claim.hardware,
     };
-    let a = side(claim, &claim.a, dataset, inputs);
-    let b = claim.b.as_ref().map(|b| side(claim, b, dataset, inputs));
+    let (a, b) = match (&claim.b, dataset) {
+        // An image pair is one side: a's image against b's.
+        (Some(b), Some(d)) if is_pair_metric(&claim.metric) => {
+            (pair_side(&claim.metric, &claim.a, b, d, inputs), None)
+        }
+        _ => (
+            side(claim, &claim.a, dataset, inputs),
+            claim.b.as_ref().map(|b| side(claim, b, dataset, inputs)),
+        ),
+    };
     let mut e = verdict::evaluate(
         &check,
         a.as_ref().map_err(Clone::clone),
@@ -764,196 +788,6 @@ fn side(
         ));
     };
     side_from_rows(&claim.metric, spec, d, inputs)
-}
-
-/// A side from a run's rows: exactly one variant must match the spec (a claim that does not
-/// pin its variant is refused, never decided by whichever variant came first).
-pub fn side_from_rows(
-    metric: &str,
-    spec: &VariantSpec,
-    dataset: &str,
-    inputs: &Inputs,
-) -> Result<Side, String> {
-    let label = spec.label(Some(dataset));
-    let rows: Vec<&Row> = inputs
-        .rows
-        .iter()
-        .filter(|r| r.dataset == dataset && r.ok() && spec.matches(r))
-        .collect();
-    let mut variants: Vec<&Settings> = rows.iter().map(|r| &r.settings).collect();
-    variants.sort();
-    variants.dedup();
-    if variants.len() > 1 {
-        return Err(format!(
-            "{label}: {} variants match ({}); the claim must name one",
-            variants.len(),
-            variants
-                .iter()
-                .map(|v| v.to_string())
-                .collect::<Vec<_>>()
-                .join(" | ")
-        ));
-    }
-    if rows.is_empty() {
-        return Err(format!(
-            "{label}: {}",
-            (inputs.why_missing)(&spec.algorithm, dataset)
-        ));
-    }
-    let label = format!("{} {} on {dataset}", spec.algorithm, variants[0]);
-    for (prefix, largest) in [("view_max:", true), ("view_min:", false)] {
-        let Some(inner) = metric.strip_prefix(prefix) else {
-            continue;
-        };
-        let values: Vec<(String, f64)> = rows
-            .iter()
-            .filter_map(|r| Some((r.viewpoint.clone(), row_sample(inner, r).ok()?.value)))
-            .collect();
-        let pick = values
-            .iter()
-            .cloned()
-            .reduce(|a, b| if (b.1 > a.1) == largest { b } else { a });
-        let Some((view, v)) = pick else {
-            return Err(format!("{label}: no {inner} in its rows"));
-        };
-        return Ok(Side::new(
-            format!(
-                "{label}, {inner} {} over {} viewpoint(s) (at {view})",
-                if largest { "largest" } else { "smallest" },
-                values.len()
-            ),
-            vec![Sample::exact(view, v)],
-        ));
-    }
-    if let Some(inner) = metric.strip_prefix("view_range:") {
-        let values: Vec<f64> = rows
-            .iter()
-            .filter_map(|r| row_sample(inner, r).ok().map(|s| s.value))
-            .collect();
-        if values.len() < 2 {
-            return Err(format!(
-                "{label}: {metric} needs at least two viewpoints, has {}",
-                values.len()
-            ));
-        }
-        let mean = values.iter().sum::<f64>() / values.len() as f64;
-        let (lo, hi) = values
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-                (l.min(v), h.max(v))
-            });
-        return Ok(Side::new(
-            format!(
-                "{label}, {inner} range/mean over {} viewpoints",
-                values.len()
-            ),
-            vec![Sample::exact("views", (hi - lo) / mean)],
-        ));
-    }
-    let mut samples = vec![];
-    let mut first_err = None;
-    for r in rows {
-        match row_sample(metric, r) {
-            Ok(s) => samples.push(s),
-            Err(e) => {
-                first_err.get_or_insert(e);
-            }
-        }
-    }
-    if samples.is_empty() {
-        return Err(format!(
-            "{label}: {}",
-            first_err.unwrap_or_else(|| format!("no {metric}"))
-        ));
-    }
-    Ok(Side::new(format!("{label}, {metric}"), samples))
-}
-
-/// One row's value of a metric, with its frames' range where the row has one.
-pub fn row_sample(metric: &str, r: &Row) -> Result<Sample, String> {
-    let key = r.viewpoint.clone();
-    let timed = |v: Option<f64>, lo: Option<f64>, hi: Option<f64>| -> Result<Sample, String> {
-        let v = v.ok_or_else(|| format!("no {metric} in its rows"))?;
-        Ok(Sample {
-            key: key.clone(),
-            value: v,
-            min: lo.unwrap_or(v),
-            max: hi.unwrap_or(v),
-            frames: r.frames.max(1),
-        })
-    };
-    // A rate from a time: the slowest frame gives the lowest rate.
-    let rate = |num: f64, s: Sample| Sample {
-        value: num / s.value,
-        min: num / s.max,
-        max: num / s.min,
-        ..s
-    };
-    let exact = |v: Option<f64>| {
-        v.map(|v| Sample::exact(key.clone(), v))
-            .ok_or_else(|| format!("no {metric} in its rows"))
-    };
-    match metric {
-        "total_ms" => timed(r.total_ms, r.total_ms_min, r.total_ms_max),
-        "gpu_ms" => timed(r.gpu_ms, r.gpu_ms_min, r.gpu_ms_max),
-        "cpu_ms" => timed(r.cpu_ms, r.cpu_ms_min, r.cpu_ms_max),
-        "fps" => Ok(rate(
-            1e3,
-            timed(r.total_ms, r.total_ms_min, r.total_ms_max)?,
-        )),
-        "tets_per_sec" => Ok(rate(
-            r.tets as f64 * 1e3,
-            timed(r.total_ms, r.total_ms_min, r.total_ms_max)?,
-        )),
-        "gpu_tets_per_sec" => Ok(rate(
-            r.tets as f64 * 1e3,
-            timed(r.gpu_ms, r.gpu_ms_min, r.gpu_ms_max)?,
-        )),
-        "bytes_per_tet" => exact(r.bytes_per_tet),
-        // Every device byte the row's renderer allocated (persistent and per frame).
-        "gpu_bytes" => exact(r.gpu_bytes.map(|b| b as f64)),
-        "psnr_db" => exact(r.psnr_db),
-        _ => {
-            if let Some(name) = metric.strip_prefix("counter:") {
-                return exact(r.counter(name));
-            }
-            if let Some(name) = metric.strip_prefix("counter_per_tet:") {
-                if r.tets == 0 {
-                    return Err(format!("{metric}: the row has no tets"));
-                }
-                return exact(r.counter(name).map(|v| v / r.tets as f64));
-            }
-            if let Some(name) = metric.strip_prefix("stage:") {
-                return timed(r.stage_ms(name), None, None).map_err(|_| no_stage(name, r));
-            }
-            if let Some(name) = metric.strip_prefix("stage_share:") {
-                let this = r.stage_ms(name).ok_or_else(|| no_stage(name, r))?;
-                let other = r
-                    .stages
-                    .iter()
-                    .filter(|(k, _)| *k != name)
-                    .map(|(_, v)| v)
-                    .fold(0.0f64, f64::max);
-                if other <= 0.0 {
-                    return Err(format!("no stage besides {name} in its rows"));
-                }
-                return timed(Some(this / other), None, None);
-            }
-            Err(format!("unknown metric {metric:?}"))
-        }
-    }
-}
-
-fn no_stage(name: &str, r: &Row) -> String {
-    let have: Vec<&str> = r.stages.names().collect();
-    format!(
-        "no stage named {name} in its rows (stages timed: {})",
-        if have.is_empty() {
-            "none".to_string()
-        } else {
-            have.join(", ")
-        }
-    )
 }
 
 /// Counts of each verdict of the measured claims, in [`verdict::Verdict::ALL`]'s order:
@@ -1173,6 +1007,7 @@ mod tests {
             why_missing: &|a, d| format!("{a} not measured on {d}"),
             software_adapter: software_adapter(rows),
             our_peaks: None,
+            row_dirs: &[],
         }
     }
 

@@ -251,6 +251,7 @@ fn memory_claims_fail_with_four_more_bytes_per_tet() {
         )],
         errors: vec![],
         calibration: None,
+        row_dirs: vec![],
     };
     let x = Extra::default();
     let ok = eval("fragment-pt", &frag(19.5), &x);
@@ -273,6 +274,7 @@ fn memory_claims_fail_with_four_more_bytes_per_tet() {
         )],
         errors: vec![],
         calibration: None,
+        row_dirs: vec![],
     };
     let ok = eval("raycast", &ray(144.0), &x);
     assert_eq!(verdict_of(&ok, "R4", Some("spx1")), Verdict::Holds);
@@ -346,6 +348,7 @@ fn gpu_speed_claims_on_lavapipe_are_not_testable_and_name_their_variants() {
         ],
         errors: vec![],
         calibration: None,
+        row_dirs: vec![],
     };
     let r = eval("havs", &m, &Extra::default());
     let h6 = r
@@ -386,6 +389,7 @@ fn peers_have_no_cpu_gpu_split_in_havs_table5() {
         rows: vec![row],
         errors: vec![],
         calibration: None,
+        row_dirs: vec![],
     };
     let report = havs::tables(&m, &Extra::default());
     let t5 = report
@@ -425,23 +429,49 @@ fn quick_plans_run_a_subset_of_the_full_variants_and_every_variant_a_claim_names
                 for q in &quick {
                     assert!(full.contains(q), "{}: {q} is not a full-mode variant", p.id);
                 }
-                let named = all
-                    .iter()
-                    .filter(|c| c.paper == p.id)
-                    .flat_map(|c| [Some(&c.a), c.b.as_ref()].into_iter().flatten())
-                    .filter(|v| &v.algorithm == alg);
-                for v in named {
-                    assert!(
-                        quick.iter().any(|q| q.includes(&v.settings)),
-                        "{}: the quick run of {alg} lacks {}",
-                        p.id,
-                        v.settings_text()
-                    );
-                }
             }
         }
     }
     assert!(narrowed > 0, "no plan narrows its quick run");
+    // Every variant a claim names is run by one of its paper's runs in quick mode.
+    for module in PAPERS.iter() {
+        let p = module.paper();
+        let quick: Vec<(String, render_core::Settings)> = module
+            .plan()
+            .iter()
+            .flat_map(|spec| {
+                let filter =
+                    SettingsFilter::parse(spec.settings_for(true).map_or("", |s| s.as_str()))
+                        .unwrap();
+                spec.algorithms
+                    .iter()
+                    .filter(|a| crate::algorithms::describe(a).is_some())
+                    .flat_map(|a| {
+                        selected_settings(a, &filter)
+                            .unwrap()
+                            .into_iter()
+                            .map(move |s| (a.clone(), s))
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let named = all
+            .iter()
+            .filter(|c| c.paper == p.id)
+            .flat_map(|c| [Some(&c.a), c.b.as_ref()].into_iter().flatten())
+            .filter(|v| crate::algorithms::describe(&v.algorithm).is_some());
+        for v in named {
+            assert!(
+                quick
+                    .iter()
+                    .any(|(a, q)| *a == v.algorithm && q.includes(&v.settings)),
+                "{}: no quick run of {} has {}",
+                p.id,
+                v.algorithm,
+                v.settings_text()
+            );
+        }
+    }
 }
 
 #[test]
@@ -494,6 +524,7 @@ fn claims_by_construction_and_derived_ones_are_counted_apart_with_their_own_word
         )],
         errors: vec![],
         calibration: None,
+        row_dirs: vec![],
     };
     let r = eval("splat", &m, &Extra::default());
     let s3 = r
@@ -534,6 +565,7 @@ fn claims_by_construction_and_derived_ones_are_counted_apart_with_their_own_word
         )],
         errors: vec![],
         calibration: None,
+        row_dirs: vec![],
     };
     let r = eval("raycast", &ray, &Extra::default());
     let r5 = r
@@ -653,6 +685,7 @@ fn hardware_independent_counts_of_gator_and_fragment_pt_flip_on_a_changed_measur
         ],
         errors: vec![],
         calibration: None,
+        row_dirs: vec![],
     };
     let ok = eval("gator", &m(4000.0, 40.0), &Extra::default());
     assert_eq!(verdict_of(&ok, "G9", Some("post")), Verdict::Holds);
@@ -668,6 +701,7 @@ fn hardware_independent_counts_of_gator_and_fragment_pt_flip_on_a_changed_measur
             rows: vec![r],
             errors: vec![],
             calibration: None,
+            row_dirs: vec![],
         }
     };
     let fits = eval("fragment-pt", &brain(200 << 20), &Extra::default());
@@ -703,6 +737,7 @@ fn havs_memory_claim_flips_when_havs_holds_more_bytes_per_tet() {
         ],
         errors: vec![],
         calibration: None,
+        row_dirs: vec![],
     };
     let lean = eval("havs", &m(68.0), &Extra::default());
     assert_eq!(verdict_of(&lean, "H11", Some("spx2")), Verdict::Holds);
@@ -733,6 +768,7 @@ fn raycast_pass_claims_flip_with_the_longest_walk() {
             .collect(),
         errors: vec![],
         calibration: None,
+        row_dirs: vec![],
     };
     let like_paper = eval("raycast", &m(590.0, 575.0), &Extra::default());
     assert_eq!(verdict_of(&like_paper, "R6", Some("spx1")), Verdict::Holds);

@@ -39,6 +39,7 @@ pub fn evaluate_claims(
                 .calibration
                 .as_ref()
                 .map(crate::papers::hardware::our_peaks),
+            row_dirs: &m.row_dirs,
         },
     )
 }

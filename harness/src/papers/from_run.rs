@@ -74,10 +74,11 @@ pub struct FromRunArgs {
     pub out: Option<PathBuf>,
 }
 
-/// Every results file under `dir` (itself, or its immediate sub-folders), in name order.
-fn results_files(dir: &Path) -> anyhow::Result<Vec<ResultsFile>> {
+/// Every results file under `dir` (itself, or its immediate sub-folders), in name order, with
+/// its folder.
+fn results_files(dir: &Path) -> anyhow::Result<Vec<(PathBuf, ResultsFile)>> {
     if dir.join(crate::results::JSON_FILE).exists() {
-        return Ok(vec![ResultsFile::read(dir)?]);
+        return Ok(vec![(dir.to_path_buf(), ResultsFile::read(dir)?)]);
     }
     let mut subdirs: Vec<PathBuf> = std::fs::read_dir(dir)
         .with_context(|| format!("cannot read {}", dir.display()))?
@@ -91,7 +92,10 @@ fn results_files(dir: &Path) -> anyhow::Result<Vec<ResultsFile>> {
         dir.display(),
         crate::results::JSON_FILE
     );
-    subdirs.iter().map(|d| ResultsFile::read(d)).collect()
+    subdirs
+        .into_iter()
+        .map(|d| Ok((d.clone(), ResultsFile::read(&d)?)))
+        .collect()
 }
 
 pub fn run(cmd: PaperAnalysis) -> anyhow::Result<()> {
@@ -99,8 +103,8 @@ pub fn run(cmd: PaperAnalysis) -> anyhow::Result<()> {
     let paper = super::find(id).expect("every subcommand is a paper");
     let files = results_files(&args.run_dir)?;
     let mut measured = Measured::default();
-    for f in &files {
-        measured.rows.extend(f.rows.iter().cloned());
+    for (dir, f) in &files {
+        measured.push_run(dir, f.rows.iter().cloned());
         if measured.calibration.is_none() {
             measured.calibration = f.machine.calibration.clone();
         }
@@ -112,7 +116,7 @@ pub fn run(cmd: PaperAnalysis) -> anyhow::Result<()> {
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
     let commits: Vec<String> = files
         .iter()
-        .map(|f| {
+        .map(|(_, f)| {
             format!(
                 "{}{}",
                 f.machine.git_commit.as_deref().unwrap_or("unknown"),
@@ -132,7 +136,7 @@ pub fn run(cmd: PaperAnalysis) -> anyhow::Result<()> {
         substitutes: vec![],
         resolution: None,
         rounds: None,
-        machine: files.first().map(|f| f.machine.clone()),
+        machine: files.first().map(|(_, f)| f.machine.clone()),
         log: vec![format!(
             "analysed {} run(s) under {} ({} rows), measured by commit(s) {}",
             files.len(),

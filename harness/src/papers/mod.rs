@@ -19,6 +19,7 @@ pub mod from_run;
 pub mod hardware;
 pub mod reproduce;
 pub mod session;
+pub mod sides;
 pub mod table;
 pub mod transcription;
 pub mod verdict;

@@ -98,9 +98,21 @@ pub struct Measured {
     /// The adapter's calibration from the first run's machine record that has one (claims
     /// normalised by a peak read it).
     pub calibration: Option<crate::results::machine::Calibration>,
+    /// The run folder of each row, by index in `rows` (its image paths are relative to it;
+    /// rows pushed without one have none).
+    pub row_dirs: Vec<Option<PathBuf>>,
 }
 
 impl Measured {
+    /// Adds a run's rows, read from `dir`.
+    pub fn push_run(&mut self, dir: &std::path::Path, rows: impl IntoIterator<Item = Row>) {
+        self.row_dirs.resize(self.rows.len(), None);
+        for row in rows {
+            self.rows.push(row);
+            self.row_dirs.push(Some(dir.to_path_buf()));
+        }
+    }
+
     pub fn aggregates(&self) -> Vec<Aggregate> {
         aggregate(&self.rows)
     }
@@ -318,15 +330,16 @@ impl Session {
             t0.elapsed().as_secs_f64()
         ));
         measured.errors.extend(outcome.errors.iter().cloned());
-        for mut row in file.rows {
+        let rows = file.rows.into_iter().map(|mut row| {
             if let Some((plan, _)) = self.substitutes.iter().find(|(_, s)| {
                 crate::results::names::slug(s) == crate::results::names::slug(&row.dataset)
                     || *s == row.dataset
             }) {
                 row.dataset = plan.clone();
             }
-            measured.rows.push(row);
-        }
+            row
+        });
+        measured.push_run(&out, rows);
         Ok(())
     }
 }

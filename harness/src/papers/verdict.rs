@@ -48,7 +48,8 @@ pub enum Hardware {
     None,
     /// CPU speed: our CPU is a real one, so the claim is tested (against a different CPU).
     Cpu,
-    /// GPU speed: meaningless on a software rasteriser.
+    /// GPU hardware: its speed, or what its concurrency does (HAVS's fragment race):
+    /// meaningless on a software rasteriser.
     Gpu,
 }
 
@@ -202,7 +203,7 @@ pub fn evaluate(
     if check.hardware == Hardware::Gpu && software_adapter {
         let _ = write!(
             numbers,
-            "; GPU speed on a software rasteriser: on this adapter it would read \"{}\"",
+            "; a claim on GPU hardware (its speed, or fragments shaded concurrently) measured on a software rasteriser: on this adapter it would read \"{}\"",
             verdict.label()
         );
         return Evaluation {

@@ -55,6 +55,9 @@ const TABLE5_ALGORITHMS: [(&str, &str, Option<&str>); 5] = [
 /// Table 2's viewport (§5.2).
 const TABLE2_RESOLUTION: u32 = 512;
 const HAVS_SETTINGS: &str = "k=2|6;sort=cpu-radix;et=off";
+/// Claims H12 and H13 (image quality): the race-free pass at the hardware's k and at k = 16,
+/// rendered at the main run's viewpoints and viewport so that each image pairs with one of it.
+const RACE_FREE_SETTINGS: &str = "k=6|16;sort=cpu-radix;et=off;mode=race-free";
 
 /// The HAVS paper.
 pub struct Havs;
@@ -78,6 +81,11 @@ impl PaperModule for Havs {
             full_viewport: false,
             full_views: false,
         }];
+        plan.push(RunSpec {
+            name: "havs-race-free".into(),
+            settings: Some(RACE_FREE_SETTINGS.into()),
+            ..plan[0].clone()
+        });
         // Table 5's other rows.
         for (label, alg, settings) in TABLE5_ALGORITHMS.iter().skip(1) {
             plan.push(RunSpec {
