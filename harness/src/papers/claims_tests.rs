@@ -433,10 +433,13 @@ fn quick_plans_run_a_subset_of_the_full_variants_and_every_variant_a_claim_names
         }
     }
     assert!(narrowed > 0, "no plan narrows its quick run");
-    // Every variant a claim names is run by one of its paper's runs in quick mode.
+    // Every side of a claim picks exactly one variant that one of its paper's runs measures in
+    // quick mode on each of the claim's data sets: none leaves it not checkable, two make it
+    // ambiguous (a run added for one claim must not capture another's side).
     for module in PAPERS.iter() {
         let p = module.paper();
-        let quick: Vec<(String, render_core::Settings)> = module
+        // (algorithm, settings, data sets) of every variant the plan runs in quick mode.
+        let quick: Vec<(String, render_core::Settings, Vec<String>)> = module
             .plan()
             .iter()
             .flat_map(|spec| {
@@ -450,26 +453,42 @@ fn quick_plans_run_a_subset_of_the_full_variants_and_every_variant_a_claim_names
                         selected_settings(a, &filter)
                             .unwrap()
                             .into_iter()
-                            .map(move |s| (a.clone(), s))
+                            .map(|s| (a.clone(), s, spec.datasets.clone()))
+                            .collect::<Vec<_>>()
                     })
                     .collect::<Vec<_>>()
             })
             .collect();
-        let named = all
-            .iter()
-            .filter(|c| c.paper == p.id)
-            .flat_map(|c| [Some(&c.a), c.b.as_ref()].into_iter().flatten())
-            .filter(|v| crate::algorithms::describe(&v.algorithm).is_some());
-        for v in named {
-            assert!(
-                quick
-                    .iter()
-                    .any(|(a, q)| *a == v.algorithm && q.includes(&v.settings)),
-                "{}: no quick run of {} has {}",
-                p.id,
-                v.algorithm,
-                v.settings_text()
-            );
+        for c in all.iter().filter(|c| c.paper == p.id) {
+            for v in [Some(&c.a), c.b.as_ref()].into_iter().flatten() {
+                if crate::algorithms::describe(&v.algorithm).is_none() {
+                    continue;
+                }
+                let datasets: Vec<&String> = match &v.dataset {
+                    Some(d) => vec![d],
+                    None => c.datasets.iter().collect(),
+                };
+                for d in datasets {
+                    let mut matching: Vec<&render_core::Settings> = quick
+                        .iter()
+                        .filter(|(a, q, ds)| {
+                            *a == v.algorithm && q.includes(&v.settings) && ds.contains(d)
+                        })
+                        .map(|(_, q, _)| q)
+                        .collect();
+                    matching.sort();
+                    matching.dedup();
+                    assert_eq!(
+                        matching.len(),
+                        1,
+                        "{} {}: {} {} on {d} matches {matching:?} in the quick runs",
+                        p.id,
+                        c.id,
+                        v.algorithm,
+                        v.settings_text()
+                    );
+                }
+            }
         }
     }
 }

@@ -14,7 +14,11 @@ type Side = (
 
 /// The two renderers H11 compares.
 const SIDES: [Side; 2] = [
-    ("HAVS (k = 2)", "havs", &[("k", "2")]),
+    (
+        "HAVS (k = 2)",
+        "havs",
+        &[("k", "2"), ("mode", "fragment-race")],
+    ),
     (
         "The ray caster (5×5 tiles, 2D table)",
         "raycast",
