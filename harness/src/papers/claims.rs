@@ -153,31 +153,20 @@ pub struct RuleChange {
 
 /// Parses a rule history; errors name the file, the line and what is wrong.
 pub fn parse_history(text: &str, file: &str) -> anyhow::Result<Vec<RuleChange>> {
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(true)
-        .from_reader(text.as_bytes());
-    let header: Vec<String> = reader
-        .headers()
-        .with_context(|| format!("{file}: header"))?
-        .iter()
-        .map(str::to_string)
-        .collect();
-    let expected = [
-        "paper",
-        "id",
-        "date",
-        "commit",
-        "reason",
-        "old_expect",
-        "old_tolerance",
-        "old_normalise",
-    ];
-    if header != expected {
-        bail!(
-            "{file}: header is {header:?}, expected {}",
-            expected.join(",")
-        );
-    }
+    let mut reader = super::transcription::reader_with_header(
+        text,
+        file,
+        &[
+            "paper",
+            "id",
+            "date",
+            "commit",
+            "reason",
+            "old_expect",
+            "old_tolerance",
+            "old_normalise",
+        ],
+    )?;
     let mut out = vec![];
     for (i, rec) in reader.records().enumerate() {
         let line = i + 2;
@@ -404,37 +393,26 @@ impl Claim {
 
 /// Parses a claims file; errors name the file, the line and what is wrong.
 pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(true)
-        .from_reader(text.as_bytes());
-    let header: Vec<String> = reader
-        .headers()
-        .with_context(|| format!("{file}: header"))?
-        .iter()
-        .map(str::to_string)
-        .collect();
-    let expected = [
-        "paper",
-        "id",
-        "source",
-        "cites",
-        "claim",
-        "metric",
-        "datasets",
-        "a",
-        "b",
-        "expect",
-        "tolerance",
-        "hardware",
-        "evidence",
-        "normalise",
-    ];
-    if header != expected {
-        bail!(
-            "{file}: header is {header:?}, expected {}",
-            expected.join(",")
-        );
-    }
+    let mut reader = super::transcription::reader_with_header(
+        text,
+        file,
+        &[
+            "paper",
+            "id",
+            "source",
+            "cites",
+            "claim",
+            "metric",
+            "datasets",
+            "a",
+            "b",
+            "expect",
+            "tolerance",
+            "hardware",
+            "evidence",
+            "normalise",
+        ],
+    )?;
     let mut claims: Vec<Claim> = vec![];
     for (i, rec) in reader.records().enumerate() {
         let line = i + 2;

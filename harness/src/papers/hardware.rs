@@ -32,28 +32,17 @@ pub struct OurPeaks {
 
 /// Parses the hardware file; errors name the file, the line and what is wrong.
 pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<PaperGpu>> {
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(true)
-        .from_reader(text.as_bytes());
-    let header: Vec<String> = reader
-        .headers()
-        .with_context(|| format!("{file}: header"))?
-        .iter()
-        .map(str::to_string)
-        .collect();
-    let expected = [
-        "paper",
-        "gpu",
-        "fill_pixels_per_sec",
-        "vertices_per_sec",
-        "source",
-    ];
-    if header != expected {
-        bail!(
-            "{file}: header is {header:?}, expected {}",
-            expected.join(",")
-        );
-    }
+    let mut reader = super::transcription::reader_with_header(
+        text,
+        file,
+        &[
+            "paper",
+            "gpu",
+            "fill_pixels_per_sec",
+            "vertices_per_sec",
+            "source",
+        ],
+    )?;
     let mut out = vec![];
     for (i, rec) in reader.records().enumerate() {
         let line = i + 2;

@@ -120,6 +120,31 @@ impl PaperTable {
     }
 }
 
+/// A CSV reader over one of our data files (claims, rule history, hardware) whose header must
+/// be exactly `expected`; the error names the file and both headers.
+pub fn reader_with_header<'t>(
+    text: &'t str,
+    file: &str,
+    expected: &[&str],
+) -> anyhow::Result<csv::Reader<&'t [u8]>> {
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = reader
+        .headers()
+        .with_context(|| format!("{file}: header"))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    if header != expected {
+        return Err(anyhow!(
+            "{file}: header is {header:?}, expected {}",
+            expected.join(",")
+        ));
+    }
+    Ok(reader)
+}
+
 /// The paper's row name of a registry data set in the tables of `paper` (`havs`, `gator`,
 /// `fragment-pt`, `raycast`), where the paper names it differently.
 pub fn paper_name(paper: &str, dataset: &str) -> Option<&'static str> {
