@@ -183,3 +183,80 @@ fn no_row_of_the_default_suite_beats_its_roofline() {
         "{name} not listed among {beaten:?}"
     );
 }
+
+/// A cached calibration that is not the backend's peak at the run's moment (here: every figure
+/// made 1000 times slower, as a VM's drift or a busy calibration can make it) is seen in the
+/// rows that beat it, and the run calibrates again after its rows, keeping each figure's best:
+/// the run's machine record and the cache then hold the new figures, and the rows are priced
+/// by them.
+#[test]
+fn a_run_that_beats_its_cached_calibration_calibrates_again_after_its_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("cache");
+    let gpu = render_core::Gpu::new().unwrap();
+    let machine = MachineInfo::collect();
+    let stale = slowed(
+        &harness::calibrate::measure(&gpu, &machine).unwrap(),
+        1000.0,
+    );
+    let path = harness::calibrate::cache_path(&cache, &gpu, &machine);
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    std::fs::write(&path, serde_json::to_string_pretty(&stale).unwrap()).unwrap();
+    let out = dir.path().join("out");
+    let args: Vec<String> = [
+        "tetbench",
+        "run",
+        "--algorithms",
+        "gator-pt",
+        "--datasets",
+        "box:1k",
+        "--viewpoints",
+        "+x",
+        "--resolution",
+        "64",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--no-report",
+        "--no-reference",
+        "--out",
+        out.to_str().unwrap(),
+        "--cache-dir",
+        cache.to_str().unwrap(),
+    ]
+    .map(String::from)
+    .to_vec();
+    let cfg = config(&args);
+    let filter = cfg.settings_filter.clone();
+    let outcome = harness::run::run(&cfg, &|name: &str| {
+        harness::algorithms::selected_variants(name, &filter)
+    })
+    .unwrap();
+    let what = outcome
+        .recalibrated
+        .expect("the stale bound was beaten and recalibrated");
+    assert!(what.contains("calibrated again after the run"), "{what}");
+    let file = ResultsFile::read(&out).unwrap();
+    let recorded = file.machine.calibration.unwrap();
+    assert!(
+        recorded.fill_fragments_per_sec > 100.0 * stale.fill_fragments_per_sec,
+        "the run records the new figures: {recorded:?}"
+    );
+    let cached: Calibration =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert_eq!(
+        cached, recorded,
+        "the cache keeps the peak the run recorded"
+    );
+    for r in &file.rows {
+        let mut again = vec![r.clone()];
+        harness::calibrate::annotate(&mut again, &recorded);
+        let (now, written) = (again[0].roofline_ms.unwrap(), r.roofline_ms.unwrap());
+        // Equal up to the last digit results.json keeps.
+        assert!(
+            (now - written).abs() <= 1e-9 * now,
+            "rows priced by the new figures: {now} against {written}"
+        );
+    }
+}

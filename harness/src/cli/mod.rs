@@ -280,6 +280,9 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
                     eprintln!("  {s}");
                 }
             }
+            if let Some(what) = &outcome.recalibrated {
+                eprintln!("tetbench: {what}");
+            }
             if !outcome.beaten_bounds.is_empty() {
                 eprintln!(
                     "{} row(s) beat their roofline bound — a defect of the bound (a calibrated \
