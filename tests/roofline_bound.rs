@@ -64,39 +64,57 @@ fn fastest_fraction(r: &Row) -> f64 {
 /// The busiest the machine may be, per core (1-minute load average), for the test to judge.
 const MAX_LOAD_PER_CORE: f64 = 1.5;
 
+/// `tetbench run` with `args`, writing into `out` with the calibration cached in `cache`
+/// (no report, no reference).
+fn run(args: &[&str], out: &std::path::Path, cache: &std::path::Path) -> harness::run::RunOutcome {
+    let args: Vec<String> = ["tetbench", "run"]
+        .iter()
+        .chain(args)
+        .chain(&[
+            "--no-report",
+            "--no-reference",
+            "--out",
+            out.to_str().unwrap(),
+            "--cache-dir",
+            cache.to_str().unwrap(),
+        ])
+        .map(|s| s.to_string())
+        .collect();
+    let cfg = config(&args);
+    let filter = cfg.settings_filter.clone();
+    harness::run::run(&cfg, &|name: &str| {
+        harness::algorithms::selected_variants(name, &filter)
+    })
+    .unwrap()
+}
+
 /// `tetbench run` of the default suite's settings on one data set into `out`.
 fn run_one(dataset: &str, out: &std::path::Path, cache: &std::path::Path) -> Vec<Row> {
     let suite = &harness::run::suite::DEFAULT_SUITE;
-    let args: Vec<String> = [
-        "tetbench",
-        "run",
-        "--datasets",
-        dataset,
-        "--viewpoints",
-        suite.viewpoints,
-        "--resolution",
-        &suite.resolution.to_string(),
-        "--frames",
-        &suite.frames.to_string(),
-        "--warmup",
-        &suite.warmup.to_string(),
-        "--rounds",
-        &suite.rounds.to_string(),
-        "--no-report",
-        "--no-reference",
-        "--out",
-        out.to_str().unwrap(),
-        "--cache-dir",
-        cache.to_str().unwrap(),
-    ]
-    .map(String::from)
-    .to_vec();
-    let cfg = config(&args);
-    let filter = cfg.settings_filter.clone();
-    let outcome = harness::run::run(&cfg, &|name: &str| {
-        harness::algorithms::selected_variants(name, &filter)
-    })
-    .unwrap();
+    let (resolution, frames, warmup, rounds) = (
+        suite.resolution.to_string(),
+        suite.frames.to_string(),
+        suite.warmup.to_string(),
+        suite.rounds.to_string(),
+    );
+    let outcome = run(
+        &[
+            "--datasets",
+            dataset,
+            "--viewpoints",
+            suite.viewpoints,
+            "--resolution",
+            &resolution,
+            "--frames",
+            &frames,
+            "--warmup",
+            &warmup,
+            "--rounds",
+            &rounds,
+        ],
+        out,
+        cache,
+    );
     assert!(outcome.all_ok(), "{outcome:?}");
     ResultsFile::read(out).unwrap().rows
 }
@@ -203,36 +221,24 @@ fn a_run_that_beats_its_cached_calibration_calibrates_again_after_its_rows() {
     std::fs::create_dir_all(path.parent().unwrap()).unwrap();
     std::fs::write(&path, serde_json::to_string_pretty(&stale).unwrap()).unwrap();
     let out = dir.path().join("out");
-    let args: Vec<String> = [
-        "tetbench",
-        "run",
-        "--algorithms",
-        "gator-pt",
-        "--datasets",
-        "box:1k",
-        "--viewpoints",
-        "+x",
-        "--resolution",
-        "64",
-        "--frames",
-        "2",
-        "--warmup",
-        "1",
-        "--no-report",
-        "--no-reference",
-        "--out",
-        out.to_str().unwrap(),
-        "--cache-dir",
-        cache.to_str().unwrap(),
-    ]
-    .map(String::from)
-    .to_vec();
-    let cfg = config(&args);
-    let filter = cfg.settings_filter.clone();
-    let outcome = harness::run::run(&cfg, &|name: &str| {
-        harness::algorithms::selected_variants(name, &filter)
-    })
-    .unwrap();
+    let outcome = run(
+        &[
+            "--algorithms",
+            "gator-pt",
+            "--datasets",
+            "box:1k",
+            "--viewpoints",
+            "+x",
+            "--resolution",
+            "64",
+            "--frames",
+            "2",
+            "--warmup",
+            "1",
+        ],
+        &out,
+        &cache,
+    );
     let what = outcome
         .recalibrated
         .expect("the stale bound was beaten and recalibrated");

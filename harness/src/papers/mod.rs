@@ -92,4 +92,6 @@ pub struct Paper {
 }
 
 #[cfg(test)]
+mod claims_flip_tests;
+#[cfg(test)]
 mod claims_tests;

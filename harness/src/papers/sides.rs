@@ -24,13 +24,16 @@ pub fn is_pair_metric(metric: &str) -> bool {
     metric == PAIR_PSNR_DB || metric == PAIR_BAD_PIXEL_SHARE
 }
 
+/// The label naming one variant, and its rows with their indices in `inputs.rows`.
+type VariantRows<'r> = (String, Vec<(usize, &'r Row)>);
+
 /// The rows of the one variant that matches `spec` on `dataset`, with their indices in
 /// `inputs.rows`, and the label naming that variant.
 fn one_variant<'r>(
     spec: &VariantSpec,
     dataset: &str,
     inputs: &Inputs<'r>,
-) -> Result<(String, Vec<(usize, &'r Row)>), String> {
+) -> Result<VariantRows<'r>, String> {
     let label = spec.label(Some(dataset));
     let rows: Vec<(usize, &Row)> = inputs
         .rows
