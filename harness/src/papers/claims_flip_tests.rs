@@ -1,7 +1,8 @@
 //! Every measured claim that compares two runs' timings (`a<b`, `a>b`, `a/b in LO..HI`) or holds
 //! one timing against a threshold (`a>N`, `a<N`) is fed rows that satisfy it and rows that do
 //! not, on a hardware adapter with five frames a side: its verdict must flip from *holds* to
-//! *does not hold*. The counts and image claims have their own flip tests (`claims_tests.rs`,
+//! *does not hold*; so do G7's spread over the viewpoints, S2's stage share and the CPU sorts
+//! of H1 and H2. The counts and image claims have their own flip tests (`claims_tests.rs`,
 //! `sides.rs`); the normalised rates H7 and F1 are re-judged from the H200's rows there.
 
 use crate::papers::claims::{self, Claim, Evidence, ExpectSpec, Normalise, VariantSpec};
@@ -173,4 +174,44 @@ fn the_spread_over_viewpoints_and_the_share_of_a_stage_flip_too() {
     assert_eq!(v, Verdict::Holds, "{n}");
     let (v, n) = verdict_on("splat", "S2", staged("buckets=2;sort=1;splat=3"));
     assert_eq!(v, Verdict::DoesNotHold, "{n}");
+}
+
+#[test]
+fn the_cpu_sort_claims_flip_with_the_sorts_timed() {
+    use crate::papers::havs::{self, analysis};
+    let sorts = |radix_ms: f64, quick_ms: f64| {
+        let sort = |name: &'static str, ms: f64| analysis::SortRow {
+            name,
+            ms,
+            min_ms: ms * 0.99,
+            max_ms: ms * 1.01,
+            repeats: 5,
+            keys_per_sec: 1e6 / (ms * 1e-3),
+        };
+        Extra::with_own(analysis::HavsAnalyses {
+            sorts: vec![
+                sort("quicksort", quick_ms),
+                sort("radix sort (HAVS §5.1, one core)", radix_ms),
+            ],
+            kbuffer: vec![],
+            kbuffer_views: 0,
+            kbuffer_resolution: 0,
+        })
+    };
+    let verdicts = |x: &Extra| {
+        let r = evaluate_claims("havs", &Measured::default(), x, &|metric, spec, d| {
+            havs::claim_side(x, metric, spec, d)
+        });
+        ["H1", "H2"].map(|id| {
+            r.iter()
+                .find(|r| r.claim.id == id)
+                .unwrap()
+                .evaluation
+                .verdict
+        })
+    };
+    // 1 M floats in 20 ms (50 M/s, quicksort 80 ms): both hold; in 100 ms (10 M/s, below
+    // §5.1's 15 M/s, and slower than quicksort's 80 ms): neither.
+    assert_eq!(verdicts(&sorts(20.0, 80.0)), [Verdict::Holds; 2]);
+    assert_eq!(verdicts(&sorts(100.0, 80.0)), [Verdict::DoesNotHold; 2]);
 }
