@@ -22,6 +22,7 @@
 use anyhow::{bail, Context as _};
 use render_core::Settings;
 
+pub use super::claims_report::{markdown, tally, tally_apart};
 use super::sides::{is_pair_metric, pair_side};
 pub use super::sides::{row_sample, side_from_rows};
 use super::verdict::{self, Check, Evaluation, Expect, Hardware, Side};
@@ -766,124 +767,6 @@ fn side(
         ));
     };
     side_from_rows(&claim.metric, spec, d, inputs)
-}
-
-/// Counts of each verdict of the measured claims, in [`verdict::Verdict::ALL`]'s order:
-/// the headline. Claims by construction and derived ones are counted apart ([`tally_apart`]).
-pub fn tally(results: &[ClaimResult]) -> Vec<(verdict::Verdict, usize)> {
-    verdict::Verdict::ALL
-        .iter()
-        .map(|v| {
-            (
-                *v,
-                results
-                    .iter()
-                    .filter(|r| {
-                        r.claim.evidence == Evidence::Measured && r.evaluation.verdict == *v
-                    })
-                    .count(),
-            )
-        })
-        .collect()
-}
-
-/// Counts of the claims that are not measured, by kind and word: (`by construction`,
-/// [(`as constructed`, 6)]), (`derived`, [(`follows`, 5)]).
-pub fn tally_apart(results: &[ClaimResult]) -> Vec<(&'static str, Vec<(&'static str, usize)>)> {
-    let mut out = vec![];
-    for (kind, is) in [
-        (
-            "by construction",
-            (|e: &Evidence| *e == Evidence::ByConstruction) as fn(&Evidence) -> bool,
-        ),
-        ("derived", |e: &Evidence| matches!(e, Evidence::Derived(_))),
-    ] {
-        let mut words: Vec<(&'static str, usize)> = vec![];
-        for r in results.iter().filter(|r| is(&r.claim.evidence)) {
-            let w = r.word();
-            match words.iter_mut().find(|(x, _)| *x == w) {
-                Some((_, n)) => *n += 1,
-                None => words.push((w, 1)),
-            }
-        }
-        if !words.is_empty() {
-            out.push((kind, words));
-        }
-    }
-    out
-}
-
-/// The verdicts as a Markdown table: claim, where, evidence, rule, verdict (in the word of its
-/// evidence kind), the numbers and variants used, and each earlier rule with its verdict.
-pub fn markdown(results: &[ClaimResult]) -> String {
-    use std::fmt::Write as _;
-    let mut md = String::from(
-        "| claim | cites | evidence | rule | data set | verdict | numbers (variants named) |\n|---|---|---|---|---|---|---|\n",
-    );
-    for r in results {
-        let c = &r.claim;
-        let label = match c.source {
-            Source::Paper => format!("**{}** {}", c.id, c.text),
-            Source::Ours => format!("**{}** (ours, not the paper's) {}", c.id, c.text),
-        };
-        let mut rule = c.rule().describe();
-        let mut verdict = r.word().to_string();
-        for (h, e) in &r.earlier {
-            let _ = write!(
-                rule,
-                "; until {} ({}): {}",
-                h.date,
-                h.commit,
-                h.old.describe()
-            );
-            let _ = write!(
-                verdict,
-                "; by the rule before {}: {}",
-                h.commit,
-                c.evidence.word(e.verdict)
-            );
-        }
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} | {} | {} | {} |",
-            cell(&label),
-            cell(&c.cites),
-            cell(&c.evidence.label()),
-            cell(&rule),
-            r.dataset.as_deref().unwrap_or("–"),
-            cell(&verdict),
-            cell(&r.evaluation.numbers)
-        );
-    }
-    let changes: Vec<&RuleChange> = {
-        let mut v: Vec<&RuleChange> = vec![];
-        for (h, _) in results.iter().flat_map(|r| &r.earlier) {
-            if !v.contains(&h) {
-                v.push(h);
-            }
-        }
-        v
-    };
-    if !changes.is_empty() {
-        md.push_str("\nRule history (`reports/papers/rule_history.csv`):\n\n");
-        for h in changes {
-            let _ = writeln!(
-                md,
-                "- {} {}: until {} (commit {}) the rule was {}. Why it changed: {}",
-                h.paper,
-                h.id,
-                h.date,
-                h.commit,
-                h.old.describe(),
-                h.reason
-            );
-        }
-    }
-    md
-}
-
-fn cell(s: &str) -> String {
-    s.replace('|', "\\|").replace('\n', " ")
 }
 
 #[cfg(test)]

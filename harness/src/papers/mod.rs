@@ -14,6 +14,7 @@
 //! implementing [`PaperModule`], and one line in [`PAPERS`].
 
 pub mod claims;
+pub mod claims_report;
 pub mod evidence;
 pub mod from_run;
 pub mod hardware;
