@@ -128,19 +128,15 @@ pub fn pair_side(
             e.bad_pixel_share
         }
     };
+    // The first of the worst viewpoints: the lowest PSNR, or the largest share of bad pixels.
     let (view, worst) = views
         .iter()
-        .cloned()
-        .reduce(|w, v| {
-            let worse = if worst_psnr {
-                value(&v.1) < value(&w.1)
+        .min_by(|a, b| {
+            let (a, b) = (value(&a.1), value(&b.1));
+            if worst_psnr {
+                a.total_cmp(&b)
             } else {
-                value(&v.1) > value(&w.1)
-            };
-            if worse {
-                v
-            } else {
-                w
+                b.total_cmp(&a)
             }
         })
         .expect("one_variant returns at least one row");
@@ -160,7 +156,7 @@ pub fn pair_side(
             views.len(),
             each.join("; ")
         ),
-        vec![Sample::exact(view, value(&worst))],
+        vec![Sample::exact(view.clone(), value(worst))],
     ))
 }
 
