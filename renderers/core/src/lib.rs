@@ -16,6 +16,7 @@ pub mod scene;
 pub mod settings;
 pub mod silhouette;
 pub mod sort;
+pub mod table_texture;
 pub mod transfer;
 pub mod visibility;
 

@@ -225,16 +225,7 @@ impl State {
                                 ),
                             }),
                         }],
-                        vec![
-                            wgpu::BindGroupEntry {
-                                binding: 4,
-                                resource: wgpu::BindingResource::TextureView(&self.table_view),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 5,
-                                resource: wgpu::BindingResource::Sampler(&self.sampler),
-                            },
-                        ],
+                        self.table.bind_entries(4, 5).to_vec(),
                         render_core::bind::whole_from(
                             6,
                             &[&pixels, &kentries, &self.counters, &heads, &nodes_buf],

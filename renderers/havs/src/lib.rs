@@ -22,10 +22,11 @@ pub mod kbuffer;
 use anyhow::{bail, Context};
 use datasets::TetMesh;
 use rayon::prelude::*;
-use render_core::bind::{check_storage_bindings, storage_entry, texture_entry, uniform_entry};
+use render_core::bind::{check_storage_bindings, storage_entry, uniform_entry};
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::preintegration::Table3d;
 use render_core::sort::RadixScratch;
+use render_core::table_texture::TableTexture;
 use render_core::{
     Camera, ChunkedBuffer, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer,
 };
@@ -297,8 +298,7 @@ struct State {
     chunks: Vec<std::ops::Range<u64>>,
     uniforms: Vec<wgpu::Buffer>,
     counters: wgpu::Buffer,
-    table_view: wgpu::TextureView,
-    sampler: wgpu::Sampler,
+    table: TableTexture,
     layout: wgpu::BindGroupLayout,
     draw_pipeline: wgpu::RenderPipeline,
     drain_pipeline: wgpu::ComputePipeline,
@@ -454,56 +454,14 @@ impl Renderer for Havs {
             max_len,
         );
         let (n_s, n_l) = (s.table_scalar, s.table_length);
-        let tex = ledger.texture(
+        let table = TableTexture::new(
             gpu,
-            Lifetime::Persistent,
-            &wgpu::TextureDescriptor {
-                label: Some("havs preintegration table"),
-                size: wgpu::Extent3d {
-                    width: n_s,
-                    height: n_s,
-                    depth_or_array_layers: n_l,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D3,
-                format: wgpu::TextureFormat::Rgba32Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            },
+            &mut ledger,
+            "havs preintegration table",
+            [n_s, n_s, n_l],
+            &table.data,
         )?;
-        gpu.queue.write_texture(
-            tex.as_image_copy(),
-            bytemuck::cast_slice(&table.data),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(n_s * 16),
-                rows_per_image: Some(n_s),
-            },
-            wgpu::Extent3d {
-                width: n_s,
-                height: n_s,
-                depth_or_array_layers: n_l,
-            },
-        );
-        let table_view = tex.create_view(&Default::default());
-        // Without FLOAT32_FILTERABLE the table is sampled nearest: a visible approximation,
-        // so every row of such an adapter carries the counter `table_filter_nearest=1`.
-        let filterable = gpu.features.contains(wgpu::Features::FLOAT32_FILTERABLE);
-        let filter = if filterable {
-            wgpu::FilterMode::Linear
-        } else {
-            wgpu::FilterMode::Nearest
-        };
-        let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("havs table sampler"),
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            address_mode_w: wgpu::AddressMode::ClampToEdge,
-            mag_filter: filter,
-            min_filter: filter,
-            ..Default::default()
-        });
+        let filterable = table.filterable;
 
         // The order buffer (face indices front to back) is bound in chunks that each fit one
         // storage binding, with offsets aligned as the device requires.
@@ -542,21 +500,8 @@ impl Renderer for Havs {
         let all =
             wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let fc = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let mut entries = vec![
-            uniform_entry(0, all),
-            storage_entry(3, all, true),
-            texture_entry(4, fc, filterable, wgpu::TextureViewDimension::D3),
-            wgpu::BindGroupLayoutEntry {
-                binding: 5,
-                visibility: fc,
-                ty: wgpu::BindingType::Sampler(if filterable {
-                    wgpu::SamplerBindingType::Filtering
-                } else {
-                    wgpu::SamplerBindingType::NonFiltering
-                }),
-                count: None,
-            },
-        ];
+        let mut entries = vec![uniform_entry(0, all), storage_entry(3, all, true)];
+        entries.extend(TableTexture::layout_entries(filterable, 4, 5, fc));
         entries.extend((6..=10).map(|b| storage_entry(b, fc, false)));
         entries.extend(verts_buf.layout_entries(MESH_BINDING, all, true));
         entries.extend(faces_buf.layout_entries(MESH_BINDING + verts_buf.bindings(), all, true));
@@ -624,8 +569,7 @@ impl Renderer for Havs {
             chunks,
             uniforms,
             counters,
-            table_view,
-            sampler,
+            table,
             layout,
             draw_pipeline,
             drain_pipeline,
