@@ -32,7 +32,7 @@ struct PassParams {
 // (peel layer the ray is in, steps taken)
 @group(1) @binding(2) var<storage, read_write> aux: array<vec2<u32>>;
 @group(1) @binding(3) var layers: texture_2d_array<u32>;
-@group(1) @binding(4) var<storage, read> table: array<vec4<f32>>;
+@group(1) @binding(4) var table: texture_3d<f32>;
 @group(1) @binding(5) var<storage, read_write> tile_counts: array<atomic<u32>>;
 @group(1) @binding(6) var<storage, read_write> stats: array<atomic<u32>>;
 @group(1) @binding(7) var<storage, read> tiles: array<TileRect>;
@@ -40,35 +40,27 @@ struct PassParams {
 @group(1) @binding(8) var<storage, read> active_tiles: array<u32>;
 @group(1) @binding(9) var<storage, read> pass_params: PassParams;
 
-// Linear interpolation coordinate as render_core::preintegration samples its tables.
-fn axis(x: f32, n: u32) -> vec2<f32> {
-    let f = clamp(x * f32(n - 1u), 0.0, f32(n - 1u));
-    let i = min(floor(f), f32(n - 2u));
-    return vec2<f32>(i, f - i);
+@group(1) @binding(10) var table_sampler: sampler;
+
+// Texture coordinate of x ∈ [0, 1] on an axis of n entries, entry i standing for i / (n − 1)
+// (render_core::preintegration's tables).
+fn texel_coord(x: f32, n: u32) -> f32 {
+    let nf = f32(n);
+    return (clamp(x, 0.0, 1.0) * (nf - 1.0) + 0.5) / nf;
 }
 
+// One filtered sample of the pre-integration table (render_core::table_texture).
 fn lookup(s_f: f32, s_b: f32, len: f32) -> vec4<f32> {
     let n = frame.table.x;
-    let a = axis(s_f, n);
-    let b = axis(s_b, n);
-    let i = u32(a.x);
-    let j = u32(b.x);
+    let u = texel_coord(s_f, n);
+    let v = texel_coord(s_b, n);
     if (frame.counts.w & FLAG_TABLE3D) != 0u {
-        let c = axis(len * frame.misc.w, frame.table.y);
-        let k = u32(c.x);
-        var plane: array<vec4<f32>, 2>;
-        for (var dk = 0u; dk < 2u; dk++) {
-            let base = (k + dk) * n * n;
-            let x0 = mix(table[base + j * n + i], table[base + j * n + i + 1u], a.y);
-            let x1 = mix(table[base + (j + 1u) * n + i], table[base + (j + 1u) * n + i + 1u], a.y);
-            plane[dk] = mix(x0, x1, b.y);
-        }
-        return mix(plane[0], plane[1], c.y);
+        let w = texel_coord(len * frame.misc.w, frame.table.y);
+        return textureSampleLevel(table, table_sampler, vec3<f32>(u, v, w), 0.0);
     }
-    let x0 = mix(table[j * n + i], table[j * n + i + 1u], a.y);
-    let x1 = mix(table[(j + 1u) * n + i], table[(j + 1u) * n + i + 1u], a.y);
+    let c = textureSampleLevel(table, table_sampler, vec3<f32>(u, v, 0.5), 0.0);
     // The 2D table holds a segment of the fixed length; the paper's code scales by length.
-    return min(mix(x0, x1, b.y) * (len * frame.misc.w), vec4<f32>(1.0));
+    return min(c * (len * frame.misc.w), vec4<f32>(1.0));
 }
 
 struct State {
@@ -194,7 +186,14 @@ fn init(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn tile_pixel(wg: vec3<u32>, lid: vec3<u32>, p: ptr<function, vec2<u32>>) -> u32 {
     let t = active_tiles[wg.z];
     let r = tiles[t];
-    *p = r.origin + wg.xy * 8u + lid.xy;
+    // Z order inside the 8×8 group: 8 consecutive invocations (one SIMD batch of a CPU
+    // backend) cover a 4×2 block instead of a row of 8, so their rays are more alike.
+    let idx = lid.y * 8u + lid.x;
+    let m = vec2<u32>(
+        (idx & 1u) | ((idx >> 1u) & 2u) | ((idx >> 2u) & 4u),
+        ((idx >> 1u) & 1u) | ((idx >> 2u) & 2u) | ((idx >> 3u) & 4u),
+    );
+    *p = r.origin + wg.xy * 8u + m;
     if (*p).x >= r.end.x || (*p).y >= r.end.y {
         return NONE;
     }

@@ -6,6 +6,7 @@ use anyhow::{anyhow, bail, Context};
 use datasets::TetMesh;
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::preintegration::{Table2d, Table3d};
+use render_core::table_texture::TableTexture;
 use render_core::{
     Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Settings,
 };
@@ -54,8 +55,7 @@ struct State {
     mesh_bind: wgpu::BindGroup,
     faces: wgpu::Buffer,
     face_vertices: u32,
-    table: wgpu::Buffer,
-    table_bytes: u64,
+    table: TableTexture,
     /// 1 / (longest edge) for the 3D table, 1 / (fixed length) for the 2D one.
     inv_table_length: f32,
     length_unit: f64,
@@ -322,30 +322,30 @@ impl Renderer for Raycast {
             bytemuck::cast_slice(&verts),
             wgpu::BufferUsages::VERTEX,
         )?;
-        let (table_data, inv_table_length) = match self.settings.table {
+        // The table is a filtered 3D texture, one sample a step as the paper's fragment
+        // program looks it up (§2.2); the 2D table is one layer of it.
+        let (table, inv_table_length) = match self.settings.table {
             TableKind::ThreeD => {
                 let t = Table3d::build(optics, TABLE_SCALAR, TABLE_LENGTH, layout.longest_edge);
+                let size = [
+                    TABLE_SCALAR as u32,
+                    TABLE_SCALAR as u32,
+                    TABLE_LENGTH as u32,
+                ];
                 (
-                    t.data,
+                    TableTexture::new(gpu, &mut ledger, "raycast 3D table", size, &t.data)?,
                     (1.0 / layout.longest_edge.max(f64::MIN_POSITIVE)) as f32,
                 )
             }
             TableKind::TwoD => {
                 let t = Table2d::build(optics, TABLE_SCALAR, layout.mean_edge);
+                let size = [TABLE_SCALAR as u32, TABLE_SCALAR as u32, 1];
                 (
-                    t.data,
+                    TableTexture::new(gpu, &mut ledger, "raycast 2D table", size, &t.data)?,
                     (1.0 / layout.mean_edge.max(f64::MIN_POSITIVE)) as f32,
                 )
             }
         };
-        let table = ledger.buffer_init(
-            gpu,
-            "raycast pre-integration table",
-            Lifetime::Persistent,
-            bytemuck::cast_slice(&table_data),
-            storage,
-        )?;
-        let table_bytes = table_data.len() as u64 * 16;
         let frame_params = ledger.buffer(
             gpu,
             "raycast frame params",
@@ -380,7 +380,6 @@ impl Renderer for Raycast {
             faces,
             face_vertices,
             table,
-            table_bytes,
             inv_table_length,
             length_unit: optics.length_unit,
             max_steps,
@@ -715,7 +714,12 @@ fn frame(
             "mesh_bytes_per_tet".to_string(),
             st.mesh_bytes as f64 / st.tets.max(1) as f64,
         ),
-        ("table_bytes".to_string(), st.table_bytes as f64),
+        ("table_bytes".to_string(), st.table.bytes as f64),
+        // An adapter that cannot filter Rgba32Float samples the table nearest (counted).
+        (
+            "table_filter_nearest".to_string(),
+            !st.table.filterable as u8 as f64,
+        ),
         ("mesh_bindings".to_string(), st.mesh_bindings as f64),
     ];
     st.last = Some(LastFrame {

@@ -6,6 +6,7 @@ use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::Gpu;
 
 use crate::layout::mesh_wgsl;
+use render_core::table_texture::TableTexture;
 
 /// Slots of the statistics buffer (see `STAT_*` in cast.wgsl).
 pub const STAT_SLOTS: usize = 8;
@@ -110,6 +111,8 @@ impl Pipelines {
             label: Some("raycast previous layer"),
             entries: &[uint_texture_entry(0, wgpu::TextureViewDimension::D2)],
         });
+        let table_entries =
+            TableTexture::layout_entries(TableTexture::filterable_on(gpu), 4, 10, STAGES);
         let cast_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("raycast traversal"),
             entries: &[
@@ -117,12 +120,13 @@ impl Pipelines {
                 buffer_entry(1, RW, false),
                 buffer_entry(2, RW, false),
                 uint_texture_entry(3, wgpu::TextureViewDimension::D2Array),
-                buffer_entry(4, RO, false),
+                table_entries[0],
                 buffer_entry(5, RW, false),
                 buffer_entry(6, RW, false),
                 buffer_entry(7, RO, false),
                 buffer_entry(8, RO, false),
                 bind::params_entry(9, STAGES),
+                table_entries[1],
             ],
         });
         let probe_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -243,7 +247,7 @@ impl Target {
         gpu: &Gpu,
         pipes: &Pipelines,
         ledger: &mut MemoryLedger,
-        table: &wgpu::Buffer,
+        table: &TableTexture,
         width: u32,
         height: u32,
         layer_slots: u32,
@@ -370,6 +374,7 @@ impl Target {
                 resource: b.as_entire_binding(),
             }
         }
+        let [table_view, table_sampler] = table.bind_entries(4, 10);
         let cast_bind = |flag: &wgpu::Buffer| {
             gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("raycast traversal"),
@@ -382,12 +387,13 @@ impl Target {
                         binding: 3,
                         resource: wgpu::BindingResource::TextureView(&array_view),
                     },
-                    buf(4, table),
+                    table_view.clone(),
                     buf(5, &tile_counts),
                     buf(6, &stats),
                     buf(7, &tile_rects),
                     buf(8, &active_tiles),
                     buf(9, flag),
+                    table_sampler.clone(),
                 ],
             })
         };
