@@ -10,10 +10,11 @@
 //!
 //! Face `i` is opposite vertex `i` (`datasets::TET_FACES`) with the outward unit normal `n_i`;
 //! `v_{3−i}` lies on face `i`, which is the point the paper's Eq. 1 uses. A neighbour `a_i` is two
-//! integers, as the paper's (t_u, t_v) texture coordinates: here (binding, index in binding),
-//! because a storage binding holds at most 128 MiB on lavapipe (≈ 932 K tets at 144 B), and
-//! larger meshes are split over several bindings (up to [`MESH_SLOTS`]); a ray walks from any tet to
-//! any other by following those pairs. The scalar is s(x) = g·x + c (Eq. 2), already normalised
+//! integers, as the paper's (t_u, t_v) texture coordinates: here (layer, index in layer) of a 2D
+//! array texture ([`MESH_TEXTURE_WIDTH`] texels a row), whose layers are at most as large as a
+//! storage binding (128 MiB on lavapipe, ≈ 932 K tets at 144 B), up to [`MESH_LAYERS`] of them;
+//! a ray walks from any tet to any other by following those pairs. The scalar is s(x) = g·x + c
+//! (Eq. 2), already normalised
 //! to the transfer function's [0, 1].
 //!
 //! Positions are in object coordinates (OCS): the mesh moved so that its bounding-box centre is
@@ -28,37 +29,13 @@ use render_core::Optics;
 pub const BYTES_PER_TET: u64 = 144;
 /// 16-byte texels per tet.
 pub const TEXELS_PER_TET: usize = 9;
-/// Most storage bindings the mesh may take; the shaders are generated for the bindings a mesh
-/// needs ([`mesh_wgsl`]), and `prepare` also checks the adapter's storage-binding limit
-/// (24 × 932 K = 22 M tets on lavapipe, whose 32 storage buffers per stage leave 26).
-pub const MESH_SLOTS: usize = 24;
+/// Most layers of the mesh texture (24 × 932 K = 22 M tets at lavapipe's 128 MiB a layer).
+pub const MESH_LAYERS: usize = 24;
+/// Texels in a row of the mesh texture: a power of two, so a shader turns an index into a
+/// texel address with a mask and a shift (`texel` in common.wgsl), and within WebGPU's
+/// guaranteed 8192.
+pub const MESH_TEXTURE_WIDTH: u32 = 8192;
 
-/// WGSL of `slots` mesh bindings `mesh0 …` at group 0, bindings 1.., and `texel(c, i)`, the
-/// paper's (t_u, t_v) texture fetch: texel `i` of binding `c`.
-pub fn mesh_wgsl(slots: usize) -> String {
-    let mut s = String::new();
-    for c in 0..slots {
-        s += &format!(
-            "@group(0) @binding({}) var<storage, read> mesh{c}: array<vec4<u32>>;\n",
-            c + 1
-        );
-    }
-    s += "fn texel(c: u32, i: u32) -> vec4<u32> {\n";
-    if slots == 1 {
-        s += "    return mesh0[i];\n}\n";
-        return s;
-    }
-    s += "    switch c {\n";
-    for c in 0..slots {
-        if c + 1 == slots {
-            s += &format!("        default: {{ return mesh{c}[i]; }}\n");
-        } else {
-            s += &format!("        case {c}u: {{ return mesh{c}[i]; }}\n");
-        }
-    }
-    s += "    }\n}\n";
-    s
-}
 /// Marks "no tet": a boundary face's missing neighbour, a ray that left the mesh.
 pub const NONE: u32 = u32::MAX;
 
@@ -80,10 +57,10 @@ impl TetRef {
     }
 }
 
-/// The packed mesh: one `Vec` of texels per storage binding.
+/// The packed mesh: one `Vec` of texels per layer of the mesh texture.
 #[derive(Debug, Clone)]
 pub struct MeshLayout {
-    /// Tets per binding (the last one may hold fewer).
+    /// Tets per layer (the last one may hold fewer).
     pub tets_per_chunk: u32,
     /// `chunks[c]` holds tets `c·tets_per_chunk ..`, [`TEXELS_PER_TET`] texels each, as u32 bits.
     pub chunks: Vec<Vec<[u32; 4]>>,
@@ -118,16 +95,20 @@ impl MeshLayout {
         &self.chunks[r.chunk as usize][base..base + TEXELS_PER_TET]
     }
 
-    /// Packs `mesh` into bindings of at most `max_binding` bytes.
-    pub fn build(mesh: &TetMesh, optics: &Optics, max_binding: u64) -> anyhow::Result<MeshLayout> {
+    /// Packs `mesh` into layers of at most `max_layer_bytes` bytes.
+    pub fn build(
+        mesh: &TetMesh,
+        optics: &Optics,
+        max_layer_bytes: u64,
+    ) -> anyhow::Result<MeshLayout> {
         let n = mesh.num_tets();
-        // 2^24 tets per binding at most, so (binding, index) could also pack into one u32.
-        let per = (max_binding / BYTES_PER_TET).clamp(1, 1 << 24);
+        // 2^24 tets per layer at most, so (layer, index) could also pack into one u32.
+        let per = (max_layer_bytes / BYTES_PER_TET).clamp(1, 1 << 24);
         let chunks_needed = (n as u64).div_ceil(per).max(1);
-        if chunks_needed > MESH_SLOTS as u64 {
+        if chunks_needed > MESH_LAYERS as u64 {
             anyhow::bail!(
                 "raycast: mesh {} has {n} tets = {} bytes at 144 B/tet, needs {chunks_needed} \
-                 storage bindings of {max_binding} bytes, at most {MESH_SLOTS} are bound",
+                 texture layers of {max_layer_bytes} bytes, at most {MESH_LAYERS} are bound",
                 mesh.name,
                 n as u64 * BYTES_PER_TET
             );
@@ -193,7 +174,7 @@ impl MeshLayout {
             }
             (texels, longest, sum / 6.0)
         };
-        // Each binding's texels written in place (no whole-mesh intermediate: at 20 M tets
+        // Each layer's texels written in place (no whole-mesh intermediate: at 20 M tets
         // one took 3.2 GB beside the 2.9 GB of bindings); the mean edges are summed in tet
         // order, as one sequential pass would.
         let mut chunks: Vec<Vec<[u32; 4]>> = Vec::with_capacity(chunks_needed as usize);
@@ -227,9 +208,16 @@ impl MeshLayout {
         })
     }
 
-    /// Bytes of all bindings together (144 per tet).
+    /// Bytes of all layers' texels together (144 per tet; the texture pads each layer to whole
+    /// rows of the largest).
     pub fn bytes(&self) -> u64 {
         self.chunks.iter().map(|c| c.len() as u64 * 16).sum()
+    }
+
+    /// Rows of the mesh texture: every layer has those of the largest.
+    pub fn texture_rows(&self) -> u32 {
+        let texels = self.chunks.iter().map(Vec::len).max().unwrap_or(0).max(1);
+        (texels as u64).div_ceil(MESH_TEXTURE_WIDTH as u64) as u32
     }
 }
 

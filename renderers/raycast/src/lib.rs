@@ -1,9 +1,9 @@
 //! Tiled ray casting with depth peeling: Bernardon, Pagot, Comba and Silva (2005), "GPU-based
 //! Tiled Ray Casting using Depth Peeling" — the one image-order algorithm of tetbench.
 //!
-//! * Mesh layout ([`layout`], §3.1 Table 1): 144 bytes per tet, in as many storage bindings
-//!   as it needs (up to [`layout::MESH_SLOTS`]) so rays walk across bindings (the paper's
-//!   2D-texture coordinates (t_u, t_v) become (binding, index)).
+//! * Mesh layout ([`layout`], §3.1 Table 1): 144 bytes per tet in a 2D array texture, as many
+//!   layers as it needs (up to [`layout::MESH_LAYERS`]) so rays walk across layers (the
+//!   paper's 2D-texture coordinates (t_u, t_v) become (layer, index)).
 //! * Phases 1–2 (`peel.wgsl`, §2.4, §3.2): the front-facing boundary faces are rasterised with
 //!   the Z-buffer to find each pixel's entry tet and λ; each further layer peels the next entry
 //!   behind the previous one (bias on λ), until a layer is empty (an occlusion query per layer)

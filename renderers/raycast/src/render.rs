@@ -11,7 +11,7 @@ use render_core::{
     Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Settings,
 };
 
-use crate::layout::{MeshLayout, TetRef};
+use crate::layout::{MeshLayout, TetRef, MESH_TEXTURE_WIDTH};
 use crate::resources::{FrameParams, Pipelines, Target, TileRect, MAX_TILES, STAT_SLOTS};
 use crate::settings::{Mode, RaycastSettings, TableKind};
 use crate::step::{LayerEntry, RayFrame};
@@ -32,8 +32,8 @@ const STAT_STEPS_HIGH: usize = 7;
 /// Tiled ray caster (`raycast`).
 pub struct Raycast {
     pub settings: RaycastSettings,
-    /// Bytes per mesh binding when smaller than the adapter's limit (tests split small meshes
-    /// across bindings this way).
+    /// Bytes per mesh texture layer when smaller than the adapter's storage-binding limit
+    /// (tests split small meshes across layers this way).
     max_binding: Option<u64>,
     state: Option<State>,
 }
@@ -41,10 +41,11 @@ pub struct Raycast {
 struct State {
     /// The OCS origin of the packed mesh ([`MeshLayout::origin`]).
     origin: [f64; 3],
-    /// Storage bindings of the packed mesh and their bytes. The packed texels themselves live
+    /// Layers of the mesh texture and its bytes. The packed texels themselves live
     /// only on the GPU: a host copy was the mesh again at 144 B/tet (2.9 GB at 20 M tets).
     mesh_bindings: usize,
     mesh_bytes: u64,
+    mesh_padding_bytes: u64,
     /// The binding size the mesh was packed for, so that [`Raycast::layout`] packs it again
     /// the same way.
     max_binding: u64,
@@ -104,7 +105,7 @@ impl Raycast {
         }
     }
 
-    /// Splits the mesh into bindings of at most `bytes` (rounded down to whole tets).
+    /// Splits the mesh into texture layers of at most `bytes` (rounded down to whole tets).
     pub fn with_max_binding(mut self, bytes: u64) -> Raycast {
         self.max_binding = Some(bytes);
         self
@@ -268,38 +269,65 @@ impl Renderer for Raycast {
     ) -> anyhow::Result<Prepared> {
         self.state = None;
         self.settings.validate()?;
-        let max_binding = self.max_binding.map_or(gpu.max_storage_binding(), |b| {
-            b.min(gpu.max_storage_binding())
-        });
+        // A layer is at most a storage binding's size (so its count and bytes are those of
+        // the storage layout it replaced) and at most the texture's largest rows.
+        let texture_bytes =
+            MESH_TEXTURE_WIDTH as u64 * gpu.limits.max_texture_dimension_2d as u64 * 16;
+        let max_binding = self
+            .max_binding
+            .map_or(gpu.max_storage_binding(), |b| {
+                b.min(gpu.max_storage_binding())
+            })
+            .min(texture_bytes);
         let mut layout = MeshLayout::build(mesh, optics, max_binding)?;
         let slots = layout.chunks.len();
+        anyhow::ensure!(
+            slots as u32 <= gpu.limits.max_texture_array_layers,
+            "raycast on {}: the mesh needs {slots} texture layers, the adapter allows {}",
+            gpu.adapter.name,
+            gpu.limits.max_texture_array_layers
+        );
         render_core::bind::check_storage_bindings(
             gpu,
-            &format!("raycast on {} ({} mesh bindings)", gpu.adapter.name, slots),
-            // Group 0: the frame and the mesh; group 1: the traversal's nine buffers.
-            (1 + slots + 9) as u32,
+            &format!("raycast on {}", gpu.adapter.name),
+            // Group 0: the frame; group 1: the traversal's eight buffers.
+            1 + 8,
         )?;
         let mut ledger = MemoryLedger::default();
-        let storage = wgpu::BufferUsages::STORAGE;
-        // Each binding's host texels are dropped once uploaded: the GPU's copy is the only one
-        // kept (`layout` keeps its addressing and origin).
-        let chunk_buffers: Vec<wgpu::Buffer> = std::mem::take(&mut layout.chunks)
-            .into_iter()
-            .enumerate()
-            .map(|(c, data)| {
-                ledger.buffer_init(
-                    gpu,
-                    &format!("{MESH_BINDING_LABEL} {c}"),
-                    Lifetime::Persistent,
-                    bytemuck::cast_slice(&data),
-                    storage,
-                )
-            })
-            .collect::<anyhow::Result<_>>()?;
-        // The mesh's bytes as allocated: the buffers just created for its bindings, read from
-        // the ledger (not from the layout's texel count), so `mesh_bytes_per_tet` measures
-        // what the device holds (§3.1's 144 B/tet is a claim about it).
-        let mesh_bytes = ledger.bytes_labelled(MESH_BINDING_LABEL);
+        // The mesh texture: every layer as many rows as the largest needs. Each layer's host
+        // texels are dropped once uploaded: the GPU's copy is the only one kept (`layout`
+        // keeps its addressing and origin).
+        let rows = layout.texture_rows();
+        let mesh_texture = ledger.texture(
+            gpu,
+            Lifetime::Persistent,
+            &wgpu::TextureDescriptor {
+                label: Some(MESH_TEXTURE_LABEL),
+                size: wgpu::Extent3d {
+                    width: MESH_TEXTURE_WIDTH,
+                    height: rows,
+                    depth_or_array_layers: slots as u32,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Uint,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            },
+        )?;
+        let mut mesh_bytes = 0;
+        for (c, data) in std::mem::take(&mut layout.chunks).into_iter().enumerate() {
+            mesh_bytes += write_layer(gpu, &mesh_texture, c as u32, &data);
+        }
+        let mesh_view = mesh_texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        // The mesh's bytes: the texels written into the texture (§3.1's 144 B/tet is a claim
+        // about the layout), and apart from them the padding of each layer's last row, read
+        // from the ledger's allocation.
+        let mesh_padding_bytes = ledger.bytes_labelled(MESH_TEXTURE_LABEL) - mesh_bytes;
         // Boundary faces as geometry (phase 1): position (OCS) and the tet's (binding, index).
         let o = layout.origin;
         let mut verts: Vec<u32> = Vec::with_capacity(mesh.boundary_faces().len() * 15);
@@ -353,10 +381,14 @@ impl Renderer for Raycast {
             std::mem::size_of::<FrameParams>() as u64,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
-        let pipes = Pipelines::new(gpu, slots);
-        let mut entries = vec![render_core::bind::whole(0, &frame_params)];
-        let refs: Vec<&wgpu::Buffer> = chunk_buffers.iter().collect();
-        entries.extend(render_core::bind::whole_from(1, &refs));
+        let pipes = Pipelines::new(gpu);
+        let entries = [
+            render_core::bind::whole(0, &frame_params),
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&mesh_view),
+            },
+        ];
         let mesh_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("raycast frame + mesh"),
             layout: &pipes.mesh_layout,
@@ -371,6 +403,7 @@ impl Renderer for Raycast {
             origin: layout.origin,
             mesh_bindings: slots,
             mesh_bytes,
+            mesh_padding_bytes,
             max_binding,
             tets: n,
             ledger,
@@ -437,8 +470,48 @@ impl Renderer for Raycast {
     }
 }
 
-/// Label of the buffers that hold the mesh (one per storage binding).
-const MESH_BINDING_LABEL: &str = "raycast mesh binding";
+/// Label of the texture that holds the mesh.
+const MESH_TEXTURE_LABEL: &str = "raycast mesh texture";
+
+/// Writes one layer's texels, row by row as the texture holds them (the last row partly);
+/// returns the bytes written.
+fn write_layer(gpu: &Gpu, texture: &wgpu::Texture, layer: u32, data: &[[u32; 4]]) -> u64 {
+    let width = MESH_TEXTURE_WIDTH as usize;
+    let full_rows = data.len() / width;
+    let write = |row: usize, texels: &[[u32; 4]]| {
+        let rows = texels.len().div_ceil(width).max(1);
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: row as u32,
+                    z: layer,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(texels),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some((texels.len().min(width) * 16) as u32),
+                rows_per_image: Some(rows as u32),
+            },
+            wgpu::Extent3d {
+                width: texels.len().min(width) as u32,
+                height: rows as u32,
+                depth_or_array_layers: 1,
+            },
+        );
+    };
+    if full_rows > 0 {
+        write(0, &data[..full_rows * width]);
+    }
+    if data.len() > full_rows * width {
+        write(full_rows, &data[full_rows * width..]);
+    }
+    data.len() as u64 * 16
+}
 
 fn frame(
     gpu: &Gpu,
@@ -713,6 +786,10 @@ fn frame(
         (
             "mesh_bytes_per_tet".to_string(),
             st.mesh_bytes as f64 / st.tets.max(1) as f64,
+        ),
+        (
+            "mesh_padding_bytes".to_string(),
+            st.mesh_padding_bytes as f64,
         ),
         ("table_bytes".to_string(), st.table.bytes as f64),
         // An adapter that cannot filter Rgba32Float samples the table nearest (counted).

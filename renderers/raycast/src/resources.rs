@@ -5,7 +5,6 @@ use render_core::bind;
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::Gpu;
 
-use crate::layout::mesh_wgsl;
 use render_core::table_texture::TableTexture;
 
 /// Slots of the statistics buffer (see `STAT_*` in cast.wgsl).
@@ -97,15 +96,16 @@ pub struct Pipelines {
 }
 
 impl Pipelines {
-    /// Layouts and pipelines for a mesh in `slots` storage bindings. The frame's and the
-    /// pass's parameters are bound with [`bind::params_entry`] (set again every pass).
-    pub fn new(gpu: &Gpu, slots: usize) -> Pipelines {
+    /// Layouts and pipelines. The frame's and the pass's parameters are bound with
+    /// [`bind::params_entry`] (set again every pass); the mesh is a texture array.
+    pub fn new(gpu: &Gpu) -> Pipelines {
         let dev = &gpu.device;
-        let mut mesh_entries = vec![bind::params_entry(0, STAGES)];
-        mesh_entries.extend((1..=slots as u32).map(|b| buffer_entry(b, RO, false)));
         let mesh_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("raycast frame + mesh"),
-            entries: &mesh_entries,
+            entries: &[
+                bind::params_entry(0, STAGES),
+                uint_texture_entry(1, wgpu::TextureViewDimension::D2Array),
+            ],
         });
         let peel_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("raycast previous layer"),
@@ -133,7 +133,7 @@ impl Pipelines {
             label: Some("raycast probe"),
             entries: &[buffer_entry(0, RO, false), buffer_entry(1, RW, false)],
         });
-        let common = format!("{}\n{}", mesh_wgsl(slots), include_str!("common.wgsl"));
+        let common = include_str!("common.wgsl");
         let peel_src = format!("{common}\n{}", include_str!("peel.wgsl"));
         let cast_src = format!("{common}\n{}", include_str!("cast.wgsl"));
         let probe_src = format!("{common}\n{}", include_str!("probe.wgsl"));

@@ -81,7 +81,7 @@ fn layout_is_144_bytes_per_tet_and_splits_across_bindings() {
     let err = MeshLayout::build(&mesh, &optics, BYTES_PER_TET * 10)
         .unwrap_err()
         .to_string();
-    assert!(err.contains("storage bindings"), "{err}");
+    assert!(err.contains("texture layers"), "{err}");
 }
 
 #[test]
@@ -255,7 +255,11 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
     assert!(empty > 0, "expected empty corner tiles");
     assert_eq!(counter(&stats, "tiles_empty"), empty as f64);
     assert_eq!(counter(&stats, "stalled_rays"), 0.0);
+    // 144 B/tet written (Table 1); the texture's last row padded to 8192 texels, counted apart.
     assert_eq!(counter(&stats, "mesh_bytes_per_tet"), 144.0);
+    let n = mesh.num_tets() as u64;
+    let padding = (9 * n).div_ceil(8192) * 8192 * 16 - 144 * n;
+    assert_eq!(counter(&stats, "mesh_padding_bytes"), padding as f64);
 }
 
 /// One tet: every ray that enters crosses exactly one tet, so the frame's `ray_steps` is its
