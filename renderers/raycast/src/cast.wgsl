@@ -42,6 +42,33 @@ struct PassParams {
 
 @group(1) @binding(10) var table_sampler: sampler;
 
+// What a step reads of the frame's parameters, loaded once at the top of an entry point: there
+// every invocation is active and the address the same, so a CPU backend loads it once, where
+// a storage load inside the step loop's divergent control flow runs lane by lane.
+struct StepParams {
+    flags: u32,
+    max_steps: u32,
+    layers: u32,
+    et_alpha: f32,
+    peel_bias: f32,
+    inv_table_length: f32,
+    table_entries: u32,
+    table_lengths: u32,
+}
+
+fn step_params() -> StepParams {
+    return StepParams(
+        frame.counts.w,
+        frame.counts.z,
+        frame.counts.y,
+        frame.misc.z,
+        frame.misc.y,
+        frame.misc.w,
+        frame.table.x,
+        frame.table.y,
+    );
+}
+
 // Texture coordinate of x ∈ [0, 1] on an axis of n entries, entry i standing for i / (n − 1)
 // (render_core::preintegration's tables).
 fn texel_coord(x: f32, n: u32) -> f32 {
@@ -50,17 +77,17 @@ fn texel_coord(x: f32, n: u32) -> f32 {
 }
 
 // One filtered sample of the pre-integration table (render_core::table_texture).
-fn lookup(s_f: f32, s_b: f32, len: f32) -> vec4<f32> {
-    let n = frame.table.x;
+fn lookup(s_f: f32, s_b: f32, len: f32, sp: StepParams) -> vec4<f32> {
+    let n = sp.table_entries;
     let u = texel_coord(s_f, n);
     let v = texel_coord(s_b, n);
-    if (frame.counts.w & FLAG_TABLE3D) != 0u {
-        let w = texel_coord(len * frame.misc.w, frame.table.y);
+    if (sp.flags & FLAG_TABLE3D) != 0u {
+        let w = texel_coord(len * sp.inv_table_length, sp.table_lengths);
         return textureSampleLevel(table, table_sampler, vec3<f32>(u, v, w), 0.0);
     }
     let c = textureSampleLevel(table, table_sampler, vec3<f32>(u, v, 0.5), 0.0);
     // The 2D table holds a segment of the fixed length; the paper's code scales by length.
-    return min(c * (len * frame.misc.w), vec4<f32>(1.0));
+    return min(c * (len * sp.inv_table_length), vec4<f32>(1.0));
 }
 
 struct State {
@@ -101,23 +128,23 @@ fn finish(st: ptr<function, State>) {
 }
 
 // One ray step (phase 3a); returns whether the ray is still active.
-fn advance(st: ptr<function, State>, p: vec2<u32>, ray: Ray) -> bool {
+fn advance(st: ptr<function, State>, p: vec2<u32>, ray: Ray, sp: StepParams) -> bool {
     let ex = exit_of((*st).tet, ray.o, ray.d, (*st).lambda);
     let next = ex.next;
     let lambda_exit = ex.lambda;
     let s_exit = ex.s;
-    let seg = lookup((*st).s, s_exit, lambda_exit - (*st).lambda);
+    let seg = lookup((*st).s, s_exit, lambda_exit - (*st).lambda, sp);
     (*st).colour += (1.0 - (*st).colour.a) * seg;
     (*st).steps += 1u;
     (*st).tet = next;
     (*st).lambda = lambda_exit;
     (*st).s = s_exit;
-    if (frame.counts.w & FLAG_ET) != 0u && (*st).colour.a >= frame.misc.z {
+    if (sp.flags & FLAG_ET) != 0u && (*st).colour.a >= sp.et_alpha {
         atomicAdd(&stats[STAT_TERMINATED], 1u);
         finish(st);
         return false;
     }
-    if (*st).steps >= frame.counts.z {
+    if (*st).steps >= sp.max_steps {
         atomicAdd(&stats[STAT_STALLED], 1u);
         finish(st);
         return false;
@@ -126,7 +153,7 @@ fn advance(st: ptr<function, State>, p: vec2<u32>, ray: Ray) -> bool {
         // Left the mesh: continue from the next peeling layer that lies ahead (§2.4).
         loop {
             (*st).layer += 1u;
-            if (*st).layer >= frame.counts.y {
+            if (*st).layer >= sp.layers {
                 finish(st);
                 return false;
             }
@@ -136,7 +163,7 @@ fn advance(st: ptr<function, State>, p: vec2<u32>, ray: Ray) -> bool {
                 return false;
             }
             let l = bitcast<f32>(e.z);
-            if l >= lambda_exit - frame.misc.y {
+            if l >= lambda_exit - sp.peel_bias {
                 (*st).tet = e.xy;
                 (*st).lambda = l;
                 (*st).s = bitcast<f32>(e.w);
@@ -205,18 +232,21 @@ fn tile_pixel(wg: vec3<u32>, lid: vec3<u32>, p: ptr<function, vec2<u32>>) -> u32
 // here an atomic count).
 @compute @workgroup_size(8, 8)
 fn step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    let sp = step_params();
+    let rf = ray_frame();
+    let width = frame.size.x;
     var p: vec2<u32>;
     let t = tile_pixel(wg, lid, &p);
     if t == NONE {
         return;
     }
-    let i = p.y * frame.size.x + p.x;
+    let i = p.y * width + p.x;
     if rays[i].x == NONE {
         return;
     }
     var st = load(i);
-    let ray = pixel_ray(vec2<f32>(p) + 0.5);
-    let still_active = advance(&st, p, ray);
+    let ray = ray_through(rf, vec2<f32>(p) + 0.5);
+    let still_active = advance(&st, p, ray, sp);
     store(i, st);
     if still_active && pass_params.count != 0u {
         atomicAdd(&tile_counts[t], 1u);
@@ -227,19 +257,22 @@ fn step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
 // layer.
 @compute @workgroup_size(8, 8)
 fn run_loop(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    let sp = step_params();
+    let rf = ray_frame();
+    let width = frame.size.x;
     var p: vec2<u32>;
     let t = tile_pixel(wg, lid, &p);
     if t == NONE {
         return;
     }
-    let i = p.y * frame.size.x + p.x;
+    let i = p.y * width + p.x;
     if rays[i].x == NONE {
         return;
     }
     var st = load(i);
-    let ray = pixel_ray(vec2<f32>(p) + 0.5);
+    let ray = ray_through(rf, vec2<f32>(p) + 0.5);
     loop {
-        if !advance(&st, p, ray) {
+        if !advance(&st, p, ray, sp) {
             break;
         }
     }

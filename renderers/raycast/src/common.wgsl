@@ -47,17 +47,43 @@ struct Ray {
     d: vec3<f32>,
 }
 
+// The frame's pixel-ray parameters ([`pixel_ray`]); an entry point whose rays start after
+// divergent branches loads them first, where one load serves every invocation.
+struct RayFrame {
+    size: vec2<f32>,
+    o0: vec3<f32>,
+    ox: vec3<f32>,
+    oy: vec3<f32>,
+    d0: vec3<f32>,
+    dx: vec3<f32>,
+    dy: vec3<f32>,
+}
+
+fn ray_frame() -> RayFrame {
+    return RayFrame(
+        vec2<f32>(f32(frame.size.x), f32(frame.size.y)),
+        frame.o0.xyz,
+        frame.ox.xyz,
+        frame.oy.xyz,
+        frame.d0.xyz,
+        frame.dx.xyz,
+        frame.dy.xyz,
+    );
+}
+
 // The ray through the pixel centre `px` (framebuffer coordinates, y down), as
 // render_core::Camera::ray builds it.
-fn pixel_ray(px: vec2<f32>) -> Ray {
-    let w = f32(frame.size.x);
-    let h = f32(frame.size.y);
-    let nx = px.x / w * 2.0 - 1.0;
-    let ny = 1.0 - px.y / h * 2.0;
+fn ray_through(rf: RayFrame, px: vec2<f32>) -> Ray {
+    let nx = px.x / rf.size.x * 2.0 - 1.0;
+    let ny = 1.0 - px.y / rf.size.y * 2.0;
     var r: Ray;
-    r.o = frame.o0.xyz + nx * frame.ox.xyz + ny * frame.oy.xyz;
-    r.d = normalize(frame.d0.xyz + nx * frame.dx.xyz + ny * frame.dy.xyz);
+    r.o = rf.o0 + nx * rf.ox + ny * rf.oy;
+    r.d = normalize(rf.d0 + nx * rf.dx + ny * rf.dy);
     return r;
+}
+
+fn pixel_ray(px: vec2<f32>) -> Ray {
+    return ray_through(ray_frame(), px);
 }
 
 // Eq. 1 for the four faces: numerators (v_{3−i} − e)·n_i and denominators r·n_i.
