@@ -154,6 +154,51 @@ fn walk_main(@builtin(global_invocation_id) id: vec3<u32>) {
     walk_out[id.x] = colour;
 }
 
+// The same walk with the cells in an Rgba32Uint texture (9 texels a cell: the 8 of geometry
+// as f32 bits, then the neighbours; 8192 texels a row) and the table a filtered 3D texture
+// sampled once a step: the ray caster's layout since it holds its mesh and its table in
+// textures (renderers/raycast, Bernardon et al. 2005 §3.1). work.rs keeps the faster walk.
+@group(0) @binding(14) var walk_cells_tex: texture_2d<u32>;
+@group(0) @binding(15) var walk_table_tex: texture_3d<f32>;
+@group(0) @binding(16) var walk_sampler: sampler;
+
+fn walk_texel(i: u32) -> vec4<u32> {
+    return textureLoad(walk_cells_tex, vec2<i32>(i32(i & 8191u), i32(i >> 13u)), 0);
+}
+
+@compute @workgroup_size(64)
+fn walk_tex_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let dims = textureDimensions(walk_cells_tex);
+    let cells = dims.x * dims.y / 9u;
+    var cell = (id.x * 2654435761u) % cells;
+    let o = vec3<f32>(f32(id.x & 15u), f32((id.x >> 4u) & 15u), 0.5) * 0.01;
+    let d = normalize(vec3<f32>(0.3, 0.2, 1.0) + o);
+    var lambda = 0.0;
+    var colour = vec4<f32>(0.0);
+    for (var i = 0u; i < WALK_STEPS; i++) {
+        let b = cell * 9u;
+        var best = 3.0e38;
+        var face = 0u;
+        for (var f = 0u; f < 4u; f++) {
+            let p = bitcast<vec4<f32>>(walk_texel(b + f));
+            let den = dot(d, p.xyz);
+            let l = (p.w - dot(o, p.xyz)) / den;
+            if den > 0.0 && l < best {
+                best = l;
+                face = f;
+            }
+        }
+        let g = bitcast<vec4<f32>>(walk_texel(b + 4u));
+        let s = clamp(dot(g.xyz, o + best * d) + g.w, 0.0, 1.0);
+        let e = textureSampleLevel(walk_table_tex, walk_sampler, vec3<f32>(s, 1.0 - s, fract(best)), 0.0);
+        let filler = bitcast<vec4<f32>>(walk_texel(b + 5u + (i % 3u)));
+        colour += (1.0 - colour.a) * e * (best - lambda + filler.x);
+        lambda = best;
+        cell = walk_texel(b + 8u)[face];
+    }
+    walk_out[id.x] = colour;
+}
+
 // Splat fill: what the splatter's compute pass does per voxel (Grau & Tost 2007 §3.6, our
 // splat.wgsl): walk the pixel centres of a square of `splat_params.px` pixels; per centre and
 // per slab of the voxel's SPLAT_RING (2r + 1 for the default r = 2), a bilinear lookup in two

@@ -45,7 +45,7 @@ pub mod floor;
 pub mod work;
 
 /// Bumped whenever a kernel or its size changes (old cache files are then re-measured).
-pub const CALIBRATION_VERSION: u32 = 7;
+pub const CALIBRATION_VERSION: u32 = 8;
 
 const GRID: u64 = 256; // calibrate.wgsl GRID
 const TRIANGLES: u64 = GRID * GRID * 2;

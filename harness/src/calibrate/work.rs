@@ -5,6 +5,7 @@
 
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::gpu_sort::GpuRadixSort;
+use render_core::table_texture::TableTexture;
 use render_core::Gpu;
 use std::time::Instant;
 
@@ -78,9 +79,12 @@ fn storage(
     )
 }
 
-/// Ray steps per second: `WALK_INVOCATIONS` walks of `WALK_STEPS` dependent cell gathers.
+/// Ray steps per second: `WALK_INVOCATIONS` walks of `WALK_STEPS` dependent cell gathers, the
+/// faster of two layouts: cells and table in storage buffers (`walk_main`), and cells in a
+/// texture with the table a filtered 3D texture (`walk_tex_main`, the ray caster's layout).
 pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Result<f64> {
-    let cells = WALK_CELLS.min(gpu.max_storage_binding() / 128);
+    // Whole rows of the texture walk's 8192 texels (9 a cell): a multiple of 8192 cells.
+    let cells = (WALK_CELLS.min(gpu.max_storage_binding() / 128) / 8192 * 8192).max(8192);
     let mut fill = Filler(0x2545_F491_4F6C_DD1D);
     // Four planes whose normals point to a tetrahedron's corners (some face is always an
     // exit), a scalar gradient, three filler texels.
@@ -113,7 +117,6 @@ pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Resu
         "calibrate walk cells",
         bytemuck::cast_slice(&geometry),
     )?;
-    drop(geometry);
     let next_buf = storage(
         gpu,
         &mut ledger,
@@ -144,18 +147,119 @@ pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Resu
             render_core::bind::whole(6, &out),
         ],
     });
-    let s = best_seconds(|| {
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups((WALK_INVOCATIONS / 64) as u32, 1, 1);
-        }
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait()
-    })?;
-    Ok((WALK_INVOCATIONS * WALK_STEPS) as f64 / s)
+    let run = |pipeline: &wgpu::ComputePipeline, bind: &wgpu::BindGroup| {
+        best_seconds(|| {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, bind, &[]);
+                pass.dispatch_workgroups((WALK_INVOCATIONS / 64) as u32, 1, 1);
+            }
+            gpu.queue.submit([enc.finish()]);
+            gpu.wait()
+        })
+    };
+    let storage_s = run(&pipeline, &bind)?;
+
+    // The texture walk: the same cells, each its 8 geometry texels then its neighbours.
+    let mut texels: Vec<[u32; 4]> = Vec::with_capacity(cells as usize * 9);
+    for (c, n) in next.iter().enumerate() {
+        texels.extend(
+            geometry[c * 8..c * 8 + 8]
+                .iter()
+                .map(|g| g.map(f32::to_bits)),
+        );
+        texels.push(*n);
+    }
+    drop(geometry);
+    let rows = (texels.len() / 8192) as u32;
+    let extent = wgpu::Extent3d {
+        width: 8192,
+        height: rows,
+        depth_or_array_layers: 1,
+    };
+    let cells_tex = ledger.texture(
+        gpu,
+        Lifetime::PerFrame,
+        &wgpu::TextureDescriptor {
+            label: Some("calibrate walk cells texture"),
+            size: extent,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Uint,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        },
+    )?;
+    gpu.queue.write_texture(
+        cells_tex.as_image_copy(),
+        bytemuck::cast_slice(&texels),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(8192 * 16),
+            rows_per_image: Some(rows),
+        },
+        extent,
+    );
+    drop(texels);
+    let side = (WALK_TABLE as f64).cbrt().round() as u32;
+    let table_tex = TableTexture::new(
+        gpu,
+        &mut ledger,
+        "calibrate walk table texture",
+        [side; 3],
+        &table,
+    )?;
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let mut entries = vec![
+        render_core::bind::storage_entry(6, compute, false),
+        render_core::bind::sampled_texture_entry(
+            14,
+            compute,
+            wgpu::TextureSampleType::Uint,
+            wgpu::TextureViewDimension::D2,
+        ),
+    ];
+    entries.extend(TableTexture::layout_entries(
+        table_tex.filterable,
+        15,
+        16,
+        compute,
+    ));
+    let tex_layout = gpu
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("calibrate texture walk"),
+            entries: &entries,
+        });
+    let tex_pipeline = gpu.compute_pipeline(
+        "calibrate texture walk",
+        Some(&render_core::bind::pipeline_layout(
+            gpu,
+            "calibrate texture walk",
+            &[Some(&tex_layout)],
+        )),
+        module,
+        "walk_tex_main",
+    );
+    let cells_view = cells_tex.create_view(&Default::default());
+    let mut bind_entries = vec![
+        render_core::bind::whole(6, &out),
+        wgpu::BindGroupEntry {
+            binding: 14,
+            resource: wgpu::BindingResource::TextureView(&cells_view),
+        },
+    ];
+    bind_entries.extend(table_tex.bind_entries(15, 16));
+    let tex_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("calibrate texture walk"),
+        layout: &tex_layout,
+        entries: &bind_entries,
+    });
+    let texture_s = run(&tex_pipeline, &tex_bind)?;
+    Ok((WALK_INVOCATIONS * WALK_STEPS) as f64 / storage_s.min(texture_s))
 }
 
 /// The two tables of the splat benchmark: 8 slices of 32² texels, one with no zero (every
