@@ -9,6 +9,11 @@
 
 use crate::gpu::{Gpu, Lifetime, MemoryLedger};
 
+/// WGSL of `table_coord(x, n)`: the texture coordinate of x ∈ [0, 1] on an axis of `n`
+/// entries. Every shader that samples a [`TableTexture`] includes it (tested against
+/// `Table3d::sample` and `Table2d::sample` in tests/table_texture.rs).
+pub const TABLE_WGSL: &str = include_str!("table_texture.wgsl");
+
 /// The table's texture view and its sampler.
 pub struct TableTexture {
     pub view: wgpu::TextureView,

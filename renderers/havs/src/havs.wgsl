@@ -1,5 +1,5 @@
 // HAVS passes (Callahan et al. 2005). Prepended by the Rust: `const K: u32 = k;`; appended:
-// kbuffer.wgsl (the k-buffer logic shared by the racy fragment pass and the race-free resolve).
+// render_core's table_coord and kbuffer.wgsl (the k-buffer logic shared by the racy fragment pass and the race-free resolve).
 //
 // Faithful mode (§4, Fig. 5): vs + fs_kbuffer draw the faces in sorted order; each fragment
 // reads the pixel's k-buffer from storage, runs kb_insert and writes it back. Fragments of one
@@ -73,16 +73,13 @@ fn early_termination() -> bool {
     return (u.flags & 2u) != 0u;
 }
 
-// Table lookup at texel centres: entry i of an axis of n stands for i/(n-1).
+// Table lookup at texel centres: entry i of an axis of n stands for i/(n-1) (`table_coord`,
+// render_core::table_texture::TABLE_WGSL).
 fn segment_color(s_front: f32, s_back: f32, length: f32) -> vec4<f32> {
     let l = clamp(length / u.max_len, 0.0, 1.0);
     let ns = u.n_s;
     let nl = u.n_l;
-    let uvw = vec3<f32>(
-        (s_front * (ns - 1.0) + 0.5) / ns,
-        (s_back * (ns - 1.0) + 0.5) / ns,
-        (l * (nl - 1.0) + 0.5) / nl,
-    );
+    let uvw = vec3<f32>(table_coord(s_front, ns), table_coord(s_back, ns), table_coord(l, nl));
     return textureSampleLevel(table, table_sampler, uvw, 0.0);
 }
 

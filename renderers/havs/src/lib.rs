@@ -371,8 +371,9 @@ fn mesh_decls(verts: &ChunkedBuffer, faces: &ChunkedBuffer, first: u32) -> Strin
 
 fn shader_source(k: u32, decls: &str) -> String {
     format!(
-        "const K: u32 = {k}u;\n{decls}\n{}\n{}",
+        "const K: u32 = {k}u;\n{decls}\n{}\n{}\n{}",
         include_str!("havs.wgsl"),
+        render_core::table_texture::TABLE_WGSL,
         include_str!("kbuffer.wgsl")
     )
 }

@@ -69,20 +69,14 @@ fn step_params() -> StepParams {
     );
 }
 
-// Texture coordinate of x ∈ [0, 1] on an axis of n entries, entry i standing for i / (n − 1)
-// (render_core::preintegration's tables).
-fn texel_coord(x: f32, n: u32) -> f32 {
-    let nf = f32(n);
-    return (clamp(x, 0.0, 1.0) * (nf - 1.0) + 0.5) / nf;
-}
-
-// One filtered sample of the pre-integration table (render_core::table_texture).
+// One filtered sample of the pre-integration table (render_core::table_texture; `table_coord`
+// from its TABLE_WGSL).
 fn lookup(s_f: f32, s_b: f32, len: f32, sp: StepParams) -> vec4<f32> {
-    let n = sp.table_entries;
-    let u = texel_coord(s_f, n);
-    let v = texel_coord(s_b, n);
+    let n = f32(sp.table_entries);
+    let u = table_coord(s_f, n);
+    let v = table_coord(s_b, n);
     if (sp.flags & FLAG_TABLE3D) != 0u {
-        let w = texel_coord(len * sp.inv_table_length, sp.table_lengths);
+        let w = table_coord(len * sp.inv_table_length, f32(sp.table_lengths));
         return textureSampleLevel(table, table_sampler, vec3<f32>(u, v, w), 0.0);
     }
     let c = textureSampleLevel(table, table_sampler, vec3<f32>(u, v, 0.5), 0.0);

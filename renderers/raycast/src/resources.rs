@@ -135,7 +135,11 @@ impl Pipelines {
         });
         let common = include_str!("common.wgsl");
         let peel_src = format!("{common}\n{}", include_str!("peel.wgsl"));
-        let cast_src = format!("{common}\n{}", include_str!("cast.wgsl"));
+        let cast_src = format!(
+            "{common}\n{}\n{}",
+            render_core::table_texture::TABLE_WGSL,
+            include_str!("cast.wgsl")
+        );
         let probe_src = format!("{common}\n{}", include_str!("probe.wgsl"));
         let peel_module = gpu.shader("raycast peel", &peel_src);
         let cast_module = gpu.shader("raycast cast", &cast_src);
