@@ -155,15 +155,16 @@ fn walk_main(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // The same walk with the cells in an Rgba32Uint texture (9 texels a cell: the 8 of geometry
-// as f32 bits, then the neighbours; 8192 texels a row) and the table a filtered 3D texture
+// as f32 bits, then the neighbours; render_core::texel_texture) and the table a filtered 3D texture
 // sampled once a step: the ray caster's layout since it holds its mesh and its table in
 // textures (renderers/raycast, Bernardon et al. 2005 §3.1). work.rs keeps the faster walk.
-@group(0) @binding(14) var walk_cells_tex: texture_2d<u32>;
+@group(0) @binding(14) var walk_cells_tex: texture_2d_array<u32>;
 @group(0) @binding(15) var walk_table_tex: texture_3d<f32>;
 @group(0) @binding(16) var walk_sampler: sampler;
 
+// render_core::texel_texture's `texel_at` (its TEXEL_WGSL is appended by mod.rs).
 fn walk_texel(i: u32) -> vec4<u32> {
-    return textureLoad(walk_cells_tex, vec2<i32>(i32(i & 8191u), i32(i >> 13u)), 0);
+    return texel_at(walk_cells_tex, 0u, i);
 }
 
 @compute @workgroup_size(64)

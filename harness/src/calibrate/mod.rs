@@ -44,6 +44,15 @@ use crate::results::Row;
 pub mod floor;
 pub mod work;
 
+/// The calibration's kernels, with render-core's texel-texture addressing (`texel_at`).
+fn calibrate_source() -> String {
+    format!(
+        "{}\n{}",
+        include_str!("calibrate.wgsl"),
+        render_core::texel_texture::TEXEL_WGSL
+    )
+}
+
 /// Bumped whenever a kernel or its size changes (old cache files are then re-measured).
 pub const CALIBRATION_VERSION: u32 = 8;
 
@@ -131,7 +140,7 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
     // One step per benchmark (the rasterisation's two legs are two).
     let mut progress = Progress::new("tetbench calibrate", 11, "benchmarks");
     progress.activity("triangle setup");
-    let module = gpu.shader("calibrate", include_str!("calibrate.wgsl"));
+    let module = gpu.shader("calibrate", &calibrate_source());
     let empty = gpu
         .device
         .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -853,7 +862,7 @@ mod tests {
     #[test]
     fn raster_triangles_have_the_counted_fragments() {
         let gpu = Gpu::new().expect("an adapter (lavapipe)");
-        let module = gpu.shader("calibrate", include_str!("calibrate.wgsl"));
+        let module = gpu.shader("calibrate", &calibrate_source());
         let format = wgpu::TextureFormat::Rgba32Float;
         let pipeline = additive_pipeline(&gpu, &module, "raster test", "raster_vs", format);
         for leg in RASTER_LEGS {

@@ -6,6 +6,7 @@
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::gpu_sort::GpuRadixSort;
 use render_core::table_texture::TableTexture;
+use render_core::texel_texture::TexelTexture;
 use render_core::Gpu;
 use std::time::Instant;
 
@@ -83,7 +84,8 @@ fn storage(
 /// faster of two layouts: cells and table in storage buffers (`walk_main`), and cells in a
 /// texture with the table a filtered 3D texture (`walk_tex_main`, the ray caster's layout).
 pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Result<f64> {
-    // Whole rows of the texture walk's 8192 texels (9 a cell): a multiple of 8192 cells.
+    // Whole rows of the texture walk's 8192 texels (9 a cell, TEXEL_ROW): a multiple of 8192
+    // cells.
     let cells = (WALK_CELLS.min(gpu.max_storage_binding() / 128) / 8192 * 8192).max(8192);
     let mut fill = Filler(0x2545_F491_4F6C_DD1D);
     // Four planes whose normals point to a tetrahedron's corners (some face is always an
@@ -173,36 +175,15 @@ pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Resu
         texels.push(*n);
     }
     drop(geometry);
-    let rows = (texels.len() / 8192) as u32;
-    let extent = wgpu::Extent3d {
-        width: 8192,
-        height: rows,
-        depth_or_array_layers: 1,
-    };
-    let cells_tex = ledger.texture(
+    let cells_tex = TexelTexture::new(
         gpu,
+        &mut ledger,
+        "calibrate walk cells texture",
         Lifetime::PerFrame,
-        &wgpu::TextureDescriptor {
-            label: Some("calibrate walk cells texture"),
-            size: extent,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Uint,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        },
+        TexelTexture::rows_for(texels.len()),
+        1,
     )?;
-    gpu.queue.write_texture(
-        cells_tex.as_image_copy(),
-        bytemuck::cast_slice(&texels),
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(8192 * 16),
-            rows_per_image: Some(rows),
-        },
-        extent,
-    );
+    cells_tex.write_layer(gpu, 0, &texels);
     drop(texels);
     let side = (WALK_TABLE as f64).cbrt().round() as u32;
     let table_tex = TableTexture::new(
@@ -219,7 +200,7 @@ pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Resu
             14,
             compute,
             wgpu::TextureSampleType::Uint,
-            wgpu::TextureViewDimension::D2,
+            wgpu::TextureViewDimension::D2Array,
         ),
     ];
     entries.extend(TableTexture::layout_entries(
@@ -244,12 +225,11 @@ pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Resu
         module,
         "walk_tex_main",
     );
-    let cells_view = cells_tex.create_view(&Default::default());
     let mut bind_entries = vec![
         render_core::bind::whole(6, &out),
         wgpu::BindGroupEntry {
             binding: 14,
-            resource: wgpu::BindingResource::TextureView(&cells_view),
+            resource: wgpu::BindingResource::TextureView(&cells_tex.view),
         },
     ];
     bind_entries.extend(table_tex.bind_entries(15, 16));

@@ -17,6 +17,7 @@ pub mod settings;
 pub mod silhouette;
 pub mod sort;
 pub mod table_texture;
+pub mod texel_texture;
 pub mod transfer;
 pub mod visibility;
 

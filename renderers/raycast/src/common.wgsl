@@ -32,14 +32,14 @@ struct Frame {
 }
 
 @group(0) @binding(0) var<storage, read> frame: Frame;
-// The mesh (layout.rs): layer `c` holds tets c·tets_per_layer.., nine texels each, 8192 texels
-// a row (MESH_TEXTURE_WIDTH). A texel load is the paper's (t_u, t_v) texture fetch; a texture
+// The mesh (layout.rs): layer `c` holds tets c·tets_per_layer.., nine texels each, in a
+// render_core::texel_texture (`texel_at`, prepended by the Rust). A texel load is the paper's (t_u, t_v) texture fetch; a texture
 // rather than a storage buffer, because a backend fetches a texel of every lane at once where
 // a storage load may go lane by lane (the ray caster's frame halved on lavapipe).
 @group(0) @binding(1) var mesh: texture_2d_array<u32>;
 
 fn texel(c: u32, i: u32) -> vec4<u32> {
-    return textureLoad(mesh, vec2<i32>(i32(i & 8191u), i32(i >> 13u)), i32(c), 0);
+    return texel_at(mesh, c, i);
 }
 
 struct Ray {

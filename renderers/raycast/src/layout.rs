@@ -31,10 +31,8 @@ pub const BYTES_PER_TET: u64 = 144;
 pub const TEXELS_PER_TET: usize = 9;
 /// Most layers of the mesh texture (24 × 932 K = 22 M tets at lavapipe's 128 MiB a layer).
 pub const MESH_LAYERS: usize = 24;
-/// Texels in a row of the mesh texture: a power of two, so a shader turns an index into a
-/// texel address with a mask and a shift (`texel` in common.wgsl), and within WebGPU's
-/// guaranteed 8192.
-pub const MESH_TEXTURE_WIDTH: u32 = 8192;
+/// Texels in a row of the mesh texture (`render_core::texel_texture`).
+pub const MESH_TEXTURE_WIDTH: u32 = render_core::texel_texture::TEXEL_ROW;
 
 /// Marks "no tet": a boundary face's missing neighbour, a ray that left the mesh.
 pub const NONE: u32 = u32::MAX;
@@ -216,8 +214,8 @@ impl MeshLayout {
 
     /// Rows of the mesh texture: every layer has those of the largest.
     pub fn texture_rows(&self) -> u32 {
-        let texels = self.chunks.iter().map(Vec::len).max().unwrap_or(0).max(1);
-        (texels as u64).div_ceil(MESH_TEXTURE_WIDTH as u64) as u32
+        let texels = self.chunks.iter().map(Vec::len).max().unwrap_or(0);
+        render_core::texel_texture::TexelTexture::rows_for(texels)
     }
 }
 

@@ -16,6 +16,7 @@ use crate::resources::{FrameParams, Pipelines, Target, TileRect, MAX_TILES, STAT
 use crate::settings::{Mode, RaycastSettings, TableKind};
 use crate::step::{LayerEntry, RayFrame};
 use crate::{COUNT_EVERY, ET_OPACITY, PEEL_BIAS, TABLE_LENGTH, TABLE_SCALAR};
+use render_core::texel_texture::TexelTexture;
 
 const FLAG_ET: u32 = 1;
 const FLAG_TABLE3D: u32 = 2;
@@ -297,33 +298,18 @@ impl Renderer for Raycast {
         // The mesh texture: every layer as many rows as the largest needs. Each layer's host
         // texels are dropped once uploaded: the GPU's copy is the only one kept (`layout`
         // keeps its addressing and origin).
-        let rows = layout.texture_rows();
-        let mesh_texture = ledger.texture(
+        let mesh_texture = TexelTexture::new(
             gpu,
+            &mut ledger,
+            MESH_TEXTURE_LABEL,
             Lifetime::Persistent,
-            &wgpu::TextureDescriptor {
-                label: Some(MESH_TEXTURE_LABEL),
-                size: wgpu::Extent3d {
-                    width: MESH_TEXTURE_WIDTH,
-                    height: rows,
-                    depth_or_array_layers: slots as u32,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Uint,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            },
+            layout.texture_rows(),
+            slots as u32,
         )?;
         let mut mesh_bytes = 0;
         for (c, data) in std::mem::take(&mut layout.chunks).into_iter().enumerate() {
-            mesh_bytes += write_layer(gpu, &mesh_texture, c as u32, &data);
+            mesh_bytes += mesh_texture.write_layer(gpu, c as u32, &data);
         }
-        let mesh_view = mesh_texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
         // The mesh's bytes: the texels written into the texture (§3.1's 144 B/tet is a claim
         // about the layout), and apart from them the padding of each layer's last row, read
         // from the ledger's allocation.
@@ -386,7 +372,7 @@ impl Renderer for Raycast {
             render_core::bind::whole(0, &frame_params),
             wgpu::BindGroupEntry {
                 binding: 1,
-                resource: wgpu::BindingResource::TextureView(&mesh_view),
+                resource: wgpu::BindingResource::TextureView(&mesh_texture.view),
             },
         ];
         let mesh_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -472,46 +458,6 @@ impl Renderer for Raycast {
 
 /// Label of the texture that holds the mesh.
 const MESH_TEXTURE_LABEL: &str = "raycast mesh texture";
-
-/// Writes one layer's texels, row by row as the texture holds them (the last row partly);
-/// returns the bytes written.
-fn write_layer(gpu: &Gpu, texture: &wgpu::Texture, layer: u32, data: &[[u32; 4]]) -> u64 {
-    let width = MESH_TEXTURE_WIDTH as usize;
-    let full_rows = data.len() / width;
-    let write = |row: usize, texels: &[[u32; 4]]| {
-        let rows = texels.len().div_ceil(width).max(1);
-        gpu.queue.write_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d {
-                    x: 0,
-                    y: row as u32,
-                    z: layer,
-                },
-                aspect: wgpu::TextureAspect::All,
-            },
-            bytemuck::cast_slice(texels),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some((texels.len().min(width) * 16) as u32),
-                rows_per_image: Some(rows as u32),
-            },
-            wgpu::Extent3d {
-                width: texels.len().min(width) as u32,
-                height: rows as u32,
-                depth_or_array_layers: 1,
-            },
-        );
-    };
-    if full_rows > 0 {
-        write(0, &data[..full_rows * width]);
-    }
-    if data.len() > full_rows * width {
-        write(full_rows, &data[full_rows * width..]);
-    }
-    data.len() as u64 * 16
-}
 
 fn frame(
     gpu: &Gpu,

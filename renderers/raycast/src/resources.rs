@@ -133,7 +133,11 @@ impl Pipelines {
             label: Some("raycast probe"),
             entries: &[buffer_entry(0, RO, false), buffer_entry(1, RW, false)],
         });
-        let common = include_str!("common.wgsl");
+        let common = format!(
+            "{}\n{}",
+            render_core::texel_texture::TEXEL_WGSL,
+            include_str!("common.wgsl")
+        );
         let peel_src = format!("{common}\n{}", include_str!("peel.wgsl"));
         let cast_src = format!(
             "{common}\n{}\n{}",
