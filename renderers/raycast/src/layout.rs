@@ -31,6 +31,40 @@ pub const BYTES_PER_TET: u64 = 144;
 pub const TEXELS_PER_TET: usize = 9;
 /// Most layers of the mesh texture (24 × 932 K = 22 M tets at lavapipe's 128 MiB a layer).
 pub const MESH_LAYERS: usize = 24;
+/// Most bytes of one mesh texture: llvmpipe refuses larger (a 2.95 GB texture of 20 M tets
+/// failed with "Out of Memory"), so a mesh over it is split over several textures, each of
+/// whole layers, bound at bindings 1.. ([`mesh_wgsl`]).
+pub const MESH_TEXTURE_BYTES: u64 = 1 << 30;
+
+/// WGSL of `textures` mesh textures `mesh0 …` (group 0, bindings 1..) of `layers_per_texture`
+/// layers each, and `texel(c, i)`: texel `i` of layer `c` of the whole mesh.
+pub fn mesh_wgsl(textures: usize, layers_per_texture: u32) -> String {
+    let mut s = String::new();
+    for k in 0..textures {
+        s += &format!(
+            "@group(0) @binding({}) var mesh{k}: texture_2d_array<u32>;\n",
+            k + 1
+        );
+    }
+    s += "fn texel(c: u32, i: u32) -> vec4<u32> {\n";
+    if textures == 1 {
+        s += "    return texel_at(mesh0, c, i);\n}\n";
+        return s;
+    }
+    s += &format!(
+        "    let l = c % {layers_per_texture}u;\n    switch c / {layers_per_texture}u {{\n"
+    );
+    for k in 0..textures {
+        if k + 1 == textures {
+            s += &format!("        default: {{ return texel_at(mesh{k}, l, i); }}\n");
+        } else {
+            s += &format!("        case {k}u: {{ return texel_at(mesh{k}, l, i); }}\n");
+        }
+    }
+    s += "    }\n}\n";
+    s
+}
+
 /// Texels in a row of the mesh texture (`render_core::texel_texture`).
 pub const MESH_TEXTURE_WIDTH: u32 = render_core::texel_texture::TEXEL_ROW;
 

@@ -11,7 +11,7 @@ use render_core::{
     Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Settings,
 };
 
-use crate::layout::{MeshLayout, TetRef, MESH_TEXTURE_WIDTH};
+use crate::layout::{MeshLayout, TetRef, MESH_TEXTURE_BYTES, MESH_TEXTURE_WIDTH};
 use crate::resources::{FrameParams, Pipelines, Target, TileRect, MAX_TILES, STAT_SLOTS};
 use crate::settings::{Mode, RaycastSettings, TableKind};
 use crate::step::{LayerEntry, RayFrame};
@@ -36,6 +36,9 @@ pub struct Raycast {
     /// Bytes per mesh texture layer when smaller than the adapter's storage-binding limit
     /// (tests split small meshes across layers this way).
     max_binding: Option<u64>,
+    /// Bytes per mesh texture when smaller than [`MESH_TEXTURE_BYTES`] (tests split small
+    /// meshes across textures this way).
+    max_texture_bytes: Option<u64>,
     state: Option<State>,
 }
 
@@ -102,6 +105,7 @@ impl Raycast {
         Raycast {
             settings,
             max_binding: None,
+            max_texture_bytes: None,
             state: None,
         }
     }
@@ -109,6 +113,12 @@ impl Raycast {
     /// Splits the mesh into texture layers of at most `bytes` (rounded down to whole tets).
     pub fn with_max_binding(mut self, bytes: u64) -> Raycast {
         self.max_binding = Some(bytes);
+        self
+    }
+
+    /// Splits the mesh texture into textures of at most `bytes` (at least one layer each).
+    pub fn with_max_texture_bytes(mut self, bytes: u64) -> Raycast {
+        self.max_texture_bytes = Some(bytes);
         self
     }
 
@@ -298,17 +308,29 @@ impl Renderer for Raycast {
         // The mesh texture: every layer as many rows as the largest needs. Each layer's host
         // texels are dropped once uploaded: the GPU's copy is the only one kept (`layout`
         // keeps its addressing and origin).
-        let mesh_texture = TexelTexture::new(
-            gpu,
-            &mut ledger,
-            MESH_TEXTURE_LABEL,
-            Lifetime::Persistent,
-            layout.texture_rows(),
-            slots as u32,
-        )?;
+        let rows = layout.texture_rows();
+        let layer_bytes = rows as u64 * MESH_TEXTURE_WIDTH as u64 * 16;
+        let max_texture_bytes = self.max_texture_bytes.unwrap_or(MESH_TEXTURE_BYTES);
+        let layers_per_texture = (max_texture_bytes / layer_bytes).clamp(1, slots as u64) as u32;
+        let textures = slots.div_ceil(layers_per_texture as usize);
+        let mesh_textures = (0..textures)
+            .map(|k| {
+                let layers =
+                    (slots - k * layers_per_texture as usize).min(layers_per_texture as usize);
+                TexelTexture::new(
+                    gpu,
+                    &mut ledger,
+                    MESH_TEXTURE_LABEL,
+                    Lifetime::Persistent,
+                    rows,
+                    layers as u32,
+                )
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
         let mut mesh_bytes = 0;
         for (c, data) in std::mem::take(&mut layout.chunks).into_iter().enumerate() {
-            mesh_bytes += mesh_texture.write_layer(gpu, c as u32, &data);
+            let texture = &mesh_textures[c / layers_per_texture as usize];
+            mesh_bytes += texture.write_layer(gpu, c as u32 % layers_per_texture, &data);
         }
         // The mesh's bytes: the texels written into the texture (§3.1's 144 B/tet is a claim
         // about the layout), and apart from them the padding of each layer's last row, read
@@ -367,14 +389,17 @@ impl Renderer for Raycast {
             std::mem::size_of::<FrameParams>() as u64,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
-        let pipes = Pipelines::new(gpu);
-        let entries = [
-            render_core::bind::whole(0, &frame_params),
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::TextureView(&mesh_texture.view),
-            },
-        ];
+        let pipes = Pipelines::new(gpu, textures, layers_per_texture);
+        let mut entries = vec![render_core::bind::whole(0, &frame_params)];
+        entries.extend(
+            mesh_textures
+                .iter()
+                .zip(1..)
+                .map(|(t, binding)| wgpu::BindGroupEntry {
+                    binding,
+                    resource: wgpu::BindingResource::TextureView(&t.view),
+                }),
+        );
         let mesh_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("raycast frame + mesh"),
             layout: &pipes.mesh_layout,

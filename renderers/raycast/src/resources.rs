@@ -7,6 +7,8 @@ use render_core::Gpu;
 
 use render_core::table_texture::TableTexture;
 
+use crate::layout::mesh_wgsl;
+
 /// Slots of the statistics buffer (see `STAT_*` in cast.wgsl).
 pub const STAT_SLOTS: usize = 8;
 /// At most 6 × 6 tiles (the paper's largest tiling).
@@ -97,15 +99,18 @@ pub struct Pipelines {
 
 impl Pipelines {
     /// Layouts and pipelines. The frame's and the pass's parameters are bound with
-    /// [`bind::params_entry`] (set again every pass); the mesh is a texture array.
-    pub fn new(gpu: &Gpu) -> Pipelines {
+    /// [`bind::params_entry`] (set again every pass); the mesh is `textures` array textures of
+    /// `layers_per_texture` layers ([`mesh_wgsl`]).
+    pub fn new(gpu: &Gpu, textures: usize, layers_per_texture: u32) -> Pipelines {
         let dev = &gpu.device;
+        let mut mesh_entries = vec![bind::params_entry(0, STAGES)];
+        mesh_entries.extend(
+            (1..=textures as u32)
+                .map(|b| uint_texture_entry(b, wgpu::TextureViewDimension::D2Array)),
+        );
         let mesh_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("raycast frame + mesh"),
-            entries: &[
-                bind::params_entry(0, STAGES),
-                uint_texture_entry(1, wgpu::TextureViewDimension::D2Array),
-            ],
+            entries: &mesh_entries,
         });
         let peel_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("raycast previous layer"),
@@ -134,9 +139,10 @@ impl Pipelines {
             entries: &[buffer_entry(0, RO, false), buffer_entry(1, RW, false)],
         });
         let common = format!(
-            "{}\n{}",
+            "{}\n{}\n{}",
             render_core::texel_texture::TEXEL_WGSL,
-            include_str!("common.wgsl")
+            include_str!("common.wgsl"),
+            mesh_wgsl(textures, layers_per_texture)
         );
         let peel_src = format!("{common}\n{}", include_str!("peel.wgsl"));
         let cast_src = format!(

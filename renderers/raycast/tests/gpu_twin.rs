@@ -323,8 +323,10 @@ fn images_match_the_reference_on_a_non_convex_mesh_in_both_modes_and_across_bind
         ..exact()
     });
     let (img_loop, ..) = render(&gpu, &mut looped, &mesh, &optics, 6, size);
-    let mut split =
-        Raycast::new(exact()).with_max_binding(mesh.num_tets().div_ceil(3) as u64 * 144);
+    // Three layers, each in a texture of its own (the path of meshes over 1 GiB).
+    let mut split = Raycast::new(exact())
+        .with_max_binding(mesh.num_tets().div_ceil(3) as u64 * 144)
+        .with_max_texture_bytes(1);
     let (img_split, _, split_stats, _) = render(&gpu, &mut split, &mesh, &optics, 6, size);
     assert_eq!(counter(&split_stats, "mesh_bindings"), 3.0);
     // The same arithmetic in the same order: identical images.
