@@ -305,37 +305,9 @@ impl Renderer for Raycast {
             1 + 8,
         )?;
         let mut ledger = MemoryLedger::default();
-        // The mesh texture: every layer as many rows as the largest needs. Each layer's host
-        // texels are dropped once uploaded: the GPU's copy is the only one kept (`layout`
-        // keeps its addressing and origin).
-        let rows = layout.texture_rows();
-        let layer_bytes = rows as u64 * MESH_TEXTURE_WIDTH as u64 * 16;
         let max_texture_bytes = self.max_texture_bytes.unwrap_or(MESH_TEXTURE_BYTES);
-        let layers_per_texture = (max_texture_bytes / layer_bytes).clamp(1, slots as u64) as u32;
-        let textures = slots.div_ceil(layers_per_texture as usize);
-        let mesh_textures = (0..textures)
-            .map(|k| {
-                let layers =
-                    (slots - k * layers_per_texture as usize).min(layers_per_texture as usize);
-                TexelTexture::new(
-                    gpu,
-                    &mut ledger,
-                    MESH_TEXTURE_LABEL,
-                    Lifetime::Persistent,
-                    rows,
-                    layers as u32,
-                )
-            })
-            .collect::<anyhow::Result<Vec<_>>>()?;
-        let mut mesh_bytes = 0;
-        for (c, data) in std::mem::take(&mut layout.chunks).into_iter().enumerate() {
-            let texture = &mesh_textures[c / layers_per_texture as usize];
-            mesh_bytes += texture.write_layer(gpu, c as u32 % layers_per_texture, &data);
-        }
-        // The mesh's bytes: the texels written into the texture (§3.1's 144 B/tet is a claim
-        // about the layout), and apart from them the padding of each layer's last row, read
-        // from the ledger's allocation.
-        let mesh_padding_bytes = ledger.bytes_labelled(MESH_TEXTURE_LABEL) - mesh_bytes;
+        let mesh_textures = MeshTextures::upload(gpu, &mut ledger, &mut layout, max_texture_bytes)?;
+        let (mesh_bytes, mesh_padding_bytes) = (mesh_textures.bytes, mesh_textures.padding_bytes);
         // Boundary faces as geometry (phase 1): position (OCS) and the tet's (binding, index).
         let o = layout.origin;
         let mut verts: Vec<u32> = Vec::with_capacity(mesh.boundary_faces().len() * 15);
@@ -389,17 +361,18 @@ impl Renderer for Raycast {
             std::mem::size_of::<FrameParams>() as u64,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
-        let pipes = Pipelines::new(gpu, textures, layers_per_texture);
-        let mut entries = vec![render_core::bind::whole(0, &frame_params)];
-        entries.extend(
-            mesh_textures
-                .iter()
-                .zip(1..)
-                .map(|(t, binding)| wgpu::BindGroupEntry {
-                    binding,
-                    resource: wgpu::BindingResource::TextureView(&t.view),
-                }),
+        let pipes = Pipelines::new(
+            gpu,
+            mesh_textures.textures.len(),
+            mesh_textures.layers_per_texture,
         );
+        let mut entries = vec![render_core::bind::whole(0, &frame_params)];
+        entries.extend(mesh_textures.textures.iter().zip(1..).map(|(t, binding)| {
+            wgpu::BindGroupEntry {
+                binding,
+                resource: wgpu::BindingResource::TextureView(&t.view),
+            }
+        }));
         let mesh_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("raycast frame + mesh"),
             layout: &pipes.mesh_layout,
@@ -483,6 +456,57 @@ impl Renderer for Raycast {
 
 /// Label of the texture that holds the mesh.
 const MESH_TEXTURE_LABEL: &str = "raycast mesh texture";
+
+/// The mesh in textures of at most `max_texture_bytes` ([`MESH_TEXTURE_BYTES`]), whole layers
+/// each, every layer as many rows as the largest needs.
+struct MeshTextures {
+    textures: Vec<TexelTexture>,
+    layers_per_texture: u32,
+    /// The texels written (§3.1's 144 B/tet is a claim about the layout).
+    bytes: u64,
+    /// The padding of each layer's last row, read from the ledger's allocation.
+    padding_bytes: u64,
+}
+
+impl MeshTextures {
+    /// Uploads `layout`'s layers and drops their host texels: the GPU's copy is the only one
+    /// kept (`layout` keeps its addressing and origin).
+    fn upload(
+        gpu: &Gpu,
+        ledger: &mut MemoryLedger,
+        layout: &mut MeshLayout,
+        max_texture_bytes: u64,
+    ) -> anyhow::Result<MeshTextures> {
+        let layers = layout.chunks.len();
+        let rows = layout.texture_rows();
+        let layer_bytes = rows as u64 * MESH_TEXTURE_WIDTH as u64 * 16;
+        let per_texture = (max_texture_bytes / layer_bytes).clamp(1, layers as u64) as usize;
+        let textures = (0..layers.div_ceil(per_texture))
+            .map(|k| {
+                let layers = (layers - k * per_texture).min(per_texture);
+                TexelTexture::new(
+                    gpu,
+                    ledger,
+                    MESH_TEXTURE_LABEL,
+                    Lifetime::Persistent,
+                    rows,
+                    layers as u32,
+                )
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let mut bytes = 0;
+        for (c, data) in std::mem::take(&mut layout.chunks).into_iter().enumerate() {
+            let layer = (c % per_texture) as u32;
+            bytes += textures[c / per_texture].write_layer(gpu, layer, &data);
+        }
+        Ok(MeshTextures {
+            textures,
+            layers_per_texture: per_texture as u32,
+            bytes,
+            padding_bytes: ledger.bytes_labelled(MESH_TEXTURE_LABEL) - bytes,
+        })
+    }
+}
 
 fn frame(
     gpu: &Gpu,
