@@ -43,8 +43,8 @@ struct Ray {
     d: vec3<f32>,
 }
 
-// The frame's pixel-ray parameters ([`pixel_ray`]); an entry point whose rays start after
-// divergent branches loads them first, where one load serves every invocation.
+// The frame's pixel-ray parameters ([`ray_through`]); a compute entry point whose rays start
+// after divergent branches loads them first, where one load serves every invocation.
 struct RayFrame {
     size: vec2<f32>,
     o0: vec3<f32>,
@@ -55,16 +55,20 @@ struct RayFrame {
     dy: vec3<f32>,
 }
 
-fn ray_frame() -> RayFrame {
+fn ray_frame_of(f: Frame) -> RayFrame {
     return RayFrame(
-        vec2<f32>(f32(frame.size.x), f32(frame.size.y)),
-        frame.o0.xyz,
-        frame.ox.xyz,
-        frame.oy.xyz,
-        frame.d0.xyz,
-        frame.dx.xyz,
-        frame.dy.xyz,
+        vec2<f32>(f32(f.size.x), f32(f.size.y)),
+        f.o0.xyz,
+        f.ox.xyz,
+        f.oy.xyz,
+        f.d0.xyz,
+        f.dx.xyz,
+        f.dy.xyz,
     );
+}
+
+fn ray_frame() -> RayFrame {
+    return ray_frame_of(frame);
 }
 
 // The ray through the pixel centre `px` (framebuffer coordinates, y down), as
@@ -76,10 +80,6 @@ fn ray_through(rf: RayFrame, px: vec2<f32>) -> Ray {
     r.o = rf.o0 + nx * rf.ox + ny * rf.oy;
     r.d = normalize(rf.d0 + nx * rf.dx + ny * rf.dy);
     return r;
-}
-
-fn pixel_ray(px: vec2<f32>) -> Ray {
-    return ray_through(ray_frame(), px);
 }
 
 // Eq. 1 for the four faces: numerators (v_{3−i} − e)·n_i and denominators r·n_i.

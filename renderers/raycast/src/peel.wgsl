@@ -5,6 +5,11 @@
 // keeps the next boundary entry behind it. Depth is λ / λ_far, so the Z order is the λ order.
 
 @group(1) @binding(0) var prev_layer: texture_2d<u32>;
+// The frame's parameters again, as a uniform block: a CPU backend loads a storage buffer in a
+// fragment shader lane by lane even where every lane reads the same address (llvmpipe takes
+// its one-load path for storage only where invocation 0 is known to be active, never in a
+// fragment shader), and a uniform block once.
+@group(2) @binding(0) var<uniform> peel_frame: Frame;
 
 struct VOut {
     @builtin(position) pos: vec4<f32>,
@@ -14,7 +19,7 @@ struct VOut {
 @vertex
 fn vs_face(@location(0) pos: vec3<f32>, @location(1) tet: vec2<u32>) -> VOut {
     var out: VOut;
-    out.pos = frame.view_proj * vec4<f32>(pos, 1.0);
+    out.pos = peel_frame.view_proj * vec4<f32>(pos, 1.0);
     out.tet = tet;
     return out;
 }
@@ -25,12 +30,12 @@ struct FOut {
 }
 
 fn first_hit(in: VOut) -> FOut {
-    let ray = pixel_ray(in.pos.xy);
+    let ray = ray_through(ray_frame_of(peel_frame), in.pos.xy);
     let lambda = entry_lambda(in.tet, ray.o, ray.d);
     let s = scalar_at(in.tet, ray.o + lambda * ray.d);
     var out: FOut;
     out.cell = vec4<u32>(in.tet, bitcast<u32>(lambda), bitcast<u32>(s));
-    out.depth = clamp(lambda * frame.misc.x, 0.0, 1.0);
+    out.depth = clamp(lambda * peel_frame.misc.x, 0.0, 1.0);
     return out;
 }
 
@@ -48,7 +53,7 @@ fn fs_peel(in: VOut) -> FOut {
         discard;
     }
     let out = first_hit(in);
-    if bitcast<f32>(out.cell.z) <= bitcast<f32>(prev.z) + frame.misc.y {
+    if bitcast<f32>(out.cell.z) <= bitcast<f32>(prev.z) + peel_frame.misc.y {
         discard;
     }
     return out;

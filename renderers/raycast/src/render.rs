@@ -58,6 +58,8 @@ struct State {
     pipes: Pipelines,
     frame_params: wgpu::Buffer,
     mesh_bind: wgpu::BindGroup,
+    /// `frame_params` as the peel's uniform block (group 2).
+    peel_frame_bind: wgpu::BindGroup,
     faces: wgpu::Buffer,
     face_vertices: u32,
     table: TableTexture,
@@ -359,7 +361,9 @@ impl Renderer for Raycast {
             "raycast frame params",
             Lifetime::PerFrame,
             std::mem::size_of::<FrameParams>() as u64,
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::UNIFORM
+                | wgpu::BufferUsages::COPY_DST,
         )?;
         let pipes = Pipelines::new(
             gpu,
@@ -378,6 +382,13 @@ impl Renderer for Raycast {
             layout: &pipes.mesh_layout,
             entries: &entries,
         });
+        // Set once per peeling layer (a render pass), never per dispatch: lavapipe keeps memory
+        // for every dispatch that sets a group holding a uniform buffer (docs/profile.md).
+        let peel_frame_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("raycast peel frame"),
+            layout: &pipes.peel_frame_layout,
+            entries: &[render_core::bind::whole(0, &frame_params)],
+        });
         let n = mesh.num_tets() as u64;
         // A guard against rays that cycle between tets through round-off: far more steps than
         // a straight ray crosses in any mesh we know (counted as stalled when reached).
@@ -394,6 +405,7 @@ impl Renderer for Raycast {
             pipes,
             frame_params,
             mesh_bind,
+            peel_frame_bind,
             faces,
             face_vertices,
             table,
@@ -614,6 +626,7 @@ fn frame(
                 pass.set_bind_group(1, &t.peel_binds[l as usize - 1], &[]);
             }
             pass.set_bind_group(0, &st.mesh_bind, &[]);
+            pass.set_bind_group(2, &st.peel_frame_bind, &[]);
             pass.set_vertex_buffer(0, st.faces.slice(..));
             pass.begin_occlusion_query(l);
             pass.draw(0..st.face_vertices, 0..1);

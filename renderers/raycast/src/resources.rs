@@ -89,6 +89,8 @@ pub struct Pipelines {
     pub peel_layout: wgpu::BindGroupLayout,
     pub cast_layout: wgpu::BindGroupLayout,
     pub probe_layout: wgpu::BindGroupLayout,
+    /// The frame's parameters as a uniform block for the peel (group 2; `peel.wgsl`).
+    pub peel_frame_layout: wgpu::BindGroupLayout,
     pub first: wgpu::RenderPipeline,
     pub peel: wgpu::RenderPipeline,
     pub init: wgpu::ComputePipeline,
@@ -134,6 +136,13 @@ impl Pipelines {
                 table_entries[1],
             ],
         });
+        let peel_frame_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("raycast peel frame"),
+            entries: &[bind::uniform_entry(
+                0,
+                wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+            )],
+        });
         let probe_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("raycast probe"),
             entries: &[buffer_entry(0, RO, false), buffer_entry(1, RW, false)],
@@ -154,15 +163,23 @@ impl Pipelines {
         let peel_module = gpu.shader("raycast peel", &peel_src);
         let cast_module = gpu.shader("raycast cast", &cast_src);
         let probe_module = gpu.shader("raycast probe", &probe_src);
-        let layout = |label: &str, groups: &[&wgpu::BindGroupLayout]| {
-            let groups: Vec<Option<&wgpu::BindGroupLayout>> =
-                groups.iter().map(|g| Some(*g)).collect();
-            render_core::bind::pipeline_layout(gpu, label, &groups)
+        let layout = |label: &str, groups: &[Option<&wgpu::BindGroupLayout>]| {
+            render_core::bind::pipeline_layout(gpu, label, groups)
         };
-        let first_layout = layout("raycast first hit", &[&mesh_layout]);
-        let peel_pl = layout("raycast peel", &[&mesh_layout, &peel_layout]);
-        let cast_pl = layout("raycast cast", &[&mesh_layout, &cast_layout]);
-        let probe_pl = layout("raycast probe", &[&mesh_layout, &probe_layout]);
+        let first_layout = layout(
+            "raycast first hit",
+            &[Some(&mesh_layout), None, Some(&peel_frame_layout)],
+        );
+        let peel_pl = layout(
+            "raycast peel",
+            &[
+                Some(&mesh_layout),
+                Some(&peel_layout),
+                Some(&peel_frame_layout),
+            ],
+        );
+        let cast_pl = layout("raycast cast", &[Some(&mesh_layout), Some(&cast_layout)]);
+        let probe_pl = layout("raycast probe", &[Some(&mesh_layout), Some(&probe_layout)]);
         let raster = |label: &str, pl: &wgpu::PipelineLayout, fs: &str| {
             dev.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
@@ -219,6 +236,7 @@ impl Pipelines {
             peel_layout,
             cast_layout,
             probe_layout,
+            peel_frame_layout,
             first,
             peel,
             init,
