@@ -347,7 +347,7 @@ struct KeyParams {
     point_stride: u32,
     verts: u32,
     value_base: u32,
-    pad: u32,
+    out_base: u32,
 }
 
 /// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
@@ -357,7 +357,7 @@ pub fn gpu_layouts() -> Vec<crate::gpu_layout::RustLayout> {
     vec![
         crate::rust_layout!(Params => "gpu_sort.wgsl::Params" { n, shift, num_tiles, flags }),
         crate::rust_layout!(KeyParams => "gpu_sort.wgsl::KeyParams" {
-            eye, perspective, forward, count, point_stride, verts, value_base, pad
+            eye, perspective, forward, count, point_stride, verts, value_base, out_base
         }),
     ]
 }
@@ -365,17 +365,56 @@ pub fn gpu_layouts() -> Vec<crate::gpu_layout::RustLayout> {
 /// Computes sort keys on the GPU, the pass before [`GpuRadixSort::encode`]: for each primitive
 /// (tet: 4 vertex indices, face: 3) the centroid's [`crate::Camera::sort_distance`] (in f32) as
 /// key and the primitive's id as value. Points are read from a caller's f32 storage buffer with
-/// 3 (xyz) or 4 (xyz + scalar) floats per point.
+/// 3 (xyz) or 4 (xyz + scalar) floats per point, in one storage binding.
+///
+/// Primitives split over several buffers (a mesh larger than one storage binding) are one key
+/// pass of several calls ([`GpuCentroidKeys::encode_ranges`], at most `max_calls` of them): each
+/// call reads one buffer and writes its keys and ids at their place in one key and one value
+/// buffer. Each call's parameters sit [`crate::bind::UNIFORM_STRIDE`] bytes apart in one buffer, written
+/// through the queue once per key pass: encode at most one key pass per instance per
+/// submission.
 pub struct GpuCentroidKeys {
     device: wgpu::Device,
     queue: wgpu::Queue,
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
     params: wgpu::Buffer,
+    max_calls: u32,
+}
+
+/// One call of a key pass: `count` primitives stored in `prims`, which holds primitives
+/// `first .. first + count` of the caller's whole array. Their keys go to `keys[first + p]` and
+/// their ids, `first + p`, to `values[first + p]`.
+#[derive(Debug, Clone, Copy)]
+pub struct KeyRange<'a> {
+    pub prims: &'a wgpu::Buffer,
+    pub first: u32,
+    pub count: u32,
+}
+
+/// One dispatch of the key pass as [`GpuCentroidKeys`] records it.
+struct KeyCall<'a> {
+    prims: &'a wgpu::Buffer,
+    count: u32,
+    value_base: u32,
+    out_base: u32,
 }
 
 impl GpuCentroidKeys {
+    /// A key pass of one call per submission ([`GpuCentroidKeys::encode`]).
     pub fn new(gpu: &Gpu, ledger: &mut MemoryLedger) -> anyhow::Result<GpuCentroidKeys> {
+        GpuCentroidKeys::with_calls(gpu, 1, ledger)
+    }
+
+    /// A key pass of up to `max_calls` calls per submission
+    /// ([`GpuCentroidKeys::encode_ranges`]); its parameter buffer ([`crate::bind::UNIFORM_STRIDE`] bytes a
+    /// call) is recorded in `ledger` as per-frame.
+    pub fn with_calls(
+        gpu: &Gpu,
+        max_calls: u32,
+        ledger: &mut MemoryLedger,
+    ) -> anyhow::Result<GpuCentroidKeys> {
+        let max_calls = max_calls.max(1);
         let device = &gpu.device;
         // The module's sort entry points need their arrays declared; one binding each.
         let module = gpu.shader(
@@ -406,7 +445,7 @@ impl GpuCentroidKeys {
             gpu,
             "centroid key params",
             Lifetime::PerFrame,
-            std::mem::size_of::<KeyParams>() as u64,
+            PARAM_STRIDE * max_calls as u64,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
         Ok(GpuCentroidKeys {
@@ -415,7 +454,13 @@ impl GpuCentroidKeys {
             layout,
             pipeline,
             params,
+            max_calls,
         })
+    }
+
+    /// Calls one key pass may hold.
+    pub fn max_calls(&self) -> u32 {
+        self.max_calls
     }
 
     /// Records the key pass for `count` primitives of `verts` (3 or 4) indices each in `prims`,
@@ -435,6 +480,73 @@ impl GpuCentroidKeys {
         keys: &wgpu::Buffer,
         values: &wgpu::Buffer,
     ) -> anyhow::Result<()> {
+        let call = KeyCall {
+            prims,
+            count,
+            value_base,
+            out_base: 0,
+        };
+        self.encode_calls(
+            encoder,
+            camera,
+            points,
+            point_stride,
+            verts,
+            &[call],
+            keys,
+            values,
+        )
+    }
+
+    /// Records one key pass over primitives split over several buffers, one call per
+    /// [`KeyRange`] (at most [`GpuCentroidKeys::max_calls`]): afterwards `keys[i]` is the sort
+    /// distance of primitive `i` of the whole array and `values[i] = i`, for every `i` a range
+    /// covers. Parameters are written through the queue, as in [`GpuCentroidKeys::encode`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_ranges(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &crate::Camera,
+        points: &wgpu::Buffer,
+        point_stride: u32,
+        verts: u32,
+        ranges: &[KeyRange<'_>],
+        keys: &wgpu::Buffer,
+        values: &wgpu::Buffer,
+    ) -> anyhow::Result<()> {
+        let calls: Vec<KeyCall> = ranges
+            .iter()
+            .map(|r| KeyCall {
+                prims: r.prims,
+                count: r.count,
+                value_base: r.first,
+                out_base: r.first,
+            })
+            .collect();
+        self.encode_calls(
+            encoder,
+            camera,
+            points,
+            point_stride,
+            verts,
+            &calls,
+            keys,
+            values,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn encode_calls(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &crate::Camera,
+        points: &wgpu::Buffer,
+        point_stride: u32,
+        verts: u32,
+        calls: &[KeyCall<'_>],
+        keys: &wgpu::Buffer,
+        values: &wgpu::Buffer,
+    ) -> anyhow::Result<()> {
         ensure!(
             verts == 3 || verts == 4,
             "centroid keys: {verts} vertices per primitive (3 or 4)"
@@ -444,63 +556,88 @@ impl GpuCentroidKeys {
             "centroid keys: point stride {point_stride} < 3 floats"
         );
         ensure!(
-            prims.size() >= count as u64 * verts as u64 * 4
-                && keys.size() >= count as u64 * 4
-                && values.size() >= count as u64 * 4,
-            "centroid keys: buffers hold fewer than {count} primitives"
+            calls.len() <= self.max_calls as usize,
+            "centroid keys: {} calls in one key pass, this instance holds {}",
+            calls.len(),
+            self.max_calls
         );
-        if count == 0 {
+        for c in calls {
+            let end = c.out_base as u64 + c.count as u64;
+            ensure!(
+                c.prims.size() >= c.count as u64 * verts as u64 * 4
+                    && keys.size() >= end * 4
+                    && values.size() >= end * 4,
+                "centroid keys: buffers hold fewer than {} primitives (from {})",
+                c.count,
+                c.out_base
+            );
+            ensure!(
+                c.value_base as u64 + c.count as u64 <= u32::MAX as u64 + 1,
+                "centroid keys: ids past 2^32"
+            );
+        }
+        let calls: Vec<&KeyCall> = calls.iter().filter(|c| c.count > 0).collect();
+        if calls.is_empty() {
             return Ok(());
         }
-        let p = KeyParams {
-            eye: camera.eye.map(|x| x as f32),
-            perspective: camera.is_perspective() as u32,
-            forward: camera.forward().map(|x| x as f32),
-            count,
-            point_stride,
-            verts,
-            value_base,
-            pad: 0,
-        };
+        let params: Vec<KeyParams> = calls
+            .iter()
+            .map(|c| KeyParams {
+                eye: camera.eye.map(|x| x as f32),
+                perspective: camera.is_perspective() as u32,
+                forward: camera.forward().map(|x| x as f32),
+                count: c.count,
+                point_stride,
+                verts,
+                value_base: c.value_base,
+                out_base: c.out_base,
+            })
+            .collect();
         self.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("centroid keys"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: points.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: prims.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: keys.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: values.as_entire_binding(),
-                },
-            ],
-        });
-        let groups = count.div_ceil(256);
-        // Two-dimensional grid when one dimension's 65,535 workgroups do not suffice.
-        let x = groups.min(65_535);
-        let y = groups.div_ceil(x);
+            .write_buffer(&self.params, 0, &crate::bind::strided_uniforms(&params));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("centroid keys"),
             timestamp_writes: None,
         });
-        pass.set_bind_group(1, &bind, &[]);
         pass.set_pipeline(&self.pipeline);
-        pass.dispatch_workgroups(x, y, 1);
+        for (i, c) in calls.iter().enumerate() {
+            let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("centroid keys"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &self.params,
+                            offset: i as u64 * PARAM_STRIDE,
+                            size: wgpu::BufferSize::new(std::mem::size_of::<KeyParams>() as u64),
+                        }),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: points.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: c.prims.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: keys.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: values.as_entire_binding(),
+                    },
+                ],
+            });
+            let groups = c.count.div_ceil(256);
+            // Two-dimensional grid when one dimension's 65,535 workgroups do not suffice.
+            let x = groups.min(65_535);
+            let y = groups.div_ceil(x);
+            pass.set_bind_group(1, &bind, &[]);
+            pass.dispatch_workgroups(x, y, 1);
+        }
         Ok(())
     }
 }
@@ -665,6 +802,104 @@ mod tests {
                 );
                 assert!(a >= b - 2e-5 * scale, "{a} before {b}");
             }
+        }
+        Ok(())
+    }
+
+    /// A key pass over primitives split over several buffers (GATOR's tet chunks) writes, in
+    /// one submission, the keys and ids one call over the whole array writes, bit for bit; one
+    /// call more than the instance holds is refused.
+    #[test]
+    fn a_key_pass_over_split_primitives_equals_one_over_the_whole() -> anyhow::Result<()> {
+        use crate::scene::{Camera, Projection, Viewpoint};
+        let gpu = Gpu::new().expect("a wgpu adapter");
+        let dims = [7usize, 6, 5];
+        let mut pts = Vec::new();
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    pts.push([i as f32 * 0.3, j as f32 * 0.5 - 1.0, k as f32 * 0.4, 1.0]);
+                }
+            }
+        }
+        let tets = datasets::volume::structured_tets(dims);
+        let n = tets.len() as u32;
+        let mut ledger = MemoryLedger::default();
+        let usage = REQUIRED_USAGE | wgpu::BufferUsages::COPY_SRC;
+        let pbuf = ledger.buffer_init(
+            &gpu,
+            "points",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&pts),
+            usage,
+        )?;
+        let whole = ledger.buffer_init(
+            &gpu,
+            "tets",
+            Lifetime::Persistent,
+            bytemuck::cast_slice(&tets),
+            usage,
+        )?;
+        // Three pieces of unequal length, as a caller's chunks of one storage binding each.
+        let cuts = [0, 100, 333, n as usize];
+        let pieces: Vec<wgpu::Buffer> = cuts
+            .windows(2)
+            .map(|w| {
+                ledger.buffer_init(
+                    &gpu,
+                    "tet piece",
+                    Lifetime::Persistent,
+                    bytemuck::cast_slice(&tets[w[0]..w[1]]),
+                    usage,
+                )
+            })
+            .collect::<anyhow::Result<_>>()?;
+        let ranges: Vec<KeyRange> = pieces
+            .iter()
+            .zip(cuts.windows(2))
+            .map(|(prims, w)| KeyRange {
+                prims,
+                first: w[0] as u32,
+                count: (w[1] - w[0]) as u32,
+            })
+            .collect();
+        let out = |ledger: &mut MemoryLedger, label| {
+            ledger.buffer(&gpu, label, Lifetime::PerFrame, n as u64 * 4, usage)
+        };
+        let (k1, v1, k3, v3) = (
+            out(&mut ledger, "k1")?,
+            out(&mut ledger, "v1")?,
+            out(&mut ledger, "k3")?,
+            out(&mut ledger, "v3")?,
+        );
+        let one = GpuCentroidKeys::new(&gpu, &mut ledger)?;
+        let three = GpuCentroidKeys::with_calls(&gpu, 3, &mut ledger)?;
+        assert_eq!(three.max_calls(), 3);
+        let bounds =
+            datasets::Aabb::of_points(&pts.iter().map(|p| [p[0], p[1], p[2]]).collect::<Vec<_>>());
+        for proj in [Projection::default(), Projection::Orthographic] {
+            let cam = Camera::fit(
+                &bounds,
+                &Viewpoint::new("oblique", [0.3, -0.6, 0.7]),
+                proj,
+                64,
+                64,
+            );
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            one.encode(&mut enc, &cam, &pbuf, 4, &whole, 4, n, 0, &k1, &v1)?;
+            three.encode_ranges(&mut enc, &cam, &pbuf, 4, 4, &ranges, &k3, &v3)?;
+            gpu.queue.submit([enc.finish()]);
+            let read = |b: &wgpu::Buffer| gpu.read_buffer(b, 0, n as u64 * 4).unwrap();
+            assert_eq!(read(&k1), read(&k3), "{proj:?}: keys");
+            assert_eq!(read(&v1), read(&v3), "{proj:?}: ids");
+            let ids: Vec<u32> = bytemuck::cast_slice(&read(&v3)).to_vec();
+            assert_eq!(ids, (0..n).collect::<Vec<_>>());
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            let e = one
+                .encode_ranges(&mut enc, &cam, &pbuf, 4, 4, &ranges, &k3, &v3)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("3 calls") && e.contains("holds 1"), "{e}");
         }
         Ok(())
     }

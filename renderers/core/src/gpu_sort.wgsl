@@ -197,7 +197,9 @@ struct KeyParams {
     verts: u32,
     // Added to the primitive index written as the value (chunked callers).
     value_base: u32,
-    pad: u32,
+    // Where primitive 0 of this call is written in key_out and value_out (a caller whose
+    // primitives are split over several buffers writes each buffer's keys at its place).
+    out_base: u32,
 }
 
 @group(1) @binding(0) var<storage, read> kp: KeyParams;
@@ -223,6 +225,6 @@ fn centroid_keys(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     if kp.perspective != 0u {
         key = length(d);
     }
-    key_out[p] = key;
-    value_out[p] = kp.value_base + p;
+    key_out[kp.out_base + p] = key;
+    value_out[kp.out_base + p] = kp.value_base + p;
 }
