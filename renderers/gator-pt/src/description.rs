@@ -1,11 +1,10 @@
 //! What the harness knows of GATOR PT without building it (see [`render_core::description`]).
 
-use render_core::visibility::VisibilityOrder;
 use render_core::{
     AlgorithmDescription, Hue, Origin, Param, Renderer, Settings, Tolerance, ValueKind,
 };
 
-use crate::{CellModel, GatorPt};
+use crate::{CellModel, GatorPt, GatorSort};
 
 pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     name: "gator-pt",
@@ -22,13 +21,14 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
         Param {
             key: "sort",
             kind: ValueKind::Text,
-            meaning:
-                "visibility order on the CPU: radix, bucket, merge (centroids) or mpvonc (exact)",
-            section: "§3 (a CPU sort per frame); orders from HAVS §5.1 and Williams 1992",
+            meaning: "visibility order: on the CPU radix, bucket, merge (centroids) or mpvonc \
+                      (exact); gpu-radix: centroid keys and radix sort on the GPU, not read back",
+            section: "§3 (a CPU sort per frame); orders from HAVS §5.1 and Williams 1992; \
+                      gpu-radix is ours",
         },
     ],
-    default_grid: || grid(&[VisibilityOrder::default()]),
-    full_grid: || grid(&VisibilityOrder::ALL),
+    default_grid: || grid(&[GatorSort::default()]),
+    full_grid: || grid(&GatorSort::all()),
     build,
     hue: Hue::Blues,
     tolerance,
@@ -38,22 +38,23 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
         "covering_tets",
         "tet_classifications",
         "cpu_sort_keys",
+        "gpu_sort_keys",
     ],
     nondeterministic_counters: render_core::description::all_counters_exact,
 };
 
-/// Both cell models with each order (constant first), the order [`crate::variants`] runs.
-fn grid(orders: &[VisibilityOrder]) -> Vec<Settings> {
-    orders
+/// Both cell models with each sort (constant first), the order [`crate::variants`] runs.
+fn grid(sorts: &[GatorSort]) -> Vec<Settings> {
+    sorts
         .iter()
         .flat_map(|&o| [CellModel::Constant, CellModel::Linear].map(|c| settings_of(c, o)))
         .collect()
 }
 
-pub(crate) fn settings_of(cells: CellModel, order: VisibilityOrder) -> Settings {
+pub(crate) fn settings_of(cells: CellModel, sort: GatorSort) -> Settings {
     Settings::new()
         .with("variant", cells.name())
-        .with("sort", order.to_string())
+        .with("sort", sort.to_string())
 }
 
 fn build(s: &Settings) -> anyhow::Result<Box<dyn Renderer>> {
@@ -62,8 +63,8 @@ fn build(s: &Settings) -> anyhow::Result<Box<dyn Renderer>> {
         "linear" => CellModel::Linear,
         v => anyhow::bail!("gator-pt: variant={v} is neither constant nor linear"),
     };
-    let order: VisibilityOrder = s.require_text("sort")?.parse()?;
-    Ok(Box::new(GatorPt::new(cells, order)))
+    let sort: GatorSort = s.require_text("sort")?.parse()?;
+    Ok(Box::new(GatorPt::new(cells, sort)))
 }
 
 /// Measured on the check scene (lavapipe): constant cells 52.3 dB, linear 73.1 dB with either

@@ -13,6 +13,14 @@
 //! sort on float keys), then writes the tet order in one buffer write. The GPU draws the fans
 //! into an `Rgba32Float` target with premultiplied "over" blending.
 //!
+//! `sort=gpu-radix` ([`GatorSort::GpuRadix`], not the paper's split: it sorts on the CPU)
+//! orders the tets on the device instead: one encoder holds the key pass
+//! (`render_core::gpu_sort::GpuCentroidKeys`, one call per tet chunk: each tet's centroid
+//! distance and its id), the radix sort of those pairs far to near
+//! (`render_core::gpu_sort::GpuRadixSort`) and the draw, which reads the sorted ids as its
+//! order. Nothing is read back and the host keeps no per-tet sort data; the order is the
+//! centroid radix order, up to the f32 rounding of the keys.
+//!
 //! Two variants, the paper's Table 3: **constant** cells (colour and extinction of the tet's
 //! mean scalar) and **linear** cells (the average of the scalars where the eye ray enters and
 //! leaves, interpolated from the thick vertex; the paper's average-scalar approach, not
@@ -34,10 +42,11 @@ pub use description::DESCRIPTION;
 
 use std::time::Instant;
 
-use anyhow::{anyhow, bail, Context};
+use anyhow::{anyhow, bail, ensure, Context};
 use datasets::TetMesh;
 use render_core::bind::{storage_entry, texture_entry, uniform_entry};
 use render_core::gpu::chunk_ranges;
+use render_core::gpu_sort::{GpuCentroidKeys, GpuRadixSort, KeyRange};
 pub use render_core::visibility::VisibilityOrder;
 use render_core::visibility::VisibilitySorter;
 use render_core::{
@@ -97,10 +106,67 @@ impl CellModel {
     }
 }
 
+/// Where GATOR's back-to-front order comes from: the `sort` setting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum GatorSort {
+    /// A visibility order on the CPU each frame, uploaded (the paper's split, §3).
+    Cpu(VisibilityOrder),
+    /// Centroid distances and their radix sort on the device, in the frame's one encoder.
+    GpuRadix,
+}
+
+impl GatorSort {
+    /// The setting's text for the GPU sort.
+    pub const GPU_RADIX: &'static str = "gpu-radix";
+
+    /// Every value of the setting: the CPU orders, then the GPU sort.
+    pub fn all() -> Vec<GatorSort> {
+        VisibilityOrder::ALL
+            .into_iter()
+            .map(GatorSort::Cpu)
+            .chain([GatorSort::GpuRadix])
+            .collect()
+    }
+}
+
+impl Default for GatorSort {
+    fn default() -> GatorSort {
+        GatorSort::Cpu(VisibilityOrder::default())
+    }
+}
+
+impl From<VisibilityOrder> for GatorSort {
+    fn from(order: VisibilityOrder) -> GatorSort {
+        GatorSort::Cpu(order)
+    }
+}
+
+impl std::fmt::Display for GatorSort {
+    /// The CPU orders' names (`radix`, `bucket`, `merge`, `mpvonc`) or `gpu-radix`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            GatorSort::Cpu(order) => order.fmt(f),
+            GatorSort::GpuRadix => f.write_str(GatorSort::GPU_RADIX),
+        }
+    }
+}
+
+impl std::str::FromStr for GatorSort {
+    type Err = anyhow::Error;
+    fn from_str(s: &str) -> anyhow::Result<GatorSort> {
+        if s.trim().eq_ignore_ascii_case(GatorSort::GPU_RADIX) {
+            return Ok(GatorSort::GpuRadix);
+        }
+        s.parse::<VisibilityOrder>()
+            .map(GatorSort::Cpu)
+            .map_err(|e| anyhow!("gator-pt: sort={s}: {e}, or gpu-radix"))
+    }
+}
+
 /// The GATOR renderer. Construct with [`GatorPt::new`], then [`Renderer::prepare`].
 pub struct GatorPt {
     cells: CellModel,
-    order: VisibilityOrder,
+    sort: GatorSort,
     /// Largest storage binding to use (defaults to the device's); tests lower it to exercise
     /// chunking on small meshes.
     max_binding: Option<u64>,
@@ -125,10 +191,11 @@ pub fn variants(orders: &[VisibilityOrder]) -> Vec<Box<dyn Renderer>> {
 }
 
 impl GatorPt {
-    pub fn new(cells: CellModel, order: VisibilityOrder) -> GatorPt {
+    /// `sort`: a [`VisibilityOrder`] (sorted on the CPU) or a [`GatorSort`].
+    pub fn new(cells: CellModel, sort: impl Into<GatorSort>) -> GatorPt {
         GatorPt {
             cells,
-            order,
+            sort: sort.into(),
             max_binding: None,
             state: None,
         }
@@ -145,13 +212,29 @@ impl GatorPt {
         self.cells
     }
 
-    pub fn order(&self) -> VisibilityOrder {
-        self.order
+    pub fn sort(&self) -> GatorSort {
+        self.sort
     }
 
     /// GPU memory of the prepared mesh (after [`Renderer::prepare`]).
     pub fn ledger(&self) -> Option<&MemoryLedger> {
         self.state.as_ref().map(|s| &s.ledger)
+    }
+
+    /// The order the last frame drew (tet ids, back to front), read back from the device: for
+    /// tests of the order, CPU or GPU made, outside any timed frame.
+    #[doc(hidden)]
+    pub fn debug_read_order(&self, gpu: &Gpu) -> anyhow::Result<Vec<u32>> {
+        let st = self
+            .state
+            .as_ref()
+            .ok_or_else(|| anyhow!("gator-pt: debug_read_order called before prepare"))?;
+        let n = st.mesh.num_tets as u64;
+        if n == 0 {
+            return Ok(Vec::new());
+        }
+        let bytes = gpu.read_buffer(&st.order_buf, 0, n * 4)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 }
 
@@ -191,6 +274,11 @@ struct MeshGpu {
     g0: wgpu::BindGroup,
     params_host: Params,
     num_tets: u32,
+    /// The tet chunks (then placeholders up to [`MAX_TET_CHUNKS`]) and the tets each holds.
+    tet_bufs: Vec<wgpu::Buffer>,
+    tet_ranges: Vec<std::ops::Range<u64>>,
+    /// The point chunks (then placeholders up to [`MAX_POINT_CHUNKS`]).
+    point_bufs: Vec<wgpu::Buffer>,
 }
 
 fn lut_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
@@ -430,6 +518,9 @@ impl MeshGpu {
             g0,
             params_host,
             num_tets: tets.len() as u32,
+            tet_bufs,
+            tet_ranges,
+            point_bufs,
         })
     }
 
@@ -456,18 +547,111 @@ struct Target {
     bytes: u64,
 }
 
+/// Where a frame's order comes from ([`GatorSort`]).
+enum Ordering {
+    /// Sorted on the host each frame and uploaded into `State::order_buf`.
+    Cpu {
+        sorter: VisibilitySorter,
+        order: Vec<u32>,
+    },
+    /// Keyed and sorted on the device; `State::order_buf` is the sort's value buffer.
+    Gpu(DeviceSort),
+}
+
+/// The device's sort of `sort=gpu-radix`.
+struct DeviceSort {
+    keys_pass: GpuCentroidKeys,
+    sorter: GpuRadixSort,
+    /// Each tet's centroid distance, sorted along with the ids in `State::order_buf`.
+    keys: wgpu::Buffer,
+    /// Per-frame device bytes of the sort besides the order: the keys, the sorter's scratch
+    /// and the key pass's parameters (from the ledger).
+    bytes: u64,
+}
+
+impl DeviceSort {
+    /// The key pass (one call per tet chunk), the sorter and the key buffer for `n` tets,
+    /// recorded in `ledger` as per-frame bytes.
+    fn new(
+        gpu: &Gpu,
+        ledger: &mut MemoryLedger,
+        mesh: &MeshGpu,
+        n: u64,
+    ) -> anyhow::Result<DeviceSort> {
+        // One binding each for the keys and the ids: GATOR binds at most MAX_TET_CHUNKS chunks
+        // of max_binding / 16 tets, so 4 bytes a tet make at most max_binding / 4 · 4 bytes
+        // = one binding (32 Mi tets, 128 MiB, on lavapipe).
+        ensure!(
+            n * 4 <= gpu.max_storage_binding(),
+            "gator-pt sort=gpu-radix: {n} tets' keys exceed one storage binding of {} bytes",
+            gpu.max_storage_binding()
+        );
+        let before = ledger.per_frame;
+        let keys = ledger.buffer(
+            gpu,
+            "gator sort keys",
+            Lifetime::PerFrame,
+            n * 4,
+            render_core::gpu_sort::REQUIRED_USAGE | wgpu::BufferUsages::COPY_SRC,
+        )?;
+        let keys_pass = GpuCentroidKeys::with_calls(gpu, mesh.tet_ranges.len() as u32, ledger)?;
+        let sorter = GpuRadixSort::new(gpu, n as u32, ledger)?;
+        Ok(DeviceSort {
+            keys_pass,
+            sorter,
+            keys,
+            bytes: ledger.per_frame - before,
+        })
+    }
+
+    /// Records the key pass over every tet chunk and the sort of its pairs far to near, so
+    /// that `order` holds the tet ids back to front.
+    fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        camera: &Camera,
+        mesh: &MeshGpu,
+        order: &wgpu::Buffer,
+    ) -> anyhow::Result<()> {
+        let ranges: Vec<KeyRange> = mesh
+            .tet_ranges
+            .iter()
+            .zip(&mesh.tet_bufs)
+            .map(|(r, prims)| KeyRange {
+                prims,
+                first: r.start as u32,
+                count: (r.end - r.start) as u32,
+            })
+            .collect();
+        // Points: xyz + normalised scalar, 4 floats, in one binding (checked in prepare).
+        self.keys_pass.encode_ranges(
+            enc,
+            camera,
+            &mesh.point_bufs[0],
+            4,
+            4,
+            &ranges,
+            &self.keys,
+            order,
+        )?;
+        self.sorter
+            .encode(enc, &self.keys, order, mesh.num_tets, true)
+    }
+}
+
 struct State {
     ledger: MemoryLedger,
     mesh: MeshGpu,
     pipeline: wgpu::RenderPipeline,
+    /// The tet ids back to front, which the draw reads.
     order_buf: wgpu::Buffer,
     index_buf: wgpu::Buffer,
     chunks: Vec<DrawChunk>,
-    /// The loaded mesh, shared, not copied (the visibility sorter reads its centroids / face
+    /// The loaded mesh, shared, not copied (a CPU visibility sorter reads its centroids / face
     /// adjacency, the counters its silhouette).
     host_mesh: std::sync::Arc<TetMesh>,
-    sorter: VisibilitySorter,
-    order: Vec<u32>,
+    ordering: Ordering,
+    /// Begin, [end of the device sort,] end.
     timer: FrameTimer,
     target: Option<Target>,
     /// The fragments counter, derived once per view (render_core::silhouette).
@@ -485,7 +669,7 @@ impl Renderer for GatorPt {
     }
 
     fn settings(&self) -> Settings {
-        description::settings_of(self.cells, self.order)
+        description::settings_of(self.cells, self.sort)
     }
 
     fn prepare(
@@ -499,6 +683,22 @@ impl Renderer for GatorPt {
             bail!("gator-pt needs FLOAT32_BLENDABLE (blending into an Rgba32Float target); adapter {} lacks it", gpu.adapter.name);
         }
         let mb = max_binding(gpu, self.max_binding);
+        if self.sort == GatorSort::GpuRadix {
+            // The key pass reads the points from one storage binding (the draw reads up to
+            // MAX_POINT_CHUNKS): refuse before uploading anything.
+            let point_bindings = chunk_ranges(mesh.num_points() as u64, 16, mb).len();
+            if point_bindings > 1 {
+                bail!(
+                    "gator-pt sort=gpu-radix: mesh {} has {} points ({} bytes as xyz + scalar), \
+                     over one storage binding of {mb} bytes: the GPU key pass reads the points \
+                     from one binding (a CPU sort such as sort=radix reads them from up to \
+                     {MAX_POINT_CHUNKS})",
+                    mesh.name,
+                    mesh.num_points(),
+                    mesh.num_points() as u64 * 16,
+                );
+            }
+        }
         let mut ledger = MemoryLedger::default();
         let points: Vec<[f32; 4]> = mesh
             .points
@@ -537,13 +737,16 @@ impl Renderer for GatorPt {
         );
 
         let n = mesh.num_tets() as u64;
-        // The order is rewritten every frame: per-frame memory, not per mesh.
+        // The order is rewritten every frame: per-frame memory, not per mesh. With the GPU
+        // sort it is the sort's value buffer. COPY_SRC: `debug_read_order`.
         let order_buf = ledger.buffer(
             gpu,
             "gator order",
             Lifetime::PerFrame,
             n * 4,
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            render_core::gpu_sort::REQUIRED_USAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
         )?;
         let index_buf = ledger.buffer_init(
             gpu,
@@ -583,19 +786,28 @@ impl Renderer for GatorPt {
             });
             chunks.push(DrawChunk { range, bind_group });
         }
-        // Per-mesh work of the visibility order (centroids; MPVONC's face planes) is done here,
-        // not in the first timed frame.
-        let mut sorter = VisibilitySorter::new(self.order);
         let host_mesh = std::sync::Arc::clone(mesh);
-        let mut order = Vec::with_capacity(n as usize);
-        let warm = Camera::fit(
-            &mesh.bounds(),
-            &render_core::fixed_viewpoints()[0],
-            Default::default(),
-            16,
-            16,
-        );
-        sorter.back_to_front(&host_mesh, &warm, &mut order);
+        let (ordering, timer) = match self.sort {
+            GatorSort::Cpu(order) => {
+                // Per-mesh work of the visibility order (centroids; MPVONC's face planes) is
+                // done here, not in the first timed frame.
+                let mut sorter = VisibilitySorter::new(order);
+                let mut order = Vec::with_capacity(n as usize);
+                let warm = Camera::fit(
+                    &mesh.bounds(),
+                    &render_core::fixed_viewpoints()[0],
+                    Default::default(),
+                    16,
+                    16,
+                );
+                sorter.back_to_front(&host_mesh, &warm, &mut order);
+                (Ordering::Cpu { sorter, order }, FrameTimer::new(gpu))
+            }
+            GatorSort::GpuRadix => (
+                Ordering::Gpu(DeviceSort::new(gpu, &mut ledger, &meshgpu, n)?),
+                FrameTimer::with_marks(gpu, 1),
+            ),
+        };
         let persistent = ledger.persistent;
         self.state = Some(State {
             ledger,
@@ -605,9 +817,8 @@ impl Renderer for GatorPt {
             index_buf,
             chunks,
             host_mesh,
-            sorter,
-            order,
-            timer: FrameTimer::new(gpu),
+            ordering,
+            timer,
             target: None,
             fragments: Default::default(),
         });
@@ -644,20 +855,30 @@ impl Renderer for GatorPt {
             });
         }
 
-        // CPU part of the frame: sort keys, radix sort, one upload of the order.
         let mut clock = FrameClock::start();
-        let t0 = Instant::now();
-        let sort = st
-            .sorter
-            .back_to_front(&st.host_mesh, camera, &mut st.order);
-        clock.stage("sort", t0);
-        let t1 = Instant::now();
-        gpu.queue
-            .write_buffer(&st.order_buf, 0, bytemuck::cast_slice(&st.order));
-        st.mesh.write_params(gpu, camera, cells);
-        clock.stage("upload", t1);
-        if sort.precompute_ms > 0.0 {
-            clock.push_stage("sort_precompute", sort.precompute_ms);
+        let mut cycle_breaks = 0;
+        match &mut st.ordering {
+            // CPU part of the frame: sort keys, radix sort, one upload of the order.
+            Ordering::Cpu { sorter, order } => {
+                let t0 = Instant::now();
+                let sort = sorter.back_to_front(&st.host_mesh, camera, order);
+                clock.stage("sort", t0);
+                let t1 = Instant::now();
+                gpu.queue
+                    .write_buffer(&st.order_buf, 0, bytemuck::cast_slice(order));
+                st.mesh.write_params(gpu, camera, cells);
+                clock.stage("upload", t1);
+                if sort.precompute_ms > 0.0 {
+                    clock.push_stage("sort_precompute", sort.precompute_ms);
+                }
+                cycle_breaks = sort.cycle_breaks;
+            }
+            // The order is made on the device, in the encoder below.
+            Ordering::Gpu(_) => {
+                let t1 = Instant::now();
+                st.mesh.write_params(gpu, camera, cells);
+                clock.stage("upload", t1);
+            }
         }
 
         let target = st.target.as_ref().expect("target created above");
@@ -667,6 +888,10 @@ impl Renderer for GatorPt {
                 label: Some("gator frame"),
             });
         st.timer.begin(&mut enc);
+        if let Ordering::Gpu(ds) = &st.ordering {
+            ds.encode(&mut enc, camera, &st.mesh, &st.order_buf)?;
+            st.timer.mark(&mut enc, 0);
+        }
         // Draws of TETS_PER_DRAW in passes of at most `gpu.triangles_per_pass` (4 a tet; see
         // render_core::gpu::MAX_TRIANGLES_PER_PASS): the first pass clears the target, the
         // rest blend onto it. A chunk's bind group is set once per pass it spans.
@@ -721,20 +946,36 @@ impl Renderer for GatorPt {
         clock.submit(gpu, [enc.finish()]);
         clock.wait(gpu)?;
         let times = clock.finish();
-        let gpu_ms = st.timer.gpu_ms(gpu)?;
-        let n = st.order.len() as f64;
-        let stages = gpu_ms.map(|g| ("draw".to_string(), g));
+        let (gpu_ms, stages, sort_bytes) = match &st.ordering {
+            Ordering::Cpu { .. } => {
+                let gpu_ms = st.timer.gpu_ms(gpu)?;
+                (gpu_ms, gpu_ms.map(|g| vec![("draw".to_string(), g)]), 0)
+            }
+            Ordering::Gpu(ds) => {
+                // GPU-timed stages: the key pass and the sort, then the draw.
+                let parts = st.timer.gpu_intervals_ms(gpu)?;
+                let stages = parts
+                    .as_ref()
+                    .map(|p| vec![("gpu_sort".to_string(), p[0]), ("draw".to_string(), p[1])]);
+                (parts.map(|p| p.iter().sum()), stages, ds.bytes)
+            }
+        };
+        let sorted_on = match st.ordering {
+            Ordering::Cpu { .. } => "cpu_sort_keys",
+            Ordering::Gpu(_) => "gpu_sort_keys",
+        };
+        let n = st.mesh.num_tets as f64;
         let projected = st.fragments.get(camera, &st.host_mesh);
         let counters = vec![
             ("tets".to_string(), n),
             ("basis_graph_vertices".to_string(), NODES as f64 * n),
-            ("cycle_breaks".to_string(), sort.cycle_breaks as f64),
+            ("cycle_breaks".to_string(), cycle_breaks as f64),
             // The roofline's work: the basis graph's 4 triangles per tet (12 indices), every
-            // tet ordered on the CPU.
+            // tet ordered, on the CPU or on the device.
             ("triangles".to_string(), 4.0 * n),
             // Counted from the draw calls issued (indices / 3), not from the formula above.
             ("triangles_drawn".to_string(), (indices_drawn / 3) as f64),
-            ("cpu_sort_keys".to_string(), n),
+            (sorted_on.to_string(), n),
             // Outside the timed frame, once per view: the pixel centres of every tet's
             // projection, which its four triangles cover once each, and the tets that hold any.
             ("fragments".to_string(), projected.fragments as f64),
@@ -750,9 +991,12 @@ impl Renderer for GatorPt {
                 camera.tets_behind_eye(&st.host_mesh) as f64,
             ),
         ];
-        Ok(times.with_stages(stages).stats(
+        Ok(times.with_stages(stages.into_iter().flatten()).stats(
             gpu_ms,
-            st.order.len() as u64 * 4 + std::mem::size_of::<Params>() as u64 + target.bytes,
+            st.mesh.num_tets as u64 * 4
+                + std::mem::size_of::<Params>() as u64
+                + target.bytes
+                + sort_bytes,
             counters,
         ))
     }

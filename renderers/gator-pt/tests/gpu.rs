@@ -1,10 +1,12 @@
 //! GPU tests of the GATOR renderer on the headless device (lavapipe on CI):
 //! the vertex shader's classification against its CPU twin on 100k+ random tets, exact images
 //! where the method is exact (constant field, orthographic axis views full of degenerate
-//! projections), and chunked storage bindings drawing the same image as one binding.
+//! projections), and chunked storage bindings drawing the same image as one binding; the
+//! device-side sort (`sort=gpu-radix`): its order is a back-to-front permutation, and chunked
+//! tets draw the image of one binding.
 
 use datasets::TetMesh;
-use gator_pt::{classify_gpu, classify_tet, CellModel, GatorPt, VisibilityOrder};
+use gator_pt::{classify_gpu, classify_tet, CellModel, GatorPt, GatorSort, VisibilityOrder};
 use glam::DVec3;
 use render_core::transfer::{ColorPoint, KappaPoint};
 use render_core::{Camera, Gpu, Image, Optics, Projection, Renderer, TransferFunction, Viewpoint};
@@ -508,6 +510,194 @@ fn chunked_bindings_draw_the_same_image() {
     }
 }
 
+/// Centroid distances in f64 ([`Camera::sort_distance`] of each tet's centroid).
+fn centroid_distances(mesh: &TetMesh, cam: &Camera) -> Vec<f64> {
+    (0..mesh.num_tets())
+        .map(|t| {
+            let p = mesh.tet_points(t);
+            cam.sort_distance([0, 1, 2].map(|a| 0.25 * (p[0][a] + p[1][a] + p[2][a] + p[3][a])))
+        })
+        .collect()
+}
+
+/// `Ok` when `order` is a permutation of the tets whose distances never increase by more than
+/// `tol` from one entry to the next (back to front, farthest first).
+fn check_back_to_front(order: &[u32], dist: &[f64], tol: f64) -> Result<(), String> {
+    let mut seen = order.to_vec();
+    seen.sort_unstable();
+    if seen != (0..dist.len() as u32).collect::<Vec<_>>() {
+        return Err(format!(
+            "not a permutation of 0..{} ({} entries)",
+            dist.len(),
+            order.len()
+        ));
+    }
+    match order
+        .windows(2)
+        .position(|w| dist[w[1] as usize] > dist[w[0] as usize] + tol)
+    {
+        Some(i) => Err(format!(
+            "position {i}: tet {} at {} before tet {} at {}",
+            order[i],
+            dist[order[i] as usize],
+            order[i + 1],
+            dist[order[i + 1] as usize]
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The order `sort=gpu-radix` makes on the device (read back through the debug hook after a
+/// frame) is a permutation of 0..n sorted back to front by the f64 centroid distances, up to
+/// the keys' f32 rounding (1e-5 of the largest distance), from perspective and orthographic
+/// views, in one tet binding and over two. The check can fail: the same order reversed (front
+/// to back) does. The frame counts its sort as GPU work, times it on the GPU and counts the
+/// keys and the sorter's scratch as per-frame device bytes.
+#[test]
+fn gpu_radix_order_is_a_back_to_front_permutation() {
+    let gpu = gpu();
+    // 11·9·8 cells · 5 = 3,960 tets; 1,080 points (17,280 bytes: one binding of 32 KiB, where
+    // 2,048 tets fit, so the tets take two).
+    let mesh = std::sync::Arc::new(box_mesh([12, 10, 9], [1.0, 0.8, 0.7]));
+    assert_eq!((mesh.num_tets(), mesh.num_points()), (3960, 1080));
+    let n = mesh.num_tets() as u64;
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    let views = [
+        (
+            Viewpoint::new("oblique", [0.4, 0.6, 0.7]),
+            Projection::default(),
+        ),
+        (
+            Viewpoint::new("-x+y-z", [-1.0, 1.0, -1.0]),
+            Projection::default(),
+        ),
+        (
+            Viewpoint::new("oblique", [0.3, -0.8, 0.5]),
+            Projection::Orthographic,
+        ),
+        (
+            Viewpoint::new("+z", [0.0, 0.0, 1.0]),
+            Projection::Orthographic,
+        ),
+    ];
+    for max_binding in [None, Some(32 << 10)] {
+        let mut r = GatorPt::new(CellModel::Linear, GatorSort::GpuRadix);
+        if let Some(b) = max_binding {
+            r = r.with_max_binding(b);
+        }
+        r.prepare(&gpu, &mesh, &optics).unwrap();
+        let ledger = r.ledger().unwrap().clone();
+        let chunks = ledger
+            .entries
+            .iter()
+            .filter(|e| e.0 == "gator tets")
+            .count();
+        assert_eq!(chunks, if max_binding.is_some() { 2 } else { 1 });
+        // Keys (4 B a tet) and the sorter's ping-pong copies (8 B a tet), per frame.
+        assert_eq!(ledger.bytes_labelled("gator sort keys"), 4 * n);
+        assert!(ledger.bytes_labelled("radix sort") >= 8 * n);
+        for (vp, projection) in &views {
+            let cam = Camera::fit(&mesh.bounds(), vp, *projection, 64, 64);
+            let stats = r.render(&gpu, &cam).unwrap();
+            let order = r.debug_read_order(&gpu).unwrap();
+            let dist = centroid_distances(&mesh, &cam);
+            let scale = dist.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+            let tol = 1e-5 * scale;
+            let what = format!("{} {projection:?}, max binding {max_binding:?}", vp.name);
+            check_back_to_front(&order, &dist, tol).unwrap_or_else(|e| panic!("{what}: {e}"));
+            let reversed: Vec<u32> = order.iter().rev().copied().collect();
+            assert!(
+                check_back_to_front(&reversed, &dist, tol).is_err(),
+                "{what}: front to back passes the check"
+            );
+            let counter = |name: &str| {
+                stats
+                    .counters
+                    .iter()
+                    .find(|(c, _)| c == name)
+                    .map(|(_, v)| *v)
+            };
+            assert_eq!(counter("gpu_sort_keys"), Some(n as f64), "{what}");
+            assert_eq!(counter("cpu_sort_keys"), None, "{what}");
+            let stage = |name: &str| stats.stages.iter().any(|(s, _)| s == name);
+            assert!(!stage("sort") && !stage("sort_precompute"), "{what}");
+            if stats.gpu_ms.is_some() {
+                assert!(
+                    stage("gpu_sort") && stage("draw"),
+                    "{what}: {:?}",
+                    stats.stages
+                );
+            }
+            // The order (4 B a tet), the keys and the sort's scratch.
+            assert!(
+                stats.frame_bytes
+                    >= 4 * n
+                        + ledger.bytes_labelled("gator sort keys")
+                        + ledger.bytes_labelled("radix sort"),
+                "{what}: {} frame bytes",
+                stats.frame_bytes
+            );
+        }
+    }
+}
+
+/// `sort=gpu-radix` with its tets split over three storage bindings (1 KiB each: 64 tets, and
+/// the 64 points in one) draws exactly the image of one binding: the key pass writes each
+/// chunk's keys and ids at their place. A mesh whose points need more than one binding is
+/// refused in prepare, naming the mesh and why, while a CPU order draws it.
+#[test]
+fn gpu_radix_over_several_tet_bindings_draws_the_same_image() {
+    let gpu = gpu();
+    // 3·3·3 cells · 5 = 135 tets (3 chunks of 64), 64 points (one chunk of 64).
+    let mesh = std::sync::Arc::new(box_mesh([4, 4, 4], [1.0, 0.8, 0.7]));
+    assert_eq!((mesh.num_tets(), mesh.num_points()), (135, 64));
+    let tf = TransferFunction::preset("high-opacity").unwrap();
+    let optics = Optics::for_mesh(tf, &mesh);
+    for (vp, projection) in [
+        (
+            Viewpoint::new("oblique", [0.4, 0.6, 0.7]),
+            Projection::default(),
+        ),
+        (
+            Viewpoint::new("-x-y+z", [-1.0, -1.0, 1.0]),
+            Projection::Orthographic,
+        ),
+    ] {
+        let cam = Camera::fit(&mesh.bounds(), &vp, projection, 48, 48);
+        for cells in [CellModel::Constant, CellModel::Linear] {
+            let whole = render(
+                &gpu,
+                &mut GatorPt::new(cells, GatorSort::GpuRadix),
+                &mesh,
+                &optics,
+                &cam,
+            );
+            let mut chunked = GatorPt::new(cells, GatorSort::GpuRadix).with_max_binding(1024);
+            let split = render(&gpu, &mut chunked, &mesh, &optics, &cam);
+            let ledger = chunked.ledger().unwrap();
+            let count = |label: &str| ledger.entries.iter().filter(|e| e.0 == label).count();
+            assert_eq!((count("gator tets"), count("gator points")), (3, 1));
+            assert!(whole.pixels.iter().any(|p| p[3] > 0.1));
+            assert!(
+                whole.pixels == split.pixels,
+                "{cells:?} {}: the chunked GPU sort's image differs",
+                vp.name
+            );
+        }
+    }
+    // 36 points over 16-point bindings: three, where the key pass reads one.
+    let wide = std::sync::Arc::new(box_mesh([4, 3, 3], [1.0, 0.8, 0.7]));
+    let mut r = GatorPt::new(CellModel::Linear, GatorSort::GpuRadix).with_max_binding(256);
+    let e = format!("{:#}", r.prepare(&gpu, &wide, &optics).unwrap_err());
+    assert!(
+        e.contains("mesh box") && e.contains("36 points") && e.contains("one storage binding"),
+        "{e}"
+    );
+    let mut cpu =
+        GatorPt::new(CellModel::Linear, VisibilityOrder::CentroidRadix).with_max_binding(256);
+    cpu.prepare(&gpu, &wide, &optics).unwrap();
+}
+
 #[test]
 fn settings_and_variants() {
     let v = gator_pt::default_variants();
@@ -517,4 +707,21 @@ fn settings_and_variants() {
         ["variant=constant;sort=radix", "variant=linear;sort=radix"]
     );
     assert!(v.iter().all(|r| r.algorithm() == "gator-pt"));
+    // The device sort is in the full grid only (the paper sorts on the CPU), and builds from
+    // its text.
+    let d = &gator_pt::DESCRIPTION;
+    let gpu_radix = d.parse_settings("variant=linear;sort=gpu-radix").unwrap();
+    assert!((d.full_grid)().contains(&gpu_radix));
+    assert!(!(d.default_grid)().contains(&gpu_radix));
+    assert_eq!((d.build)(&gpu_radix).unwrap().settings(), gpu_radix);
+    assert_eq!(
+        "gpu-radix".parse::<GatorSort>().unwrap(),
+        GatorSort::GpuRadix
+    );
+    assert_eq!(
+        "mpvonc".parse::<GatorSort>().unwrap(),
+        GatorSort::Cpu(VisibilityOrder::Mpvonc)
+    );
+    let e = "gpu".parse::<GatorSort>().unwrap_err().to_string();
+    assert!(e.contains("gpu-radix"), "{e}");
 }
