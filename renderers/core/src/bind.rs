@@ -101,6 +101,14 @@ pub fn sampled_texture_entry(
     }
 }
 
+/// A bind-group entry binding a texture view.
+pub fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: wgpu::BindingResource::TextureView(view),
+    }
+}
+
 /// A bind-group entry binding a whole buffer.
 pub fn whole(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry {
@@ -162,6 +170,61 @@ pub fn render_target(
     )?;
     let view = texture.create_view(&Default::default());
     Ok((texture, view))
+}
+
+/// A persistent lookup table of `width` × `height` texels (`height` 1: a 1D texture) read by
+/// `textureLoad`: tables a fragment shader indexes per fragment. A CPU backend gathers a
+/// texel fetch across lanes, where it loads a storage array with per-lane addresses one lane
+/// at a time (llvmpipe, in every fragment shader; docs/roofline.md). `data` holds the texels'
+/// bytes, rows x fastest.
+pub fn lookup_texture(
+    gpu: &Gpu,
+    ledger: &mut MemoryLedger,
+    label: &str,
+    format: wgpu::TextureFormat,
+    (width, height): (u32, u32),
+    data: &[u8],
+) -> anyhow::Result<wgpu::TextureView> {
+    let texel = format.block_copy_size(None).unwrap_or(4);
+    anyhow::ensure!(
+        data.len() as u64 == texel as u64 * width as u64 * height as u64,
+        "{label}: {} bytes for {width}x{height} texels of {texel} bytes",
+        data.len()
+    );
+    let size = wgpu::Extent3d {
+        width,
+        height,
+        depth_or_array_layers: 1,
+    };
+    let texture = ledger.texture(
+        gpu,
+        Lifetime::Persistent,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: if height == 1 {
+                wgpu::TextureDimension::D1
+            } else {
+                wgpu::TextureDimension::D2
+            },
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        },
+    )?;
+    gpu.queue.write_texture(
+        texture.as_image_copy(),
+        data,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(texel * width),
+            rows_per_image: Some(height),
+        },
+        size,
+    );
+    Ok(texture.create_view(&Default::default()))
 }
 
 /// Begins a render pass into one colour attachment, cleared to transparent black first when

@@ -26,7 +26,8 @@ mod frame;
 use anyhow::{anyhow, bail, Context};
 use datasets::TetMesh;
 use render_core::bind::{
-    buffer_entry, check_storage_bindings, render_target, whole as storage, ChunkedBuffer,
+    buffer_entry, check_storage_bindings, render_target, texture_entry, view_entry,
+    whole as storage, ChunkedBuffer,
 };
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::sort;
@@ -408,31 +409,37 @@ impl Renderer for FragmentPt {
             bytemuck::cast_slice(&packed_table()),
             storage_use,
         )?;
-        let tf = ledger.buffer_init(
+        let tf = render_core::bind::lookup_texture(
             gpu,
+            &mut ledger,
             "fragment-pt transfer function",
-            Lifetime::Persistent,
+            wgpu::TextureFormat::Rgba32Float,
+            (TF_ENTRIES as u32, 1),
             bytemuck::cast_slice(&optics.tf.rgb_kappa_table(TF_ENTRIES)),
-            storage_use,
         )?;
-        let expt = ledger.buffer_init(
+        let expt = render_core::bind::lookup_texture(
             gpu,
+            &mut ledger,
             "fragment-pt exp table",
-            Lifetime::Persistent,
+            wgpu::TextureFormat::R32Float,
+            (EXP_ENTRIES as u32, 1),
             bytemuck::cast_slice(&exp_table()),
-            storage_use,
         )?;
-        let psi_values: Vec<f32> = match self.settings.shading {
-            Shading::Psi => render_core::preintegration::PsiTable::build(PSI_SIDE).data,
-            // The average mode never reads ψ; bind a minimal buffer.
-            Shading::Average => vec![0.0; 4],
+        let (psi_side, psi_values) = match self.settings.shading {
+            Shading::Psi => (
+                PSI_SIDE as u32,
+                render_core::preintegration::PsiTable::build(PSI_SIDE).data,
+            ),
+            // The average mode never reads ψ; bind a minimal texture.
+            Shading::Average => (2, vec![0.0; 4]),
         };
-        let psi = ledger.buffer_init(
+        let psi = render_core::bind::lookup_texture(
             gpu,
+            &mut ledger,
             "fragment-pt psi table",
-            Lifetime::Persistent,
+            wgpu::TextureFormat::R32Float,
+            (psi_side, psi_side),
             bytemuck::cast_slice(&psi_values),
-            storage_use,
         )?;
         // Per-frame buffers written by pass 1 and the sort.
         let records = ChunkedBuffer::new(
@@ -534,7 +541,12 @@ impl Renderer for FragmentPt {
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
         let mut layout_entries = vec![buffer_entry(0, vf, wgpu::BufferBindingType::Uniform)];
-        layout_entries.extend((4..=7).map(|b| buffer_entry(b, vf, ro)));
+        layout_entries.push(buffer_entry(4, vf, ro));
+        layout_entries.extend([
+            texture_entry(5, vf, false, wgpu::TextureViewDimension::D1),
+            texture_entry(6, vf, false, wgpu::TextureViewDimension::D1),
+            texture_entry(7, vf, false, wgpu::TextureViewDimension::D2),
+        ]);
         layout_entries.extend((0..mesh_bindings).map(|i| buffer_entry(MESH_BINDING + i, vf, ro)));
         let pass2_layout = gpu
             .device
@@ -562,9 +574,9 @@ impl Renderer for FragmentPt {
                 vec![
                     storage(0, &pass2_params),
                     storage(4, &order),
-                    storage(5, &tf),
-                    storage(6, &expt),
-                    storage(7, &psi),
+                    view_entry(5, &tf),
+                    view_entry(6, &expt),
+                    view_entry(7, &psi),
                 ],
                 mesh_entries(),
             ]

@@ -31,12 +31,15 @@ struct TetOut {
 // vertices_at, tets_at, records_at: declared by the Rust (render_core::ChunkedBuffer) at
 // bindings 10.., split over as many storage bindings as the mesh needs.
 @group(0) @binding(4) var<storage, read> order: array<u32>;
+// The tables are textures read with textureLoad and interpolated here: a CPU backend gathers a
+// texel fetch across lanes, where it loads storage with per-fragment addresses lane by lane
+// (render_core::bind::lookup_texture).
 // Transfer function sampled at n points: rgb chromaticity, a = κ per length unit.
-@group(0) @binding(5) var<storage, read> tf: array<vec4<f32>>;
+@group(0) @binding(5) var tf: texture_1d<f32>;
 // e^(−x) for x in [0, misc.z], n points (Shirley–Tuchman's exponential table).
-@group(0) @binding(6) var<storage, read> exp_table: array<f32>;
-// ψ(γ_f, γ_b), side n, row-major with γ_b as the row (see render_core::preintegration).
-@group(0) @binding(7) var<storage, read> psi_table: array<f32>;
+@group(0) @binding(6) var exp_table: texture_1d<f32>;
+// ψ(γ_f, γ_b), side n, γ_b as the row (see render_core::preintegration).
+@group(0) @binding(7) var psi_table: texture_2d<f32>;
 
 struct VsOut {
     @builtin(position) pos: vec4<f32>,
@@ -80,7 +83,7 @@ fn tf_at(s: f32) -> vec4<f32> {
     let x = clamp(s, 0.0, 1.0) * f32(n - 1u);
     let i = min(u32(floor(x)), n - 2u);
     let f = x - f32(i);
-    return mix(tf[i], tf[i + 1u], f);
+    return mix(textureLoad(tf, i, 0), textureLoad(tf, i + 1u, 0), f);
 }
 
 // e^(−x) from the exponential table, linear interpolation; 0 beyond its range.
@@ -92,7 +95,11 @@ fn exp_neg(x: f32) -> f32 {
     }
     let i = u32(floor(u));
     let f = u - f32(i);
-    return mix(exp_table[i], exp_table[i + 1u], f);
+    return mix(textureLoad(exp_table, i, 0).x, textureLoad(exp_table, i + 1u, 0).x, f);
+}
+
+fn psi_at_texel(i: u32, j: u32) -> f32 {
+    return textureLoad(psi_table, vec2<u32>(i, j), 0).x;
 }
 
 // Bilinear ψ lookup (entry i ↔ γ = i / (n − 1)).
@@ -104,8 +111,8 @@ fn psi_at(gf: f32, gb: f32) -> f32 {
     let j = min(u32(floor(y)), n - 2u);
     let fx = x - f32(i);
     let fy = y - f32(j);
-    let a = mix(psi_table[j * n + i], psi_table[j * n + i + 1u], fx);
-    let b = mix(psi_table[(j + 1u) * n + i], psi_table[(j + 1u) * n + i + 1u], fx);
+    let a = mix(psi_at_texel(i, j), psi_at_texel(i + 1u, j), fx);
+    let b = mix(psi_at_texel(i, j + 1u), psi_at_texel(i + 1u, j + 1u), fx);
     return mix(a, b, fy);
 }
 
