@@ -44,7 +44,7 @@ use std::time::Instant;
 
 use anyhow::{anyhow, bail, ensure, Context};
 use datasets::TetMesh;
-use render_core::bind::{storage_entry, texture_entry, uniform_entry};
+use render_core::bind::{lookup_texture, storage_entry, texture_entry, uniform_entry};
 use render_core::gpu::chunk_ranges;
 use render_core::gpu_sort::{GpuCentroidKeys, GpuRadixSort, KeyRange};
 pub use render_core::visibility::VisibilityOrder;
@@ -290,50 +290,6 @@ fn lut_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     )
 }
 
-/// A 1D float lookup table texture.
-fn lut_texture(
-    gpu: &Gpu,
-    ledger: &mut MemoryLedger,
-    label: &str,
-    format: wgpu::TextureFormat,
-    texels: u32,
-    data: &[u8],
-) -> anyhow::Result<wgpu::TextureView> {
-    let texture = ledger.texture(
-        gpu,
-        Lifetime::Persistent,
-        &wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width: texels,
-                height: 1,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D1,
-            format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        },
-    )?;
-    gpu.queue.write_texture(
-        texture.as_image_copy(),
-        data,
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(data.len() as u32),
-            rows_per_image: Some(1),
-        },
-        wgpu::Extent3d {
-            width: texels,
-            height: 1,
-            depth_or_array_layers: 1,
-        },
-    );
-    Ok(texture.create_view(&Default::default()))
-}
-
 /// Opacity table: α(τ) = 1 − exp(−τ) for τ = i/(n−1)·TAU_MAX.
 fn exp_table() -> Vec<f32> {
     (0..EXP_LUT_SIZE)
@@ -436,21 +392,21 @@ impl MeshGpu {
             }
         };
         let tf = optics.tf.rgb_kappa_table(TF_LUT_SIZE as usize);
-        let tf_view = lut_texture(
+        let tf_view = lookup_texture(
             gpu,
             ledger,
             "gator tf table",
             wgpu::TextureFormat::Rgba32Float,
-            TF_LUT_SIZE,
+            (TF_LUT_SIZE, 1),
             bytemuck::cast_slice(&tf),
         )?;
         let ex = exp_table();
-        let exp_view = lut_texture(
+        let exp_view = lookup_texture(
             gpu,
             ledger,
             "gator opacity table",
             wgpu::TextureFormat::R32Float,
-            EXP_LUT_SIZE,
+            (EXP_LUT_SIZE, 1),
             bytemuck::cast_slice(&ex),
         )?;
 
