@@ -174,9 +174,9 @@ pub fn render_target(
 
 /// A persistent lookup table of `width` × `height` texels (`height` 1: a 1D texture) read by
 /// `textureLoad`: tables a fragment shader indexes per fragment. A CPU backend gathers a
-/// texel fetch across lanes, where it loads a storage array with per-lane addresses one lane
-/// at a time (llvmpipe, in every fragment shader; docs/roofline.md). `data` holds the texels'
-/// bytes, rows x fastest.
+/// texel fetch across lanes, where llvmpipe loads storage in a fragment shader one lane at a
+/// time; on an idle EPYC the difference for fragment PT's tables was within noise
+/// (docs/roofline.md). `data` holds the texels' bytes, rows x fastest.
 pub fn lookup_texture(
     gpu: &Gpu,
     ledger: &mut MemoryLedger,
@@ -191,10 +191,38 @@ pub fn lookup_texture(
         "{label}: {} bytes for {width}x{height} texels of {texel} bytes",
         data.len()
     );
+    let dimension = if height == 1 {
+        wgpu::TextureDimension::D1
+    } else {
+        wgpu::TextureDimension::D2
+    };
+    let texture = texture_with_data(
+        gpu,
+        ledger,
+        label,
+        dimension,
+        format,
+        [width, height, 1],
+        data,
+    )?;
+    Ok(texture.create_view(&Default::default()))
+}
+
+/// A persistent texture read by shaders only, of `[width, height, depth]` texels in `format`,
+/// holding `data` (texels x fastest, then rows, then slices): what lookup tables need.
+pub fn texture_with_data(
+    gpu: &Gpu,
+    ledger: &mut MemoryLedger,
+    label: &str,
+    dimension: wgpu::TextureDimension,
+    format: wgpu::TextureFormat,
+    [width, height, depth]: [u32; 3],
+    data: &[u8],
+) -> anyhow::Result<wgpu::Texture> {
     let size = wgpu::Extent3d {
         width,
         height,
-        depth_or_array_layers: 1,
+        depth_or_array_layers: depth,
     };
     let texture = ledger.texture(
         gpu,
@@ -204,11 +232,7 @@ pub fn lookup_texture(
             size,
             mip_level_count: 1,
             sample_count: 1,
-            dimension: if height == 1 {
-                wgpu::TextureDimension::D1
-            } else {
-                wgpu::TextureDimension::D2
-            },
+            dimension,
             format,
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
@@ -219,12 +243,12 @@ pub fn lookup_texture(
         data,
         wgpu::TexelCopyBufferLayout {
             offset: 0,
-            bytes_per_row: Some(texel * width),
+            bytes_per_row: Some(format.block_copy_size(None).unwrap_or(4) * width),
             rows_per_image: Some(height),
         },
         size,
     );
-    Ok(texture.create_view(&Default::default()))
+    Ok(texture)
 }
 
 /// Begins a render pass into one colour attachment, cleared to transparent black first when

@@ -715,22 +715,29 @@ mod tests {
         );
     }
 
+    /// A lattice of `dims` points (xyz; `w` in the fourth lane), its tets and its bounds: the
+    /// mesh of the key-pass tests.
+    fn lattice(dims: [usize; 3], w: f32) -> (Vec<[f32; 4]>, Vec<[u32; 4]>, datasets::Aabb) {
+        let mut pts = Vec::new();
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    pts.push([i as f32 * 0.3, j as f32 * 0.5 - 1.0, k as f32 * 0.4, w]);
+                }
+            }
+        }
+        let bounds =
+            datasets::Aabb::of_points(&pts.iter().map(|p| [p[0], p[1], p[2]]).collect::<Vec<_>>());
+        (pts, datasets::volume::structured_tets(dims), bounds)
+    }
+
     /// Keys computed on the GPU match the CPU's centroid distances, and key pass + sort give
     /// the CPU's back-to-front centroid order (up to near-ties of f32 rounding).
     #[test]
     fn gpu_centroid_keys_then_sort_match_the_cpu() -> anyhow::Result<()> {
         use crate::scene::{fixed_viewpoints, Camera, Projection};
         let gpu = Gpu::new().expect("a wgpu adapter");
-        let dims = [9usize, 8, 7];
-        let mut pts = Vec::new();
-        for k in 0..dims[2] {
-            for j in 0..dims[1] {
-                for i in 0..dims[0] {
-                    pts.push([i as f32 * 0.3, j as f32 * 0.5 - 1.0, k as f32 * 0.4, 7.0]);
-                }
-            }
-        }
-        let tets = datasets::volume::structured_tets(dims);
+        let (pts, tets, bounds) = lattice([9, 8, 7], 7.0);
         let n = tets.len() as u32;
         let mut ledger = MemoryLedger::default();
         let storage = REQUIRED_USAGE | wgpu::BufferUsages::COPY_SRC;
@@ -752,8 +759,6 @@ mod tests {
         let vbuf = ledger.buffer(&gpu, "values", Lifetime::PerFrame, n as u64 * 4, storage)?;
         let keys_pass = GpuCentroidKeys::new(&gpu, &mut ledger).unwrap();
         let sorter = GpuRadixSort::new(&gpu, n, &mut ledger).unwrap();
-        let bounds =
-            datasets::Aabb::of_points(&pts.iter().map(|p| [p[0], p[1], p[2]]).collect::<Vec<_>>());
         for (vi, vp) in fixed_viewpoints().iter().enumerate().step_by(3) {
             let proj = if vi % 2 == 0 {
                 Projection::default()
@@ -813,16 +818,7 @@ mod tests {
     fn a_key_pass_over_split_primitives_equals_one_over_the_whole() -> anyhow::Result<()> {
         use crate::scene::{Camera, Projection, Viewpoint};
         let gpu = Gpu::new().expect("a wgpu adapter");
-        let dims = [7usize, 6, 5];
-        let mut pts = Vec::new();
-        for k in 0..dims[2] {
-            for j in 0..dims[1] {
-                for i in 0..dims[0] {
-                    pts.push([i as f32 * 0.3, j as f32 * 0.5 - 1.0, k as f32 * 0.4, 1.0]);
-                }
-            }
-        }
-        let tets = datasets::volume::structured_tets(dims);
+        let (pts, tets, bounds) = lattice([7, 6, 5], 1.0);
         let n = tets.len() as u32;
         let mut ledger = MemoryLedger::default();
         let usage = REQUIRED_USAGE | wgpu::BufferUsages::COPY_SRC;
@@ -875,8 +871,6 @@ mod tests {
         let one = GpuCentroidKeys::new(&gpu, &mut ledger)?;
         let three = GpuCentroidKeys::with_calls(&gpu, 3, &mut ledger)?;
         assert_eq!(three.max_calls(), 3);
-        let bounds =
-            datasets::Aabb::of_points(&pts.iter().map(|p| [p[0], p[1], p[2]]).collect::<Vec<_>>());
         for proj in [Projection::default(), Projection::Orthographic] {
             let cam = Camera::fit(
                 &bounds,

@@ -7,7 +7,7 @@
 //! backend's texture unit; interpolating by hand from storage costs eight (3D) or four (2D)
 //! vec4 loads a step, which is what a CPU backend executes lane by lane.
 
-use crate::gpu::{Gpu, Lifetime, MemoryLedger};
+use crate::gpu::{Gpu, MemoryLedger};
 
 /// WGSL of `table_coord(x, n)`: the texture coordinate of x ∈ [0, 1] on an axis of `n`
 /// entries. Every shader that samples a [`TableTexture`] includes it (tested against
@@ -42,35 +42,15 @@ impl TableTexture {
             "{label}: {} texels for a {width}×{height}×{depth} table",
             data.len()
         );
-        let extent = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: depth,
-        };
-        let tex = ledger.texture(
+        let tex = crate::bind::texture_with_data(
             gpu,
-            Lifetime::Persistent,
-            &wgpu::TextureDescriptor {
-                label: Some(label),
-                size: extent,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D3,
-                format: wgpu::TextureFormat::Rgba32Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            },
-        )?;
-        gpu.queue.write_texture(
-            tex.as_image_copy(),
+            ledger,
+            label,
+            wgpu::TextureDimension::D3,
+            wgpu::TextureFormat::Rgba32Float,
+            size,
             bytemuck::cast_slice(data),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(width * 16),
-                rows_per_image: Some(height),
-            },
-            extent,
-        );
+        )?;
         let filterable = TableTexture::filterable_on(gpu);
         let filter = if filterable {
             wgpu::FilterMode::Linear
