@@ -70,18 +70,18 @@ fn step_params() -> StepParams {
 }
 
 // One filtered sample of the pre-integration table (render_core::table_texture; `table_coord`
-// from its TABLE_WGSL).
+// from its TABLE_WGSL). The 2D table is a 3D texture of one length: both tables take the same
+// sample, and selects (not branches) pick the coordinate and the scaling, since a SIMD backend
+// that runs both sides of a branch under a mask (llvmpipe) would otherwise sample twice a step.
 fn lookup(s_f: f32, s_b: f32, len: f32, sp: StepParams) -> vec4<f32> {
     let n = f32(sp.table_entries);
     let u = table_coord(s_f, n);
     let v = table_coord(s_b, n);
-    if (sp.flags & FLAG_TABLE3D) != 0u {
-        let w = table_coord(len * sp.inv_table_length, f32(sp.table_lengths));
-        return textureSampleLevel(table, table_sampler, vec3<f32>(u, v, w), 0.0);
-    }
-    let c = textureSampleLevel(table, table_sampler, vec3<f32>(u, v, 0.5), 0.0);
+    let is_3d = (sp.flags & FLAG_TABLE3D) != 0u;
+    let w = select(0.5, table_coord(len * sp.inv_table_length, f32(sp.table_lengths)), is_3d);
+    let c = textureSampleLevel(table, table_sampler, vec3<f32>(u, v, w), 0.0);
     // The 2D table holds a segment of the fixed length; the paper's code scales by length.
-    return min(c * (len * sp.inv_table_length), vec4<f32>(1.0));
+    return select(min(c * (len * sp.inv_table_length), vec4<f32>(1.0)), c, is_3d);
 }
 
 struct State {
@@ -91,6 +91,9 @@ struct State {
     layer: u32,
     steps: u32,
     colour: vec4<f32>,
+    // Layer entries passed over because they lie behind the ray (STAT_SKIPPED), since the
+    // last `count_end`.
+    skipped: u32,
 }
 
 fn load(i: u32) -> State {
@@ -103,6 +106,7 @@ fn load(i: u32) -> State {
     st.layer = a.x;
     st.steps = a.y;
     st.colour = colours[i];
+    st.skipped = 0u;
     return st;
 }
 
@@ -112,8 +116,30 @@ fn store(i: u32, st: State) {
     colours[i] = st.colour;
 }
 
-fn finish(st: ptr<function, State>) {
+// Why `advance` ended a ray; ACTIVE: it did not.
+const ACTIVE: u32 = 0u;
+const END_LEFT: u32 = 1u;
+const END_TERMINATED: u32 = 2u;
+const END_STALLED: u32 = 3u;
+
+// The statistics of a ray that ended (`end` ≠ ACTIVE) and the skipped entries of any ray,
+// counted once after its steps. A CPU backend runs an atomic lane by lane, and llvmpipe (Mesa
+// 22.3's gallivm) runs the body of every `if` under a mask instead of branching around it, so
+// atomics inside the step's branches cost their lane-by-lane loop on every step of every ray.
+fn count_end(st: ptr<function, State>, end: u32) {
+    if (*st).skipped != 0u {
+        atomicAdd(&stats[STAT_SKIPPED], (*st).skipped);
+        (*st).skipped = 0u;
+    }
+    if end == ACTIVE {
+        return;
+    }
     (*st).tet = vec2<u32>(NONE, NONE);
+    if end == END_TERMINATED {
+        atomicAdd(&stats[STAT_TERMINATED], 1u);
+    } else if end == END_STALLED {
+        atomicAdd(&stats[STAT_STALLED], 1u);
+    }
     let before = atomicAdd(&stats[STAT_STEPS], (*st).steps);
     if before > 0xffffffffu - (*st).steps {
         atomicAdd(&stats[STAT_STEPS_HIGH], 1u);
@@ -121,8 +147,8 @@ fn finish(st: ptr<function, State>) {
     atomicMax(&stats[STAT_MAX_STEPS], (*st).steps);
 }
 
-// One ray step (phase 3a); returns whether the ray is still active.
-fn advance(st: ptr<function, State>, p: vec2<u32>, ray: Ray, sp: StepParams) -> bool {
+// One ray step (phase 3a); returns ACTIVE or why the ray ended.
+fn advance(st: ptr<function, State>, p: vec2<u32>, ray: Ray, sp: StepParams) -> u32 {
     let ex = exit_of((*st).tet, ray.o, ray.d, (*st).lambda);
     let next = ex.next;
     let lambda_exit = ex.lambda;
@@ -134,27 +160,21 @@ fn advance(st: ptr<function, State>, p: vec2<u32>, ray: Ray, sp: StepParams) -> 
     (*st).lambda = lambda_exit;
     (*st).s = s_exit;
     if (sp.flags & FLAG_ET) != 0u && (*st).colour.a >= sp.et_alpha {
-        atomicAdd(&stats[STAT_TERMINATED], 1u);
-        finish(st);
-        return false;
+        return END_TERMINATED;
     }
     if (*st).steps >= sp.max_steps {
-        atomicAdd(&stats[STAT_STALLED], 1u);
-        finish(st);
-        return false;
+        return END_STALLED;
     }
     if next.x == NONE {
         // Left the mesh: continue from the next peeling layer that lies ahead (§2.4).
         loop {
             (*st).layer += 1u;
             if (*st).layer >= sp.layers {
-                finish(st);
-                return false;
+                return END_LEFT;
             }
             let e = textureLoad(layers, vec2<i32>(p), i32((*st).layer), 0);
             if e.x == NONE {
-                finish(st);
-                return false;
+                return END_LEFT;
             }
             let l = bitcast<f32>(e.z);
             if l >= lambda_exit - sp.peel_bias {
@@ -163,10 +183,10 @@ fn advance(st: ptr<function, State>, p: vec2<u32>, ray: Ray, sp: StepParams) -> 
                 (*st).s = bitcast<f32>(e.w);
                 break;
             }
-            atomicAdd(&stats[STAT_SKIPPED], 1u);
+            (*st).skipped += 1u;
         }
     }
-    return true;
+    return ACTIVE;
 }
 
 fn tile_of(p: vec2<u32>) -> u32 {
@@ -240,9 +260,10 @@ fn step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     }
     var st = load(i);
     let ray = ray_through(rf, vec2<f32>(p) + 0.5);
-    let still_active = advance(&st, p, ray, sp);
+    let end = advance(&st, p, ray, sp);
+    count_end(&st, end);
     store(i, st);
-    if still_active && pass_params.count != 0u {
+    if end == ACTIVE && pass_params.count != 0u {
         atomicAdd(&tile_counts[t], 1u);
     }
 }
@@ -265,10 +286,13 @@ fn run_loop(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) 
     }
     var st = load(i);
     let ray = ray_through(rf, vec2<f32>(p) + 0.5);
+    var end = ACTIVE;
     loop {
-        if !advance(&st, p, ray, sp) {
+        end = advance(&st, p, ray, sp);
+        if end != ACTIVE {
             break;
         }
     }
+    count_end(&st, end);
     store(i, st);
 }
