@@ -275,7 +275,8 @@ pub(crate) fn key(r: &Row) -> Key {
 /// |ln(group ratio / run-wide factor)| — robust to the few groups a real change moves — given
 /// as a factor; when it reaches √threshold (a typical unchanged group already moved half way
 /// to the threshold, on the log scale) time cannot gate, and the reason says so. Only for
-/// unpaired runs with a run-wide factor: `ab`'s paired rounds divide each pair's drift out.
+/// unpaired runs with a run-wide factor: `ab`'s paired rounds are judged by a t-test whose
+/// variance is pooled over the groups, with or without each pair's drift divided out.
 /// Returns (spread, reason when too noisy).
 pub fn time_noise(
     groups: &[GroupComparison],
@@ -359,16 +360,25 @@ pub fn compare(
     let rounds = Rounds::of(&base, &new);
     let unscaled = group_tests(&base.rows, &new.rows, opt, &[1.0], rounds)?;
     let run_factor = run_wide_factor(unscaled.iter().map(|g| &g.total));
-    let pair_factors = (opt.paired && opt.drift_correction && rounds.base == rounds.new)
+    let paired = opt.paired && rounds.base == rounds.new && rounds.base > 1;
+    let pair_factors = (paired && opt.drift_correction)
         .then(|| pair_factors(&group_pair_ratios(&base.rows, &new.rows, rounds, opt).ok()?))
         .flatten();
     let scale: Vec<f64> = match (&pair_factors, run_factor) {
         (Some(per_pair), _) => per_pair.clone(),
         (None, Some(f)) if opt.drift_correction => vec![f],
+        // Paired rounds on absolute times (`ab --no-drift-correction`, for a change that moves
+        // most of the matrix): a factor of 1 per pair keeps the paired test.
+        (None, _) if paired && !opt.drift_correction => vec![1.0; rounds.base as usize],
         _ => vec![1.0],
     };
-    let (group_spread, noise) = match (&pair_factors, rounds.enough()) {
-        (None, true) => time_noise(&unscaled, run_factor, opt.threshold),
+    let paired_test = scale.len() > 1;
+    let drift_per_pair = pair_factors.is_some();
+    // The groups' scatter around the run-wide factor measures the noise of separate runs
+    // only: in paired rounds the test's own pooled variance does, and a change to half the
+    // groups would read as scatter.
+    let (group_spread, noise) = match (paired_test, rounds.enough()) {
+        (false, true) => time_noise(&unscaled, run_factor, opt.threshold),
         _ => (None, None),
     };
     let time_judged = rounds.enough() && noise.is_none();
@@ -409,7 +419,7 @@ pub fn compare(
         group_spread,
         too_noisy: noise.is_some(),
         run_factor,
-        drift_corrected: scale != [1.0],
+        drift_corrected: drift_per_pair || (opt.drift_correction && scale != [1.0]),
         pair_factors,
         test: format!(
             "work counters and GPU bytes exact; time: Mann–Whitney U (two-sided, α = {}, \
@@ -417,11 +427,18 @@ pub fn compare(
              rule){}",
             opt.alpha,
             opt.threshold,
-            if scale.len() > 1 {
-                "; groups (paired rounds): a t-test of each group's per-pair ln(NEW/BASE), each \
-                 pair's drift divided out, variance pooled over the groups; ratio = exp(mean)"
-            } else {
-                ""
+            match (paired_test, drift_per_pair) {
+                (true, true) => {
+                    "; groups (paired rounds): a t-test of each group's per-pair ln(NEW/BASE), \
+                     each pair's drift divided out, variance pooled over the groups; ratio = \
+                     exp(mean)"
+                }
+                (true, false) => {
+                    "; groups (paired rounds): a t-test of each group's per-pair ln(NEW/BASE) \
+                     on absolute times (no drift divided out), variance pooled over the groups; \
+                     ratio = exp(mean)"
+                }
+                _ => "",
             }
         ),
         groups,

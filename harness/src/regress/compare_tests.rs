@@ -289,3 +289,59 @@ fn paired_rounds_divide_out_each_pairs_drift() {
         Vec::<String>::new()
     );
 }
+
+/// `ab --no-drift-correction`, for a change that moves half the matrix: 3 pairs, the machine
+/// ×0.95–×1.05 from pair to pair, groups 0–3 ×0.8 in NEW and groups 4–7 unchanged (the
+/// control). The paired test on absolute times finds exactly the four faster groups; the
+/// groups' scatter around the run-wide factor is the change itself, not noise, and must not
+/// withhold time (it did until c94ce65's `ab`: "too noisy to judge" on every group).
+#[test]
+fn paired_rounds_on_absolute_times_judge_a_change_to_half_the_groups() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b, same) = (
+        tmp.path().join("a"),
+        tmp.path().join("b"),
+        tmp.path().join("same"),
+    );
+    let machine = [1.0, 1.05, 0.95];
+    run_dir_with_machine(&a, &[1.0; 8], &machine, 3, 0.0, 11);
+    let mut fast = [1.0; 8];
+    fast[..4].fill(0.8);
+    run_dir_with_machine(&b, &fast, &machine, 3, 0.0, 12);
+    run_dir_with_machine(&same, &[1.0; 8], &machine, 3, 0.0, 13);
+    let out = tmp.path().join("out");
+    let absolute = CompareOptions {
+        paired: true,
+        ..options(&out, false, 1.5)
+    };
+    let faster = |c: &Comparison| -> Vec<String> {
+        c.groups
+            .iter()
+            .filter(|g| g.total.verdict == Verdict::Faster)
+            .map(|g| g.algorithm.clone())
+            .collect()
+    };
+    let c = compare(&a, &b, &absolute).unwrap();
+    assert!(!c.too_noisy, "{:?}", c.time_refused);
+    assert!(!c.drift_corrected && c.pair_factors.is_none());
+    assert_eq!(
+        faster(&c),
+        ["alg0", "alg1", "alg2", "alg3"],
+        "{:#?}",
+        c.groups
+    );
+    assert!(c.test.contains("absolute times"), "{}", c.test);
+    let same_build = compare(&a, &same, &absolute).unwrap();
+    assert!(
+        same_build
+            .groups
+            .iter()
+            .all(|g| g.total.verdict == Verdict::NoChange),
+        "{:#?}",
+        same_build.groups
+    );
+    // The same rounds judged as separate runs keep the old rule: the scatter is taken for
+    // noise and time is withheld.
+    let separate = compare(&a, &b, &options(&out, false, 1.5)).unwrap();
+    assert!(separate.too_noisy);
+}
