@@ -203,9 +203,9 @@ pub struct Walk {
     pub stalled: bool,
 }
 
-/// Walks a ray through every peeling layer (no early termination), as `advance` in cast.wgsl:
-/// one step per tet, a ray that leaves continues at the next layer entry not behind it (by
-/// more than `bias`), at most `max_steps` steps.
+/// Walks a ray through every peeling layer (no early termination), as cast.wgsl's `advance`
+/// and `next_layer` do: one step per tet, a ray that leaves continues at the next layer entry
+/// not behind it (by more than `bias`), at most `max_steps` steps.
 pub fn walk(
     layout: &MeshLayout,
     layers: &[Option<LayerEntry>],
