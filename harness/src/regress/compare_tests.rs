@@ -294,7 +294,8 @@ fn paired_rounds_divide_out_each_pairs_drift() {
 /// ×0.95–×1.05 from pair to pair, groups 0–3 ×0.8 in NEW and groups 4–7 unchanged (the
 /// control). The paired test on absolute times finds exactly the four faster groups; the
 /// groups' scatter around the run-wide factor is the change itself, not noise, and must not
-/// withhold time (it did until c94ce65's `ab`: "too noisy to judge" on every group).
+/// withhold time (before 32b0b77 it did: `ab` of c94ce65 read "too noisy to judge" on every
+/// group).
 #[test]
 fn paired_rounds_on_absolute_times_judge_a_change_to_half_the_groups() {
     let tmp = tempfile::tempdir().unwrap();
