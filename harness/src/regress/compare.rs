@@ -419,7 +419,7 @@ pub fn compare(
         group_spread,
         too_noisy: noise.is_some(),
         run_factor,
-        drift_corrected: drift_per_pair || (opt.drift_correction && scale != [1.0]),
+        drift_corrected: opt.drift_correction && scale != [1.0],
         pair_factors,
         test: format!(
             "work counters and GPU bytes exact; time: Mann–Whitney U (two-sided, α = {}, \

@@ -231,11 +231,7 @@ fn dirty_or_debug_sides_are_warned() {
 #[test]
 fn paired_rounds_divide_out_each_pairs_drift() {
     let tmp = tempfile::tempdir().unwrap();
-    let (a, b, same) = (
-        tmp.path().join("a"),
-        tmp.path().join("b"),
-        tmp.path().join("same"),
-    );
+    let [a, b, same] = ["a", "b", "same"].map(|n| tmp.path().join(n));
     let machine = [1.0, 1.3, 0.75, 1.2, 0.8];
     run_dir_with_machine(&a, &[1.0; 8], &machine, 1, 0.0, 1);
     let mut slow = [1.0; 8];
@@ -272,7 +268,7 @@ fn paired_rounds_divide_out_each_pairs_drift() {
 
     // Unpaired (`compare` of two separate runs): NEW's rounds met the machine in another
     // order, and one run-wide factor leaves the rounds' scatter in the samples.
-    let (b2, same2) = (tmp.path().join("b2"), tmp.path().join("same2"));
+    let [b2, same2] = ["b2", "same2"].map(|n| tmp.path().join(n));
     let shuffled = [0.75, 1.0, 1.2, 0.8, 1.3];
     run_dir_with_machine(&b2, &slow, &shuffled, 1, 0.0, 2);
     run_dir_with_machine(&same2, &[1.0; 8], &shuffled, 1, 0.0, 3);
@@ -299,11 +295,7 @@ fn paired_rounds_divide_out_each_pairs_drift() {
 #[test]
 fn paired_rounds_on_absolute_times_judge_a_change_to_half_the_groups() {
     let tmp = tempfile::tempdir().unwrap();
-    let (a, b, same) = (
-        tmp.path().join("a"),
-        tmp.path().join("b"),
-        tmp.path().join("same"),
-    );
+    let [a, b, same] = ["a", "b", "same"].map(|n| tmp.path().join(n));
     let machine = [1.0, 1.05, 0.95];
     run_dir_with_machine(&a, &[1.0; 8], &machine, 3, 0.0, 11);
     let mut fast = [1.0; 8];
