@@ -91,8 +91,8 @@ struct State {
     layer: u32,
     steps: u32,
     colour: vec4<f32>,
-    // Layer entries passed over because they lie behind the ray (STAT_SKIPPED), since the
-    // last `count_end`.
+    // Layer entries passed over because they lie behind the ray (STAT_SKIPPED) in this
+    // invocation; `count_end` adds them to the statistics.
     skipped: u32,
 }
 
@@ -129,7 +129,6 @@ const END_STALLED: u32 = 3u;
 fn count_end(st: ptr<function, State>, end: u32) {
     if (*st).skipped != 0u {
         atomicAdd(&stats[STAT_SKIPPED], (*st).skipped);
-        (*st).skipped = 0u;
     }
     if end == ACTIVE {
         return;
