@@ -186,7 +186,11 @@ impl Pipelines {
                 c | wgpu::ShaderStages::FRAGMENT,
             ))],
         );
-        let splat_module = gpu.shader("splat splat.wgsl", &with_frame(include_str!("splat.wgsl")));
+        let splat_source = format!(
+            "const SPLAT_WORKGROUP: u32 = {SPLAT_WORKGROUP}u;\n{}",
+            with_frame(include_str!("splat.wgsl"))
+        );
+        let splat_module = gpu.shader("splat splat.wgsl", &splat_source);
         let splat = gpu.compute_pipeline(
             "splat sheet",
             Some(&pipeline_layout(
@@ -249,7 +253,20 @@ impl Pipelines {
 /// Workgroups (x, y) for `threads` threads of 256, split over two dimensions past the
 /// per-dimension limit (shaders rebuild the flat id).
 pub fn workgroups(threads: u32) -> (u32, u32) {
-    let wg = threads.div_ceil(256).max(1);
+    workgroups_of(threads, 256)
+}
+
+/// Invocations in one workgroup of the splat pass (`splat_cs`, given to the shader as
+/// `SPLAT_WORKGROUP`). A bucket holds a few hundred voxels, so a dispatch is a handful of
+/// workgroups, and a software rasteriser runs each workgroup on one thread: at 256, a bucket of
+/// 300 voxels left one of lavapipe's two threads idle for five sixths of its dispatch (box:10k
+/// and shell:10k at 128² from diagonal views, docs/roofline.md). 64 keeps whole warps and
+/// wavefronts on a GPU.
+pub const SPLAT_WORKGROUP: u32 = 64;
+
+/// Workgroups (x, y) for `threads` threads of `size`, split like [`workgroups`].
+pub fn workgroups_of(threads: u32, size: u32) -> (u32, u32) {
+    let wg = threads.div_ceil(size).max(1);
     let x = wg.min(32_768);
     (x, wg.div_ceil(x))
 }

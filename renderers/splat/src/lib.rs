@@ -662,7 +662,7 @@ impl Splat {
                 pass.set_pipeline(&st.pipes.splat);
                 pass.set_bind_group(0, &splat_bind, &[]);
                 pass.set_bind_group(1, &slab_bind, &[offset]);
-                let (x, y) = gpu::workgroups(step.count * step.lanes);
+                let (x, y) = gpu::workgroups_of(step.count * step.lanes, gpu::SPLAT_WORKGROUP);
                 pass.dispatch_workgroups(x, y, 1);
             }
             if composite.is_some() {

@@ -88,10 +88,11 @@ fn first_centre(edge: f32, n: f32) -> u32 {
 // the largest footprint of the frame, `Splat::lanes`): one invocation per voxel walked up to
 // thousands of pixels one after the other, and a bucket holds too few voxels to fill a GPU
 // (docs/gpu.md). The sums are fixed point, so the split changes no bit of the image.
-@compute @workgroup_size(256)
+// SPLAT_WORKGROUP (gpu.rs, prepended to this source) invocations a workgroup.
+@compute @workgroup_size(SPLAT_WORKGROUP)
 fn splat_cs(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let lanes = max(slab.lanes, 1u);
-    let flat = g.x + g.y * nwg.x * 256u;
+    let flat = g.x + g.y * nwg.x * SPLAT_WORKGROUP;
     let i = flat / lanes;
     let lane = flat % lanes;
     if (i >= slab.count) {
