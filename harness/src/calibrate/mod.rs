@@ -544,18 +544,28 @@ pub fn resource_times(row: &Row, cal: &Calibration) -> Vec<(&'static str, f64)> 
 /// Fills each measured row's roofline columns from `cal`.
 pub fn annotate(rows: &mut [Row], cal: &Calibration) {
     for row in rows.iter_mut() {
-        let Some(total) = row.total_ms.filter(|t| *t > 0.0) else {
+        if row.total_ms.is_none_or(|t| t <= 0.0) {
             continue;
-        };
+        }
         let bound = resource_times(row, cal)
             .into_iter()
             .max_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((name, ms)) = bound.filter(|b| b.1 > 0.0) {
             row.roofline_ms = Some(ms);
             row.bound_by = name.to_string();
-            row.limit_fraction = Some(ms / total);
-            row.normalized_time = Some(total / ms);
+            set_fraction(row);
         }
+    }
+}
+
+/// Sets `limit_fraction` (roofline / total) and `normalized_time` (its inverse) from the row's
+/// `roofline_ms` and `total_ms`: by [`annotate`], and again wherever a row's total changes
+/// after it (rounds merged into one row, `ab`), so that the fraction is always the one of the
+/// time the row reports.
+pub fn set_fraction(row: &mut Row) {
+    if let (Some(ms), Some(total)) = (row.roofline_ms, row.total_ms.filter(|t| *t > 0.0)) {
+        row.limit_fraction = Some(ms / total);
+        row.normalized_time = Some(total / ms);
     }
 }
 

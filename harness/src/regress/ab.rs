@@ -370,6 +370,9 @@ fn summarise_samples(row: &mut Row, samples: crate::results::FrameSamples) {
             row.fps = Some(1000.0 / t.median);
             row.tets_per_sec = Some(row.tets as f64 / (t.median * 1e-3));
         }
+        // The roofline is the first round's (the counters are the same in every round); its
+        // fraction is of the merged median.
+        crate::calibrate::set_fraction(row);
     }
     if let Some(c) = cpu {
         (row.cpu_ms, row.cpu_ms_min, row.cpu_ms_max) = (Some(c.median), Some(c.min), Some(c.max));

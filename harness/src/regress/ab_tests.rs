@@ -59,13 +59,11 @@ fn rounds_merge_into_one_run_of_n_rounds() {
     let dirs: Vec<PathBuf> = (1..=3).map(|i| side.join(format!("round-0{i}"))).collect();
     for (i, d) in dirs.iter().enumerate() {
         let t = 10.0 * (i + 1) as f64;
-        round(
-            d,
-            vec![
-                row("havs", "+x", &[t, t + 1.0]),
-                row("gator-pt", "+x", &[1.0, 3.0]),
-            ],
-        );
+        // Each round's roofline columns are of its own median.
+        let mut havs = row("havs", "+x", &[t, t + 1.0]);
+        havs.roofline_ms = Some(10.25);
+        crate::calibrate::set_fraction(&mut havs);
+        round(d, vec![havs, row("gator-pt", "+x", &[1.0, 3.0])]);
     }
     let merged = merge_rounds(&dirs, &side).unwrap();
     assert_eq!(merged.run.rounds, 3);
@@ -80,6 +78,9 @@ fn rounds_merge_into_one_run_of_n_rounds() {
         (Some(10.0), Some(31.0))
     );
     assert_eq!(havs.image_f32, "round-01/images/havs+x.f32.zz");
+    // The limit fraction is of the merged median, not the first round's (0.5, not 1).
+    assert_eq!(havs.limit_fraction, Some(0.5));
+    assert_eq!(havs.normalized_time, Some(2.0));
     let values = crate::regress::compare::round_values(havs, "total_ms", 3, false).unwrap();
     assert_eq!(values, [10.5, 20.5, 30.5]);
     assert!(merged.errors.is_empty(), "{:?}", merged.errors);
