@@ -63,28 +63,40 @@ fn kb_closest(st: ptr<function, KState>) -> u32 {
 }
 
 // One incoming fragment: a free entry takes it; otherwise the closest of the K + 1 candidates
-// is popped and composited against the closest of the K that remain.
+// is popped and composited against the closest of the K that remain. Written with selects
+// over every entry, and no index computed at run time, so that a compiler can keep the K
+// entries in registers: a software rasteriser keeps an array indexed at run time in memory
+// and reaches it lane by lane (docs/roofline.md). The same choices as a search that stops at
+// the first free entry and indexes the one it finds: the first free entry, the first of the
+// closest, ties to the lower index.
 fn kb_insert(st: ptr<function, KState>, f: vec2<f32>, two_tags: bool) {
+    var placed = false;
     for (var i = 0u; i < K; i++) {
-        if (*st).e[i].y >= KB_EMPTY {
-            (*st).e[i] = f;
-            return;
-        }
+        let take = !placed && (*st).e[i].y >= KB_EMPTY;
+        (*st).e[i] = select((*st).e[i], f, take);
+        placed = placed || take;
+    }
+    if placed {
+        return;
     }
     var imin = K;
     var dmin = f.y;
     for (var i = 0u; i < K; i++) {
-        if (*st).e[i].y < dmin {
-            dmin = (*st).e[i].y;
-            imin = i;
-        }
+        let closer = (*st).e[i].y < dmin;
+        dmin = select(dmin, (*st).e[i].y, closer);
+        imin = select(imin, i, closer);
     }
     var popped = f;
-    if imin < K {
-        popped = (*st).e[imin];
-        (*st).e[imin] = f;
+    for (var i = 0u; i < K; i++) {
+        let hit = i == imin;
+        popped = select(popped, (*st).e[i], hit);
+        (*st).e[i] = select((*st).e[i], f, hit);
     }
-    let back = (*st).e[kb_closest(st)];
+    // Every entry is full here: the closest is the first of the smallest depth.
+    var back = (*st).e[0];
+    for (var i = 1u; i < K; i++) {
+        back = select(back, (*st).e[i], (*st).e[i].y < back.y);
+    }
     kb_emit(st, popped, back, two_tags);
 }
 
