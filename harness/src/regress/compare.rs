@@ -36,7 +36,7 @@ pub use crate::regress::compare_image::{
 use crate::regress::compare_rounds::{group_pair_ratios, group_tests, round_test};
 pub use crate::regress::compare_rounds::{round_values, Rounds, MIN_ROUNDS};
 pub use crate::regress::compare_time::{
-    adjust_family, fmt_p, pair_factors, paired_t_tests, run_wide_factor, scaled, time_test,
+    adjust_family, fmt_p, pair_factors, pooled_t_tests, run_wide_factor, scaled, time_test,
     TimeTest, Verdict, MIN_GROUPS_FOR_DRIFT,
 };
 pub use crate::regress::compare_work::{WorkChange, WorkRule, WorkVerdict};
@@ -429,14 +429,14 @@ pub fn compare(
             opt.threshold,
             match (paired_test, drift_per_pair) {
                 (true, true) => {
-                    "; groups (paired rounds): a t-test of each group's per-pair ln(NEW/BASE), \
-                     each pair's drift divided out, variance pooled over the groups; ratio = \
-                     exp(mean)"
+                    "; groups and rows (paired rounds): a t-test of each one's per-pair \
+                     ln(NEW/BASE), each pair's drift divided out, variance pooled over the \
+                     groups (rows: over their group's rows); ratio = exp(mean)"
                 }
                 (true, false) => {
-                    "; groups (paired rounds): a t-test of each group's per-pair ln(NEW/BASE) \
-                     on absolute times (no drift divided out), variance pooled over the groups; \
-                     ratio = exp(mean)"
+                    "; groups and rows (paired rounds): a t-test of each one's per-pair \
+                     ln(NEW/BASE) on absolute times (no drift divided out), variance pooled \
+                     over the groups (rows: over their group's rows); ratio = exp(mean)"
                 }
                 _ => "",
             }
@@ -468,28 +468,59 @@ fn compare_all_rows(
         .collect();
     // The rows' total_ms tests are one family (Holm): their adjusted p decides each row.
     let mut raw_total_p = vec![];
+    // Per row, its ln(NEW/BASE) in each pair of rounds (paired rounds only).
+    let mut pair_logs: Vec<Option<Vec<f64>>> = vec![];
     for (b, n) in &pairs {
-        raw_total_p.push(match n {
-            Some(n) => {
-                let bs = round_values(b, "total_ms", rounds.base, opt.normalised)?;
-                let ns = scaled(
-                    round_values(n, "total_ms", rounds.new, opt.normalised)?,
-                    scale,
-                );
-                (rounds.enough() && bs.len() >= 2 && ns.len() >= 2)
-                    .then(|| mann_whitney_p(&bs, &ns))
-                    .flatten()
+        let (mut p, mut logs) = (None, None);
+        if let Some(n) = n {
+            let bs = round_values(b, "total_ms", rounds.base, opt.normalised)?;
+            let ns = scaled(
+                round_values(n, "total_ms", rounds.new, opt.normalised)?,
+                scale,
+            );
+            if rounds.enough() && bs.len() >= 2 && ns.len() >= 2 {
+                p = mann_whitney_p(&bs, &ns);
             }
-            None => None,
-        });
+            let one_per_pair = bs.len() == scale.len() && ns.len() == scale.len();
+            if scale.len() > 1 && one_per_pair && bs.iter().chain(&ns).all(|x| *x > 0.0) {
+                logs = Some(bs.iter().zip(&ns).map(|(b, n)| (n / b).ln()).collect());
+            }
+        }
+        raw_total_p.push(p);
+        pair_logs.push(logs);
+    }
+    // Paired rounds: each row is judged as the groups are, by the t-test of its per-pair
+    // ln(NEW/BASE), with the variance pooled over its group's rows (the viewpoints of one
+    // variant: pooled over every row, a bimodal GATOR row of an unchanged build was called
+    // faster beside HAVS rows whose pairs agree to 2 %). A rank test of 3 rounds against 3
+    // cannot go below p = 0.1, so no row of an `ab` could be faster or slower before.
+    let mut paired = vec![None; pairs.len()];
+    if rounds.enough() {
+        for group in GroupKey::distinct(base.rows.iter()) {
+            let members: Vec<usize> = (0..pairs.len())
+                .filter(|&i| pair_logs[i].is_some() && group.matches(pairs[i].0))
+                .collect();
+            let logs: Vec<Vec<f64>> = members
+                .iter()
+                .filter_map(|&i| pair_logs[i].clone())
+                .collect();
+            for (&i, (ratio, p)) in members
+                .iter()
+                .zip(pooled_t_tests(&logs).unwrap_or_default())
+            {
+                paired[i] = Some((ratio, p));
+                raw_total_p[i] = p;
+            }
+        }
     }
     let mut rows = vec![];
-    for ((b, n), p_total) in pairs.into_iter().zip(holm_adjust(&raw_total_p)) {
+    let adjusted = holm_adjust(&raw_total_p);
+    for (((b, n), p_total), paired) in pairs.into_iter().zip(adjusted).zip(paired) {
         rows.push(match n {
             Some(n) => compare_rows(
                 b,
                 n,
-                (p_total, scale, rounds, time_judged),
+                (p_total, paired, scale, rounds, time_judged),
                 (base_dir, new_dir, &heat_dir),
                 opt,
             )?,
@@ -528,16 +559,23 @@ struct Direction {
     changed: bool,
 }
 
-/// One matched row. `time`: the Holm-adjusted p of its `total_ms`, the drift NEW is divided
-/// by, the rounds, and whether time is judged; `dirs`: BASE, NEW and where heatmaps go.
+/// One matched row. `time`: the Holm-adjusted p of its `total_ms`, its paired test (paired
+/// rounds: exp of the mean per-pair ln(NEW/BASE), and the raw p), the drift NEW is divided by,
+/// the rounds, and whether time is judged; `dirs`: BASE, NEW and where heatmaps go.
 fn compare_rows(
     b: &Row,
     n: &Row,
-    time: (Option<f64>, &[f64], Rounds, bool),
+    time: (
+        Option<f64>,
+        Option<(f64, Option<f64>)>,
+        &[f64],
+        Rounds,
+        bool,
+    ),
     dirs: (&Path, &Path, &Path),
     opt: &CompareOptions,
 ) -> anyhow::Result<RowComparison> {
-    let (total_p_adjusted, scale, rounds, time_judged) = time;
+    let (total_p_adjusted, paired_test, scale, rounds, time_judged) = time;
     let (base_dir, new_dir, heat_dir) = dirs;
     let mut out = only(b, RowStatus::NoChange);
     out.notes.clear();
@@ -584,6 +622,9 @@ fn compare_rows(
         }
         let mut t = round_test(metric, &bs, &ns, opt, rounds);
         if metric == "total_ms" {
+            if let Some((ratio, p)) = paired_test {
+                t = t.with_paired(ratio, p, opt.threshold, opt.alpha);
+            }
             t = t.with_family_p(total_p_adjusted, opt.threshold, opt.alpha);
             if rounds.enough() && !time_judged {
                 t.verdict = Verdict::TooNoisy;

@@ -324,6 +324,19 @@ fn paired_rounds_on_absolute_times_judge_a_change_to_half_the_groups() {
         c.groups
     );
     assert!(c.test.contains("absolute times"), "{}", c.test);
+    // Rows are judged by the same paired test, its variance pooled over the rows: the twelve
+    // rows of the faster groups read faster and no other row changes. A rank test of 3 rounds
+    // against 3 (the rows' test before) cannot go below p = 0.1: none of them could.
+    let improved: Vec<&str> = c
+        .rows
+        .iter()
+        .filter(|r| r.status == RowStatus::Improvement)
+        .map(|r| r.algorithm.as_str())
+        .collect();
+    assert_eq!(improved.len(), 12, "{:#?}", c.rows);
+    assert!(improved
+        .iter()
+        .all(|a| ["alg0", "alg1", "alg2", "alg3"].contains(a)));
     let same_build = compare(&a, &same, &absolute).unwrap();
     assert!(
         same_build
@@ -332,6 +345,14 @@ fn paired_rounds_on_absolute_times_judge_a_change_to_half_the_groups() {
             .all(|g| g.total.verdict == Verdict::NoChange),
         "{:#?}",
         same_build.groups
+    );
+    assert!(
+        same_build
+            .rows
+            .iter()
+            .all(|r| r.status == RowStatus::NoChange),
+        "{:#?}",
+        same_build.rows
     );
     // The same rounds judged as separate runs keep the old rule: the scatter is taken for
     // noise and time is withheld.

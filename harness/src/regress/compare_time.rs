@@ -211,9 +211,20 @@ pub fn run_wide_factor<'a>(group_totals: impl Iterator<Item = &'a TimeTest>) -> 
 /// of degrees of freedom. Measured on the 2-core VM (docs/regression.md, "A/B power"):
 /// the residual per-pair scatter is 0.10–0.20 in ln units for every group.
 pub fn paired_t_tests(logs: &[Vec<f64>]) -> Option<Vec<(f64, Option<f64>)>> {
+    if logs.len() < MIN_GROUPS_FOR_DRIFT {
+        return None;
+    }
+    pooled_t_tests(logs)
+}
+
+/// The t-test of [`paired_t_tests`] for any number of series (at least one) of one length
+/// (at least 3): each series' mean against 0, the variance pooled over the series given.
+/// compare's rows use it per group of viewpoints (a row's pairs scatter like its group's,
+/// not like another algorithm's).
+pub fn pooled_t_tests(logs: &[Vec<f64>]) -> Option<Vec<(f64, Option<f64>)>> {
     use statrs::distribution::{ContinuousCDF, StudentsT};
     let n = logs.first()?.len();
-    if n < 3 || logs.len() < MIN_GROUPS_FOR_DRIFT || logs.iter().any(|l| l.len() != n) {
+    if n < 3 || logs.iter().any(|l| l.len() != n) {
         return None;
     }
     let mean = |l: &[f64]| l.iter().sum::<f64>() / l.len() as f64;
