@@ -106,9 +106,9 @@ fn text(o: &Output) -> String {
     )
 }
 
-/// Two binaries: the same code gives exit 0, alg2 made ×1.5 slower exit 3 naming it; the
-/// output shows each pair's drift; the matrix options and `--rounds 1` reach every round; too
-/// few pairs and an unknown side are errors (1).
+/// Two binaries: the same code gives exit 0, alg2 made ×1.5 slower exit 3 naming it (its
+/// group and its rows); the output shows each pair's drift; the matrix options and
+/// `--rounds 1` reach every round; too few pairs and an unknown side are errors (1).
 #[test]
 fn ab_of_two_binaries_gates_like_compare() {
     let tmp = tempfile::tempdir().unwrap();
@@ -177,7 +177,14 @@ fn ab_of_two_binaries_gates_like_compare() {
         out.contains("regression: slower: alg2 k=2 on box:1k"),
         "{out}"
     );
-    assert_eq!(out.matches("regression: ").count(), 1, "{out}");
+    // The group and its three rows (paired rounds judge rows by the paired t-test too), and
+    // nothing of the unchanged algorithms.
+    assert_eq!(out.matches("regression: ").count(), 4, "{out}");
+    assert_eq!(
+        out.matches("regression: alg2 k=2 box:1k ").count(),
+        3,
+        "{out}"
+    );
     // --fail-on never reports it and exits 0.
     let never = tetbench(
         &[
