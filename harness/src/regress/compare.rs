@@ -520,7 +520,13 @@ fn compare_all_rows(
             Some(n) => compare_rows(
                 b,
                 n,
-                (p_total, paired, scale, rounds, time_judged),
+                RowTime {
+                    p_adjusted: p_total,
+                    paired,
+                    scale,
+                    rounds,
+                    judged: time_judged,
+                },
                 (base_dir, new_dir, &heat_dir),
                 opt,
             )?,
@@ -559,23 +565,34 @@ struct Direction {
     changed: bool,
 }
 
-/// One matched row. `time`: the Holm-adjusted p of its `total_ms`, its paired test (paired
-/// rounds: exp of the mean per-pair ln(NEW/BASE), and the raw p), the drift NEW is divided by,
-/// the rounds, and whether time is judged; `dirs`: BASE, NEW and where heatmaps go.
+/// What decides one matched row's time ([`compare_rows`]).
+struct RowTime<'a> {
+    /// The Holm-adjusted p of its `total_ms` (over the rows).
+    p_adjusted: Option<f64>,
+    /// Paired rounds: its ratio, exp of the mean per-pair ln(NEW/BASE), and the raw p.
+    paired: Option<(f64, Option<f64>)>,
+    /// The drift NEW is divided by.
+    scale: &'a [f64],
+    rounds: Rounds,
+    /// Whether time is judged at all (enough rounds, not too noisy).
+    judged: bool,
+}
+
+/// One matched row; `dirs`: BASE, NEW and where heatmaps go.
 fn compare_rows(
     b: &Row,
     n: &Row,
-    time: (
-        Option<f64>,
-        Option<(f64, Option<f64>)>,
-        &[f64],
-        Rounds,
-        bool,
-    ),
+    time: RowTime<'_>,
     dirs: (&Path, &Path, &Path),
     opt: &CompareOptions,
 ) -> anyhow::Result<RowComparison> {
-    let (total_p_adjusted, paired_test, scale, rounds, time_judged) = time;
+    let RowTime {
+        p_adjusted: total_p_adjusted,
+        paired: paired_test,
+        scale,
+        rounds,
+        judged: time_judged,
+    } = time;
     let (base_dir, new_dir, heat_dir) = dirs;
     let mut out = only(b, RowStatus::NoChange);
     out.notes.clear();
