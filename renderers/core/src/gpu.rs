@@ -53,6 +53,7 @@ fn wanted_features() -> wgpu::Features {
         | wgpu::Features::FLOAT32_BLENDABLE
         | wgpu::Features::VERTEX_WRITABLE_STORAGE
         | wgpu::Features::INDIRECT_FIRST_INSTANCE
+        | wgpu::Features::DEPTH32FLOAT_STENCIL8
 }
 
 /// What to ask of the adapter beyond "everything it offers": the paths a given machine would

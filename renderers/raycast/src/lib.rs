@@ -7,7 +7,9 @@
 //! * Phases 1–2 (`peel.wgsl`, §2.4, §3.2): the front-facing boundary faces are rasterised with
 //!   the Z-buffer to find each pixel's entry tet and λ; each further layer peels the next entry
 //!   behind the previous one (bias on λ), until a layer is empty (an occlusion query per layer)
-//!   or [`RaycastSettings::max_layers`].
+//!   or [`RaycastSettings::max_layers`]. Where the device has a stencil with its 32-bit depth,
+//!   each pass also counts every pixel's candidates, and a layer after which no pixel had two
+//!   ends the peel without drawing the empty layer (`resources::Pipelines::more`).
 //! * Phase 3a (`cast.wgsl`): each active ray crosses one tet per step and composites the segment
 //!   front to back with the 2D or 3D pre-integrated table; a ray that leaves the mesh continues
 //!   from its next layer; early ray termination at opacity [`ET_OPACITY`] (the paper's code).

@@ -580,7 +580,9 @@ fn frame(
         .write_buffer(&st.frame_params, 0, bytemuck::bytes_of(&params));
 
     // Phases 1–2: peel until a layer is empty (occlusion query) or the maximum is reached; then
-    // one more layer into the spare slot, only to count the re-entries that are dropped.
+    // one more layer into the spare slot, only to count the re-entries that are dropped. With a
+    // stencil, a layer after which no pixel had a second candidate ends the peel without the
+    // empty pass that would show it (`Pipelines::more`): the same layers, one draw fewer.
     let mut layers_used = 0u32;
     let mut peel_draws = 0u32;
     let mut dropped_check = false;
@@ -613,7 +615,10 @@ fn frame(
                         load: wgpu::LoadOp::Clear(1.0),
                         store: wgpu::StoreOp::Store,
                     }),
-                    stencil_ops: None,
+                    stencil_ops: st.pipes.more.as_ref().map(|_| wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
                 }),
                 timestamp_writes: None,
                 occlusion_query_set: Some(&t.occlusion),
@@ -628,13 +633,21 @@ fn frame(
             pass.set_bind_group(0, &st.mesh_bind, &[]);
             pass.set_bind_group(2, &st.peel_frame_bind, &[]);
             pass.set_vertex_buffer(0, st.faces.slice(..));
-            pass.begin_occlusion_query(l);
+            pass.begin_occlusion_query(2 * l);
             pass.draw(0..st.face_vertices, 0..1);
             pass.end_occlusion_query();
+            if let Some(more) = &st.pipes.more {
+                pass.set_pipeline(more);
+                pass.set_stencil_reference(1);
+                pass.begin_occlusion_query(2 * l + 1);
+                pass.draw(0..3, 0..1);
+                pass.end_occlusion_query();
+            }
         }
+        let queries = if st.pipes.more.is_some() { 2 } else { 1 };
         enc.resolve_query_set(
             &t.occlusion,
-            l..l + 1,
+            2 * l..2 * l + queries,
             &t.occlusion_resolve,
             l as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
         );
@@ -644,10 +657,10 @@ fn frame(
             gpu,
             &t.occlusion_resolve,
             l as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
-            8,
+            8 * queries as u64,
         )?;
-        let samples = u64::from_le_bytes(q[..8].try_into().expect("8 bytes"));
-        if samples == 0 {
+        let count = |i: usize| u64::from_le_bytes(q[8 * i..8 * i + 8].try_into().expect("8 bytes"));
+        if count(0) == 0 {
             break;
         }
         if l == s.max_layers {
@@ -655,6 +668,9 @@ fn frame(
             break;
         }
         layers_used += 1;
+        if queries == 2 && count(1) == 0 {
+            break;
+        }
     }
     clock.stage("peel", t_peel);
 

@@ -83,6 +83,37 @@ const RW: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only
 pub const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
+/// [`DEPTH_FORMAT`] with a stencil, where the device has it (`DEPTH32FLOAT_STENCIL8`): the
+/// same depths, and a count of each pixel's candidates for the layer being peeled
+/// ([`Pipelines::more`]).
+pub const DEPTH_STENCIL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32FloatStencil8;
+
+/// The depth format of the peel on `gpu`, and whether it has the stencil.
+pub fn depth_format(gpu: &Gpu) -> (wgpu::TextureFormat, bool) {
+    if gpu.features.contains(wgpu::Features::DEPTH32FLOAT_STENCIL8) {
+        (DEPTH_STENCIL_FORMAT, true)
+    } else {
+        (DEPTH_FORMAT, false)
+    }
+}
+
+/// Every fragment a peeling pass does not discard (the candidates for its layer) adds 1 to its
+/// pixel's stencil, whether or not it is the nearest.
+const COUNT_CANDIDATES: wgpu::StencilFaceState = wgpu::StencilFaceState {
+    compare: wgpu::CompareFunction::Always,
+    fail_op: wgpu::StencilOperation::Keep,
+    depth_fail_op: wgpu::StencilOperation::IncrementClamp,
+    pass_op: wgpu::StencilOperation::IncrementClamp,
+};
+
+/// Passes where the stencil holds more than the reference (set to 1: two candidates or more).
+const MORE_THAN_REFERENCE: wgpu::StencilFaceState = wgpu::StencilFaceState {
+    compare: wgpu::CompareFunction::Less,
+    fail_op: wgpu::StencilOperation::Keep,
+    depth_fail_op: wgpu::StencilOperation::Keep,
+    pass_op: wgpu::StencilOperation::Keep,
+};
+
 /// Layouts and pipelines, independent of the viewport.
 pub struct Pipelines {
     pub mesh_layout: wgpu::BindGroupLayout,
@@ -93,6 +124,12 @@ pub struct Pipelines {
     pub peel_frame_layout: wgpu::BindGroupLayout,
     pub first: wgpu::RenderPipeline,
     pub peel: wgpu::RenderPipeline,
+    /// With a stencil: a full-screen triangle that passes where a peeling pass left two
+    /// candidates or more in a pixel. Drawn under an occlusion query after each layer, it
+    /// says whether the next layer can hold anything: every candidate of layer l + 1 (λ beyond
+    /// layer l's plus the bias) was a candidate of layer l besides layer l's own fragment. At
+    /// 0 the empty pass that would find that out is not drawn.
+    pub more: Option<wgpu::RenderPipeline>,
     pub init: wgpu::ComputePipeline,
     pub step: wgpu::ComputePipeline,
     pub run_loop: wgpu::ComputePipeline,
@@ -180,6 +217,7 @@ impl Pipelines {
         );
         let cast_pl = layout("raycast cast", &[Some(&mesh_layout), Some(&cast_layout)]);
         let probe_pl = layout("raycast probe", &[Some(&mesh_layout), Some(&probe_layout)]);
+        let (depth, stencil) = depth_format(gpu);
         let raster = |label: &str, pl: &wgpu::PipelineLayout, fs: &str| {
             dev.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
@@ -203,10 +241,19 @@ impl Pipelines {
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
+                    format: depth,
                     depth_write_enabled: Some(true),
                     depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
+                    stencil: if stencil {
+                        wgpu::StencilState {
+                            front: COUNT_CANDIDATES,
+                            back: COUNT_CANDIDATES,
+                            read_mask: 0xff,
+                            write_mask: 0xff,
+                        }
+                    } else {
+                        Default::default()
+                    },
                     bias: Default::default(),
                 }),
                 multisample: Default::default(),
@@ -226,6 +273,44 @@ impl Pipelines {
         };
         let first = raster("raycast first hit", &first_layout, "fs_first");
         let peel = raster("raycast peel", &peel_pl, "fs_peel");
+        let more = stencil.then(|| {
+            dev.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("raycast more candidates"),
+                layout: Some(&layout("raycast more candidates", &[])),
+                vertex: wgpu::VertexState {
+                    module: &peel_module,
+                    entry_point: Some("vs_screen"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: depth,
+                    depth_write_enabled: Some(false),
+                    depth_compare: Some(wgpu::CompareFunction::Always),
+                    stencil: wgpu::StencilState {
+                        front: MORE_THAN_REFERENCE,
+                        back: MORE_THAN_REFERENCE,
+                        read_mask: 0xff,
+                        write_mask: 0,
+                    },
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &peel_module,
+                    entry_point: Some("fs_nothing"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: LAYER_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::empty(),
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        });
         let init = gpu.compute_pipeline("raycast init", Some(&cast_pl), &cast_module, "init");
         let step = gpu.compute_pipeline("raycast step", Some(&cast_pl), &cast_module, "step");
         let run_loop =
@@ -239,6 +324,7 @@ impl Pipelines {
             peel_frame_layout,
             first,
             peel,
+            more,
             init,
             step,
             run_loop,
@@ -379,7 +465,7 @@ impl Target {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: DEPTH_FORMAT,
+                format: depth_format(gpu).0,
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
                 view_formats: &[],
             },
@@ -446,8 +532,10 @@ impl Target {
         let occlusion = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("raycast peel occlusion"),
             ty: wgpu::QueryType::Occlusion,
-            count: layer_slots,
+            count: 2 * layer_slots,
         });
+        // Per layer l: queries 2l (the layer's samples) and 2l + 1 (pixels with more candidates,
+        // `Pipelines::more`), resolved together at l × the alignment.
         let occlusion_resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("raycast occlusion resolve"),
             size: layer_slots as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
