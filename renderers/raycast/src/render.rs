@@ -18,6 +18,9 @@ use crate::step::{LayerEntry, RayFrame};
 use crate::{COUNT_EVERY, ET_OPACITY, PEEL_BIAS, TABLE_LENGTH, TABLE_SCALAR};
 use render_core::texel_texture::TexelTexture;
 
+mod peel;
+use peel::{peel, Peeled};
+
 const FLAG_ET: u32 = 1;
 const FLAG_TABLE3D: u32 = 2;
 const FLAG_COUNT_DROPPED: u32 = 4;
@@ -579,100 +582,11 @@ fn frame(
     gpu.queue
         .write_buffer(&st.frame_params, 0, bytemuck::bytes_of(&params));
 
-    // Phases 1–2: peel until a layer is empty (occlusion query) or the maximum is reached; then
-    // one more layer into the spare slot, only to count the re-entries that are dropped. With a
-    // stencil, a layer after which no pixel had a second candidate ends the peel without the
-    // empty pass that would show it (`Pipelines::more`): the same layers, one draw fewer.
-    let mut layers_used = 0u32;
-    let mut peel_draws = 0u32;
-    let mut dropped_check = false;
-    let t_peel = Instant::now();
-    for l in 0..slots {
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        if l == 0 {
-            st.timer.begin(&mut enc);
-        }
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("raycast peel"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &t.layer_views[l as usize],
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: u32::MAX as f64,
-                            g: u32::MAX as f64,
-                            b: u32::MAX as f64,
-                            a: u32::MAX as f64,
-                        }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &t.depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: st.pipes.more.as_ref().map(|_| wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: Some(&t.occlusion),
-                multiview_mask: None,
-            });
-            if l == 0 {
-                pass.set_pipeline(&st.pipes.first);
-            } else {
-                pass.set_pipeline(&st.pipes.peel);
-                pass.set_bind_group(1, &t.peel_binds[l as usize - 1], &[]);
-            }
-            pass.set_bind_group(0, &st.mesh_bind, &[]);
-            pass.set_bind_group(2, &st.peel_frame_bind, &[]);
-            pass.set_vertex_buffer(0, st.faces.slice(..));
-            pass.begin_occlusion_query(2 * l);
-            pass.draw(0..st.face_vertices, 0..1);
-            pass.end_occlusion_query();
-            if let Some(more) = &st.pipes.more {
-                pass.set_pipeline(more);
-                pass.set_stencil_reference(1);
-                pass.begin_occlusion_query(2 * l + 1);
-                pass.draw(0..3, 0..1);
-                pass.end_occlusion_query();
-            }
-        }
-        let queries = if st.pipes.more.is_some() { 2 } else { 1 };
-        enc.resolve_query_set(
-            &t.occlusion,
-            2 * l..2 * l + queries,
-            &t.occlusion_resolve,
-            l as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
-        );
-        clock.submit(gpu, [enc.finish()]);
-        peel_draws += 1;
-        let q = clock.read_buffer(
-            gpu,
-            &t.occlusion_resolve,
-            l as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
-            8 * queries as u64,
-        )?;
-        let count = |i: usize| u64::from_le_bytes(q[8 * i..8 * i + 8].try_into().expect("8 bytes"));
-        if count(0) == 0 {
-            break;
-        }
-        if l == s.max_layers {
-            dropped_check = true;
-            break;
-        }
-        layers_used += 1;
-        if queries == 2 && count(1) == 0 {
-            break;
-        }
-    }
-    clock.stage("peel", t_peel);
+    let Peeled {
+        layers: layers_used,
+        draws: peel_draws,
+        dropped_check,
+    } = peel(gpu, st, t, s, slots, &mut clock)?;
 
     // Rays start at their first entry; active rays are counted per tile.
     params.counts[1] = layers_used;
