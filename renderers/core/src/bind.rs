@@ -251,6 +251,11 @@ pub fn texture_with_data(
     Ok(texture)
 }
 
+/// WGSL of `fullscreen_vs`: one triangle over the whole viewport from `draw(0..3, 0..1)`,
+/// without a vertex buffer. Included by the shaders of per-pixel passes (the splatter's
+/// composite, the ray caster's count of peeling candidates).
+pub const FULLSCREEN_WGSL: &str = include_str!("fullscreen.wgsl");
+
 /// Begins a render pass into one colour attachment, cleared to transparent black first when
 /// `clear`, kept (`store`) or thrown away after the pass (a dummy attachment of passes that
 /// write storage only), with optional timestamps.

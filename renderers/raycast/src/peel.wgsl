@@ -59,15 +59,9 @@ fn fs_peel(in: VOut) -> FOut {
     return out;
 }
 
-// `Pipelines::more`: a triangle over the whole screen, tested against the stencil only (the
-// peeling pass's count of candidates per pixel) under an occlusion query; it writes nothing.
-@vertex
-fn vs_screen(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((vi << 1u) & 2u) * 2.0 - 1.0;
-    let y = f32(vi & 2u) * 2.0 - 1.0;
-    return vec4<f32>(x, y, 0.5, 1.0);
-}
-
+// `Pipelines::more`: render_core's `fullscreen_vs` (bind::FULLSCREEN_WGSL, appended), tested
+// against the stencil only (the peeling pass's count of candidates per pixel) under an
+// occlusion query; it writes nothing.
 @fragment
 fn fs_nothing() -> @location(0) vec4<u32> {
     return vec4<u32>(0u);

@@ -190,7 +190,11 @@ impl Pipelines {
             include_str!("common.wgsl"),
             mesh_wgsl(textures, layers_per_texture)
         );
-        let peel_src = format!("{common}\n{}", include_str!("peel.wgsl"));
+        let peel_src = format!(
+            "{common}\n{}\n{}",
+            include_str!("peel.wgsl"),
+            render_core::bind::FULLSCREEN_WGSL
+        );
         let cast_src = format!(
             "{common}\n{}\n{}",
             render_core::table_texture::TABLE_WGSL,
@@ -279,7 +283,7 @@ impl Pipelines {
                 layout: Some(&layout("raycast more candidates", &[])),
                 vertex: wgpu::VertexState {
                     module: &peel_module,
-                    entry_point: Some("vs_screen"),
+                    entry_point: Some("fullscreen_vs"),
                     compilation_options: Default::default(),
                     buffers: &[],
                 },

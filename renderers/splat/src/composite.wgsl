@@ -14,12 +14,7 @@ const SHEET_UNIT: f32 = 1.0 / 16777216.0;
 @group(0) @binding(2) var<storage, read> tf: array<vec4<f32>>;
 @group(1) @binding(0) var<storage, read> slab: Slab;
 
-@vertex
-fn fullscreen_vs(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((vi << 1u) & 2u) * 2.0 - 1.0;
-    let y = f32(vi & 2u) * 2.0 - 1.0;
-    return vec4<f32>(x, y, 0.5, 1.0);
-}
+// The vertex stage is render_core's `fullscreen_vs` (bind::FULLSCREEN_WGSL, appended).
 
 @fragment
 fn composite_fs(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {

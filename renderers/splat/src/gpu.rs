@@ -211,7 +211,11 @@ impl Pipelines {
         );
         let composite_module = gpu.shader(
             "splat composite.wgsl",
-            &with_frame(include_str!("composite.wgsl")),
+            &format!(
+                "{}\n{}",
+                with_frame(include_str!("composite.wgsl")),
+                render_core::bind::FULLSCREEN_WGSL
+            ),
         );
         // Front-to-back "under": C += (1 − A_dst) · C_src, premultiplied.
         let under = wgpu::BlendComponent {
