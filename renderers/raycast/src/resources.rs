@@ -98,9 +98,13 @@ pub fn depth_format(gpu: &Gpu) -> (wgpu::TextureFormat, bool) {
 }
 
 /// Every fragment a peeling pass does not discard (the candidates for its layer) adds 1 to its
-/// pixel's stencil, whether or not it is the nearest.
+/// pixel's stencil, whether or not it is the nearest. The test is 0 ≤ stencil (reference 0),
+/// true everywhere like `Always`, but a test that reads the reference makes wgpu set it: Vulkan
+/// requires the dynamic reference of a stencil-testing pipeline to be set before it draws,
+/// and wgpu sets it only for a test or op that uses it (the validation layer reported
+/// VUID-vkCmdDraw-commandBuffer-02701 under `Always`).
 const COUNT_CANDIDATES: wgpu::StencilFaceState = wgpu::StencilFaceState {
-    compare: wgpu::CompareFunction::Always,
+    compare: wgpu::CompareFunction::LessEqual,
     fail_op: wgpu::StencilOperation::Keep,
     depth_fail_op: wgpu::StencilOperation::IncrementClamp,
     pass_op: wgpu::StencilOperation::IncrementClamp,

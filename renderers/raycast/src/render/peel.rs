@@ -111,6 +111,8 @@ fn encode_layer(enc: &mut wgpu::CommandEncoder, st: &State, t: &Target, l: u32) 
         pass.set_bind_group(0, &st.mesh_bind, &[]);
         pass.set_bind_group(2, &st.peel_frame_bind, &[]);
         pass.set_vertex_buffer(0, st.faces.slice(..));
+        // The candidates' count tests 0 ≤ stencil (`COUNT_CANDIDATES`).
+        pass.set_stencil_reference(0);
         pass.begin_occlusion_query(2 * l);
         pass.draw(0..st.face_vertices, 0..1);
         pass.end_occlusion_query();
