@@ -203,9 +203,6 @@ pub struct FragmentPt {
     state: Option<State>,
     /// Storage binding size to split at instead of the adapter's (tests of the split path).
     max_binding: Option<u64>,
-    /// Interpolate the tables' texels by hand even where the adapter filters f32 textures
-    /// (tests of the path for adapters that cannot).
-    unfiltered_tables: bool,
 }
 
 impl FragmentPt {
@@ -214,15 +211,7 @@ impl FragmentPt {
             settings,
             state: None,
             max_binding: None,
-            unfiltered_tables: false,
         }
-    }
-
-    /// Looks the tables up with texel loads interpolated in the shader, as on an adapter
-    /// without `FLOAT32_FILTERABLE`. Only useful to test that path.
-    pub fn with_unfiltered_tables(mut self) -> FragmentPt {
-        self.unfiltered_tables = true;
-        self
     }
 
     /// Splits the vertex, tet and record arrays at `bytes` per storage binding (rounded down
@@ -420,35 +409,16 @@ impl Renderer for FragmentPt {
             bytemuck::cast_slice(&packed_table()),
             storage_use,
         )?;
-        // The tables as 2D textures (1D ones one row high) sampled with linear filtering, one
-        // sample a lookup, as the paper's textures were (§3.4); where the adapter cannot filter
-        // f32 textures the shader interpolates texel loads by hand (`TABLES_FILTERED`).
-        let filtered =
-            render_core::table_texture::TableTexture::filterable_on(gpu) && !self.unfiltered_tables;
-        let table_view = |ledger: &mut MemoryLedger,
-                          label: &str,
-                          format: wgpu::TextureFormat,
-                          (width, height): (u32, u32),
-                          data: &[u8]| {
-            render_core::bind::texture_with_data(
-                gpu,
-                ledger,
-                label,
-                wgpu::TextureDimension::D2,
-                format,
-                [width, height, 1],
-                data,
-            )
-            .map(|t| t.create_view(&Default::default()))
-        };
-        let tf = table_view(
+        let tf = render_core::bind::lookup_texture(
+            gpu,
             &mut ledger,
             "fragment-pt transfer function",
             wgpu::TextureFormat::Rgba32Float,
             (TF_ENTRIES as u32, 1),
             bytemuck::cast_slice(&optics.tf.rgb_kappa_table(TF_ENTRIES)),
         )?;
-        let expt = table_view(
+        let expt = render_core::bind::lookup_texture(
+            gpu,
             &mut ledger,
             "fragment-pt exp table",
             wgpu::TextureFormat::R32Float,
@@ -463,7 +433,8 @@ impl Renderer for FragmentPt {
             // The average mode never reads ψ; bind a minimal texture.
             Shading::Average => (2, vec![0.0; 4]),
         };
-        let psi = table_view(
+        let psi = render_core::bind::lookup_texture(
+            gpu,
             &mut ledger,
             "fragment-pt psi table",
             wgpu::TextureFormat::R32Float,
@@ -559,10 +530,7 @@ impl Renderer for FragmentPt {
         });
         let m2 = gpu.shader(
             "fragment-pt pass 2",
-            &(decls(true)
-                + &format!("const TABLES_FILTERED: bool = {filtered};\n")
-                + render_core::table_texture::TABLE_WGSL
-                + include_str!("pass2.wgsl")),
+            &(decls(true) + include_str!("pass2.wgsl")),
         );
         let fs = match self.settings.shading {
             Shading::Average => "fs_average",
@@ -575,19 +543,9 @@ impl Renderer for FragmentPt {
         let mut layout_entries = vec![buffer_entry(0, vf, wgpu::BufferBindingType::Uniform)];
         layout_entries.push(buffer_entry(4, vf, ro));
         layout_entries.extend([
-            texture_entry(5, vf, filtered, wgpu::TextureViewDimension::D2),
-            texture_entry(6, vf, filtered, wgpu::TextureViewDimension::D2),
-            texture_entry(7, vf, filtered, wgpu::TextureViewDimension::D2),
-            wgpu::BindGroupLayoutEntry {
-                binding: 8,
-                visibility: vf,
-                ty: wgpu::BindingType::Sampler(if filtered {
-                    wgpu::SamplerBindingType::Filtering
-                } else {
-                    wgpu::SamplerBindingType::NonFiltering
-                }),
-                count: None,
-            },
+            texture_entry(5, vf, false, wgpu::TextureViewDimension::D1),
+            texture_entry(6, vf, false, wgpu::TextureViewDimension::D1),
+            texture_entry(7, vf, false, wgpu::TextureViewDimension::D2),
         ]);
         layout_entries.extend((0..mesh_bindings).map(|i| buffer_entry(MESH_BINDING + i, vf, ro)));
         let pass2_layout = gpu
@@ -609,17 +567,6 @@ impl Renderer for FragmentPt {
             Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
             wgpu::ColorWrites::ALL,
         );
-        let filter = if filtered {
-            wgpu::FilterMode::Linear
-        } else {
-            wgpu::FilterMode::Nearest
-        };
-        let table_sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("fragment-pt tables"),
-            mag_filter: filter,
-            min_filter: filter,
-            ..Default::default()
-        });
         let pass2_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("fragment-pt pass 2"),
             layout: &pass2_layout,
@@ -630,10 +577,6 @@ impl Renderer for FragmentPt {
                     view_entry(5, &tf),
                     view_entry(6, &expt),
                     view_entry(7, &psi),
-                    wgpu::BindGroupEntry {
-                        binding: 8,
-                        resource: wgpu::BindingResource::Sampler(&table_sampler),
-                    },
                 ],
                 mesh_entries(),
             ]

@@ -31,17 +31,15 @@ struct TetOut {
 // vertices_at, tets_at, records_at: declared by the Rust (render_core::ChunkedBuffer) at
 // bindings 10.., split over as many storage bindings as the mesh needs.
 @group(0) @binding(4) var<storage, read> order: array<u32>;
-// The tables are textures, each lookup one sample with linear filtering (`table_sampler`;
-// `table_coord` from render_core::table_texture::TABLE_WGSL puts entry i at i / (n − 1)), or,
-// where the adapter cannot filter f32 textures (TABLES_FILTERED false, prepended by the Rust),
-// texel loads interpolated here. The 1D tables are 2D textures one row high.
+// The tables are textures read with textureLoad and interpolated here: a CPU backend gathers a
+// texel fetch across lanes, where it loads storage with per-fragment addresses lane by lane
+// (render_core::bind::lookup_texture).
 // Transfer function sampled at n points: rgb chromaticity, a = κ per length unit.
-@group(0) @binding(5) var tf: texture_2d<f32>;
+@group(0) @binding(5) var tf: texture_1d<f32>;
 // e^(−x) for x in [0, misc.z], n points (Shirley–Tuchman's exponential table).
-@group(0) @binding(6) var exp_table: texture_2d<f32>;
+@group(0) @binding(6) var exp_table: texture_1d<f32>;
 // ψ(γ_f, γ_b), side n, γ_b as the row (see render_core::preintegration).
 @group(0) @binding(7) var psi_table: texture_2d<f32>;
-@group(0) @binding(8) var table_sampler: sampler;
 
 struct VsOut {
     @builtin(position) pos: vec4<f32>,
@@ -82,30 +80,22 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
 // Linear interpolation in the transfer-function table (entry i ↔ s = i / (n − 1)).
 fn tf_at(s: f32) -> vec4<f32> {
     let n = params.sizes.x;
-    if TABLES_FILTERED {
-        return textureSampleLevel(tf, table_sampler, vec2<f32>(table_coord(s, f32(n)), 0.5), 0.0);
-    }
     let x = clamp(s, 0.0, 1.0) * f32(n - 1u);
     let i = min(u32(floor(x)), n - 2u);
     let f = x - f32(i);
-    return mix(textureLoad(tf, vec2<u32>(i, 0u), 0), textureLoad(tf, vec2<u32>(i + 1u, 0u), 0), f);
+    return mix(textureLoad(tf, i, 0), textureLoad(tf, i + 1u, 0), f);
 }
 
 // e^(−x) from the exponential table, linear interpolation; 0 beyond its range.
 fn exp_neg(x: f32) -> f32 {
     let n = params.sizes.y;
-    let t = max(x, 0.0) / params.misc.z;
-    if TABLES_FILTERED {
-        let e = textureSampleLevel(exp_table, table_sampler, vec2<f32>(table_coord(t, f32(n)), 0.5), 0.0).x;
-        return select(e, 0.0, t >= 1.0);
-    }
-    let u = t * f32(n - 1u);
+    let u = max(x, 0.0) / params.misc.z * f32(n - 1u);
     if (u >= f32(n - 1u)) {
         return 0.0;
     }
     let i = u32(floor(u));
     let f = u - f32(i);
-    return mix(textureLoad(exp_table, vec2<u32>(i, 0u), 0).x, textureLoad(exp_table, vec2<u32>(i + 1u, 0u), 0).x, f);
+    return mix(textureLoad(exp_table, i, 0).x, textureLoad(exp_table, i + 1u, 0).x, f);
 }
 
 fn psi_at_texel(i: u32, j: u32) -> f32 {
@@ -115,10 +105,6 @@ fn psi_at_texel(i: u32, j: u32) -> f32 {
 // Bilinear ψ lookup (entry i ↔ γ = i / (n − 1)).
 fn psi_at(gf: f32, gb: f32) -> f32 {
     let n = params.sizes.z;
-    if TABLES_FILTERED {
-        let c = vec2<f32>(table_coord(gf, f32(n)), table_coord(gb, f32(n)));
-        return textureSampleLevel(psi_table, table_sampler, c, 0.0).x;
-    }
     let x = clamp(gf, 0.0, 1.0) * f32(n - 1u);
     let y = clamp(gb, 0.0, 1.0) * f32(n - 1u);
     let i = min(u32(floor(x)), n - 2u);
