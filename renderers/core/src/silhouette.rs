@@ -142,17 +142,37 @@ pub fn hull_pixels(q: &[[f64; 2]; 4], w: f64, h: f64) -> u64 {
 /// and its own f32 projection, which this count does not reproduce, so it is left out.
 pub const EDGE_MARGIN_PX: f64 = 1e-3;
 
+/// A fan triangle whose area is at most this times the square of its projection's larger
+/// extent is not counted in [`covering_triangles`]: a renderer may classify the projection with
+/// a tolerance and not draw it (the zero-area tests of the classifications here drop a face
+/// of area up to 1e-5 of that square, or test signs exactly). Ten times the largest such
+/// tolerance, so the count stays a lower bound.
+pub const DEGENERATE_AREA_REL: f64 = 1e-4;
+
 /// The triangles a projected tet is drawn as (Shirley and Tuchman's decomposition, which
 /// GATOR's basis graph and fragment PT's fans both draw) that hold a pixel centre at least
 /// [`EDGE_MARGIN_PX`] inside: a fan from the "thick" point over the edges of the projection's
 /// hull, the thick point being the vertex inside the other three's triangle (3 triangles) or
 /// else the crossing of the quadrilateral's diagonals (4 triangles). Centres near an edge are
 /// not counted, so the count never exceeds the triangles that yield fragments; a degenerate
-/// projection (a vertex on an edge, three in a line) counts the fan's non-degenerate part.
+/// projection (a vertex on an edge, three in a line) counts the fan's non-degenerate part, and
+/// triangles thinner than [`DEGENERATE_AREA_REL`] are left out.
 pub fn covering_triangles(q: &[[f64; 2]; 4], w: f64, h: f64) -> u64 {
+    let extent = |k: usize| {
+        let (lo, hi) = q
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p[k]), hi.max(p[k]))
+            });
+        hi - lo
+    };
+    let min_area = DEGENERATE_AREA_REL * extent(0).max(extent(1)).powi(2);
     let fan = |thick: [f64; 2], ring: &[[f64; 2]]| -> u64 {
         (0..ring.len())
-            .filter(|&i| has_inner_centre(thick, ring[i], ring[(i + 1) % ring.len()], w, h))
+            .filter(|&i| {
+                let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+                0.5 * cross(thick, a, b).abs() > min_area && has_inner_centre(thick, a, b, w, h)
+            })
             .count() as u64
     };
     for i in 0..4 {
@@ -322,6 +342,13 @@ mod tests {
         // Flat: nothing.
         let flat = [[1.0, 2.0], [5.0, 2.0], [3.0, 2.0], [4.0, 2.0]];
         assert_eq!(covering_triangles(&flat, 16.0, 16.0), 0);
+        // The inner vertex 0.003 pixel above the hull's lower edge: the sliver between them
+        // holds the centre (8.5, 0.5) 0.0013 pixel inside, but its area is 9.4e-5 of the
+        // extent's square, a face a renderer's zero test may drop: only the other two count.
+        let sliver = [[0.0, 0.4985], [16.0, 0.4985], [8.0, 16.0], [8.0, 0.5015]];
+        assert_eq!(covering_triangles(&sliver, 32.0, 32.0), 2);
+        let (v, a, b) = (sliver[3], sliver[0], sliver[1]);
+        assert!(has_inner_centre(v, a, b, 32.0, 32.0));
     }
 
     /// On random small tets, never more covering triangles than the fan has, nor than the
