@@ -53,7 +53,6 @@ fn slowed(c: &Calibration, factor: f64) -> Calibration {
         tet_classifications_per_sec: c.tet_classifications_per_sec / factor,
         raster_seconds_per_triangle: c.raster_seconds_per_triangle * factor,
         raster_seconds_per_fragment: c.raster_seconds_per_fragment * factor,
-        raster_seconds_one_fragment_triangle: c.raster_seconds_one_fragment_triangle * factor,
         ..c.clone()
     }
 }

@@ -1,13 +1,12 @@
 //! `tetbench calibrate`: a short, fixed micro-benchmark of the backend, and the roofline every
 //! row gets from it.
 //!
-//! Ten figures, each from one kernel that stresses one resource (`calibrate.wgsl`):
+//! Nine figures, each from one kernel that stresses one resource (`calibrate.wgsl`):
 //! small-triangle setup rate (triangles covering one pixel each), fill rate (a viewport-sized
 //! triangle blended additively into the target format the algorithms use), rasterisation of
 //! triangles that cover pixels (two sizes, fitted as a cost per triangle plus a cost per
 //! fragment: small triangles cost far more per fragment than one viewport-sized triangle, and a
-//! projected cell's are small; and triangles of one fragment, which cap the fit's per-triangle
-//! cost where it would overprice them), compute throughput
+//! projected cell's are small), compute throughput
 //! (vec4 FMA chains), storage-copy bandwidth (a compute copy between two storage buffers), the
 //! CPU radix sort of `render_core::sort` (HAVS §5.1) in keys/s, and the work-specific ones of
 //! `work.rs`: ray steps (a walk through 144-byte cells), splat fragments (a compute pass's
@@ -19,7 +18,7 @@
 //! pays for it once (a few seconds on lavapipe).
 //!
 //! The roofline ([`annotate`]) reads work counters, never names: each [`Resource`] lists the
-//! counters that measure a row's work on it (`triangles`, `fragments`, `covering_triangles`,
+//! counters that measure a row's work on it (`triangles`, `fragments`, `covering_tets`,
 //! `splat_fragments`, `ray_steps`, `cpu_sort_keys`, `gpu_sort_keys`) with the calibrated cost
 //! of one unit of each; a row's time on a resource is the sum of its counters times their
 //! costs, plus per-frame GPU bytes (scratch, k-buffers, targets: each written at least once a
@@ -55,7 +54,7 @@ fn calibrate_source() -> String {
 }
 
 /// Bumped whenever a kernel or its size changes (old cache files are then re-measured).
-pub const CALIBRATION_VERSION: u32 = 9;
+pub const CALIBRATION_VERSION: u32 = 8;
 
 const GRID: u64 = 256; // calibrate.wgsl GRID
 const TRIANGLES: u64 = GRID * GRID * 2;
@@ -65,8 +64,6 @@ const RASTER_SIZE: u32 = 512; // calibrate.wgsl RASTER_SIZE
 const RASTER_TRIANGLES: u64 = 1 << 17;
 /// The two leg lengths (pixels) of the rasterisation benchmark's right triangles.
 const RASTER_LEGS: [u32; 2] = [4, 16];
-/// The leg of the benchmark's one-fragment triangles (the centre of their cell's first pixel).
-const ONE_FRAGMENT_LEG: u32 = 1;
 const FMA_ITERS: u64 = 256; // calibrate.wgsl FMA_ITERS
 const FMA_INVOCATIONS: u64 = 64 * 1024;
 const COPY_BYTES: u64 = 32 << 20;
@@ -141,7 +138,7 @@ pub fn cached_or_measure(
 pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> {
     let started = Instant::now();
     // One step per benchmark (the rasterisation's two legs are two).
-    let mut progress = Progress::new("tetbench calibrate", 12, "benchmarks");
+    let mut progress = Progress::new("tetbench calibrate", 11, "benchmarks");
     progress.activity("triangle setup");
     let module = gpu.shader("calibrate", &calibrate_source());
     let empty = gpu
@@ -242,14 +239,6 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
     }
     let (raster_seconds_per_triangle, raster_seconds_per_fragment) =
         raster_costs(raster_points[0], raster_points[1]);
-    // 2c. Triangles of one fragment each, the smallest a covering triangle can be.
-    let leg = ONE_FRAGMENT_LEG;
-    let s = best_seconds(|| {
-        let vertices = (RASTER_TRIANGLES * 3) as u32;
-        draw(&raster, &raster_view, vertices, leg..leg + 1)
-    })?;
-    let raster_seconds_one_fragment_triangle = s / RASTER_TRIANGLES as f64;
-    progress.step("rasterisation, one fragment");
 
     // 3. Compute throughput.
     let storage = |label: &str, bytes: u64| {
@@ -381,7 +370,6 @@ pub fn measure(gpu: &Gpu, machine: &MachineInfo) -> anyhow::Result<Calibration> 
         tet_classifications_per_sec,
         raster_seconds_per_triangle,
         raster_seconds_per_fragment,
-        raster_seconds_one_fragment_triangle,
     })
 }
 
@@ -460,20 +448,6 @@ fn per(rate: f64) -> f64 {
     }
 }
 
-/// The least a triangle that yields fragments costs beside its fragments: the fit's
-/// per-triangle figure, or less where a one-fragment triangle costs less than the fit says
-/// (its time less one fragment), so that a triangle of any size between one fragment and the
-/// fit's largest is priced at most at its measured cost.
-pub fn covering_triangle_seconds(c: &Calibration) -> f64 {
-    let fit = c.raster_seconds_per_triangle;
-    if c.raster_seconds_one_fragment_triangle > 0.0 {
-        fit.min(c.raster_seconds_one_fragment_triangle - c.raster_seconds_per_fragment)
-            .max(0.0)
-    } else {
-        fit
-    }
-}
-
 /// Every counter-priced resource. A renderer opts in by reporting the counter; nothing here
 /// knows which renderer reports what.
 pub const RESOURCES: [Resource; 8] = [
@@ -486,10 +460,10 @@ pub const RESOURCES: [Resource; 8] = [
         costs: &[("fragments", |c| per(c.fill_fragments_per_sec))],
     },
     // Every triangle costs at least its setup (the sub-pixel figure); one that yields fragments
-    // costs [`covering_triangle_seconds`], and each fragment the fit's per-fragment figure.
-    // `covering_triangles` (triangles holding a pixel centre well inside them) never exceeds
-    // the triangles that yield fragments. Rows without it (and calibrations without the fit)
-    // price no triangle above its setup.
+    // costs the fit's per-triangle figure, and each fragment the fit's per-fragment one.
+    // `covering_tets` (tets whose projection holds a pixel centre) is a lower bound of the
+    // triangles that yield fragments: each such tet draws at least one. Rows without it (and
+    // calibrations without the fit) price no triangle above its setup.
     Resource {
         name: "rasterisation",
         costs: &[
@@ -500,8 +474,8 @@ pub const RESOURCES: [Resource; 8] = [
                     0.0
                 }
             }),
-            ("covering_triangles", |c| {
-                (covering_triangle_seconds(c) - per(c.triangles_per_sec)).max(0.0)
+            ("covering_tets", |c| {
+                (c.raster_seconds_per_triangle - per(c.triangles_per_sec)).max(0.0)
             }),
             ("fragments", |c| c.raster_seconds_per_fragment),
         ],
@@ -646,8 +620,6 @@ mod tests {
             tet_classifications_per_sec: 1e7,
             raster_seconds_per_triangle: 1.5e-6,
             raster_seconds_per_fragment: 0.8e-8,
-            // Above the fit's 1.5 µs + 8 ns: no cap.
-            raster_seconds_one_fragment_triangle: 2e-6,
         }
     }
 
@@ -762,7 +734,7 @@ mod tests {
             assert_close(rows[0].roofline_ms.unwrap(), ms, counters);
             assert_close(rows[0].limit_fraction.unwrap(), ms / 400.0, counters);
         }
-        // With it, triangles and fragments add up on the rasteriser, and covering triangles cost
+        // With it, triangles and fragments add up on the rasteriser, and covering tets cost
         // the fit's per-triangle figure above the setup (1.5 − 1 µs here).
         for (counters, bound, ms) in [
             // 150 ms of setup + 160 ms of fragments, against 150 and 200 alone.
@@ -771,17 +743,11 @@ mod tests {
                 "rasterisation",
                 310.0,
             ),
-            // + 100,000 covering triangles × 0.5 µs.
-            (
-                "triangles=150000;covering_triangles=100000;fragments=20000000",
-                "rasterisation",
-                360.0,
-            ),
-            // Covering tets are not priced (their triangles are).
+            // + 100,000 covering tets × 0.5 µs.
             (
                 "triangles=150000;covering_tets=100000;fragments=20000000",
                 "rasterisation",
-                310.0,
+                360.0,
             ),
             (
                 "triangles=1000;fragments=1000;ray_steps=200000",
@@ -794,37 +760,6 @@ mod tests {
             assert_eq!(rows[0].bound_by, bound, "{counters}");
             assert_close(rows[0].roofline_ms.unwrap(), ms, counters);
         }
-    }
-
-    /// A one-fragment triangle measured faster than the fit's per-triangle cost plus one
-    /// fragment caps what a covering triangle is priced at; one measured slower does not raise
-    /// it, and a calibration without it keeps the fit's figure.
-    #[test]
-    fn a_one_fragment_triangle_caps_the_covering_cost() {
-        let counters = "triangles=150000;covering_triangles=100000;fragments=20000000";
-        let priced = |one: f64| {
-            let c = Calibration {
-                raster_seconds_one_fragment_triangle: one,
-                ..cal()
-            };
-            let mut rows = vec![row(counters, 400.0)];
-            annotate(&mut rows, &c);
-            (covering_triangle_seconds(&c), rows[0].roofline_ms.unwrap())
-        };
-        // 1.208 µs less 8 ns: 1.2 µs, 0.2 µs above the setup, 20 ms for 100,000.
-        let (cost, ms) = priced(1.208e-6);
-        assert_close(cost, 1.2e-6, "capped");
-        assert_close(ms, 330.0, "capped roofline");
-        // Not measured, or slower than the fit: the fit's 1.5 µs.
-        for one in [0.0, 2e-6] {
-            let (cost, ms) = priced(one);
-            assert_close(cost, 1.5e-6, "fit");
-            assert_close(ms, 360.0, "fit roofline");
-        }
-        // Below its one fragment's cost: never negative, the setup only.
-        let (cost, ms) = priced(4e-9);
-        assert_eq!(cost, 0.0);
-        assert_close(ms, 310.0, "setup only");
     }
 
     /// Without work counters only the memory term remains; a resource the calibration did not
@@ -898,7 +833,6 @@ mod tests {
             tet_classifications_per_sec: 0.0,
             raster_seconds_per_triangle: 1e-6,
             raster_seconds_per_fragment: 0.0,
-            raster_seconds_one_fragment_triangle: 3e-6,
             date_utc: "later".into(),
             ..cal()
         };
@@ -908,7 +842,6 @@ mod tests {
         assert_eq!(p.tet_classifications_per_sec, 1e7);
         assert_eq!(p.raster_seconds_per_triangle, 1e-6);
         assert_eq!(p.raster_seconds_per_fragment, 0.8e-8);
-        assert_eq!(p.raster_seconds_one_fragment_triangle, 2e-6);
         assert_eq!(p.date_utc, "later");
         assert_eq!(a.peak_with(&a), a);
     }
@@ -942,7 +875,7 @@ mod tests {
         let module = gpu.shader("calibrate", &calibrate_source());
         let format = wgpu::TextureFormat::Rgba32Float;
         let pipeline = additive_pipeline(&gpu, &module, "raster test", "raster_vs", format);
-        for leg in RASTER_LEGS.into_iter().chain([ONE_FRAGMENT_LEG]) {
+        for leg in RASTER_LEGS {
             let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: None,
                 size: wgpu::Extent3d {

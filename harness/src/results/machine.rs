@@ -217,10 +217,6 @@ pub struct Calibration {
     /// The fit's seconds per fragment (see `raster_seconds_per_triangle`).
     #[serde(default)]
     pub raster_seconds_per_fragment: f64,
-    /// Seconds per triangle of one fragment (inside one pixel, holding its centre), blended as
-    /// the fit's triangles. 0 in calibrations made before it.
-    #[serde(default)]
-    pub raster_seconds_one_fragment_triangle: f64,
 }
 
 impl Calibration {
@@ -258,10 +254,6 @@ impl Calibration {
                 self.raster_seconds_per_fragment,
                 other.raster_seconds_per_fragment,
             ),
-            raster_seconds_one_fragment_triangle: cost(
-                self.raster_seconds_one_fragment_triangle,
-                other.raster_seconds_one_fragment_triangle,
-            ),
             ..self.clone()
         }
     }
@@ -280,7 +272,6 @@ impl Calibration {
              splat fill        {:.1} M fragments/s (compute footprint lookup, best of 4-32 px)\n\
              classification    {:.1} M tets/s (projection, orientation tests, diagonals)\n\
              rasterisation     {:.0} ns/triangle + {:.2} ns/fragment (covering triangles, blended)\n\
-             one-fragment tri  {:.0} ns/triangle (blended)\n\
              measured in {:.1} s on {}",
             self.adapter,
             self.driver,
@@ -298,7 +289,6 @@ impl Calibration {
             self.tet_classifications_per_sec * 1e-6,
             self.raster_seconds_per_triangle * 1e9,
             self.raster_seconds_per_fragment * 1e9,
-            self.raster_seconds_one_fragment_triangle * 1e9,
             self.seconds,
             self.date_utc
         )

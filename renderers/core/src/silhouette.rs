@@ -22,9 +22,6 @@ pub struct ProjectedWork {
     /// that yields fragments, which costs the rasteriser more than a triangle that yields none
     /// (the roofline's `rasterisation` resource prices them apart; `covering_tets`).
     pub covering_tets: u64,
-    /// Triangles of the tets' projections that hold a pixel centre well inside them (see
-    /// [`covering_triangles`]): the triangles that must yield fragments, whatever the tie rule.
-    pub covering_triangles: u64,
 }
 
 /// Pixel centres inside the projections of every tet of `mesh` (tets with a vertex at or
@@ -57,24 +54,18 @@ pub fn projected_work(camera: &Camera, mesh: &datasets::TetMesh) -> ProjectedWor
             for (k, &v) in t.iter().enumerate() {
                 match screen[v as usize] {
                     Some(p) => q[k] = p,
-                    None => return ProjectedWork::default(),
+                    None => return 0,
                 }
             }
-            let n = hull_pixels(&q, w, h);
-            ProjectedWork {
-                fragments: n,
-                covering_tets: (n > 0) as u64,
-                covering_triangles: if n > 0 {
-                    covering_triangles(&q, w, h)
-                } else {
-                    0
-                },
-            }
+            hull_pixels(&q, w, h)
+        })
+        .map(|n| ProjectedWork {
+            fragments: n,
+            covering_tets: (n > 0) as u64,
         })
         .reduce(ProjectedWork::default, |a, b| ProjectedWork {
             fragments: a.fragments + b.fragments,
             covering_tets: a.covering_tets + b.covering_tets,
-            covering_triangles: a.covering_triangles + b.covering_triangles,
         })
 }
 
@@ -137,121 +128,6 @@ pub fn hull_pixels(q: &[[f64; 2]; 4], w: f64, h: f64) -> u64 {
     n
 }
 
-/// How far inside a triangle (in pixels) a centre must lie to count in [`covering_triangles`]:
-/// a centre on or next to an edge goes to one of the two triangles by the rasteriser's tie rule
-/// and its own f32 projection, which this count does not reproduce, so it is left out.
-pub const EDGE_MARGIN_PX: f64 = 1e-3;
-
-/// A fan triangle whose area is at most this times the square of its projection's larger
-/// extent is not counted in [`covering_triangles`]: a renderer may classify the projection with
-/// a tolerance and not draw it (the zero-area tests of the classifications here drop a face
-/// of area up to 1e-5 of that square, or test signs exactly). Ten times the largest such
-/// tolerance, so the count stays a lower bound.
-pub const DEGENERATE_AREA_REL: f64 = 1e-4;
-
-/// The triangles a projected tet is drawn as (Shirley and Tuchman's decomposition, which
-/// GATOR's basis graph and fragment PT's fans both draw) that hold a pixel centre at least
-/// [`EDGE_MARGIN_PX`] inside: a fan from the "thick" point over the edges of the projection's
-/// hull, the thick point being the vertex inside the other three's triangle (3 triangles) or
-/// else the crossing of the quadrilateral's diagonals (4 triangles). Centres near an edge are
-/// not counted, so the count never exceeds the triangles that yield fragments; a degenerate
-/// projection (a vertex on an edge, three in a line) counts the fan's non-degenerate part, and
-/// triangles thinner than [`DEGENERATE_AREA_REL`] are left out.
-pub fn covering_triangles(q: &[[f64; 2]; 4], w: f64, h: f64) -> u64 {
-    let extent = |k: usize| {
-        let (lo, hi) = q
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p[k]), hi.max(p[k]))
-            });
-        hi - lo
-    };
-    let min_area = DEGENERATE_AREA_REL * extent(0).max(extent(1)).powi(2);
-    let fan = |thick: [f64; 2], ring: &[[f64; 2]]| -> u64 {
-        (0..ring.len())
-            .filter(|&i| {
-                let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
-                0.5 * cross(thick, a, b).abs() > min_area && has_inner_centre(thick, a, b, w, h)
-            })
-            .count() as u64
-    };
-    for i in 0..4 {
-        let others: Vec<[f64; 2]> = (0..4).filter(|&k| k != i).map(|k| q[k]).collect();
-        if in_triangle(q[i], others[0], others[1], others[2]) {
-            return fan(q[i], &others);
-        }
-    }
-    // No vertex inside the others' triangle: a quadrilateral whose diagonals cross.
-    for (a, b, c, d) in [(0, 1, 2, 3), (0, 2, 1, 3), (0, 3, 1, 2)] {
-        if let Some(x) = crossing(q[a], q[b], q[c], q[d]) {
-            // Diagonals a–b and c–d: the hull is a, c, b, d in order.
-            return fan(x, &[q[a], q[c], q[b], q[d]]);
-        }
-    }
-    0
-}
-
-fn cross(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-}
-
-/// `p` inside the triangle or on its boundary (a triangle of any orientation).
-fn in_triangle(p: [f64; 2], a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> bool {
-    let (d1, d2, d3) = (cross(a, b, p), cross(b, c, p), cross(c, a, p));
-    let negative = d1 < 0.0 || d2 < 0.0 || d3 < 0.0;
-    let positive = d1 > 0.0 || d2 > 0.0 || d3 > 0.0;
-    !(negative && positive) && cross(a, b, c) != 0.0
-}
-
-/// Where segments a–b and c–d cross (each strictly between its ends), if they do.
-fn crossing(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> Option<[f64; 2]> {
-    let (c1, c2) = (cross(a, b, c), cross(a, b, d));
-    let (c3, c4) = (cross(c, d, a), cross(c, d, b));
-    if c1 * c2 < 0.0 && c3 * c4 < 0.0 {
-        let t = c3 / (c3 - c4);
-        Some([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])])
-    } else {
-        None
-    }
-}
-
-/// Whether a pixel centre (k + ½, j + ½) of the `w`×`h` viewport lies at least
-/// [`EDGE_MARGIN_PX`] inside triangle a, b, c: per row of centres, the x-interval each edge's
-/// half-plane leaves.
-fn has_inner_centre(a: [f64; 2], b: [f64; 2], c: [f64; 2], w: f64, h: f64) -> bool {
-    let (a, b, c) = match cross(a, b, c) {
-        s if s > 0.0 => (a, b, c),
-        s if s < 0.0 => (a, c, b),
-        _ => return false,
-    };
-    let edges = [(a, b), (b, c), (c, a)];
-    let ymin = a[1].min(b[1]).min(c[1]);
-    let ymax = a[1].max(b[1]).max(c[1]);
-    let first_row = (ymin - 0.5).ceil().clamp(0.0, h) as u32;
-    let end_row = (ymax - 0.5).ceil().clamp(0.0, h) as u32;
-    (first_row..end_row).any(|j| {
-        let y = j as f64 + 0.5;
-        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
-        for (p, r) in edges {
-            let (dx, dy) = (r[0] - p[0], r[1] - p[1]);
-            // Inside: dx·(y − p.y) − dy·(x − p.x) > margin·|d|, a bound on x unless dy = 0.
-            let rest = EDGE_MARGIN_PX * dx.hypot(dy) - dx * (y - p[1]);
-            if dy == 0.0 {
-                if rest >= 0.0 {
-                    return false;
-                }
-            } else if dy < 0.0 {
-                lo = lo.max(p[0] + rest / -dy);
-            } else {
-                hi = hi.min(p[0] - rest / dy);
-            }
-        }
-        // The first centre right of lo, if it is left of hi and inside the viewport.
-        let k = ((lo - 0.5).floor() + 1.0).max(0.0);
-        k < w && k + 0.5 < hi
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -310,68 +186,5 @@ mod tests {
         let both = one(vec![[0, 1, 2, 3], [4, 5, 6, 7]]);
         assert_eq!(both.covering_tets, 1, "{both:?}");
         assert!(both.fragments <= big.fragments + 1, "{both:?}");
-    }
-
-    /// The fan's triangles that hold a centre: all of a large projection's, the one of three
-    /// that holds a lone centre, and none where the only centre is on the fan's edges.
-    #[test]
-    fn covering_triangles_count_the_fan_triangles_with_centres() {
-        // A triangle with its fourth vertex inside: a fan of three, each holding centres.
-        let tri = [[0.0, 0.0], [16.0, 0.0], [0.0, 16.0], [4.0, 4.0]];
-        assert_eq!(covering_triangles(&tri, 32.0, 32.0), 3);
-        // The same with the inner vertex listed first: the same fan.
-        let tri_first = [[4.0, 4.0], [0.0, 0.0], [16.0, 0.0], [0.0, 16.0]];
-        assert_eq!(covering_triangles(&tri_first, 32.0, 32.0), 3);
-        // A square, diagonals 0–2 and 1–3 crossing at (5, 5): four triangles.
-        let square = [[1.0, 1.0], [9.0, 1.0], [9.0, 9.0], [1.0, 9.0]];
-        assert_eq!(covering_triangles(&square, 32.0, 32.0), 4);
-        // Outside the viewport, nothing; half inside, the two triangles there.
-        assert_eq!(covering_triangles(&square, 0.5, 32.0), 0);
-        let left_half = [[-9.0, 1.0], [-1.0, 1.0], [7.0, 9.0], [-9.0, 9.0]];
-        assert!(covering_triangles(&left_half, 32.0, 32.0) < 4);
-        // Inside one pixel around its centre (0.5, 0.5): one of the fan's three holds it.
-        let pixel = [[0.2, 0.2], [0.95, 0.3], [0.3, 0.95], [0.4, 0.35]];
-        assert_eq!(hull_pixels(&pixel, 4.0, 4.0), 1);
-        assert_eq!(covering_triangles(&pixel, 4.0, 4.0), 1);
-        // The unit pixel's square: its diagonals cross at the centre, which lies on all four
-        // triangles' edges; the rasteriser gives it to one, this count to none (it is a lower
-        // bound), while the hull holds it.
-        let unit = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-        assert_eq!(hull_pixels(&unit, 4.0, 4.0), 1);
-        assert_eq!(covering_triangles(&unit, 4.0, 4.0), 0);
-        // Flat: nothing.
-        let flat = [[1.0, 2.0], [5.0, 2.0], [3.0, 2.0], [4.0, 2.0]];
-        assert_eq!(covering_triangles(&flat, 16.0, 16.0), 0);
-        // The inner vertex 0.003 pixel above the hull's lower edge: the sliver between them
-        // holds the centre (8.5, 0.5) 0.0013 pixel inside, but its area is 9.4e-5 of the
-        // extent's square, a face a renderer's zero test may drop: only the other two count.
-        let sliver = [[0.0, 0.4985], [16.0, 0.4985], [8.0, 16.0], [8.0, 0.5015]];
-        assert_eq!(covering_triangles(&sliver, 32.0, 32.0), 2);
-        let (v, a, b) = (sliver[3], sliver[0], sliver[1]);
-        assert!(has_inner_centre(v, a, b, 32.0, 32.0));
-    }
-
-    /// On random small tets, never more covering triangles than the fan has, nor than the
-    /// hull has centres.
-    #[test]
-    fn covering_triangles_are_at_most_the_centres_and_the_fan() {
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut total = 0;
-        for _ in 0..20_000 {
-            let (cx, cy, size) = (next() * 16.0, next() * 16.0, next() * 6.0);
-            let q: [[f64; 2]; 4] =
-                std::array::from_fn(|_| [cx + next() * size, cy + next() * size]);
-            let n = covering_triangles(&q, 16.0, 16.0);
-            assert!(n <= 4 && n <= hull_pixels(&q, 16.0, 16.0), "{q:?}: {n}");
-            total += n;
-        }
-        // Not vacuous: most of these tets hold centres (18,037 covering triangles here).
-        assert!(total > 10_000, "{total}");
     }
 }

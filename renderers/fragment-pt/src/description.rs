@@ -35,7 +35,6 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
         "triangles",
         "fragments",
         "covering_tets",
-        "covering_triangles",
         "tet_classifications",
         "cpu_sort_keys",
         "gpu_sort_keys",

@@ -218,14 +218,9 @@ pub(crate) fn render(
         // visibility order covers every tet, on the device or on the host.
         ("triangles".to_string(), 4.0 * st.tets as f64),
         // Outside the timed frame, once per view: the pixel centres of every tet's projection,
-        // which its fan covers once, the tets that hold any, and the fan's triangles that hold
-        // one well inside.
+        // which its fan covers once, and the tets that hold any.
         ("fragments".to_string(), projected.fragments as f64),
         ("covering_tets".to_string(), projected.covering_tets as f64),
-        (
-            "covering_triangles".to_string(),
-            projected.covering_triangles as f64,
-        ),
         // Pass 1 classifies every tet once (one invocation per tet).
         ("tet_classifications".to_string(), st.tets as f64),
         (

@@ -933,15 +933,9 @@ impl Renderer for GatorPt {
             ("triangles_drawn".to_string(), (indices_drawn / 3) as f64),
             (sorted_on.to_string(), n),
             // Outside the timed frame, once per view: the pixel centres of every tet's
-            // projection, which its four triangles cover once each, the tets that hold any, and
-            // the triangles that hold one well inside (the basis graph draws Shirley and
-            // Tuchman's decomposition of the projection, §3).
+            // projection, which its four triangles cover once each, and the tets that hold any.
             ("fragments".to_string(), projected.fragments as f64),
             ("covering_tets".to_string(), projected.covering_tets as f64),
-            (
-                "covering_triangles".to_string(),
-                projected.covering_triangles as f64,
-            ),
             // The vertex program classifies the tet once per basis-graph node it shades
             // (§3: every node's invocation repeats the tests): at least 5 per tet, since an
             // indexed draw shades each of its 5 indices at least once.
