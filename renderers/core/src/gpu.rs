@@ -54,6 +54,7 @@ fn wanted_features() -> wgpu::Features {
         | wgpu::Features::VERTEX_WRITABLE_STORAGE
         | wgpu::Features::INDIRECT_FIRST_INSTANCE
         | wgpu::Features::DEPTH32FLOAT_STENCIL8
+        | wgpu::Features::SHADER_EARLY_DEPTH_TEST
 }
 
 /// What to ask of the adapter beyond "everything it offers": the paths a given machine would

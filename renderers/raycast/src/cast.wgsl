@@ -56,17 +56,21 @@ struct StepParams {
     table_lengths: u32,
 }
 
-fn step_params() -> StepParams {
+fn step_params_of(f: Frame) -> StepParams {
     return StepParams(
-        frame.counts.w,
-        frame.counts.z,
-        frame.counts.y,
-        frame.misc.z,
-        frame.misc.y,
-        frame.misc.w,
-        frame.table.x,
-        frame.table.y,
+        f.counts.w,
+        f.counts.z,
+        f.counts.y,
+        f.misc.z,
+        f.misc.y,
+        f.misc.w,
+        f.table.x,
+        f.table.y,
     );
+}
+
+fn step_params() -> StepParams {
+    return step_params_of(frame);
 }
 
 // One filtered sample of the pre-integration table (render_core::table_texture; `table_coord`
@@ -241,26 +245,16 @@ fn tile_pixel(wg: vec3<u32>, lid: vec3<u32>, p: ptr<function, vec2<u32>>) -> u32
     return t;
 }
 
-// mode=passes: one step of every active ray of the listed tiles (one GPU pass); on the pass
-// that ends a round the rays still active are counted per tile (the paper's occlusion query,
-// here an atomic count).
-@compute @workgroup_size(8, 8)
-fn step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
-    let sp = step_params();
-    let rf = ray_frame();
-    let width = frame.size.x;
-    var p: vec2<u32>;
-    let t = tile_pixel(wg, lid, &p);
-    if t == NONE {
-        return;
-    }
+// One pass of mode=passes for the ray of pixel `p` in tile `t`: one step (§2.3), and a ray that
+// left the mesh finds its next entry in the same pass; on the pass that ends a round the rays
+// still active are counted per tile (the paper's occlusion query, here an atomic count).
+fn pass_step(p: vec2<u32>, t: u32, width: u32, sp: StepParams, rf: RayFrame) {
     let i = p.y * width + p.x;
     if rays[i].x == NONE {
         return;
     }
     var st = load(i);
     let ray = ray_through(rf, vec2<f32>(p) + 0.5);
-    // One step a pass (§2.3); a ray that left the mesh finds its next entry in the same pass.
     var end = advance(&st, ray, sp);
     loop {
         if end != ACTIVE || st.tet.x != NONE {
@@ -273,6 +267,22 @@ fn step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     if end == ACTIVE && pass_params.count != 0u {
         atomicAdd(&tile_counts[t], 1u);
     }
+}
+
+// mode=passes as a compute pass (adapters without forced early depth tests): every pixel of
+// the listed tiles runs `pass_step`; a ray that has ended returns at its first test, but a CPU
+// backend still runs the step under an empty mask (it branches around no `if`).
+@compute @workgroup_size(8, 8)
+fn step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    let sp = step_params();
+    let rf = ray_frame();
+    let width = frame.size.x;
+    var p: vec2<u32>;
+    let t = tile_pixel(wg, lid, &p);
+    if t == NONE {
+        return;
+    }
+    pass_step(p, t, width, sp, rf);
 }
 
 // mode=loop: one dispatch over the non-empty tiles; each ray steps until it leaves the last

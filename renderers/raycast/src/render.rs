@@ -15,10 +15,12 @@ use crate::layout::{MeshLayout, TetRef, MESH_TEXTURE_BYTES, MESH_TEXTURE_WIDTH};
 use crate::resources::{FrameParams, Pipelines, Target, TileRect, MAX_TILES, STAT_SLOTS};
 use crate::settings::{Mode, RaycastSettings, TableKind};
 use crate::step::{LayerEntry, RayFrame};
-use crate::{COUNT_EVERY, ET_OPACITY, PEEL_BIAS, TABLE_LENGTH, TABLE_SCALAR};
+use crate::{ET_OPACITY, PEEL_BIAS, TABLE_LENGTH, TABLE_SCALAR};
 use render_core::texel_texture::TexelTexture;
 
+mod passes;
 mod peel;
+use passes::run_passes;
 use peel::{peel, Peeled};
 
 const FLAG_ET: u32 = 1;
@@ -42,6 +44,9 @@ pub struct Raycast {
     /// Bytes per mesh texture when smaller than [`MESH_TEXTURE_BYTES`] (tests split small
     /// meshes across textures this way).
     max_texture_bytes: Option<u64>,
+    /// mode=passes as compute dispatches even where the device can draw it as tile rectangles
+    /// (tests compare the two).
+    compute_passes: bool,
     state: Option<State>,
 }
 
@@ -111,6 +116,7 @@ impl Raycast {
             settings,
             max_binding: None,
             max_texture_bytes: None,
+            compute_passes: false,
             state: None,
         }
     }
@@ -124,6 +130,13 @@ impl Raycast {
     /// Splits the mesh texture into textures of at most `bytes` (at least one layer each).
     pub fn with_max_texture_bytes(mut self, bytes: u64) -> Raycast {
         self.max_texture_bytes = Some(bytes);
+        self
+    }
+
+    /// Runs mode=passes as compute dispatches, the path of devices without forced early depth
+    /// tests, instead of tile rectangles.
+    pub fn with_compute_passes(mut self) -> Raycast {
+        self.compute_passes = true;
         self
     }
 
@@ -372,6 +385,7 @@ impl Renderer for Raycast {
             gpu,
             mesh_textures.textures.len(),
             mesh_textures.layers_per_texture,
+            self.settings.mode == Mode::Passes && !self.compute_passes,
         );
         let mut entries = vec![render_core::bind::whole(0, &frame_params)];
         entries.extend(mesh_textures.textures.iter().zip(1..).map(|(t, binding)| {
@@ -612,50 +626,22 @@ fn frame(
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
     clock.submit(gpu, [enc.finish()]);
-    let mut counts = read_counts(gpu, &mut clock, &t.tile_counts, ntiles)?;
+    let counts = read_counts(gpu, &mut clock, &t.tile_counts, ntiles)?;
     let mut tile_passes = vec![0u32; ntiles];
     let mut rounds = 0u32;
+    let mut rect_triangles = 0u64;
     // One dispatch per pass covers every listed tile (workgroup z = slot in the list).
     let groups = [tile_size[0].div_ceil(8), tile_size[1].div_ceil(8)];
-    let list = |counts: &[u32]| -> Vec<u32> {
-        (0..ntiles as u32)
-            .filter(|&i| counts[i as usize] > 0)
-            .collect()
-    };
     match s.mode {
         Mode::Passes => {
-            // Phase 3: rounds of k passes over the tiles that still have active rays; the last
-            // pass of a round counts them, and tiles at zero leave the list.
-            loop {
-                let active = list(&counts);
-                if active.is_empty() {
-                    break;
-                }
-                gpu.queue
-                    .write_buffer(&t.active_tiles, 0, bytemuck::cast_slice(&active));
-                gpu.queue
-                    .write_buffer(&t.tile_counts, 0, &[0u8; MAX_TILES * 4]);
-                let mut enc = gpu.device.create_command_encoder(&Default::default());
-                {
-                    let mut pass = enc.begin_compute_pass(&Default::default());
-                    pass.set_pipeline(&st.pipes.step);
-                    pass.set_bind_group(0, &st.mesh_bind, &[]);
-                    for k in 0..COUNT_EVERY {
-                        let count = (k + 1 == COUNT_EVERY) as usize;
-                        pass.set_bind_group(1, &t.cast_binds[count], &[]);
-                        pass.dispatch_workgroups(groups[0], groups[1], active.len() as u32);
-                    }
-                }
-                clock.submit(gpu, [enc.finish()]);
-                for &tile in &active {
-                    tile_passes[tile as usize] += COUNT_EVERY;
-                }
-                rounds += 1;
-                counts = read_counts(gpu, &mut clock, &t.tile_counts, ntiles)?;
-            }
+            let r = run_passes(gpu, st, t, groups, counts, &mut tile_passes, &mut clock)?;
+            rounds = r.rounds;
+            rect_triangles = 2 * r.rect_draws;
         }
         Mode::Loop => {
-            let active = list(&counts);
+            let active: Vec<u32> = (0..ntiles as u32)
+                .filter(|&i| counts[i as usize] > 0)
+                .collect();
             if !active.is_empty() {
                 gpu.queue
                     .write_buffer(&t.active_tiles, 0, bytemuck::cast_slice(&active));
@@ -696,6 +682,7 @@ fn frame(
             tile_passes.iter().filter(|&&p| p == 0).count() as f64,
         ),
         ("count_rounds".to_string(), rounds as f64),
+        ("tile_rectangles".to_string(), rect_triangles as f64 / 2.0),
         ("peel_layers".to_string(), layers_used as f64),
         ("rays".to_string(), entered),
         (
@@ -709,10 +696,11 @@ fn frame(
         ("steps_max".to_string(), stats[STAT_MAX_STEPS] as f64),
         ("ray_steps".to_string(), ray_steps),
         // Every peeling layer draws all boundary faces (the last draw finds its layer empty or
-        // fills the spare slot that counts dropped re-entries).
+        // fills the spare slot that counts dropped re-entries); passes drawn as tile rectangles
+        // add two triangles a rectangle.
         (
             "triangles".to_string(),
-            (st.face_vertices / 3) as f64 * peel_draws as f64,
+            (st.face_vertices / 3) as f64 * peel_draws as f64 + rect_triangles as f64,
         ),
         (
             "early_terminated_rays".to_string(),

@@ -118,6 +118,17 @@ const MORE_THAN_REFERENCE: wgpu::StencilFaceState = wgpu::StencilFaceState {
     pass_op: wgpu::StencilOperation::Keep,
 };
 
+/// The two pipelines of mode=passes drawn as rectangles (`tile_pass.wgsl`).
+pub struct TilePipelines {
+    /// One ray step per pixel; ended rays fail the early depth test.
+    pub step: wgpu::RenderPipeline,
+    /// The depth update: depth 0 where the ray has ended.
+    pub cull: wgpu::RenderPipeline,
+}
+
+/// The depth format of the tile passes' early depth test (depth only).
+pub const ZCULL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
 /// Layouts and pipelines, independent of the viewport.
 pub struct Pipelines {
     pub mesh_layout: wgpu::BindGroupLayout,
@@ -136,6 +147,9 @@ pub struct Pipelines {
     pub more: Option<wgpu::RenderPipeline>,
     pub init: wgpu::ComputePipeline,
     pub step: wgpu::ComputePipeline,
+    /// mode=passes as rectangles per tile (`tile_pass.wgsl`), where the device can force early
+    /// depth tests; `None`: the compute pass `step`.
+    pub tile_passes: Option<TilePipelines>,
     pub run_loop: wgpu::ComputePipeline,
     pub probe: wgpu::ComputePipeline,
 }
@@ -144,7 +158,14 @@ impl Pipelines {
     /// Layouts and pipelines. The frame's and the pass's parameters are bound with
     /// [`bind::params_entry`] (set again every pass); the mesh is `textures` array textures of
     /// `layers_per_texture` layers ([`mesh_wgsl`]).
-    pub fn new(gpu: &Gpu, textures: usize, layers_per_texture: u32) -> Pipelines {
+    /// `tile_passes` (mode=passes): build [`TilePipelines`] where the device can force early
+    /// depth tests.
+    pub fn new(
+        gpu: &Gpu,
+        textures: usize,
+        layers_per_texture: u32,
+        tile_passes: bool,
+    ) -> Pipelines {
         let dev = &gpu.device;
         let mut mesh_entries = vec![bind::params_entry(0, STAGES)];
         mesh_entries.extend(
@@ -324,6 +345,23 @@ impl Pipelines {
         let run_loop =
             gpu.compute_pipeline("raycast loop", Some(&cast_pl), &cast_module, "run_loop");
         let probe = gpu.compute_pipeline("raycast probe", Some(&probe_pl), &probe_module, "probe");
+        let tile_passes = (tile_passes
+            && gpu
+                .device
+                .features()
+                .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST))
+        .then(|| {
+            let tile_pl = layout(
+                "raycast tile passes",
+                &[
+                    Some(&mesh_layout),
+                    Some(&cast_layout),
+                    Some(&peel_frame_layout),
+                ],
+            );
+            let src = format!("{cast_src}\n{}", include_str!("tile_pass.wgsl"));
+            TilePipelines::new(gpu, &tile_pl, &gpu.shader("raycast tile passes", &src))
+        });
         Pipelines {
             mesh_layout,
             peel_layout,
@@ -335,8 +373,59 @@ impl Pipelines {
             more,
             init,
             step,
+            tile_passes,
             run_loop,
             probe,
+        }
+    }
+}
+
+impl TilePipelines {
+    fn new(gpu: &Gpu, layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule) -> Self {
+        let pipeline = |label: &str, fs: &str, compare, write| {
+            gpu.device
+                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(label),
+                    layout: Some(layout),
+                    vertex: wgpu::VertexState {
+                        module,
+                        entry_point: Some("vs_tile"),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    primitive: Default::default(),
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: ZCULL_FORMAT,
+                        depth_write_enabled: Some(write),
+                        depth_compare: Some(compare),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    }),
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module,
+                        entry_point: Some(fs),
+                        compilation_options: Default::default(),
+                        targets: &[],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+        };
+        TilePipelines {
+            // The rectangles lie at depth 0.5: in front of the clear (1), behind an ended ray (0).
+            step: pipeline(
+                "raycast tile step",
+                "fs_step",
+                wgpu::CompareFunction::Less,
+                false,
+            ),
+            cull: pipeline(
+                "raycast tile cull",
+                "fs_cull",
+                wgpu::CompareFunction::Always,
+                true,
+            ),
         }
     }
 }
@@ -365,6 +454,9 @@ pub struct Target {
     pub peel_binds: Vec<wgpu::BindGroup>,
     pub occlusion: wgpu::QuerySet,
     pub occlusion_resolve: wgpu::Buffer,
+    /// The tile passes' depth ([`ZCULL_FORMAT`]): 0 where a ray has ended. Only with
+    /// [`Pipelines::tile_passes`].
+    pub zcull: Option<wgpu::TextureView>,
 }
 
 impl Target {
@@ -550,6 +642,29 @@ impl Target {
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
+        let zcull = if pipes.tile_passes.is_some() {
+            let texture = ledger.texture(
+                gpu,
+                Lifetime::PerFrame,
+                &wgpu::TextureDescriptor {
+                    label: Some("raycast tile depth"),
+                    size: wgpu::Extent3d {
+                        width,
+                        height,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: ZCULL_FORMAT,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                    view_formats: &[],
+                },
+            )?;
+            Some(texture.create_view(&Default::default()))
+        } else {
+            None
+        };
         Ok(Target {
             width,
             height,
@@ -567,6 +682,7 @@ impl Target {
             peel_binds,
             occlusion,
             occlusion_resolve,
+            zcull,
         })
     }
 }

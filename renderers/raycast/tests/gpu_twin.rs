@@ -230,9 +230,22 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
     // second candidate: a ray crosses the outer sphere's front and the inner sphere's far side
     // once each, and both are layers.
     let empty_pass = !gpu.features.contains(wgpu::Features::DEPTH32FLOAT_STENCIL8);
+    // Passes drawn as tile rectangles (where the device forces early depth tests) add two
+    // triangles a rectangle: each round draws every active tile's once for the depth update
+    // and once a pass.
+    let rectangles = if gpu
+        .features
+        .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST)
+    {
+        d.tile_passes.iter().sum::<u32>() / COUNT_EVERY * (COUNT_EVERY + 1)
+    } else {
+        0
+    };
+    assert_eq!(counter(&stats, "tile_rectangles"), rectangles as f64);
     assert_eq!(
         counter(&stats, "triangles"),
-        (mesh.boundary_faces().len() as u32 * (d.layers_used + empty_pass as u32)) as f64
+        (mesh.boundary_faces().len() as u32 * (d.layers_used + empty_pass as u32) + 2 * rectangles)
+            as f64
     );
     let n = settings.tiles;
     let mut empty = 0;
@@ -348,6 +361,39 @@ fn images_match_the_reference_on_a_non_convex_mesh_in_both_modes_and_across_bind
     // with early termination at 0.95: an approximation whose error depends on the mesh; on this
     // smooth shell it stays above 50 dB, so a drop below means the 2D path broke.
     assert!(p2 >= 50.0, "{p2:.2} dB");
+}
+
+/// The passes drawn as tile rectangles whose ended rays fail the early depth test (§3.2's early
+/// z-test) do what the compute passes do: the same image bit for bit, the same steps, passes
+/// and statistics; only the rectangles' triangles differ.
+#[test]
+fn passes_drawn_as_tiles_match_the_compute_passes() {
+    let gpu = gpu();
+    let mesh = std::sync::Arc::new(shell());
+    let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);
+    for settings in [exact(), RaycastSettings::default()] {
+        let mut tiled = Raycast::new(settings);
+        let (img, d, stats, _) = render(&gpu, &mut tiled, &mesh, &optics, 6, 64);
+        let mut compute = Raycast::new(settings).with_compute_passes();
+        let (img_c, d_c, stats_c, _) = render(&gpu, &mut compute, &mesh, &optics, 6, 64);
+        let differing = (img.pixels.iter())
+            .zip(&img_c.pixels)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(differing, 0, "pixels differing, {settings:?}");
+        assert_eq!(d.steps, d_c.steps);
+        assert_eq!(d.tile_passes, d_c.tile_passes);
+        assert_eq!(counter(&stats_c, "tile_rectangles"), 0.0);
+        let drawn = gpu
+            .features
+            .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
+        assert_eq!(counter(&stats, "tile_rectangles") > 0.0, drawn);
+        for (name, value) in &stats_c.counters {
+            if name != "triangles" && name != "tile_rectangles" {
+                assert_eq!(counter(&stats, name), *value, "{name}");
+            }
+        }
+    }
 }
 
 #[test]
