@@ -14,9 +14,13 @@
 //!   front to back with the 2D or 3D pre-integrated table; a ray that leaves the mesh continues
 //!   from its next layer; early ray termination at opacity [`ET_OPACITY`] (the paper's code).
 //! * Phase 3b / tiles (§2.3): the screen is cut into N×N tiles; each runs its own number of
-//!   passes. The paper's z-update and occlusion query every k passes is here an atomic count of
-//!   the tile's active rays in every [`COUNT_EVERY`]-th pass, read back by the CPU; a tile whose
-//!   count is zero gets no more passes, and a tile no ray enters gets none at all.
+//!   passes. The paper's occlusion query every k passes is here an atomic count of the tile's
+//!   active rays in every [`COUNT_EVERY`]-th pass, read back by the CPU; a tile whose count is
+//!   zero gets no more passes, and a tile no ray enters gets none at all. Its z-update is drawn
+//!   where the device forces early depth tests (`tile_pass.wgsl`): each pass a rectangle per
+//!   active tile, the step in the fragment shader, rays that have ended given depth 0 at the
+//!   start of each round so that the early depth test rejects them (§3.2); elsewhere the passes
+//!   are compute dispatches over the tiles.
 //! * [`Mode::Loop`]: the modern variant, one dispatch per tile looping each ray to its end.
 //!
 //! The CPU twin of a ray step is [`step`]; the pass-count map (the paper's Fig. 5) is

@@ -674,7 +674,7 @@ fn frame(
     let ray_steps = ((stats[STAT_STEPS_HIGH] as u64) << 32 | stats[STAT_STEPS] as u64) as f64;
     let max_passes = tile_passes.iter().copied().max().unwrap_or(0);
     let mean_passes = tile_passes.iter().map(|&p| p as f64).sum::<f64>() / ntiles as f64;
-    let counters = vec![
+    let mut counters = vec![
         ("passes_max".to_string(), max_passes as f64),
         ("passes_mean".to_string(), mean_passes),
         (
@@ -682,7 +682,6 @@ fn frame(
             tile_passes.iter().filter(|&&p| p == 0).count() as f64,
         ),
         ("count_rounds".to_string(), rounds as f64),
-        ("tile_rectangles".to_string(), rect_triangles as f64 / 2.0),
         ("peel_layers".to_string(), layers_used as f64),
         ("rays".to_string(), entered),
         (
@@ -725,6 +724,10 @@ fn frame(
         ),
         ("mesh_bindings".to_string(), st.mesh_bindings as f64),
     ];
+    if s.mode == Mode::Passes {
+        // The passes' and depth updates' rectangles (0 where the passes are compute dispatches).
+        counters.push(("tile_rectangles".to_string(), rect_triangles as f64 / 2.0));
+    }
     st.last = Some(LastFrame {
         camera: camera.clone(),
         layers_used,
