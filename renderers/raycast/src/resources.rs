@@ -552,23 +552,13 @@ impl Target {
                 view_formats: &[],
             },
         )?;
-        let depth = ledger.texture(
+        let depth = depth_target(
             gpu,
-            Lifetime::PerFrame,
-            &wgpu::TextureDescriptor {
-                label: Some("raycast depth"),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: depth_format(gpu).0,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            },
+            ledger,
+            "raycast depth",
+            depth_format(gpu).0,
+            width,
+            height,
         )?;
         let layer_views: Vec<wgpu::TextureView> = (0..layer_slots)
             .map(|l| {
@@ -643,23 +633,13 @@ impl Target {
             mapped_at_creation: false,
         });
         let zcull = if pipes.tile_passes.is_some() {
-            let texture = ledger.texture(
+            let texture = depth_target(
                 gpu,
-                Lifetime::PerFrame,
-                &wgpu::TextureDescriptor {
-                    label: Some("raycast tile depth"),
-                    size: wgpu::Extent3d {
-                        width,
-                        height,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: ZCULL_FORMAT,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                    view_formats: &[],
-                },
+                ledger,
+                "raycast tile depth",
+                ZCULL_FORMAT,
+                width,
+                height,
             )?;
             Some(texture.create_view(&Default::default()))
         } else {
@@ -685,4 +665,33 @@ impl Target {
             zcull,
         })
     }
+}
+
+/// A viewport-sized depth (and stencil) attachment, counted per frame.
+fn depth_target(
+    gpu: &Gpu,
+    ledger: &mut MemoryLedger,
+    label: &str,
+    format: wgpu::TextureFormat,
+    width: u32,
+    height: u32,
+) -> anyhow::Result<wgpu::Texture> {
+    ledger.texture(
+        gpu,
+        Lifetime::PerFrame,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        },
+    )
 }
