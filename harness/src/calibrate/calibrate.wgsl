@@ -214,6 +214,7 @@ fn walk_tex_main(@builtin(global_invocation_id) id: vec3<u32>) {
 const SPLAT_RING: u32 = 5u;
 const SPLAT_TARGET: u32 = 512u;
 const SPLAT_SLICE: u32 = 32u;
+const SPLAT_SLICES: u32 = 8u;
 const SPLAT_ONE: f32 = 16777216.0;
 
 // x: square side in pixels (even); y: squares per row of the grid.
@@ -244,30 +245,72 @@ fn splat_bilinear(q: u32, uv: vec2<f32>) -> f32 {
                mix(splat_texel(q, i.x, i.y + 1), splat_texel(q, i.x + 1, i.y + 1), t.x), t.y);
 }
 
-@compute @workgroup_size(256)
-fn splat_cs(@builtin(global_invocation_id) id: vec3<u32>) {
+// One invocation's square: its origin, the first and one-past-last pixel centres, its slice.
+struct SplatSquare {
+    origin: vec2<f32>,
+    lo: vec2<u32>,
+    hi: vec2<u32>,
+    q: u32,
+}
+
+fn splat_square(id: u32) -> SplatSquare {
     let px = f32(splat_params.px);
     let grid = splat_params.grid;
-    let cell = id.x % (grid * grid);
+    let cell = id % (grid * grid);
     let origin = vec2<f32>(f32(cell % grid), f32(cell / grid)) * (px * 0.5) + 0.25;
-    let q = id.x % 3u;
-    let lo = vec2<u32>(ceil(origin - 0.5));
-    let hi = vec2<u32>(ceil(origin + px - 0.5));
-    for (var y = lo.y; y < hi.y; y++) {
-        for (var x = lo.x; x < hi.x; x++) {
-            let uv = (vec2<f32>(f32(x) + 0.5, f32(y) + 0.5) - origin) / px * f32(SPLAT_SLICE) - 0.5;
-            let pixel = (y * SPLAT_TARGET + x) * SPLAT_RING;
+    return SplatSquare(origin, vec2<u32>(ceil(origin - 0.5)), vec2<u32>(ceil(origin + px - 0.5)), id % 3u);
+}
+
+// Where pixel (x, y) falls in the table's slices (texel units, centres at integers).
+fn splat_uv(sq: SplatSquare, x: u32, y: u32) -> vec2<f32> {
+    return (vec2<f32>(f32(x) + 0.5, f32(y) + 0.5) - sq.origin) / f32(splat_params.px) * f32(SPLAT_SLICE) - 0.5;
+}
+
+// Adds a footprint term to slab o's two fixed-point sums of a pixel (a term that rounds to 0
+// skips its atomic).
+fn splat_add(x: u32, y: u32, o: u32, w: f32) {
+    let p = 2u * ((y * SPLAT_TARGET + x) * SPLAT_RING + o);
+    let wv = u32(w * 0.5 * SPLAT_ONE + 0.5);
+    let ww = u32(w * SPLAT_ONE + 0.5);
+    if wv != 0u {
+        atomicAdd(&splat_sheet[p], wv);
+    }
+    if ww != 0u {
+        atomicAdd(&splat_sheet[p + 1u], ww);
+    }
+}
+
+@compute @workgroup_size(256)
+fn splat_cs(@builtin(global_invocation_id) id: vec3<u32>) {
+    let sq = splat_square(id.x);
+    for (var y = sq.lo.y; y < sq.hi.y; y++) {
+        for (var x = sq.lo.x; x < sq.hi.x; x++) {
+            let uv = splat_uv(sq, x, y);
             for (var o = 0u; o < SPLAT_RING; o++) {
-                let w = mix(splat_bilinear(q + o, uv), splat_bilinear(q + o + 1u, uv), 0.5);
-                let p = 2u * (pixel + o);
-                let wv = u32(w * 0.5 * SPLAT_ONE + 0.5);
-                let ww = u32(w * SPLAT_ONE + 0.5);
-                if wv != 0u {
-                    atomicAdd(&splat_sheet[p], wv);
-                }
-                if ww != 0u {
-                    atomicAdd(&splat_sheet[p + 1u], ww);
-                }
+                splat_add(x, y, o, mix(splat_bilinear(sq.q + o, uv), splat_bilinear(sq.q + o + 1u, uv), 0.5));
+            }
+        }
+    }
+}
+
+// The same fill with the footprint table in a filtered R32Float 3D texture (the splatter's
+// layout where the device filters it): one trilinear sample a slab does the two slices'
+// bilinear lookups and their mix; the slices are bordered by a texel of zeros, so that a centre
+// outside the table reads 0 as `splat_texel` does.
+@group(0) @binding(17) var splat_table_tex: texture_3d<f32>;
+@group(0) @binding(18) var splat_sampler: sampler;
+
+@compute @workgroup_size(256)
+fn splat_tex_cs(@builtin(global_invocation_id) id: vec3<u32>) {
+    let sq = splat_square(id.x);
+    let bordered = f32(SPLAT_SLICE + 2u);
+    for (var y = sq.lo.y; y < sq.hi.y; y++) {
+        for (var x = sq.lo.x; x < sq.hi.x; x++) {
+            let uv = clamp(splat_uv(sq, x, y), vec2<f32>(-1.0), vec2<f32>(f32(SPLAT_SLICE)));
+            let st = (uv + 1.5) / bordered;
+            for (var o = 0u; o < SPLAT_RING; o++) {
+                let z = f32(sq.q + o + 1u) / f32(SPLAT_SLICES);
+                splat_add(x, y, o, textureSampleLevel(splat_table_tex, splat_sampler, vec3<f32>(st, z), 0.0).x);
             }
         }
     }
