@@ -198,6 +198,14 @@ impl Splat {
         self
     }
 
+    /// The footprint table loaded and interpolated by hand (the path of devices that cannot
+    /// filter `R32Float`) instead of sampled with trilinear filtering.
+    #[doc(hidden)]
+    pub fn with_table_loads(mut self) -> Splat {
+        self.table_loads = true;
+        self
+    }
+
     /// Footprint pixel centres of `camera`'s view outside `rect` (see [`centres_outside`]).
     #[doc(hidden)]
     pub fn centres_outside(&self, camera: &Camera, rect: [u32; 4]) -> anyhow::Result<u64> {

@@ -96,7 +96,9 @@ impl Pipelines {
     /// Every parameter block (frame, step, bitonic stage) is bound with
     /// [`bind::params_entry`]: a uniform buffer set again before every dispatch made lavapipe's
     /// memory grow with every frame. The images are bit for bit the same.
-    pub fn new(gpu: &Gpu) -> Pipelines {
+    /// `filtered`: the footprint table is sampled with trilinear filtering (`splat.wgsl`,
+    /// TABLE_FILTERED) rather than loaded and interpolated by hand.
+    pub fn new(gpu: &Gpu, filtered: bool) -> Pipelines {
         let d = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
@@ -171,7 +173,17 @@ impl Pipelines {
             &[
                 bind::params_entry(0, c),
                 storage(1, c, true),
-                storage(2, c, true),
+                bind::texture_entry(2, c, filtered, wgpu::TextureViewDimension::D3),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 6,
+                    visibility: c,
+                    ty: wgpu::BindingType::Sampler(if filtered {
+                        wgpu::SamplerBindingType::Filtering
+                    } else {
+                        wgpu::SamplerBindingType::NonFiltering
+                    }),
+                    count: None,
+                },
                 float_texture(3, c),
                 // Fragments dropped by early splat elimination (counted, not timed).
                 storage(4, c, false),
@@ -187,7 +199,7 @@ impl Pipelines {
             ))],
         );
         let splat_source = format!(
-            "const SPLAT_WORKGROUP: u32 = {SPLAT_WORKGROUP}u;\n{}",
+            "const SPLAT_WORKGROUP: u32 = {SPLAT_WORKGROUP}u;\nconst TABLE_FILTERED: bool = {filtered};\n{}",
             with_frame(include_str!("splat.wgsl"))
         );
         let splat_module = gpu.shader("splat splat.wgsl", &splat_source);

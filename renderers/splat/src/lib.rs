@@ -161,7 +161,9 @@ struct State {
     table: FootprintTable,
     pipes: Pipelines,
     bricks: Vec<wgpu::Buffer>,
-    table_buf: wgpu::Buffer,
+    /// The footprint slices, an `R32Float` 3D texture ((footprint + 2)² texels a slice row).
+    table_view: wgpu::TextureView,
+    table_sampler: wgpu::Sampler,
     tf_buf: wgpu::Buffer,
     frame_buf: wgpu::Buffer,
     slab_buf: wgpu::Buffer,
@@ -197,6 +199,9 @@ pub struct Splat {
     /// Test hook: invocations per voxel in the splat pass, whatever the adapter
     /// (`Splat::lanes`).
     forced_lanes: Option<u32>,
+    /// Test hook: the footprint table loaded and interpolated by hand, the path of devices
+    /// that cannot filter `R32Float`.
+    table_loads: bool,
 }
 
 /// What one brick of one frame did.
@@ -218,7 +223,14 @@ impl Splat {
             count_every_fragment: false,
             slab_by_slab: false,
             forced_lanes: None,
+            table_loads: false,
         }
+    }
+
+    /// Whether the footprint table is sampled with trilinear filtering: where the device
+    /// filters `R32Float` (`FLOAT32_FILTERABLE`) and no test asked for the loads.
+    fn table_filtered(&self, gpu: &Gpu) -> bool {
+        !self.table_loads && gpu.features.contains(wgpu::Features::FLOAT32_FILTERABLE)
     }
 
     /// Every GPU allocation of the prepared data (after `prepare`).
@@ -621,7 +633,14 @@ impl Splat {
             entries: &[
                 entry(0, &st.frame_buf),
                 entry(1, &st.sorted),
-                entry(2, &st.table_buf),
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&st.table_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::Sampler(&st.table_sampler),
+                },
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: wgpu::BindingResource::TextureView(&t.image_view),
@@ -760,13 +779,29 @@ impl Splat {
                 )
             })
             .collect::<anyhow::Result<_>>()?;
-        let table_buf = ledger.buffer_init(
+        let side = table.footprint + 2;
+        let table_view = render_core::bind::texture_with_data(
             gpu,
+            &mut ledger,
             "splat footprint slices",
-            Lifetime::Persistent,
+            wgpu::TextureDimension::D3,
+            wgpu::TextureFormat::R32Float,
+            [side, side, table.rows()],
             bytemuck::cast_slice(&table.bordered()),
-            storage,
-        )?;
+        )?
+        .create_view(&Default::default());
+        let filtered = self.table_filtered(gpu);
+        let filter = if filtered {
+            wgpu::FilterMode::Linear
+        } else {
+            wgpu::FilterMode::Nearest
+        };
+        let table_sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("splat footprint slices"),
+            mag_filter: filter,
+            min_filter: filter,
+            ..Default::default()
+        });
         let tf_buf = ledger.buffer_init(
             gpu,
             "splat transfer function",
@@ -856,9 +891,10 @@ impl Splat {
         self.state = Some(State {
             set,
             table,
-            pipes: Pipelines::new(gpu),
+            pipes: Pipelines::new(gpu, filtered),
             bricks,
-            table_buf,
+            table_view,
+            table_sampler,
             tf_buf,
             frame_buf,
             slab_buf,

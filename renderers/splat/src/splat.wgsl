@@ -24,7 +24,15 @@ const SHEET_ONE: f32 = 16777216.0;
 // 10-20 % longer a frame (docs/profile.md, "Uniform buffers on lavapipe").
 var<private> frame: Frame;
 @group(0) @binding(1) var<storage, read> sorted_in: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> table: array<f32>;
+// The footprint slices (FootprintTable::bordered) as a 3D texture, texel (x, y) of slice row
+// q. With TABLE_FILTERED (prepended by gpu.rs: the device filters R32Float) one trilinear
+// sample a slab does the two slices' bilinear lookups and their mix, as the paper looks its
+// footprints up in a texture (§3.6); the eight storage loads interpolated by hand before were
+// half of this pass on a CPU backend, which runs a storage load lane by lane
+// (docs/roofline.md). Without filtering, the same eight texels are loaded and interpolated by
+// hand (`bilinear`), the arithmetic of FootprintTable::sample.
+@group(0) @binding(2) var table: texture_3d<f32>;
+@group(0) @binding(6) var table_sampler: sampler;
 @group(0) @binding(3) var image_tex: texture_2d<f32>;
 // Splat fragments early splat elimination dropped (the row's `ese_dropped_fragments`).
 @group(0) @binding(4) var<storage, read_write> ese_dropped: atomic<u32>;
@@ -37,7 +45,7 @@ var<private> frame: Frame;
 // offset from the slab falls between (kernel.rs, FootprintTable::bordered) and the weight of
 // the second.
 struct Slices {
-    base: u32,
+    q0: i32,
     fq: f32,
 }
 
@@ -45,19 +53,26 @@ fn slices_of(delta: f32) -> Slices {
     let rows = (2u * frame.radius_slabs + 1u) * frame.subslices + 1u;
     let qf = clamp((delta + f32(frame.radius_slabs)) * f32(frame.subslices), 0.0, f32(rows - 1u));
     let q0 = min(u32(floor(qf)), rows - 2u);
-    let side = frame.footprint + 2u;
-    return Slices(q0 * side * side, qf - f32(q0));
+    return Slices(i32(q0), qf - f32(q0));
 }
 
-fn bilinear(i: u32, side: u32, fx: f32, fy: f32) -> f32 {
-    return mix(mix(table[i], table[i + 1u], fx), mix(table[i + side], table[i + side + 1u], fx), fy);
+fn texel(xy: vec2<i32>, q: i32) -> f32 {
+    return textureLoad(table, vec3<i32>(xy, q), 0).x;
 }
 
-// Where a pixel falls in a footprint slice: the table index of its bilinear cell relative to
-// the slice's start, and the fractions. Twin of FootprintTable::sample (kernel.rs): bilinear
+fn bilinear(xy: vec2<i32>, q: i32, fx: f32, fy: f32) -> f32 {
+    return mix(
+        mix(texel(xy, q), texel(xy + vec2<i32>(1, 0), q), fx),
+        mix(texel(xy + vec2<i32>(0, 1), q), texel(xy + vec2<i32>(1, 1), q), fx),
+        fy
+    );
+}
+
+// Where a pixel falls in a footprint slice: the bordered texel of its bilinear cell's first
+// corner, and the fractions. Twin of FootprintTable::sample (kernel.rs): bilinear
 // in a slice, 0 outside the table (the slices' zero border; u, v are clamped onto it).
 struct Cell {
-    at: u32,
+    at: vec2<i32>,
     fx: f32,
     fy: f32,
 }
@@ -68,15 +83,18 @@ fn cell_of(kxy: vec2<f32>) -> Cell {
     let v = clamp((kxy.y + frame.kernel_radius) / (2.0 * frame.kernel_radius) * f - 0.5, -1.0, f - 0.5);
     let x0 = floor(u);
     let y0 = floor(v);
-    let side = frame.footprint + 2u;
-    return Cell(u32(y0 + 1.0) * side + u32(x0 + 1.0), u - x0, v - y0);
+    return Cell(vec2<i32>(i32(x0 + 1.0), i32(y0 + 1.0)), u - x0, v - y0);
 }
 
 // The footprint of one slab: linear between its two slice rows.
 fn footprint(sl: Slices, c: Cell) -> f32 {
-    let side = frame.footprint + 2u;
-    let i = sl.base + c.at;
-    return mix(bilinear(i, side, c.fx, c.fy), bilinear(i + side * side, side, c.fx, c.fy), sl.fq);
+    if TABLE_FILTERED {
+        // Texel centres at +0.5: the cell's first corner plus the fractions, on every axis.
+        let size = vec3<f32>(textureDimensions(table));
+        let at = vec3<f32>(vec2<f32>(c.at) + vec2<f32>(c.fx, c.fy), f32(sl.q0) + sl.fq) + 0.5;
+        return textureSampleLevel(table, table_sampler, at / size, 0.0).x;
+    }
+    return mix(bilinear(c.at, sl.q0, c.fx, c.fy), bilinear(c.at, sl.q0 + 1, c.fx, c.fy), sl.fq);
 }
 
 // First pixel index whose centre k + 1/2 is >= edge, clamped to [0, n].
