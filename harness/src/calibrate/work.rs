@@ -295,40 +295,25 @@ pub fn splat_fragments_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow
         wgpu::BufferUsages::STORAGE,
     )?;
     let c = wgpu::ShaderStages::COMPUTE;
-    let filtered = TableTexture::filterable_on(gpu);
-    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("calibrate splat table"),
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        ..Default::default()
-    });
+    let sampler = TableTexture::sampler(gpu, "calibrate splat table", true);
     // The storage table (binding 7) and, where the device filters R32Float, the texture (17,
     // with its sampler at 18), each with both tables.
-    let mut variants: Vec<(&str, Vec<wgpu::BindGroupLayoutEntry>)> = vec![(
-        "splat_cs",
-        vec![render_core::bind::storage_entry(7, c, true)],
-    )];
-    if filtered {
-        variants.push((
-            "splat_tex_cs",
-            vec![
-                render_core::bind::texture_entry(17, c, true, wgpu::TextureViewDimension::D3),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 18,
-                    visibility: c,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        ));
-    }
     let mut best = 0.0f64;
-    for (entry, table_entries) in variants {
+    let textures = [false, true];
+    for texture in textures
+        .into_iter()
+        .filter(|&t| !t || TableTexture::filterable_on(gpu))
+    {
         let mut entries = vec![
             render_core::bind::storage_entry(8, c, false),
             render_core::bind::storage_entry(9, c, true),
         ];
-        entries.extend(table_entries);
+        if texture {
+            entries.extend(TableTexture::layout_entries(true, 17, 18, c));
+        } else {
+            entries.push(render_core::bind::storage_entry(7, c, true));
+        }
+        let entry = if texture { "splat_tex_cs" } else { "splat_cs" };
         let group = gpu
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -338,7 +323,7 @@ pub fn splat_fragments_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow
         let layout = render_core::bind::pipeline_layout(gpu, "calibrate splat", &[Some(&group)]);
         let pipeline = gpu.compute_pipeline("calibrate splat", Some(&layout), module, entry);
         for table in splat_tables() {
-            let table = SplatTable::new(gpu, &mut ledger, &table, entry == "splat_tex_cs")?;
+            let table = SplatTable::new(gpu, &mut ledger, &table, texture)?;
             for side in SPLAT_SIDES {
                 let grid = splat_grid(side);
                 let params = storage(

@@ -52,12 +52,23 @@ impl TableTexture {
             bytemuck::cast_slice(data),
         )?;
         let filterable = TableTexture::filterable_on(gpu);
+        Ok(TableTexture {
+            view: tex.create_view(&Default::default()),
+            sampler: TableTexture::sampler(gpu, label, filterable),
+            filterable,
+            bytes: data.len() as u64 * 16,
+        })
+    }
+
+    /// A table's sampler: clamped to the edge on every axis, linear where `filterable` (what
+    /// [`TableTexture::layout_entries`] declares for it), else nearest.
+    pub fn sampler(gpu: &Gpu, label: &str, filterable: bool) -> wgpu::Sampler {
         let filter = if filterable {
             wgpu::FilterMode::Linear
         } else {
             wgpu::FilterMode::Nearest
         };
-        let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        gpu.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some(label),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
             address_mode_v: wgpu::AddressMode::ClampToEdge,
@@ -65,12 +76,6 @@ impl TableTexture {
             mag_filter: filter,
             min_filter: filter,
             ..Default::default()
-        });
-        Ok(TableTexture {
-            view: tex.create_view(&Default::default()),
-            sampler,
-            filterable,
-            bytes: data.len() as u64 * 16,
         })
     }
 

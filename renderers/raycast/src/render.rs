@@ -629,19 +629,17 @@ fn frame(
     let counts = read_counts(gpu, &mut clock, &t.tile_counts, ntiles)?;
     let mut tile_passes = vec![0u32; ntiles];
     let mut rounds = 0u32;
-    let mut rect_triangles = 0u64;
+    let mut tile_rectangles = 0u64;
     // One dispatch per pass covers every listed tile (workgroup z = slot in the list).
     let groups = [tile_size[0].div_ceil(8), tile_size[1].div_ceil(8)];
     match s.mode {
         Mode::Passes => {
             let r = run_passes(gpu, st, t, groups, counts, &mut tile_passes, &mut clock)?;
             rounds = r.rounds;
-            rect_triangles = 2 * r.rect_draws;
+            tile_rectangles = r.rectangles;
         }
         Mode::Loop => {
-            let active: Vec<u32> = (0..ntiles as u32)
-                .filter(|&i| counts[i as usize] > 0)
-                .collect();
+            let active = active_tiles(&counts);
             if !active.is_empty() {
                 gpu.queue
                     .write_buffer(&t.active_tiles, 0, bytemuck::cast_slice(&active));
@@ -699,7 +697,7 @@ fn frame(
         // add two triangles a rectangle.
         (
             "triangles".to_string(),
-            (st.face_vertices / 3) as f64 * peel_draws as f64 + rect_triangles as f64,
+            (st.face_vertices / 3) as f64 * peel_draws as f64 + 2.0 * tile_rectangles as f64,
         ),
         (
             "early_terminated_rays".to_string(),
@@ -726,7 +724,7 @@ fn frame(
     ];
     if s.mode == Mode::Passes {
         // The passes' and depth updates' rectangles (0 where the passes are compute dispatches).
-        counters.push(("tile_rectangles".to_string(), rect_triangles as f64 / 2.0));
+        counters.push(("tile_rectangles".to_string(), tile_rectangles as f64));
     }
     st.last = Some(LastFrame {
         camera: camera.clone(),
@@ -735,6 +733,13 @@ fn frame(
         tile_size,
     });
     Ok(times.stats(gpu_ms, st.ledger.per_frame + st.target_bytes, counters))
+}
+
+/// The tiles that still have active rays, from their counts.
+fn active_tiles(counts: &[u32]) -> Vec<u32> {
+    (0..counts.len() as u32)
+        .filter(|&i| counts[i as usize] > 0)
+        .collect()
 }
 
 fn read_counts(

@@ -345,12 +345,10 @@ impl Pipelines {
         let run_loop =
             gpu.compute_pipeline("raycast loop", Some(&cast_pl), &cast_module, "run_loop");
         let probe = gpu.compute_pipeline("raycast probe", Some(&probe_pl), &probe_module, "probe");
-        let tile_passes = (tile_passes
-            && gpu
-                .device
-                .features()
-                .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST))
-        .then(|| {
+        let early_depth = gpu
+            .features
+            .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
+        let tile_passes = (tile_passes && early_depth).then(|| {
             let tile_pl = layout(
                 "raycast tile passes",
                 &[

@@ -1,6 +1,7 @@
 //! Pipelines, bind group layouts and the per-frame parameters of the splatter.
 
 use render_core::bind::{self, storage_entry as storage};
+use render_core::table_texture::TableTexture;
 use render_core::Gpu;
 
 /// Must match `Frame` in `frame.wgsl`.
@@ -168,22 +169,15 @@ impl Pipelines {
             "bitonic_narrow",
         );
 
+        // The footprint slices (binding 2) and their sampler (6), a 3D table texture's entries.
+        let table = TableTexture::layout_entries(filtered, 2, 6, c);
         let splat_layout = layout(
             "splat sheet",
             &[
                 bind::params_entry(0, c),
                 storage(1, c, true),
-                bind::texture_entry(2, c, filtered, wgpu::TextureViewDimension::D3),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 6,
-                    visibility: c,
-                    ty: wgpu::BindingType::Sampler(if filtered {
-                        wgpu::SamplerBindingType::Filtering
-                    } else {
-                        wgpu::SamplerBindingType::NonFiltering
-                    }),
-                    count: None,
-                },
+                table[0],
+                table[1],
                 float_texture(3, c),
                 // Fragments dropped by early splat elimination (counted, not timed).
                 storage(4, c, false),

@@ -55,6 +55,7 @@ pub use description::{from_settings, DESCRIPTION};
 use gpu::{FrameParams, Pipelines, SlabParams, IMAGE_FORMAT};
 use kernel::{FootprintTable, Kernel, SIGMA};
 use render_core::bind::{strided_uniforms, UNIFORM_STRIDE};
+use render_core::table_texture::TableTexture;
 use voxels::VoxelSet;
 
 /// Where the per-slab buckets are built.
@@ -230,7 +231,7 @@ impl Splat {
     /// Whether the footprint table is sampled with trilinear filtering: where the device
     /// filters `R32Float` (`FLOAT32_FILTERABLE`) and no test asked for the loads.
     fn table_filtered(&self, gpu: &Gpu) -> bool {
-        !self.table_loads && gpu.features.contains(wgpu::Features::FLOAT32_FILTERABLE)
+        !self.table_loads && TableTexture::filterable_on(gpu)
     }
 
     /// Every GPU allocation of the prepared data (after `prepare`).
@@ -791,17 +792,7 @@ impl Splat {
         )?
         .create_view(&Default::default());
         let filtered = self.table_filtered(gpu);
-        let filter = if filtered {
-            wgpu::FilterMode::Linear
-        } else {
-            wgpu::FilterMode::Nearest
-        };
-        let table_sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("splat footprint slices"),
-            mag_filter: filter,
-            min_filter: filter,
-            ..Default::default()
-        });
+        let table_sampler = TableTexture::sampler(gpu, "splat footprint slices", filtered);
         let tf_buf = ledger.buffer_init(
             gpu,
             "splat transfer function",

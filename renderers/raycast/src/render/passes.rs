@@ -4,7 +4,7 @@
 
 use render_core::{FrameClock, Gpu};
 
-use super::{read_counts, State};
+use super::{active_tiles, read_counts, State};
 use crate::resources::{Target, TilePipelines};
 use crate::COUNT_EVERY;
 
@@ -12,7 +12,7 @@ use crate::COUNT_EVERY;
 /// the passes are drawn rather than dispatched.
 pub(super) struct Rounds {
     pub rounds: u32,
-    pub rect_draws: u64,
+    pub rectangles: u64,
 }
 
 /// Runs the rounds from the per-tile counts of active rays `counts` (every tile that has any is
@@ -29,13 +29,11 @@ pub(super) fn run_passes(
     let ntiles = tile_passes.len();
     let mut rounds = Rounds {
         rounds: 0,
-        rect_draws: 0,
+        rectangles: 0,
     };
     let tiled = st.pipes.tile_passes.as_ref().zip(t.zcull.as_ref());
     loop {
-        let active: Vec<u32> = (0..ntiles as u32)
-            .filter(|&i| counts[i as usize] > 0)
-            .collect();
+        let active = active_tiles(&counts);
         if active.is_empty() {
             break;
         }
@@ -55,7 +53,7 @@ pub(super) fn run_passes(
                     active.len() as u32,
                     rounds.rounds == 0,
                 );
-                rounds.rect_draws += active.len() as u64 * (COUNT_EVERY as u64 + 1);
+                rounds.rectangles += active.len() as u64 * (COUNT_EVERY as u64 + 1);
             }
             None => {
                 let mut pass = enc.begin_compute_pass(&Default::default());
