@@ -69,6 +69,31 @@ fn sort_source(chunks: u32, per_chunk: u64) -> String {
     s + include_str!("gpu_sort.wgsl")
 }
 
+/// How a pass computes, for each digit, the exclusive prefix of its counts over the tiles and
+/// its total (the same integers either way).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TileScan {
+    /// One workgroup a digit, its tiles scanned in parallel (`scan_tiles`): 256 workgroups a
+    /// pass, a few microseconds on a GPU.
+    PerDigit,
+    /// One workgroup, each invocation a digit walking its tiles in order (`scan_digits`). A CPU
+    /// backend runs a workgroup on one core and each barrier as a switch through all its
+    /// invocations: `PerDigit`'s 256 workgroups of 16 barriers cost lavapipe 12.5 ms a sort
+    /// whatever its size (docs/roofline.md), this one a load and a store a digit a tile.
+    Serial,
+}
+
+impl TileScan {
+    /// `Serial` on a CPU adapter, `PerDigit` on a GPU.
+    pub fn for_adapter(gpu: &Gpu) -> TileScan {
+        if gpu.adapter.device_type == "Cpu" {
+            TileScan::Serial
+        } else {
+            TileScan::PerDigit
+        }
+    }
+}
+
 /// A reusable GPU radix sorter for up to `max_len` pairs.
 pub struct GpuRadixSort {
     device: wgpu::Device,
@@ -80,7 +105,9 @@ pub struct GpuRadixSort {
     layout: wgpu::BindGroupLayout,
     histogram: wgpu::ComputePipeline,
     scan_tiles: wgpu::ComputePipeline,
+    scan_digits: wgpu::ComputePipeline,
     scatter: wgpu::ComputePipeline,
+    tile_scan: TileScan,
     params: wgpu::Buffer,
     tmp_keys: wgpu::Buffer,
     tmp_vals: wgpu::Buffer,
@@ -146,7 +173,9 @@ impl GpuRadixSort {
             chunks,
             histogram: pipeline("histogram"),
             scan_tiles: pipeline("scan_tiles"),
+            scan_digits: pipeline("scan_digits"),
             scatter: pipeline("scatter"),
+            tile_scan: TileScan::for_adapter(gpu),
             layout,
             params: ledger.buffer(
                 gpu,
@@ -184,6 +213,18 @@ impl GpuRadixSort {
                 storage,
             )?,
         })
+    }
+
+    /// The same sorter with the prefix over tiles computed the other way (tests run both
+    /// on any adapter; both give the same result bit for bit).
+    pub fn with_tile_scan(mut self, tile_scan: TileScan) -> GpuRadixSort {
+        self.tile_scan = tile_scan;
+        self
+    }
+
+    /// How this sorter computes each digit's prefix over tiles.
+    pub fn tile_scan(&self) -> TileScan {
+        self.tile_scan
     }
 
     /// The largest `n` this sorter takes.
@@ -288,8 +329,16 @@ impl GpuRadixSort {
             pass.set_bind_group(0, &bind, &[]);
             pass.set_pipeline(&self.histogram);
             pass.dispatch_workgroups(num_tiles, 1, 1);
-            pass.set_pipeline(&self.scan_tiles);
-            pass.dispatch_workgroups(256, 1, 1);
+            match self.tile_scan {
+                TileScan::PerDigit => {
+                    pass.set_pipeline(&self.scan_tiles);
+                    pass.dispatch_workgroups(256, 1, 1);
+                }
+                TileScan::Serial => {
+                    pass.set_pipeline(&self.scan_digits);
+                    pass.dispatch_workgroups(1, 1, 1);
+                }
+            }
             pass.set_pipeline(&self.scatter);
             pass.dispatch_workgroups(num_tiles, 1, 1);
         }
@@ -678,37 +727,53 @@ mod tests {
     }
 
     /// The GPU sort equals the CPU radix sort exactly (both are stable LSD sorts on the same
-    /// ordered-u32 images), for sizes around and off the tile size, ascending and descending.
+    /// ordered-u32 images), for sizes around and off the tile size, ascending and descending,
+    /// with either way of scanning the tiles (the adapter's own and the other).
     #[test]
     fn gpu_radix_sort_agrees_with_cpu() {
         let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
-        let sorter = GpuRadixSort::new(&gpu, 100_000, &mut MemoryLedger::default()).unwrap();
         let mut scratch = RadixScratch::default();
-        for (n, seed) in [
-            (0usize, 1u64),
-            (1, 2),
-            (255, 3),
-            (4096, 4),
-            (4097, 5),
-            (33_333, 6),
-            (100_000, 7),
-        ] {
-            let keys = xorshift_keys(n, seed);
-            for descending in [false, true] {
-                let (sorted, perm) = sorter.sort_pairs_blocking(&gpu, &keys, descending).unwrap();
-                let mut want = Vec::new();
-                if descending {
-                    radix_sort_indices_descending(&keys, &mut want, &mut scratch);
-                } else {
-                    radix_sort_indices(&keys, &mut want, &mut scratch);
+        for tile_scan in [TileScan::PerDigit, TileScan::Serial] {
+            let sorter = GpuRadixSort::new(&gpu, 100_000, &mut MemoryLedger::default())
+                .unwrap()
+                .with_tile_scan(tile_scan);
+            for (n, seed) in [
+                (0usize, 1u64),
+                (1, 2),
+                (255, 3),
+                (4096, 4),
+                (4097, 5),
+                (33_333, 6),
+                (100_000, 7),
+            ] {
+                let keys = xorshift_keys(n, seed);
+                for descending in [false, true] {
+                    let (sorted, perm) =
+                        sorter.sort_pairs_blocking(&gpu, &keys, descending).unwrap();
+                    let mut want = Vec::new();
+                    if descending {
+                        radix_sort_indices_descending(&keys, &mut want, &mut scratch);
+                    } else {
+                        radix_sort_indices(&keys, &mut want, &mut scratch);
+                    }
+                    let case = format!("n = {n}, descending = {descending}, {tile_scan:?}");
+                    assert_eq!(perm, want, "{case}");
+                    let want_keys: Vec<u32> =
+                        want.iter().map(|&i| keys[i as usize].to_bits()).collect();
+                    let got_keys: Vec<u32> = sorted.iter().map(|k| k.to_bits()).collect();
+                    assert_eq!(
+                        got_keys, want_keys,
+                        "{case}: keys come back sorted, bit for bit"
+                    );
                 }
-                assert_eq!(perm, want, "n = {n}, descending = {descending}");
-                let want_keys: Vec<u32> =
-                    want.iter().map(|&i| keys[i as usize].to_bits()).collect();
-                let got_keys: Vec<u32> = sorted.iter().map(|k| k.to_bits()).collect();
-                assert_eq!(got_keys, want_keys, "keys come back sorted, bit for bit");
             }
         }
+        let expected = if gpu.adapter.device_type == "Cpu" {
+            TileScan::Serial
+        } else {
+            TileScan::PerDigit
+        };
+        assert_eq!(TileScan::for_adapter(&gpu), expected);
         assert_eq!(
             sort_blocking(&gpu, &[3.0, -1.0, 2.0]).unwrap(),
             vec![1, 2, 0]

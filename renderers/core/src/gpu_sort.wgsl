@@ -1,10 +1,15 @@
 // LSD radix sort of (key, value) u32 pairs on the GPU: four passes of 8 bits, each made of
-//   histogram  – per-workgroup (tile) digit counts,
-//   scan_tiles – per digit, the exclusive prefix over tiles, and the digit's total,
-//   scatter    – a stable scatter: tiles in order, and inside a tile sub-blocks of 256 keys in
-//                order, each key ranked among the equal digits of lower threads of its sub-block
-//                through per-digit thread bitsets (the "match" of Onesweep-style sorts, done with
-//                workgroup atomics because subgroup ballots are not portable).
+//   histogram   – per-workgroup (tile) digit counts,
+//   scan_tiles  – per digit, the exclusive prefix over tiles, and the digit's total: one
+//                 workgroup a digit scanning its tiles in parallel (a GPU's choice), or
+//   scan_digits – the same prefixes and totals from one workgroup, each invocation a digit
+//                 walking the tiles in order (a CPU backend's: it runs a workgroup on one core
+//                 and each barrier as a switch through all its invocations, so scan_tiles's 256
+//                 workgroups of 16 barriers were a fixed 12.5 ms a sort on lavapipe),
+//   scatter     – a stable scatter: tiles in order, and inside a tile sub-blocks of 256 keys in
+//                 order, each key ranked among the equal digits of lower threads of its
+//                 sub-block through per-digit thread bitsets (the "match" of Onesweep-style
+//                 sorts, done with workgroup atomics because subgroup ballots are not portable).
 // Keys arrive as f32 bits and are mapped to ordered u32 in the first pass (HAVS §5.1: flip the
 // sign bit of positives, all bits of negatives; complemented again for a descending sort); the
 // last pass maps them back, so the caller's key buffer ends sorted as f32.
@@ -75,6 +80,8 @@ var<workgroup> scan_buf: array<u32, 256>;
 // match_mask[d][w]: bit b set when thread 32 w + b of the current sub-block has digit d.
 var<workgroup> match_mask: array<array<atomic<u32>, 8>, 256>;
 var<workgroup> running: array<u32, 256>;
+// Keys of each digit in the current sub-block (scatter).
+var<workgroup> sub_count: array<atomic<u32>, 256>;
 
 // Inclusive Hillis–Steele scan over the workgroup (must be called in uniform control flow).
 fn workgroup_inclusive_scan(lid: u32, v: u32) -> u32 {
@@ -134,6 +141,20 @@ fn scan_tiles(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
     }
 }
 
+// One workgroup, invocation `lid` = digit: what scan_tiles computes, each digit's row of tile
+// counts walked in order (the row is contiguous, tile_hist[digit * num_tiles + tile]).
+@compute @workgroup_size(256)
+fn scan_digits(@builtin(local_invocation_index) lid: u32) {
+    let row = lid * params.num_tiles;
+    var sum = 0u;
+    for (var t = 0u; t < params.num_tiles; t = t + 1u) {
+        let c = tile_hist[row + t];
+        tile_hist[row + t] = sum;
+        sum = sum + c;
+    }
+    digit_total[lid] = sum;
+}
+
 @compute @workgroup_size(256)
 fn scatter(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>) {
     let tile = wid.x;
@@ -141,12 +162,15 @@ fn scatter(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid
     let total = digit_total[lid];
     let inc = workgroup_inclusive_scan(lid, total);
     running[lid] = inc - total + tile_hist[lid * params.num_tiles + tile];
+    // The bitsets start empty; each key clears its own bit after its sub-block, so they are
+    // empty again at the next (one atomic a key instead of eight stores an invocation).
+    for (var w = 0u; w < 8u; w = w + 1u) {
+        atomicStore(&match_mask[lid][w], 0u);
+    }
+    atomicStore(&sub_count[lid], 0u);
     let word = lid >> 5u;
     let bit = 1u << (lid & 31u);
     for (var s = 0u; s < SUB; s = s + 1u) {
-        for (var w = 0u; w < 8u; w = w + 1u) {
-            atomicStore(&match_mask[lid][w], 0u);
-        }
         workgroupBarrier();
         let i = tile * TILE + s * WG + lid;
         let valid = i < params.n;
@@ -167,14 +191,14 @@ fn scatter(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid
             let dst = running[d] + rank;
             keys_out_set(dst, store_key(key));
             vals_out_set(dst, vals_in_at(i));
+            // The digit's count in the sub-block is its highest rank + 1.
+            atomicMax(&sub_count[d], rank + 1u);
         }
         workgroupBarrier();
-        var count = 0u;
-        for (var w = 0u; w < 8u; w = w + 1u) {
-            count = count + countOneBits(atomicLoad(&match_mask[lid][w]));
+        if valid {
+            atomicAnd(&match_mask[d][word], ~bit);
         }
-        running[lid] = running[lid] + count;
-        workgroupBarrier();
+        running[lid] = running[lid] + atomicExchange(&sub_count[lid], 0u);
     }
 }
 
