@@ -32,21 +32,8 @@ pub fn projected_fragments(camera: &Camera, mesh: &datasets::TetMesh) -> u64 {
 
 /// [`projected_fragments`] and the tets that hold any of them.
 pub fn projected_work(camera: &Camera, mesh: &datasets::TetMesh) -> ProjectedWork {
-    let m = camera.view_proj_f32();
     let (w, h) = (camera.width as f64, camera.height as f64);
-    // Pixel coordinates (x right, y down) of every vertex, None at or behind the eye.
-    let screen: Vec<Option<[f64; 2]>> = mesh
-        .points
-        .par_iter()
-        .map(|p| {
-            let c: [f32; 4] =
-                std::array::from_fn(|r| m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r]);
-            (c[3] > 0.0).then(|| {
-                let (x, y) = ((c[0] / c[3]) as f64, (c[1] / c[3]) as f64);
-                [(x + 1.0) * 0.5 * w, (1.0 - y) * 0.5 * h]
-            })
-        })
-        .collect();
+    let screen = screen_points(camera, mesh);
     mesh.tets
         .par_iter()
         .map(|t| {
@@ -69,23 +56,102 @@ pub fn projected_work(camera: &Camera, mesh: &datasets::TetMesh) -> ProjectedWor
         })
 }
 
-/// [`projected_work`] of the last view asked for: a renderer derives its counters once per
-/// view, not once per frame.
-#[derive(Debug, Default)]
-pub struct FragmentsPerView {
-    last: Option<(Camera, ProjectedWork)>,
+/// Pixel coordinates (x right, y down) of every vertex of `mesh`, None at or behind the eye,
+/// with the shaders' f32 projection.
+fn screen_points(camera: &Camera, mesh: &datasets::TetMesh) -> Vec<Option<[f64; 2]>> {
+    let m = camera.view_proj_f32();
+    let (w, h) = (camera.width as f64, camera.height as f64);
+    mesh.points
+        .par_iter()
+        .map(|p| {
+            let c: [f32; 4] =
+                std::array::from_fn(|r| m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r]);
+            (c[3] > 0.0).then(|| {
+                let (x, y) = ((c[0] / c[3]) as f64, (c[1] / c[3]) as f64);
+                [(x + 1.0) * 0.5 * w, (1.0 - y) * 0.5 * h]
+            })
+        })
+        .collect()
 }
 
-impl FragmentsPerView {
-    pub fn get(&mut self, camera: &Camera, mesh: &datasets::TetMesh) -> ProjectedWork {
+/// The rasterisation work of drawing every face of a mesh once (HAVS draws its unique faces,
+/// one triangle each), counted on the CPU.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FaceWork {
+    /// Pixel centres inside the projections of all unique faces.
+    pub fragments: u64,
+    /// Unique faces whose projection holds at least one pixel centre: the triangles that yield
+    /// fragments, each costing the rasteriser more than one that yields none
+    /// (`covering_faces`; the roofline's `rasterisation` resource).
+    pub covering_faces: u64,
+}
+
+/// [`FaceWork`] of the faces [`datasets::TetMesh::unique_faces`] lists (a face shared by two
+/// tets once; faces with a vertex at or behind the eye count nothing).
+pub fn face_work(camera: &Camera, mesh: &datasets::TetMesh) -> FaceWork {
+    let (w, h) = (camera.width as f64, camera.height as f64);
+    let screen = screen_points(camera, mesh);
+    let adjacency = mesh.adjacency();
+    mesh.tets
+        .par_iter()
+        .zip(adjacency)
+        .enumerate()
+        .map(|(t, (tet, neighbours))| {
+            let mut work = FaceWork::default();
+            for (f, &n) in neighbours.iter().enumerate() {
+                // The owner's rule of `unique_faces`: a boundary face, or the lower tet's.
+                if n != datasets::NO_NEIGHBOUR && (n as usize) < t {
+                    continue;
+                }
+                let [a, b, c] = datasets::TET_FACES[f].map(|i| screen[tet[i] as usize]);
+                let (Some(a), Some(b), Some(c)) = (a, b, c) else {
+                    continue;
+                };
+                let n = hull_pixels(&[a, b, c, a], w, h);
+                work.fragments += n;
+                work.covering_faces += (n > 0) as u64;
+            }
+            work
+        })
+        .reduce(FaceWork::default, |a, b| FaceWork {
+            fragments: a.fragments + b.fragments,
+            covering_faces: a.covering_faces + b.covering_faces,
+        })
+}
+
+/// A value derived from a view, kept for the last view asked for: a renderer derives its
+/// counters once per view, not once per frame.
+#[derive(Debug)]
+pub struct PerView<T> {
+    last: Option<(Camera, T)>,
+}
+
+impl<T> Default for PerView<T> {
+    fn default() -> Self {
+        PerView { last: None }
+    }
+}
+
+impl<T: Copy> PerView<T> {
+    /// The value for `camera`: the kept one, or `derive()`'s, then kept.
+    pub fn get_or(&mut self, camera: &Camera, derive: impl FnOnce() -> T) -> T {
         match &self.last {
-            Some((c, w)) if c == camera => *w,
+            Some((c, v)) if c == camera => *v,
             _ => {
-                let w = projected_work(camera, mesh);
-                self.last = Some((camera.clone(), w));
-                w
+                let v = derive();
+                self.last = Some((camera.clone(), v));
+                v
             }
         }
+    }
+}
+
+/// [`projected_work`] of the last view asked for.
+pub type FragmentsPerView = PerView<ProjectedWork>;
+
+impl PerView<ProjectedWork> {
+    pub fn get(&mut self, camera: &Camera, mesh: &datasets::TetMesh) -> ProjectedWork {
+        self.get_or(camera, || projected_work(camera, mesh))
     }
 }
 
@@ -186,5 +252,55 @@ mod tests {
         let both = one(vec![[0, 1, 2, 3], [4, 5, 6, 7]]);
         assert_eq!(both.covering_tets, 1, "{both:?}");
         assert!(both.fragments <= big.fragments + 1, "{both:?}");
+    }
+
+    /// Two tets sharing a face: seven unique faces, the shared one counted once. Seen along
+    /// +z, faces that stand edge-on cover nothing, and the faces' fragments are the tets' hull
+    /// fragments counted once per face that lies over them (a pixel ray through a convex tet
+    /// crosses two of its faces).
+    #[test]
+    fn covering_faces_count_each_unique_face_once() {
+        let points: Vec<[f32; 3]> = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.2, 0.3, 1.0],
+            [0.3, 0.2, -1.0],
+        ];
+        let mesh = |tets: Vec<[u32; 4]>| {
+            datasets::TetMesh::new("pair", points.clone(), vec![0.0; points.len()], "s", tets)
+                .unwrap()
+        };
+        let vp = crate::Viewpoint::new("+z", [0.0, 0.0, 1.0]);
+        let one = mesh(vec![[0, 1, 2, 3]]);
+        let cam = Camera::fit(&one.bounds(), &vp, crate::Projection::Orthographic, 64, 64);
+        let w1 = face_work(&cam, &one);
+        // Seen from +z the apex projects inside the base: all four faces hold centres, and
+        // every centre of the base's triangle lies under exactly two of them, up to centres on
+        // the side faces' shared edges, where each face's own f64 crossing decides (one here).
+        assert_eq!(w1.covering_faces, 4, "{w1:?}");
+        let hull = projected_work(&cam, &one).fragments;
+        assert!(hull > 500, "{hull}");
+        assert!(
+            w1.fragments.abs_diff(2 * hull) <= 3,
+            "{w1:?} against 2 × {hull}"
+        );
+        let pair = mesh(vec![[0, 1, 2, 3], [0, 2, 1, 4]]);
+        let cam = Camera::fit(&pair.bounds(), &vp, crate::Projection::Orthographic, 64, 64);
+        let w2 = face_work(&cam, &pair);
+        assert_eq!(pair.unique_faces().faces.len(), 7);
+        assert_eq!(w2.covering_faces, 7, "{w2:?}");
+        // From +x, points 0 and 1 project onto one point: the base and the two side faces
+        // through edge 0–1 stand edge-on and cover nothing.
+        let side = crate::Viewpoint::new("+x", [1.0, 0.0, 0.0]);
+        let cam = Camera::fit(
+            &pair.bounds(),
+            &side,
+            crate::Projection::Orthographic,
+            64,
+            64,
+        );
+        let w3 = face_work(&cam, &pair);
+        assert_eq!(w3.covering_faces, 4, "{w3:?}");
     }
 }

@@ -84,7 +84,13 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     build: |s| Ok(Box::new(Havs::new(from_settings(s)?)) as Box<dyn Renderer>),
     hue: Hue::Oranges,
     tolerance,
-    counters: &["triangles", "fragments", "cpu_sort_keys", "gpu_sort_keys"],
+    counters: &[
+        "triangles",
+        "covering_faces",
+        "fragments",
+        "cpu_sort_keys",
+        "gpu_sort_keys",
+    ],
     nondeterministic_counters,
 };
 

@@ -419,6 +419,14 @@ impl State {
         counters.push(("faces".to_string(), self.num_faces as f64));
         // The roofline's work: every unique face is one triangle, and the sort orders them all.
         counters.push(("triangles".to_string(), self.num_faces as f64));
+        // Outside the timed frame, once per view: the faces whose projection holds a pixel
+        // centre, the triangles that yield fragments (each one costs the rasteriser more than
+        // its setup; the roofline's `rasterisation` resource).
+        let mesh = &self.host_mesh;
+        let faces = self
+            .face_work
+            .get_or(camera, || render_core::silhouette::face_work(camera, mesh));
+        counters.push(("covering_faces".to_string(), faces.covering_faces as f64));
         let sorted_on = if self.gpu_sort.is_some() {
             "gpu_sort_keys"
         } else {
@@ -511,5 +519,35 @@ mod tests {
                 counter(&no_et, "fragments")
             );
         }
+    }
+
+    /// `covering_faces`, derived on the CPU (render_core::silhouette::face_work), counts the
+    /// faces the GPU rasterises into fragments: the same derivation's fragments equal the
+    /// GPU's count of rasterised fragments (early termination off) up to centres on a face's
+    /// edge, and the faces that cover are fewer than the faces drawn and more than the
+    /// fragments' share of the largest face's.
+    #[test]
+    fn covering_faces_are_the_faces_the_gpu_rasterises() {
+        let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
+        let mesh = std::sync::Arc::new(datasets::generate::from_spec("shell:2k", 1).unwrap());
+        let vp = Viewpoint::new("oblique", [0.4, 0.6, 0.7]);
+        let cam = Camera::fit(&mesh.bounds(), &vp, Projection::default(), 64, 64);
+        let s = HavsSettings {
+            early_termination: false,
+            mode: Mode::RaceFree,
+            ..Default::default()
+        };
+        let (_, c) = render(&gpu, &mut Havs::new(s), &mesh, &cam);
+        let cpu = render_core::silhouette::face_work(&cam, &mesh);
+        assert_eq!(counter(&c, "covering_faces"), cpu.covering_faces as f64);
+        let gpu_fragments = counter(&c, "fragments");
+        let off = (gpu_fragments - cpu.fragments as f64).abs() / gpu_fragments;
+        assert!(off < 2e-3, "GPU {gpu_fragments} against CPU {cpu:?}");
+        let faces = counter(&c, "faces");
+        assert!(cpu.covering_faces as f64 <= faces, "{cpu:?} of {faces}");
+        assert!(
+            cpu.covering_faces as f64 > 0.5 * faces,
+            "{cpu:?} of {faces}"
+        );
     }
 }

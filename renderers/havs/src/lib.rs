@@ -293,6 +293,9 @@ struct State {
     centroids: Vec<[f32; 3]>,
     /// The mesh's bounding box: the per-pixel passes cover only its screen rectangle.
     bounds: datasets::Aabb,
+    /// The mesh, for the counters derived on the CPU once per view (`covering_faces`).
+    host_mesh: std::sync::Arc<TetMesh>,
+    face_work: render_core::silhouette::PerView<render_core::silhouette::FaceWork>,
     order: wgpu::Buffer,
     /// Face ranges of the order buffer that fit one storage binding each.
     chunks: Vec<std::ops::Range<u64>>,
@@ -566,6 +569,8 @@ impl Renderer for Havs {
             num_faces,
             centroids,
             bounds: mesh.bounds(),
+            host_mesh: mesh.clone(),
+            face_work: Default::default(),
             order,
             chunks,
             uniforms,
