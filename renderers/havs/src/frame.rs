@@ -524,8 +524,8 @@ mod tests {
     /// `covering_faces`, derived on the CPU (render_core::silhouette::face_work), counts the
     /// faces the GPU rasterises into fragments: the same derivation's fragments equal the
     /// GPU's count of rasterised fragments (early termination off) up to centres on a face's
-    /// edge, and the faces that cover are fewer than the faces drawn and more than the
-    /// fragments' share of the largest face's.
+    /// edge, and from this oblique view the faces that cover are at most the faces drawn (a
+    /// face counted twice would break it) and more than half of them.
     #[test]
     fn covering_faces_are_the_faces_the_gpu_rasterises() {
         let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
