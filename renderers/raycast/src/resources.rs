@@ -550,13 +550,13 @@ impl Target {
                 view_formats: &[],
             },
         )?;
-        let depth = depth_target(
+        let (_, depth_view) = bind::render_target(
             gpu,
             ledger,
             "raycast depth",
+            (width, height),
             depth_format(gpu).0,
-            width,
-            height,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
         )?;
         let layer_views: Vec<wgpu::TextureView> = (0..layer_slots)
             .map(|l| {
@@ -631,15 +631,15 @@ impl Target {
             mapped_at_creation: false,
         });
         let zcull = if pipes.tile_passes.is_some() {
-            let texture = depth_target(
+            let (_, view) = bind::render_target(
                 gpu,
                 ledger,
                 "raycast tile depth",
+                (width, height),
                 ZCULL_FORMAT,
-                width,
-                height,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
             )?;
-            Some(texture.create_view(&Default::default()))
+            Some(view)
         } else {
             None
         };
@@ -651,7 +651,7 @@ impl Target {
             aux,
             layers,
             layer_views,
-            depth_view: depth.create_view(&Default::default()),
+            depth_view,
             tile_rects,
             active_tiles,
             tile_counts,
@@ -663,33 +663,4 @@ impl Target {
             zcull,
         })
     }
-}
-
-/// A viewport-sized depth (and stencil) attachment, counted per frame.
-fn depth_target(
-    gpu: &Gpu,
-    ledger: &mut MemoryLedger,
-    label: &str,
-    format: wgpu::TextureFormat,
-    width: u32,
-    height: u32,
-) -> anyhow::Result<wgpu::Texture> {
-    ledger.texture(
-        gpu,
-        Lifetime::PerFrame,
-        &wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        },
-    )
 }
