@@ -87,7 +87,7 @@ fn variants() -> Vec<Box<dyn Renderer>> {
 /// concurrently (`renderers/havs/tests/racy_twin.rs`); a CPU adapter shades them in order.
 fn deterministic(renderer: &dyn Renderer, gpu: &Gpu) -> bool {
     let racy = renderer.algorithm() == "havs" && renderer.settings().is("mode", "fragment-race");
-    !racy || gpu.adapter.device_type == "Cpu" // wgpu::DeviceType::Cpu, as Debug
+    !racy || gpu.adapter.is_cpu()
 }
 
 /// Lowest PSNR accepted between the splatter's bricked and unbricked images (every other

@@ -22,6 +22,14 @@ pub struct AdapterDescription {
     pub driver_info: String,
 }
 
+impl AdapterDescription {
+    /// A CPU backend (`wgpu::DeviceType::Cpu`, recorded as its `Debug` name), such as
+    /// lavapipe: it runs a workgroup on one core and a shader's lanes as SIMD batches.
+    pub fn is_cpu(&self) -> bool {
+        self.device_type == "Cpu"
+    }
+}
+
 /// The device, its queue and what it can do.
 pub struct Gpu {
     pub device: wgpu::Device,

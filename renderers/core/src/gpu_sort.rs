@@ -86,7 +86,7 @@ pub enum TileScan {
 impl TileScan {
     /// `Serial` on a CPU adapter, `PerDigit` on a GPU.
     pub fn for_adapter(gpu: &Gpu) -> TileScan {
-        if gpu.adapter.device_type == "Cpu" {
+        if gpu.adapter.is_cpu() {
             TileScan::Serial
         } else {
             TileScan::PerDigit
@@ -220,11 +220,6 @@ impl GpuRadixSort {
     pub fn with_tile_scan(mut self, tile_scan: TileScan) -> GpuRadixSort {
         self.tile_scan = tile_scan;
         self
-    }
-
-    /// How this sorter computes each digit's prefix over tiles.
-    pub fn tile_scan(&self) -> TileScan {
-        self.tile_scan
     }
 
     /// The largest `n` this sorter takes.

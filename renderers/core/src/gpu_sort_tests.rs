@@ -67,7 +67,7 @@ fn gpu_radix_sort_agrees_with_cpu() {
             }
         }
     }
-    let expected = if gpu.adapter.device_type == "Cpu" {
+    let expected = if gpu.adapter.is_cpu() {
         TileScan::Serial
     } else {
         TileScan::PerDigit
@@ -77,6 +77,32 @@ fn gpu_radix_sort_agrees_with_cpu() {
         sort_blocking(&gpu, &[3.0, -1.0, 2.0]).unwrap(),
         vec![1, 2, 0]
     );
+}
+
+/// Usage of the key-pass tests' buffers: what the sort needs, and read back.
+fn test_usage() -> wgpu::BufferUsages {
+    REQUIRED_USAGE | wgpu::BufferUsages::COPY_SRC
+}
+
+/// `data` in a persistent buffer, as a key pass reads points and primitives.
+fn upload<T: bytemuck::Pod>(
+    gpu: &Gpu,
+    ledger: &mut MemoryLedger,
+    label: &str,
+    data: &[T],
+) -> anyhow::Result<wgpu::Buffer> {
+    let bytes = bytemuck::cast_slice(data);
+    ledger.buffer_init(gpu, label, Lifetime::Persistent, bytes, test_usage())
+}
+
+/// A per-frame array of `n` keys or ids.
+fn per_element(
+    gpu: &Gpu,
+    ledger: &mut MemoryLedger,
+    label: &str,
+    n: u32,
+) -> anyhow::Result<wgpu::Buffer> {
+    ledger.buffer(gpu, label, Lifetime::PerFrame, n as u64 * 4, test_usage())
 }
 
 /// A lattice of `dims` points (xyz; `w` in the fourth lane), its tets and its bounds: the
@@ -104,23 +130,10 @@ fn gpu_centroid_keys_then_sort_match_the_cpu() -> anyhow::Result<()> {
     let (pts, tets, bounds) = lattice([9, 8, 7], 7.0);
     let n = tets.len() as u32;
     let mut ledger = MemoryLedger::default();
-    let storage = REQUIRED_USAGE | wgpu::BufferUsages::COPY_SRC;
-    let pbuf = ledger.buffer_init(
-        &gpu,
-        "points",
-        Lifetime::Persistent,
-        bytemuck::cast_slice(&pts),
-        storage,
-    )?;
-    let tbuf = ledger.buffer_init(
-        &gpu,
-        "tets",
-        Lifetime::Persistent,
-        bytemuck::cast_slice(&tets),
-        storage,
-    )?;
-    let kbuf = ledger.buffer(&gpu, "keys", Lifetime::PerFrame, n as u64 * 4, storage)?;
-    let vbuf = ledger.buffer(&gpu, "values", Lifetime::PerFrame, n as u64 * 4, storage)?;
+    let pbuf = upload(&gpu, &mut ledger, "points", &pts)?;
+    let tbuf = upload(&gpu, &mut ledger, "tets", &tets)?;
+    let kbuf = per_element(&gpu, &mut ledger, "keys", n)?;
+    let vbuf = per_element(&gpu, &mut ledger, "values", n)?;
     let keys_pass = GpuCentroidKeys::new(&gpu, &mut ledger).unwrap();
     let sorter = GpuRadixSort::new(&gpu, n, &mut ledger).unwrap();
     for (vi, vp) in fixed_viewpoints().iter().enumerate().step_by(3) {
@@ -185,34 +198,13 @@ fn a_key_pass_over_split_primitives_equals_one_over_the_whole() -> anyhow::Resul
     let (pts, tets, bounds) = lattice([7, 6, 5], 1.0);
     let n = tets.len() as u32;
     let mut ledger = MemoryLedger::default();
-    let usage = REQUIRED_USAGE | wgpu::BufferUsages::COPY_SRC;
-    let pbuf = ledger.buffer_init(
-        &gpu,
-        "points",
-        Lifetime::Persistent,
-        bytemuck::cast_slice(&pts),
-        usage,
-    )?;
-    let whole = ledger.buffer_init(
-        &gpu,
-        "tets",
-        Lifetime::Persistent,
-        bytemuck::cast_slice(&tets),
-        usage,
-    )?;
+    let pbuf = upload(&gpu, &mut ledger, "points", &pts)?;
+    let whole = upload(&gpu, &mut ledger, "tets", &tets)?;
     // Three pieces of unequal length, as a caller's chunks of one storage binding each.
     let cuts = [0, 100, 333, n as usize];
     let pieces: Vec<wgpu::Buffer> = cuts
         .windows(2)
-        .map(|w| {
-            ledger.buffer_init(
-                &gpu,
-                "tet piece",
-                Lifetime::Persistent,
-                bytemuck::cast_slice(&tets[w[0]..w[1]]),
-                usage,
-            )
-        })
+        .map(|w| upload(&gpu, &mut ledger, "tet piece", &tets[w[0]..w[1]]))
         .collect::<anyhow::Result<_>>()?;
     let ranges: Vec<KeyRange> = pieces
         .iter()
@@ -223,14 +215,11 @@ fn a_key_pass_over_split_primitives_equals_one_over_the_whole() -> anyhow::Resul
             count: (w[1] - w[0]) as u32,
         })
         .collect();
-    let out = |ledger: &mut MemoryLedger, label| {
-        ledger.buffer(&gpu, label, Lifetime::PerFrame, n as u64 * 4, usage)
-    };
     let (k1, v1, k3, v3) = (
-        out(&mut ledger, "k1")?,
-        out(&mut ledger, "v1")?,
-        out(&mut ledger, "k3")?,
-        out(&mut ledger, "v3")?,
+        per_element(&gpu, &mut ledger, "k1", n)?,
+        per_element(&gpu, &mut ledger, "v1", n)?,
+        per_element(&gpu, &mut ledger, "k3", n)?,
+        per_element(&gpu, &mut ledger, "v3", n)?,
     );
     let one = GpuCentroidKeys::new(&gpu, &mut ledger)?;
     let three = GpuCentroidKeys::with_calls(&gpu, 3, &mut ledger)?;

@@ -152,7 +152,7 @@ fn the_racy_single_pass_counts_what_its_cpu_twin_counts_per_pixel() {
             "{what}: race-free"
         );
 
-        let sequential = gpu.adapter.device_type == "Cpu";
+        let sequential = gpu.adapter.is_cpu();
         let mut wrong = vec![];
         for (i, (g, t)) in got.iter().zip(&twin).enumerate() {
             // The atomic count of fragments shaded is exact everywhere.

@@ -491,7 +491,7 @@ impl Splat {
         if let Some(lanes) = self.forced_lanes {
             return lanes.max(1);
         }
-        if gpu.adapter.device_type == "Cpu" {
+        if gpu.adapter.is_cpu() {
             return 1;
         }
         // The frame's own projection constants, as the shaders get them (any brick's).
