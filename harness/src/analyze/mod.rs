@@ -14,6 +14,7 @@ use clap::Subcommand;
 use crate::papers::fragment_pt::fig8;
 use crate::papers::havs::analysis;
 
+pub mod peers;
 pub mod summary;
 
 /// What every analysis may need from the global options.
@@ -35,6 +36,10 @@ pub enum AnalyzeCommand {
     Sort(analysis::SortArgs),
     /// HAVS Table 2 and Fig. 6: exact A-buffer analysis of how large the k-buffer must be.
     Kbuffer(analysis::KbufferArgs),
+    /// Every variant's tets/s against each peer's in the same run (one input a run: run
+    /// directories or results CSVs), and targets on those ratios judged by a rule file
+    /// (`--targets docs/targets/issue-43.json`), each beside the ratio its roofline allows.
+    Peers(peers::Args),
 }
 
 pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
@@ -43,5 +48,6 @@ pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
         AnalyzeCommand::Resolution(args) => fig8::run_resolution(*args, ctx.data_dir.clone()),
         AnalyzeCommand::Sort(args) => analysis::run_sort(args),
         AnalyzeCommand::Kbuffer(args) => analysis::run_kbuffer(args, ctx.data_dir.clone()),
+        AnalyzeCommand::Peers(args) => peers::run(args),
     }
 }

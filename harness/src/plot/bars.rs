@@ -123,11 +123,12 @@ impl Chart for Bars<'_> {
                     continue;
                 };
                 let Some(mean) = r.mean else { continue };
-                let v = Spread {
-                    mean: mean * self.scale,
-                    min: r.min.unwrap_or(mean) * self.scale,
-                    max: r.max.unwrap_or(mean) * self.scale,
-                };
+                // The bar at the mean, the whisker over the viewpoints' range.
+                let (height, low, high) = (
+                    mean * self.scale,
+                    r.min.unwrap_or(mean) * self.scale,
+                    r.max.unwrap_or(mean) * self.scale,
+                );
                 let x0 = gi as f64 + 0.1 + si as f64 * bar;
                 let x1 = x0 + bar * 0.9;
                 let xc = 0.5 * (x0 + x1);
@@ -138,23 +139,23 @@ impl Chart for Bars<'_> {
                 };
                 chart
                     .draw_series(std::iter::once(Rectangle::new(
-                        [(x0, 0.0), (x1, v.mean)],
+                        [(x0, 0.0), (x1, height)],
                         fill,
                     )))
                     .map_err(err)?;
-                if v.max > v.min {
+                if high > low {
                     let cap = bar * 0.2;
                     let k = BLACK.stroke_width(1);
                     chart
                         .draw_series([
-                            PathElement::new(vec![(xc, v.min), (xc, v.max)], k),
-                            PathElement::new(vec![(xc - cap, v.min), (xc + cap, v.min)], k),
-                            PathElement::new(vec![(xc - cap, v.max), (xc + cap, v.max)], k),
+                            PathElement::new(vec![(xc, low), (xc, high)], k),
+                            PathElement::new(vec![(xc - cap, low), (xc + cap, low)], k),
+                            PathElement::new(vec![(xc - cap, high), (xc + cap, high)], k),
                         ])
                         .map_err(err)?;
                 }
                 // Shades repeat within a family; the marker on the bar tells variants apart.
-                let top = chart.backend_coord(&(xc, v.mean));
+                let top = chart.backend_coord(&(xc, height));
                 let r = ((chart.backend_coord(&(x1, 0.0)).0 - chart.backend_coord(&(x0, 0.0)).0)
                     / 3)
                 .clamp(3, 7);
@@ -166,8 +167,8 @@ impl Chart for Bars<'_> {
                         .pos(Pos::new(HPos::Center, VPos::Bottom));
                     chart
                         .draw_series(std::iter::once(Text::new(
-                            short_number(v.mean),
-                            (xc, v.max.max(v.mean) + ymax * 0.01),
+                            short_number(height),
+                            (xc, high.max(height) + ymax * 0.01),
                             ts,
                         )))
                         .map_err(err)?;

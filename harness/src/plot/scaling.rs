@@ -222,11 +222,7 @@ pub fn write(
                     .iter()
                     .map(|p| LinePoint {
                         x: p.tets as f64,
-                        y: p.gpu_bytes.map(|b| Spread {
-                            mean: b as f64,
-                            min: b as f64,
-                            max: b as f64,
-                        }),
+                        y: p.gpu_bytes.map(|b| Spread::single(b as f64)),
                     })
                     .collect(),
                 extra: exponent_text(fit.gpu_bytes_exponent) + &failed_note,

@@ -484,11 +484,7 @@ mod tests {
     }
 
     fn point(algorithm: &str, settings: &str, speed: f64, psnr: f64) -> Point {
-        let spread = |v: f64| crate::results::stats::Spread {
-            mean: v,
-            min: v,
-            max: v,
-        };
+        let spread = crate::results::stats::Spread::single;
         Point {
             algorithm: algorithm.into(),
             settings: settings.into(),

@@ -74,6 +74,9 @@ pub struct Aggregate {
     pub gpu_ms: Option<Spread>,
     pub fps: Option<Spread>,
     pub tets_per_sec: Option<Spread>,
+    /// The tets/s each row would read at its roofline (`tets / roofline_ms`): the fastest the
+    /// backend's calibrated peaks allow for the work the row reported (docs/roofline.md).
+    pub bound_tets_per_sec: Option<Spread>,
     pub psnr_db: Option<Spread>,
     pub rmse: Option<Spread>,
     pub bad_pixel_share: Option<Spread>,
@@ -151,6 +154,11 @@ pub fn aggregate(rows: &[Row]) -> Vec<Aggregate> {
                 gpu_ms: spread(g.iter().filter_map(|r| r.gpu_ms)),
                 fps: spread(g.iter().filter_map(|r| r.fps)),
                 tets_per_sec: spread(g.iter().filter_map(|r| r.tets_per_sec)),
+                bound_tets_per_sec: spread(g.iter().filter_map(|r| {
+                    r.roofline_ms
+                        .filter(|&ms| ms > 0.0)
+                        .map(|ms| r.tets as f64 / (ms * 1e-3))
+                })),
                 psnr_db: spread(g.iter().filter_map(|r| r.psnr_db)),
                 rmse: spread(g.iter().filter_map(|r| r.rmse)),
                 bad_pixel_share: spread(g.iter().filter_map(|r| r.bad_pixel_share)),

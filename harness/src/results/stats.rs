@@ -108,12 +108,25 @@ fn u_distribution(m: usize, n: usize) -> Vec<f64> {
     std::mem::take(&mut table[m][n])
 }
 
-/// Mean, minimum and maximum over the viewpoints of a group.
+/// Mean, median, minimum and maximum over the viewpoints of a group.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Spread {
     pub mean: f64,
+    pub median: f64,
     pub min: f64,
     pub max: f64,
+}
+
+impl Spread {
+    /// One value: every statistic is that value (a plot's single point).
+    pub fn single(v: f64) -> Spread {
+        Spread {
+            mean: v,
+            median: v,
+            min: v,
+            max: v,
+        }
+    }
 }
 
 pub fn spread(values: impl Iterator<Item = f64>) -> Option<Spread> {
@@ -123,6 +136,7 @@ pub fn spread(values: impl Iterator<Item = f64>) -> Option<Spread> {
     }
     Some(Spread {
         mean: v.iter().sum::<f64>() / v.len() as f64,
+        median: median(&v),
         min: v.iter().copied().fold(f64::INFINITY, f64::min),
         max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
     })
