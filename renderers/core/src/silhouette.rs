@@ -135,14 +135,28 @@ impl<T> Default for PerView<T> {
 impl<T: Copy> PerView<T> {
     /// The value for `camera`: the kept one, or `derive()`'s, then kept.
     pub fn get_or(&mut self, camera: &Camera, derive: impl FnOnce() -> T) -> T {
-        match &self.last {
-            Some((c, v)) if c == camera => *v,
-            _ => {
+        match self.kept(camera) {
+            Some(v) => v,
+            None => {
                 let v = derive();
-                self.last = Some((camera.clone(), v));
+                self.keep(camera, v);
                 v
             }
         }
+    }
+
+    /// The kept value, if it was kept for `camera` (a value derived with the GPU, which a
+    /// closure borrowing the renderer cannot derive inside [`PerView::get_or`]).
+    pub fn kept(&self, camera: &Camera) -> Option<T> {
+        match &self.last {
+            Some((c, v)) if c == camera => Some(*v),
+            _ => None,
+        }
+    }
+
+    /// Keeps `v` as the value for `camera`.
+    pub fn keep(&mut self, camera: &Camera, v: T) {
+        self.last = Some((camera.clone(), v));
     }
 }
 

@@ -16,6 +16,42 @@ use super::{
     TagScheme, Target, Uniforms, KEY_MESH_BINDING, MESH_BINDING,
 };
 
+/// Which fragment program a frame draws with (`mode=fragment-race`; the race-free mode has one).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Draw {
+    /// `fs_kbuffer`, the paper's program: what the timed frames run.
+    Timed,
+    /// `fs_kbuffer_counting`: the same with the row's per-pixel counts, once per view.
+    Counting,
+}
+
+/// The row's counters from the GPU's `counters` words of a counting frame.
+pub(super) fn gpu_counters(mode: Mode, c: &[u32; 8]) -> Vec<(String, f64)> {
+    let mut counters = vec![
+        ("fragments".to_string(), c[0] as f64),
+        ("kbuffer_out_of_order".to_string(), c[1] as f64),
+        // Fragments that reached an opaque pixel and were dropped before the k-buffer and
+        // the table (early ray termination, §4).
+        ("et_culled_fragments".to_string(), c[4] as f64),
+    ];
+    match mode {
+        Mode::RaceFree => {
+            counters.push(("lists_over_512".to_string(), c[2] as f64));
+            counters.push(("nodes".to_string(), c[3] as f64));
+        }
+        // Fragments whose read-modify-write of their pixel another fragment overwrote (the
+        // race the paper accepted, §4): shaded (an exact atomic count per pixel) less what
+        // the racy per-pixel counts kept. 0 where fragments of a pixel run one after the
+        // other (lavapipe); their k-buffer updates were lost too, so `fragments` is short
+        // by this much. Counted in the view's counting frame, whose race is not the timed
+        // frames' on a GPU.
+        Mode::FragmentRace => {
+            counters.push(("race_lost_updates".to_string(), c[5] as f64));
+        }
+    }
+    counters
+}
+
 impl GpuSortState {
     pub(super) fn new(
         gpu: &Gpu,
@@ -250,12 +286,20 @@ impl State {
         Ok(())
     }
 
+    /// One frame of `camera`, drawn with the timed program or the counting one; its stats
+    /// (without the GPU's counts) and the GPU's `counters` words, which mean something only
+    /// after a counting draw.
     pub(super) fn frame(
         &mut self,
         gpu: &Gpu,
         s: HavsSettings,
         camera: &Camera,
-    ) -> anyhow::Result<FrameStats> {
+        draw: Draw,
+    ) -> anyhow::Result<(FrameStats, [u32; 8])> {
+        let pipeline = match (draw, &self.counting_pipeline) {
+            (Draw::Counting, Some(counting)) => counting,
+            _ => &self.draw_pipeline,
+        };
         let eye = camera.eye.map(|c| c as f32);
         let fwd = camera.forward().map(|c| c as f32);
         let persp = camera.is_perspective();
@@ -372,7 +416,7 @@ impl State {
                     false,
                     None,
                 );
-                pass.set_pipeline(&self.draw_pipeline);
+                pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, bg, &[]);
                 render_core::bind::draw_in_slices(&mut pass, slice);
             }
@@ -394,29 +438,9 @@ impl State {
         let times = clock.finish();
         let gpu_ms = self.timer.gpu_ms(gpu)?;
         let c = gpu.read_buffer(&self.counters, 0, 32)?;
-        let c: &[u32] = bytemuck::cast_slice(&c);
-        let mut counters = vec![
-            ("fragments".to_string(), c[0] as f64),
-            ("kbuffer_out_of_order".to_string(), c[1] as f64),
-            // Fragments that reached an opaque pixel and were dropped before the k-buffer and
-            // the table (early ray termination, §4).
-            ("et_culled_fragments".to_string(), c[4] as f64),
-        ];
-        match s.mode {
-            Mode::RaceFree => {
-                counters.push(("lists_over_512".to_string(), c[2] as f64));
-                counters.push(("nodes".to_string(), c[3] as f64));
-            }
-            // Fragments whose read-modify-write of their pixel another fragment overwrote (the
-            // race the paper accepted, §4): shaded (an exact atomic count per pixel) less what
-            // the racy per-pixel counts kept. 0 where fragments of a pixel run one after the
-            // other (lavapipe); their k-buffer updates were lost too, so `fragments` is short
-            // by this much.
-            Mode::FragmentRace => {
-                counters.push(("race_lost_updates".to_string(), c[5] as f64));
-            }
-        }
-        counters.push(("faces".to_string(), self.num_faces as f64));
+        let c: [u32; 8] = bytemuck::pod_read_unaligned(&c);
+        self.last_frame_counted = draw == Draw::Counting;
+        let mut counters = vec![("faces".to_string(), self.num_faces as f64)];
         // The roofline's work: every unique face is one triangle, and the sort orders them all.
         counters.push(("triangles".to_string(), self.num_faces as f64));
         // Outside the timed frame, once per view: the faces whose projection holds a pixel
@@ -441,7 +465,7 @@ impl State {
             "mesh_bindings".to_string(),
             (self.verts.bindings() + self.faces.bindings()) as f64,
         ));
-        Ok(times.stats(gpu_ms, self.ledger.per_frame, counters))
+        Ok((times.stats(gpu_ms, self.ledger.per_frame, counters), c))
     }
 }
 
@@ -519,6 +543,62 @@ mod tests {
                 counter(&no_et, "fragments")
             );
         }
+    }
+
+    /// The timed frames draw with the paper's program, which counts nothing; the first render
+    /// of a view adds one counting frame. The two programs make the same image bit for bit
+    /// (where fragments of a pixel run in order: lavapipe; on a GPU both race), the counts of
+    /// a view are kept for its later frames, and a new view counts again. With early
+    /// termination the counts move fragments from `fragments` to `et_culled_fragments`.
+    #[test]
+    fn timed_frames_count_nothing_and_keep_the_view_s_counts() {
+        let gpu = Gpu::new().expect("a wgpu adapter (install mesa-vulkan-drivers)");
+        let mesh = std::sync::Arc::new(datasets::generate::from_spec("shell:2k", 1).unwrap());
+        let views = [[0.4, 0.6, 0.7], [-0.8, 0.1, 0.3]];
+        let cams: Vec<Camera> = views
+            .iter()
+            .map(|&d| {
+                let vp = Viewpoint::new("oblique", d);
+                Camera::fit(&mesh.bounds(), &vp, Projection::default(), 64, 64)
+            })
+            .collect();
+        let mut r = Havs::new(HavsSettings::default());
+        let (first, counted) = render(&gpu, &mut r, &mesh, &cams[0]);
+        assert!(
+            r.read_pixel_counts(&gpu).is_ok(),
+            "the first render ends counting"
+        );
+        let timed = r.render(&gpu, &cams[0]).unwrap();
+        let again = r.read_image(&gpu).unwrap();
+        assert!(
+            r.read_pixel_counts(&gpu).is_err(),
+            "a second render of the view is one timed frame"
+        );
+        assert_eq!(first.pixels, again.pixels, "counting and timed programs");
+        assert!(first.pixels.iter().any(|p| p[3] > 0.1));
+        assert_eq!(counted, timed.counters);
+        assert!(counter(&counted, "fragments") > 1000.0, "{counted:?}");
+
+        let other = r.render(&gpu, &cams[1]).unwrap();
+        assert!(r.read_pixel_counts(&gpu).is_ok(), "a new view counts again");
+        assert_ne!(
+            counter(&other.counters, "fragments"),
+            counter(&counted, "fragments")
+        );
+        let (_, no_et) = render(
+            &gpu,
+            &mut Havs::new(HavsSettings {
+                early_termination: false,
+                ..Default::default()
+            }),
+            &mesh,
+            &cams[0],
+        );
+        assert_eq!(counter(&no_et, "et_culled_fragments"), 0.0);
+        assert_eq!(
+            counter(&counted, "fragments") + counter(&counted, "et_culled_fragments"),
+            counter(&no_et, "fragments")
+        );
     }
 
     /// `covering_faces`, derived on the CPU (render_core::silhouette::face_work), counts the

@@ -4,7 +4,8 @@
 // Faithful mode (§4, Fig. 5): vs + fs_kbuffer draw the faces in sorted order; each fragment
 // reads the pixel's k-buffer from storage, runs kb_insert and writes it back. Fragments of one
 // pixel may be shaded concurrently, so this read-modify-write races exactly as the paper's
-// render-to-texture did; `drain` then empties each pixel's k-buffer.
+// render-to-texture did; `drain` then empties each pixel's k-buffer. fs_kbuffer_counting is
+// the same with the row's per-pixel counts, drawn in an untimed frame once per view.
 // Race-free mode: vs + fs_append store every fragment with its submission index (its face's
 // place in the sorted order) in per-pixel linked lists; `resolve_lists` sorts each list by
 // submission index and streams it through the same k-buffer.
@@ -123,16 +124,22 @@ fn pixel_index(pos: vec4<f32>) -> u32 {
     return px.y * u.width + px.x;
 }
 
-fn load_state(p: u32) -> KState {
+// The pixel's k-buffer as the fragment reads it: `color` and `last_back` from its record, the
+// K entries from `kentries`.
+fn load_entries(p: u32, color: vec4<f32>, last_back: f32) -> KState {
     var st: KState;
-    st.color = pixels[p].color;
-    st.last_back = bitcast<f32>(pixels[p].info.x);
+    st.color = color;
+    st.last_back = last_back;
     st.errors = 0u;
     for (var i = 0u; i < K; i++) {
         let e = kentries[p * K + i];
         st.e[i] = select(e, vec2<f32>(0.0, KB_EMPTY), e.y == 0.0);
     }
     return st;
+}
+
+fn load_state(p: u32) -> KState {
+    return load_entries(p, pixels[p].color, bitcast<f32>(pixels[p].info.x));
 }
 
 fn store_entries(p: u32, st: ptr<function, KState>) {
@@ -142,22 +149,41 @@ fn store_entries(p: u32, st: ptr<function, KState>) {
     }
 }
 
-// Faithful single pass: read, insert, write back (racing with other fragments of the pixel).
+// Faithful single pass, the paper's fragment program (§4): read the pixel's k-buffer, insert,
+// write it back, racing with other fragments of the pixel. Early ray termination reads the
+// pixel's opacity first and stops above the threshold, before the k-buffer is read or the
+// table sampled. The timed frames run this; it counts nothing.
 @fragment
 fn fs_kbuffer(in: VOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let p = pixel_index(in.pos);
-    // Not the paper's: an exact count of the pixel's fragments, against which the drain pass
-    // measures the updates the race lost (`race_lost_updates`).
-    atomicAdd(&heads[p], 1u);
-    // §4, early ray termination as the paper's fragment program does it: read the pixel's
-    // accumulated opacity first and stop above the threshold, before the k-buffer is read or
-    // the table sampled. Culled fragments are counted (racing like the other per-pixel counts).
-    if early_termination() && pixels[p].color.a >= u.et_alpha {
-        pixels[p].info.w += 1u;
+    let color = pixels[p].color;
+    if early_termination() && color.a >= u.et_alpha {
         return vec4<f32>(0.0);
     }
-    var st = load_state(p);
+    var st = load_entries(p, color, bitcast<f32>(pixels[p].info.x));
+    kb_insert(&st, fragment_entry(in.world, in.v, front_facing), two_tags());
+    store_entries(p, &st);
+    pixels[p].color = st.color;
+    pixels[p].info.x = bitcast<u32>(st.last_back);
+    return vec4<f32>(0.0);
+}
+
+// The same program with the row's counts (not the paper's), run in one untimed frame per view:
+// per pixel the fragments the k-buffer took in (`info.y`), its out-of-order pops (`info.z`),
+// the fragments early termination culled (`info.w`), all racing like the k-buffer itself, and
+// the exact atomic count of fragments shaded (`heads`), against which the drain measures the
+// updates the race lost (`race_lost_updates`). Its image is the timed program's.
+@fragment
+fn fs_kbuffer_counting(in: VOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let p = pixel_index(in.pos);
+    atomicAdd(&heads[p], 1u);
+    let color = pixels[p].color;
     let info = pixels[p].info;
+    if early_termination() && color.a >= u.et_alpha {
+        pixels[p].info.w = info.w + 1u;
+        return vec4<f32>(0.0);
+    }
+    var st = load_entries(p, color, bitcast<f32>(info.x));
     kb_insert(&st, fragment_entry(in.world, in.v, front_facing), two_tags());
     store_entries(p, &st);
     pixels[p].color = st.color;

@@ -17,6 +17,7 @@
 pub mod abuffer;
 mod description;
 mod frame;
+use frame::Draw;
 pub mod kbuffer;
 
 use anyhow::{bail, Context};
@@ -154,16 +155,23 @@ impl Havs {
         self.state.as_ref().map(|s| &s.ledger)
     }
 
-    /// Per pixel of the last frame (row-major), as `fs_kbuffer` counted them in
+    /// Per pixel of the last frame (row-major), as `fs_kbuffer_counting` counted them in
     /// `mode=fragment-race`: `[fragments the k-buffer took in, out-of-order pops before the
     /// drain pass, fragments shaded]` (`Pixel.info.y`, `.z` of `havs.wgsl`, racing, and the
-    /// exact atomic count in `heads`). For the test that holds the racy pass to its CPU twin
+    /// exact atomic count in `heads`). The last frame must be a counting frame: the first
+    /// `render` of a view ends with one. For the test that holds the racy pass to its CPU twin
     /// ([`kbuffer`]); race-free mode keeps no per-pixel counts (zeros and list heads).
     pub fn read_pixel_counts(&self, gpu: &Gpu) -> anyhow::Result<Vec<[u32; 3]>> {
-        let t = self
+        let st = self
             .state
             .as_ref()
-            .and_then(|s| s.target.as_ref())
+            .context("HAVS: read_pixel_counts before prepare")?;
+        if !st.last_frame_counted {
+            bail!("HAVS: the last frame counted nothing (only the first render of a view counts)");
+        }
+        let t = st
+            .target
+            .as_ref()
             .context("HAVS: read_pixel_counts before render")?;
         let n = t.width as u64 * t.height as u64;
         let bytes = gpu.read_buffer(&t.pixels, 0, n * 32)?;
@@ -304,6 +312,14 @@ struct State {
     table: TableTexture,
     layout: wgpu::BindGroupLayout,
     draw_pipeline: wgpu::RenderPipeline,
+    /// `mode=fragment-race`: the draw with the row's per-pixel counts (`fs_kbuffer_counting`),
+    /// run in one untimed frame per view; the timed frames draw with `fs_kbuffer`, the
+    /// paper's program, which counts nothing.
+    counting_pipeline: Option<wgpu::RenderPipeline>,
+    /// The counts of the last view's counting frame (`counters` of havs.wgsl).
+    counts: render_core::silhouette::PerView<[u32; 8]>,
+    /// Whether the last frame drawn was a counting frame (its per-pixel counts are readable).
+    last_frame_counted: bool,
     drain_pipeline: wgpu::ComputePipeline,
     max_len: f32,
     n_s: u32,
@@ -527,16 +543,21 @@ impl Renderer for Havs {
         };
         // Every face is needed from both sides (entry and exit of a ray). wgpu needs an attachment;
         // the k-buffer lives in storage, so nothing is written to it.
-        let draw_pipeline = gpu.triangle_pipeline(
-            "havs draw",
-            &pipeline_layout,
-            &module,
-            "vs",
-            fs_entry,
-            wgpu::TextureFormat::R8Unorm,
-            None,
-            wgpu::ColorWrites::empty(),
-        );
+        let draw = |label: &str, entry: &str| {
+            gpu.triangle_pipeline(
+                label,
+                &pipeline_layout,
+                &module,
+                "vs",
+                entry,
+                wgpu::TextureFormat::R8Unorm,
+                None,
+                wgpu::ColorWrites::empty(),
+            )
+        };
+        let draw_pipeline = draw("havs draw", fs_entry);
+        let counting_pipeline = (s.mode == Mode::FragmentRace)
+            .then(|| draw("havs draw, counting", "fs_kbuffer_counting"));
         let drain_pipeline = gpu.compute_pipeline(
             "havs drain",
             Some(&pipeline_layout),
@@ -578,6 +599,9 @@ impl Renderer for Havs {
             table,
             layout,
             draw_pipeline,
+            counting_pipeline,
+            counts: Default::default(),
+            last_frame_counted: false,
             drain_pipeline,
             max_len: max_len as f32,
             n_s,
@@ -602,20 +626,36 @@ impl Renderer for Havs {
         let (w, h) = (camera.width, camera.height);
         st.ensure_target(gpu, settings, w, h, None)?;
         loop {
-            let stats = st.frame(gpu, settings, camera)?;
+            let (mut stats, counts) = match settings.mode {
+                // The race-free mode's counts are its lists, made in its own frame.
+                Mode::RaceFree => st.frame(gpu, settings, camera, Draw::Counting)?,
+                // The timed frame draws with the paper's program; the counts come from one
+                // counting frame of the same view, after it and outside its clock (the
+                // harness books that time as its own, `harness_ms`).
+                Mode::FragmentRace => {
+                    let (stats, _) = st.frame(gpu, settings, camera, Draw::Timed)?;
+                    let counts = match st.counts.kept(camera) {
+                        Some(c) => c,
+                        None => {
+                            let (_, c) = st.frame(gpu, settings, camera, Draw::Counting)?;
+                            st.counts.keep(camera, c);
+                            c
+                        }
+                    };
+                    (stats, counts)
+                }
+            };
             // Race-free mode: the node pool was too small for this view's fragments. Grow it
             // and render the frame again (the first frame of a new view pays this once).
-            let needed = stats
-                .counters
-                .iter()
-                .find(|(n, _)| n == "nodes")
-                .map(|c| c.1 as u64)
-                .unwrap_or(0);
+            let needed = counts[3] as u64;
             let cap = st.target.as_ref().map(|t| t.node_capacity).unwrap_or(0);
             if settings.mode == Mode::RaceFree && needed > cap {
                 st.ensure_target(gpu, settings, w, h, Some(needed + needed / 4))?;
                 continue;
             }
+            stats
+                .counters
+                .splice(0..0, frame::gpu_counters(settings.mode, &counts));
             return Ok(stats);
         }
     }
