@@ -152,7 +152,8 @@ fn store_entries(p: u32, st: ptr<function, KState>) {
 // Faithful single pass, the paper's fragment program (§4): read the pixel's k-buffer, insert,
 // write it back, racing with other fragments of the pixel. Early ray termination reads the
 // pixel's opacity first and stops above the threshold, before the k-buffer is read or the
-// table sampled. The timed frames run this; it counts nothing.
+// table sampled. The timed frames run this; it counts nothing, so it neither reads nor keeps
+// the depth of the last segment, which only the count of out-of-order pops uses (kb_emit).
 @fragment
 fn fs_kbuffer(in: VOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let p = pixel_index(in.pos);
@@ -160,11 +161,10 @@ fn fs_kbuffer(in: VOut, @builtin(front_facing) front_facing: bool) -> @location(
     if early_termination() && color.a >= u.et_alpha {
         return vec4<f32>(0.0);
     }
-    var st = load_entries(p, color, bitcast<f32>(pixels[p].info.x));
+    var st = load_entries(p, color, 0.0);
     kb_insert(&st, fragment_entry(in.world, in.v, front_facing), two_tags());
     store_entries(p, &st);
     pixels[p].color = st.color;
-    pixels[p].info.x = bitcast<u32>(st.last_back);
     return vec4<f32>(0.0);
 }
 
