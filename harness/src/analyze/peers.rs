@@ -347,6 +347,52 @@ pub fn target_table(source: &str, cells: &[Cell]) -> String {
     md
 }
 
+/// Where several runs judged one target on one data set: how many met it, and the spread of
+/// their ratios. Each run's verdict stands on its own; this says how far one run's verdict
+/// can be trusted to repeat.
+pub fn repeat_table(cells: &[Cell]) -> String {
+    let mut keys: Vec<(&str, &str)> = vec![];
+    for c in cells {
+        if !keys.contains(&(c.target.as_str(), c.dataset.as_str())) {
+            keys.push((&c.target, &c.dataset));
+        }
+    }
+    let mut md = String::new();
+    for (target, dataset) in keys {
+        let runs: Vec<&Cell> = cells
+            .iter()
+            .filter(|c| c.target == target && c.dataset == dataset)
+            .collect();
+        if runs.len() < 2 {
+            continue;
+        }
+        if md.is_empty() {
+            md.push_str(
+                "\nTargets judged in more than one run (each run's verdict above stands on its own):\n\n\
+                 | target | data set | runs | met | ratio min–max |\n|---|---|---:|---:|---|\n",
+            );
+        }
+        let ratios: Vec<f64> = runs.iter().filter_map(|c| c.ratio).collect();
+        let (lo, hi) = ratios
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &r| {
+                (l.min(r), h.max(r))
+            });
+        let spread = if ratios.is_empty() {
+            "–".to_string()
+        } else {
+            format!("{lo:.2}–{hi:.2}")
+        };
+        let _ = writeln!(
+            md,
+            "| {target} | {dataset} | {} | {} | {spread} |",
+            runs.len(),
+            runs.iter().filter(|c| c.verdict == Verdict::Met).count()
+        );
+    }
+    md
+}
+
 /// Every target's cells over the inputs: one cell per target, data set and input that holds
 /// either side.
 pub fn judge_all(
@@ -411,6 +457,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let file = TargetFile::read(t)?;
         let cells = judge_all(&file, &inputs)?;
         md.push_str(&target_table(&file.source, &cells));
+        md.push_str(&repeat_table(&cells));
     }
     if let Some(out) = &args.out {
         std::fs::write(out, &md).with_context(|| format!("cannot write {}", out.display()))?;

@@ -127,6 +127,39 @@ fn ceiling_and_fraction_needed_come_from_the_roofline() {
     assert_eq!(cell(&run_rows(), 1.5).ceiling, None);
 }
 
+/// Two runs of one data set: each has its own verdict, and the repeat table says 1 of 2 met
+/// with the spread of the two ratios; one run alone has no repeat line.
+#[test]
+fn repeated_runs_are_summed_up_beside_their_verdicts() {
+    let mut slower_peer = run_rows();
+    slower_peer[3] = row("vtk-pt", "sort=cell-centre", 1, 101e3);
+    let file = TargetFile {
+        source: "test".into(),
+        targets: vec![target(1.6)],
+    };
+    let two = [
+        ("a".to_string(), aggregate(&run_rows())),
+        ("b".to_string(), aggregate(&slower_peer)),
+    ];
+    let cells = judge_all(&file, &two).unwrap();
+    assert_eq!(cells.len(), 2);
+    assert_eq!(
+        (cells[0].verdict.clone(), cells[1].verdict.clone()),
+        (Verdict::Met, Verdict::Missed)
+    );
+    let table = repeat_table(&cells);
+    assert!(
+        table.contains("| loop vs PT | spx | 2 | 1 | 1.58–1.60 |"),
+        "{table}"
+    );
+    // A Markdown table: every line of it starts with its first cell.
+    assert!(
+        table.contains("\n| target | data set | runs | met |"),
+        "{table}"
+    );
+    assert_eq!(repeat_table(&cells[..1]), "");
+}
+
 /// A rule that selects two variants is an error, not a pick.
 #[test]
 fn a_side_must_select_one_variant() {
