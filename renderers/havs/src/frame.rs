@@ -533,21 +533,33 @@ mod tests {
             assert!(orders >= 2, "the order buffer is bound in {orders} chunks");
             assert_eq!(whole.pixels, split.pixels, "{sort:?}");
             assert!(whole.pixels.iter().any(|p| p[3] > 0.1));
-            let (_, no_et) = render(
-                &gpu,
-                &mut Havs::new(HavsSettings {
-                    early_termination: false,
-                    ..s
-                }),
-                &mesh,
-                &cam,
-            );
-            assert_eq!(counter(&no_et, "et_culled_fragments"), 0.0);
-            assert_eq!(
-                counter(&cw, "fragments") + counter(&cw, "et_culled_fragments"),
-                counter(&no_et, "fragments")
-            );
+            et_only_moves_fragments(&gpu, &mesh, &cam, s, &cw);
         }
+    }
+
+    /// With early termination off, `s` renders `cam` with no culled fragment, and as many
+    /// fragments as `with_et` (the counters of `s` with it on) has fragments and culled ones.
+    fn et_only_moves_fragments(
+        gpu: &Gpu,
+        mesh: &std::sync::Arc<TetMesh>,
+        cam: &Camera,
+        s: HavsSettings,
+        with_et: &[(String, f64)],
+    ) {
+        let (_, no_et) = render(
+            gpu,
+            &mut Havs::new(HavsSettings {
+                early_termination: false,
+                ..s
+            }),
+            mesh,
+            cam,
+        );
+        assert_eq!(counter(&no_et, "et_culled_fragments"), 0.0);
+        assert_eq!(
+            counter(with_et, "fragments") + counter(with_et, "et_culled_fragments"),
+            counter(&no_et, "fragments")
+        );
     }
 
     /// The timed frames draw with the paper's program, which counts nothing; the first render
@@ -590,20 +602,7 @@ mod tests {
             counter(&other.counters, "fragments"),
             counter(&counted, "fragments")
         );
-        let (_, no_et) = render(
-            &gpu,
-            &mut Havs::new(HavsSettings {
-                early_termination: false,
-                ..Default::default()
-            }),
-            &mesh,
-            &cams[0],
-        );
-        assert_eq!(counter(&no_et, "et_culled_fragments"), 0.0);
-        assert_eq!(
-            counter(&counted, "fragments") + counter(&counted, "et_culled_fragments"),
-            counter(&no_et, "fragments")
-        );
+        et_only_moves_fragments(&gpu, &mesh, &cams[0], HavsSettings::default(), &counted);
     }
 
     /// `covering_faces`, derived on the CPU (render_core::silhouette::face_work), counts the
