@@ -96,6 +96,13 @@ def floor_section(dest):
             f"| {cell(s['step'])} | {s['median_us']:.1f} | {s['min_us']:.1f} |"
             for s in floor["steps"]
         ]
+        if floor.get("render_pass_us") is not None and floor.get("compute_pass_us") is not None:
+            out += [
+                "",
+                f"One empty pass: render {floor['render_pass_us']:.1f} µs, compute "
+                f"{floor['compute_pass_us']:.1f} µs (the fastest 64-pass step less the fastest "
+                "`submit + wait`, over 64).",
+            ]
         out.append("")
     tiny = runs(dest / "floor")
     if tiny:

@@ -66,6 +66,8 @@ fn the_software_scale_and_floor_steps_have_their_shape() {
             "submit",
             "submit + wait",
             "clear + wait",
+            "64 empty render passes + wait",
+            "64 empty compute passes + wait",
             "readback, reused buffer",
         ] {
             assert!(steps.contains(&s), "floor {res}: no {s} in {steps:?}");
@@ -82,6 +84,7 @@ fn the_software_scale_and_floor_steps_have_their_shape() {
     }
     assert!(gpu_md.contains("## Scale"), "{gpu_md}");
     assert!(gpu_md.contains("## Per-frame floor"), "{gpu_md}");
+    assert!(gpu_md.contains("One empty pass: render "), "{gpu_md}");
     assert!(gpu_md.contains("| scale 32 |"), "{gpu_md}");
     assert!(!gpu_md.contains("failed"), "{gpu_md}");
 }

@@ -11,6 +11,9 @@
 //! - `submit + wait`: the same, then the device wait every frame ends with;
 //! - `clear + wait`: a render pass that only clears a viewport-sized `Rgba32Float` target (the
 //!   frame of an empty mesh: every renderer clears its target), submitted and waited for;
+//! - `64 empty render passes + wait`, `64 empty compute passes + wait`: [`PASSES`] passes
+//!   that do nothing (the render passes load and store that target), in one command buffer,
+//!   submitted and waited for: less `submit + wait`, over 64, the fixed cost of a pass;
 //! - `readback, new buffer`: 32 bytes copied into a mappable buffer created for it, submitted,
 //!   mapped (what every counter and timestamp readback cost before the reuse);
 //! - `readback, reused buffer`: the same into a buffer kept from the last readback (what
@@ -25,6 +28,15 @@ use serde::{Deserialize, Serialize};
 
 /// Timed repetitions of each step (after `FLOOR_REPS / 10` warm-ups).
 pub const FLOOR_REPS: usize = 200;
+
+/// Empty passes in one submission of the passes steps: enough that the submission and the
+/// wait (the `submit + wait` step) are a small part of the step.
+pub const PASSES: u32 = 64;
+
+/// The name of the step that times [`PASSES`] empty passes of `kind` ("render", "compute").
+pub fn passes_step(kind: &str) -> String {
+    format!("{PASSES} empty {kind} passes + wait")
+}
 
 /// One step's times (microseconds).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -41,6 +53,12 @@ pub struct Floor {
     pub width: u32,
     pub reps: usize,
     pub steps: Vec<FloorStep>,
+    /// One empty render pass and one empty compute pass, µs ([`Floor::per_pass_us`]); absent
+    /// in floors measured before the passes steps.
+    #[serde(default)]
+    pub render_pass_us: Option<f64>,
+    #[serde(default)]
+    pub compute_pass_us: Option<f64>,
 }
 
 fn step(
@@ -106,6 +124,26 @@ pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
         gpu.queue.submit([enc.finish()]);
         gpu.wait()
     })?);
+    // What a pass costs before it does anything: the ray caster's passes mode draws ~10 a
+    // round and the splatter one a slab, so a frame of many passes pays this many times.
+    steps.push(step(&passes_step("render"), reps, || {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        for _ in 0..PASSES {
+            drop(render_core::bind::color_pass(
+                &mut enc, "floor", &view, false, true, None,
+            ));
+        }
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait()
+    })?);
+    steps.push(step(&passes_step("compute"), reps, || {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        for _ in 0..PASSES {
+            drop(enc.begin_compute_pass(&Default::default()));
+        }
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait()
+    })?);
     let counters = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("floor counters"),
         size: 32,
@@ -139,15 +177,33 @@ pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
             timer.gpu_ms(gpu).map(|_| ())
         })?);
     }
-    Ok(Floor {
+    let mut floor = Floor {
         adapter: gpu.adapter.name.clone(),
         width,
         reps,
         steps,
-    })
+        render_pass_us: None,
+        compute_pass_us: None,
+    };
+    floor.render_pass_us = floor.per_pass_us("render");
+    floor.compute_pass_us = floor.per_pass_us("compute");
+    Ok(floor)
 }
 
 impl Floor {
+    /// The fastest time of the step named `name` (µs).
+    fn fastest(&self, name: &str) -> Option<f64> {
+        self.steps.iter().find(|s| s.step == name).map(|s| s.min_us)
+    }
+
+    /// The fixed cost of one empty pass of `kind` ("render", "compute"), µs: the fastest
+    /// [`PASSES`]-pass step less the fastest `submit + wait`, over [`PASSES`]; never below 0.
+    pub fn per_pass_us(&self, kind: &str) -> Option<f64> {
+        let passes = self.fastest(&passes_step(kind))?;
+        let submit = self.fastest("submit + wait")?;
+        Some(((passes - submit) / PASSES as f64).max(0.0))
+    }
+
     /// A Markdown table of the steps.
     pub fn markdown(&self) -> String {
         let mut s = format!(
@@ -162,6 +218,12 @@ impl Floor {
             s.push_str(&format!(
                 "| {} | {:.1} | {:.1} |\n",
                 st.step, st.median_us, st.min_us
+            ));
+        }
+        if let (Some(render), Some(compute)) = (self.render_pass_us, self.compute_pass_us) {
+            s.push_str(&format!(
+                "\nOne empty pass (the fastest {PASSES}-pass step less the fastest `submit + wait`, \
+                 over {PASSES}): render {render:.1} µs, compute {compute:.1} µs.\n"
             ));
         }
         s
@@ -197,6 +259,8 @@ mod tests {
             "submit",
             "submit + wait",
             "clear + wait",
+            "64 empty render passes + wait",
+            "64 empty compute passes + wait",
             "readback, new buffer",
             "readback, reused buffer",
         ];
@@ -208,10 +272,47 @@ mod tests {
             assert!(s.min_us > 0.0 && s.min_us <= s.median_us, "{s:?}");
         }
         assert!(gpu.staging_buffers_created() - before <= 1);
+        assert!(floor.render_pass_us.is_some() && floor.compute_pass_us.is_some());
+        assert_eq!(floor.render_pass_us, floor.per_pass_us("render"));
         let table = floor.markdown();
         assert_eq!(
             table.lines().filter(|l| l.starts_with("| ")).count(),
             want.len() + 1
         );
+    }
+
+    /// A pass's cost is the passes step less one submission and wait, over the passes: it
+    /// moves with either step, and reads 0 rather than below it.
+    #[test]
+    fn one_pass_is_the_passes_less_the_submission() {
+        let at = |step: &str, min_us: f64| FloorStep {
+            step: step.to_string(),
+            median_us: min_us + 1.0,
+            min_us,
+        };
+        let mut floor = Floor {
+            adapter: "test".into(),
+            width: 16,
+            reps: 1,
+            steps: vec![
+                at("submit + wait", 40.0),
+                at(&passes_step("render"), 40.0 + 64.0 * 17.0),
+                at(&passes_step("compute"), 40.0 + 64.0 * 14.0),
+            ],
+            render_pass_us: None,
+            compute_pass_us: None,
+        };
+        assert_eq!(floor.per_pass_us("render"), Some(17.0));
+        assert_eq!(floor.per_pass_us("compute"), Some(14.0));
+        assert!(!floor.markdown().contains("One empty pass"));
+        floor.render_pass_us = floor.per_pass_us("render");
+        floor.compute_pass_us = floor.per_pass_us("compute");
+        assert!(floor.markdown().contains("render 17.0 µs, compute 14.0 µs"));
+        floor.steps[0].min_us = 40.0 + 64.0;
+        assert_eq!(floor.per_pass_us("render"), Some(16.0));
+        floor.steps[0].min_us = 1e6;
+        assert_eq!(floor.per_pass_us("compute"), Some(0.0));
+        floor.steps.remove(0);
+        assert_eq!(floor.per_pass_us("render"), None);
     }
 }

@@ -91,8 +91,8 @@ pub enum Command {
         /// Print JSON instead of the table.
         #[arg(long)]
         json: bool,
-        /// Measure the per-frame floor instead (submit, wait, an empty frame's clear,
-        /// readbacks, timestamps; docs/gpu.md), not cached.
+        /// Measure the per-frame floor instead (submit, wait, an empty frame's clear, empty
+        /// passes, readbacks, timestamps; docs/gpu.md), not cached.
         #[arg(long)]
         floor: bool,
         /// The floor's square viewport in pixels.
