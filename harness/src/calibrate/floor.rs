@@ -116,33 +116,37 @@ pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
         view_formats: &[],
     });
     let view = target.create_view(&Default::default());
-    steps.push(step("clear + wait", reps, || {
+    // One command buffer, encoded by `encode`, submitted and waited for.
+    let submitted = |encode: &dyn Fn(&mut wgpu::CommandEncoder)| {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        drop(render_core::bind::color_pass(
-            &mut enc, "floor", &view, true, true, None,
-        ));
+        encode(&mut enc);
         gpu.queue.submit([enc.finish()]);
         gpu.wait()
+    };
+    steps.push(step("clear + wait", reps, || {
+        submitted(&|enc| {
+            drop(render_core::bind::color_pass(
+                enc, "floor", &view, true, true, None,
+            ))
+        })
     })?);
     // What a pass costs before it does anything: the ray caster's passes mode draws ~10 a
     // round and the splatter one a slab, so a frame of many passes pays this many times.
     steps.push(step(&passes_step("render"), reps, || {
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        for _ in 0..PASSES {
-            drop(render_core::bind::color_pass(
-                &mut enc, "floor", &view, false, true, None,
-            ));
-        }
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait()
+        submitted(&|enc| {
+            for _ in 0..PASSES {
+                drop(render_core::bind::color_pass(
+                    enc, "floor", &view, false, true, None,
+                ));
+            }
+        })
     })?);
     steps.push(step(&passes_step("compute"), reps, || {
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        for _ in 0..PASSES {
-            drop(enc.begin_compute_pass(&Default::default()));
-        }
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait()
+        submitted(&|enc| {
+            for _ in 0..PASSES {
+                drop(enc.begin_compute_pass(&Default::default()));
+            }
+        })
     })?);
     let counters = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("floor counters"),
