@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context as _};
 use serde::Deserialize;
 
+use crate::plot::data::distinct;
 use crate::results::aggregate::{aggregate, Aggregate};
 use crate::results::{ResultsFile, Row};
 
@@ -238,7 +239,7 @@ pub fn read_rows(path: &Path) -> anyhow::Result<Vec<Row>> {
     for (i, row) in reader.deserialize::<Row>().enumerate() {
         let mut row: Row =
             row.with_context(|| format!("{}: row {} is not a result row", path.display(), i + 1))?;
-        row.settings = crate::algorithms::retype(&row.algorithm, std::mem::take(&mut row.settings));
+        row.retype_settings();
         rows.push(row);
     }
     crate::algorithms::note_external_rows(rows.iter().map(|r| (r.algorithm.as_str(), &r.settings)));
@@ -259,23 +260,13 @@ fn ratio(v: Option<f64>) -> String {
 
 /// One input's table: every variant per data set, with its ratio to each peer present.
 pub fn ratio_table(aggs: &[Aggregate]) -> String {
-    let peers: Vec<&str> = {
-        let mut names: Vec<&str> = vec![];
-        for a in aggs {
-            if crate::algorithms::is_peer(&a.algorithm) && !names.contains(&a.algorithm.as_str()) {
-                names.push(&a.algorithm);
-            }
-        }
-        names
-    };
+    let peers = distinct(
+        aggs.iter()
+            .map(|a| a.algorithm.as_str())
+            .filter(|a| crate::algorithms::is_peer(a)),
+    );
     let mut md = String::new();
-    let mut datasets: Vec<&str> = vec![];
-    for a in aggs {
-        if !datasets.contains(&a.dataset.as_str()) {
-            datasets.push(&a.dataset);
-        }
-    }
-    for d in datasets {
+    for d in distinct(aggs.iter().map(|a| a.dataset.as_str())) {
         let here: Vec<&Aggregate> = aggs.iter().filter(|a| a.dataset == d).collect();
         let _ = write!(
             md,
@@ -351,14 +342,12 @@ pub fn target_table(source: &str, cells: &[Cell]) -> String {
 /// their ratios. Each run's verdict stands on its own; this says how far one run's verdict
 /// can be trusted to repeat.
 pub fn repeat_table(cells: &[Cell]) -> String {
-    let mut keys: Vec<(&str, &str)> = vec![];
-    for c in cells {
-        if !keys.contains(&(c.target.as_str(), c.dataset.as_str())) {
-            keys.push((&c.target, &c.dataset));
-        }
-    }
     let mut md = String::new();
-    for (target, dataset) in keys {
+    for (target, dataset) in distinct(
+        cells
+            .iter()
+            .map(|c| (c.target.as_str(), c.dataset.as_str())),
+    ) {
         let runs: Vec<&Cell> = cells
             .iter()
             .filter(|c| c.target == target && c.dataset == dataset)

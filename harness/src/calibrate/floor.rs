@@ -83,6 +83,9 @@ fn step(
     })
 }
 
+/// Commands a step records into its command buffer.
+type Encode<'a> = &'a dyn Fn(&mut wgpu::CommandEncoder);
+
 /// Measures every step at a `width`² viewport, `reps` times each.
 pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
     anyhow::ensure!(reps >= 1, "the floor needs at least one repetition");
@@ -117,7 +120,7 @@ pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
     });
     let view = target.create_view(&Default::default());
     // One command buffer, encoded by `encode`, submitted and waited for.
-    let submitted = |encode: &dyn Fn(&mut wgpu::CommandEncoder)| {
+    let submitted = |encode: Encode| {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         encode(&mut enc);
         gpu.queue.submit([enc.finish()]);
@@ -132,22 +135,25 @@ pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
     })?);
     // What a pass costs before it does anything: the ray caster's passes mode draws ~10 a
     // round and the splatter one a slab, so a frame of many passes pays this many times.
-    steps.push(step(&passes_step("render"), reps, || {
-        submitted(&|enc| {
-            for _ in 0..PASSES {
-                drop(render_core::bind::color_pass(
-                    enc, "floor", &view, false, true, None,
-                ));
-            }
-        })
-    })?);
-    steps.push(step(&passes_step("compute"), reps, || {
-        submitted(&|enc| {
-            for _ in 0..PASSES {
-                drop(enc.begin_compute_pass(&Default::default()));
-            }
-        })
-    })?);
+    let empty_passes: [(&str, Encode); 2] = [
+        ("render", &|enc| {
+            drop(render_core::bind::color_pass(
+                enc, "floor", &view, false, true, None,
+            ))
+        }),
+        ("compute", &|enc| {
+            drop(enc.begin_compute_pass(&Default::default()))
+        }),
+    ];
+    for (kind, one_pass) in empty_passes {
+        steps.push(step(&passes_step(kind), reps, || {
+            submitted(&|enc| {
+                for _ in 0..PASSES {
+                    one_pass(enc);
+                }
+            })
+        })?);
+    }
     let counters = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("floor counters"),
         size: 32,

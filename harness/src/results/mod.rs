@@ -192,6 +192,13 @@ fn serialize_csv_row<W: Write>(csv: &mut csv::Writer<W>, row: &Row) -> csv::Resu
 }
 
 impl Row {
+    /// Gives the settings read back from a file the types their algorithm declares (a file
+    /// holds every value as text).
+    pub fn retype_settings(&mut self) {
+        let settings = std::mem::take(&mut self.settings);
+        self.settings = crate::algorithms::retype(&self.algorithm, settings);
+    }
+
     /// A setting of the row's variant, as written (`cpu-radix`, `6`).
     pub fn setting(&self, key: &str) -> Option<String> {
         self.settings.text(key)
@@ -294,8 +301,7 @@ impl ResultsFile {
         let mut file: ResultsFile = serde_json::from_str(&text)
             .with_context(|| format!("{}: unexpected layout", path.display()))?;
         for row in &mut file.rows {
-            let settings = std::mem::take(&mut row.settings);
-            row.settings = crate::algorithms::retype(&row.algorithm, settings);
+            row.retype_settings();
         }
         Ok(file)
     }
