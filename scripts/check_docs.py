@@ -13,6 +13,8 @@ note in docs/notes/ (README.md there is its index) names its date (YYYY-MM-DD) a
 the notes are checked like the manual's.
 
 Usage: scripts/check_docs.py [REPO_ROOT]. Prints each problem as FILE: what, exits 1 if any.
+scripts/check_docs.py --self-test checks the checker: a small tree that passes, and each rule
+flipped by changing one line of it.
 Standard library only, so CI runs it before anything is installed."""
 
 import glob
@@ -151,7 +153,66 @@ def check(root):
     return problems
 
 
+def self_test():
+    """A tree that passes, then one change per rule that must fail it, and look-alikes that
+    must not (a hex colour, an anchor, a date in prose, a note's own dated heading)."""
+    import tempfile
+
+    good = {
+        "README.md": "# t\n\n./scripts/bench.sh ./scripts/test.sh [m](docs/page.md#now)\n",
+        "ARCHITECTURE.md": "# a\n",
+        "docs/page.md": "# Page\n\n## Now\n\nColour #1f77b4, [here](#now), measured on "
+                        "2026-12-05 ([note](notes/2026-12-05-x.md)).\n",
+        "docs/notes/README.md": "# Notes\n\n[x](2026-12-05-x.md)\n",
+        "docs/notes/2026-12-05-x.md": "# X\n\nDate: 2026-12-05. Commit: `abc1234`.\n\n"
+                                      "Text.\n\n## Again after issue 43 (2026-12-05)\n",
+        "scripts/bench.sh": "", "scripts/test.sh": "",
+    }
+    flips = [
+        ("docs/page.md", "## Now", "## Now (2026-12-05, night)", "dated heading"),
+        ("docs/page.md", "## Now", "## Now, 5 December 2026", "dated heading"),
+        ("docs/page.md", "## Now", "## Again after the sort", "dated heading"),
+        ("docs/page.md", "Colour", "As issue 43 asks, colour", "names an issue"),
+        ("docs/page.md", "Colour", "Issues 25 and 43: colour", "names an issue"),
+        ("docs/page.md", "Colour", "See #43. Colour", "names an issue"),
+        ("README.md", "# t", "# t (issue-43)", "names an issue"),
+        ("docs/notes/2026-12-05-x.md", "Date: 2026-12-05. ", "", "no date"),
+        ("docs/notes/2026-12-05-x.md", "Commit: `abc1234`.", "", "no commit"),
+        ("docs/page.md", "(#now)", "(#later)", "no heading with that anchor"),
+    ]
+
+    def problems_of(files):
+        with tempfile.TemporaryDirectory() as root:
+            for name, text in files.items():
+                path = os.path.join(root, name)
+                os.makedirs(os.path.dirname(path), exist_ok=True)
+                with open(path, "w", encoding="utf-8") as f:
+                    f.write(text)
+                if name.endswith(".sh"):
+                    os.chmod(path, 0o755)
+            return check(root)
+
+    failures = []
+    found = problems_of(good)
+    if found:
+        failures.append(f"the good tree fails: {found}")
+    for name, old, new, expected in flips:
+        files = dict(good)
+        assert old in files[name], (name, old)
+        files[name] = files[name].replace(old, new, 1)
+        found = problems_of(files)
+        if not any(expected in p for p in found):
+            failures.append(f"{name}: {old!r} -> {new!r} should give \"{expected}\", gave {found}")
+    for f in failures:
+        print(f)
+    print(f"check_docs --self-test: {len(flips) + 1 - len(failures)} of {len(flips) + 1} cases "
+          "as expected", file=sys.stderr)
+    return 1 if failures else 0
+
+
 def main():
+    if sys.argv[1:] == ["--self-test"]:
+        return self_test()
     root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..")
     problems = check(os.path.abspath(root))
     for p in problems:
