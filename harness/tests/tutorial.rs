@@ -154,7 +154,7 @@ fn check_run(dir: &Path) {
             row.algorithm
         );
         assert!(row.psnr_db.is_some(), "{}: no image error", row.algorithm);
-        assert_eq!(row.dataset, "tutorial/my-mesh.vtu");
+        assert_eq!(row.dataset, "my-mesh.vtu");
     }
     assert!(results.errors.is_empty(), "{:?}", results.errors);
     assert!(dir.join("results.csv").is_file() && dir.join("index.html").is_file());
