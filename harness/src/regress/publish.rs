@@ -1,5 +1,5 @@
 //! `tetbench publish DIR… --out SITE`: one static site over baselines, runs and reproduced
-//! papers (issue 44), as asv's `publish` makes one over its results — our own, smaller version.
+//! papers, as asv's `publish` makes one over its results — our own, smaller version.
 //!
 //! - `index.html`: per adapter its latest run (by the date it started) and how many runs it
 //!   has, the papers reproduced with their verdicts, every run, and the speed–error charts
