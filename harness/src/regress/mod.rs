@@ -28,7 +28,9 @@ pub mod compare_time;
 pub mod compare_work;
 pub mod export;
 pub mod history;
+pub mod history_page;
 pub mod publish;
+pub mod publish_runs;
 
 // The run matrix of `ab` and `bisect` is `tetbench run`'s, handed on to every side's `run` as
 // `MatrixArgs::run_args` (only the options given, so an older build that lacks a newer option
