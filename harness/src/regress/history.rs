@@ -87,6 +87,12 @@ pub struct Run {
     pub date_utc: String,
     /// `commit date` as the x-axis shows it.
     pub label: String,
+    /// The machine's speed during this run against the first run of the history with a
+    /// control (the geometric mean over the control's figures of the two runs' median
+    /// controls): every time of the run was multiplied by it before the steps were sought.
+    /// Absent for a run without a control, whose times are as measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<f64>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
@@ -159,6 +165,8 @@ pub struct GroupValues {
 pub struct RunSummary {
     pub run: Run,
     pub adapter: String,
+    /// The run's median control, where every measured row has one.
+    pub control: Option<crate::results::control::Figures>,
     pub groups: Vec<(SeriesKey, Option<GroupValues>)>,
 }
 
@@ -187,9 +195,38 @@ pub fn summarise(dir: &Path, file: &ResultsFile) -> RunSummary {
             label: format!("{} {date}", &commit[..commit.len().min(7)]),
             commit,
             date_utc: file.machine.date_utc.clone(),
+            machine: None,
         },
         adapter: adapter_of(file),
+        control: crate::regress::compare_control::has_control(file)
+            .then(|| file.control.as_ref().map(|c| c.median()))
+            .flatten(),
         groups,
+    }
+}
+
+/// Puts every run with a control on the scale of the first such run: its group times times its
+/// machine's speed over that run's (a run measured on a machine half as fast counts half its
+/// time), as compare does for a pair, so that a step is the code and not the hour. Runs
+/// without a control keep their times, and their `machine` stays empty.
+pub fn divide_out_the_machine(runs: &mut [RunSummary]) {
+    let Some(reference) = runs.iter().find_map(|r| r.control.clone()) else {
+        return;
+    };
+    for run in runs.iter_mut() {
+        let Some(k) = run
+            .control
+            .as_ref()
+            .and_then(|c| crate::results::control::speed_factor(c, &reference))
+        else {
+            continue;
+        };
+        run.run.machine = Some(k);
+        for v in run.groups.iter_mut().filter_map(|(_, v)| v.as_mut()) {
+            v.total_ms *= k;
+            v.band_lo *= k;
+            v.band_hi *= k;
+        }
     }
 }
 
@@ -511,6 +548,7 @@ pub fn history(
     check_one_adapter(&runs[0], &runs)?;
     // The x-axis is time: the date each run started (then the order given, for equal dates).
     sort_by_date(&mut runs);
+    divide_out_the_machine(&mut runs);
     // compare's verdicts for each adjacent pair.
     let pairs: Vec<Option<PairFindings>> = std::iter::once(Ok(None))
         .chain(

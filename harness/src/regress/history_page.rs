@@ -395,6 +395,7 @@ mod tests {
             commit: format!("c{k}"),
             date_utc: format!("2026-01-0{}T00:00:00Z", k + 1),
             label: HOSTILE_NAME.into(),
+            machine: None,
         };
         let point = |k: usize, ms: f64, step: Option<f64>| Point {
             run: k,
