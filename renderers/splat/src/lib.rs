@@ -125,26 +125,6 @@ const MAX_SPLAT_INVOCATIONS: u32 = 1 << 30;
 /// Transfer function table entries (linear between entries).
 const TF_ENTRIES: usize = 256;
 
-/// The variants `tetbench run` measures by default ([`DESCRIPTION`]'s default grid).
-pub fn default_variants() -> Vec<Box<dyn Renderer>> {
-    build_all((DESCRIPTION.default_grid)())
-}
-
-/// Every variant `--settings` selects from ([`DESCRIPTION`]'s full grid).
-pub fn all_variants() -> Vec<Box<dyn Renderer>> {
-    build_all((DESCRIPTION.full_grid)())
-}
-
-fn build_all(grid: Vec<render_core::Settings>) -> Vec<Box<dyn Renderer>> {
-    grid.iter()
-        .map(|s| {
-            Box::new(Splat::new(
-                description::from_settings(s).expect("declared grid"),
-            )) as Box<dyn Renderer>
-        })
-        .collect()
-}
-
 struct Targets {
     width: u32,
     height: u32,
