@@ -22,7 +22,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from rust_source import ATTRS, block_end, body_open, is_test_file, line_of, mask, test_regions  # noqa: E402
+from rust_source import block_end, body_open, is_test_file, line_of, mask, test_regions  # noqa: E402
 
 FILE_LIMIT = 800
 FN_LIMIT = 150
