@@ -7,6 +7,7 @@ Every `.html` file under SITE_DIR is loaded from the file system (file://). On e
 
 - console errors: console.error/assert calls, uncaught exceptions, and the browser's own
   error log entries (a resource that failed to load is one);
+- every resource a page embeds (scripts, styles, frames, `<object>` charts): a file of the site;
 - every image: loaded eagerly (`loading=lazy` is lifted so that every one is fetched), and
   counted missing when it failed or has no pixels; images must be files of the site;
 - every link: a file of the site (with its `#anchor`, which must exist in the target page);
@@ -16,7 +17,8 @@ Every `.html` file under SITE_DIR is loaded from the file system (file://). On e
   an element `img[src=x]` means a name's markup ran as a tag;
 - with --expect-text, TEXT must be a page's visible text somewhere (the name stays text).
 
-Every page must be reachable by links from index.html. Prints a JSON summary (pages, links,
+Every page must be reachable by links from index.html. With --only GLOB (repeatable) only the
+matching pages are walked (for a site of a thousand runs: index.html and the histories). Prints a JSON summary (pages, links,
 images, and the lists of problems) and exits 1 when there is any problem.
 
 The browser is driven through the Chrome DevTools Protocol over a pipe
@@ -25,6 +27,7 @@ nothing beyond Python's standard library and the browser is needed.
 """
 
 import argparse
+import fnmatch
 import json
 import os
 import shutil
@@ -143,8 +146,8 @@ PAGE_CHECK = r"""
   return JSON.stringify({
     images: Array.from(document.images).map(i => ({
       src: i.src, ok: i.complete && i.naturalWidth > 0 })),
-    resources: Array.from(document.querySelectorAll("script[src],link[href],source[src],iframe[src]"))
-      .map(e => e.src || e.href),
+    resources: Array.from(document.querySelectorAll("script[src],link[href],source[src],iframe[src],object[data]"))
+      .map(e => e.src || e.href || e.data),
     links: Array.from(document.querySelectorAll("a[href]")).map(a => a.href),
     ids: Array.from(document.querySelectorAll("[id],a[name]")).map(e => e.id || e.name),
     handlers: handlers,
@@ -171,11 +174,18 @@ def main():
                     or shutil.which("google-chrome"))
     ap.add_argument("--expect-text", action="append", default=[])
     ap.add_argument("--json")
+    ap.add_argument("--only", action="append", default=[], metavar="GLOB",
+                    help="walk only the pages whose path in the site matches GLOB (fnmatch; "
+                         "repeatable), for a site too large to walk whole: links to other "
+                         "pages must still name files of the site, their anchors are not checked")
     a = ap.parse_args()
     if not a.browser:
         sys.exit("check_site: no Chromium (chromium, chromium-browser, google-chrome) on PATH")
     site = Path(a.site).resolve()
     pages = sorted(site.rglob("*.html"))
+    if a.only:
+        pages = [p for p in pages
+                 if any(fnmatch.fnmatch(p.relative_to(site).as_posix(), g) for g in a.only)]
     if not (site / "index.html").is_file():
         sys.exit(f"check_site: {site}/index.html does not exist")
 
@@ -271,6 +281,8 @@ def main():
         browser.close()
 
     for rel, path, fragment in anchors:
+        if a.only and path not in ids_of:
+            continue  # a page outside --only: not walked
         if fragment not in ids_of.get(path, set()):
             problems["broken_links"].append(f"{rel}: #{fragment} is not an anchor of "
                                             f"{path.relative_to(site).as_posix()}")

@@ -14,8 +14,10 @@
 #
 #   scripts/control-power.sh [TRIALS]        # default 10
 #
-# Environment: CONTROL_POWER_WORK (default target/control-power), CONTROL_POWER_MATRIX (the
-# run options; default four algorithms on box:10k, 3 viewpoints, 128 px, 3 rounds of 1 frame
+# Environment: CONTROL_POWER_WORK (default target/control-power), CONTROL_POWER_SEED (a release
+# target directory to copy before the first build, so that the dependencies are not built
+# again; default target/release when it exists), CONTROL_POWER_MATRIX (the
+# run options; default three algorithms on box:10k, 3 viewpoints, 128 px, 3 rounds of 1 frame
 # after 1 warm-up, without the reference), CONTROL_POWER_LOAD (the command run twice beside
 # BUSY; default a shell busy loop).
 set -euo pipefail
@@ -27,7 +29,8 @@ trials=${1:-10}
 work=$(realpath -m "${CONTROL_POWER_WORK:-target/control-power}")
 src="$work/src"
 target="$work/target"
-matrix=${CONTROL_POWER_MATRIX:---datasets box:10k --viewpoints +x,+x+y+z,-x+y-z --resolution 128 --algorithms gator-pt,havs,fragment-pt,raycast --rounds 3 --frames 1 --warmup 1 --no-reference}
+matrix=${CONTROL_POWER_MATRIX:---datasets box:10k --viewpoints +x,+x+y+z,-x+y-z --resolution 128 --algorithms gator-pt,havs,raycast --rounds 3 --frames 1 --warmup 1 --no-reference}
+seed=${CONTROL_POWER_SEED:-target/release}
 load=${CONTROL_POWER_LOAD:-while :; do :; done}
 head=$(git rev-parse HEAD)
 mkdir -p "$work/bin" "$work/trials"
@@ -36,6 +39,9 @@ if [ -e "$src/.git" ]; then
     git -C "$src" checkout --quiet --force --detach "$head"
 else
     git worktree add --quiet --detach "$src" "$head"
+fi
+if [ ! -d "$target/release" ] && [ -d "$seed" ]; then
+    mkdir -p "$target" && cp -r "$seed" "$target/release"
 fi
 build() {
     (cd "$src" && CARGO_TARGET_DIR="$target" cargo build --release -q -p harness --bin tetbench)

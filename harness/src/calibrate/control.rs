@@ -11,13 +11,14 @@
 //! How: the run takes a [`ControlSample`] before every round of a data set and after its last
 //! (one variant at a time, `--rounds 1`: before the data set's first variant, after its last,
 //! and between variants when [`INTERVAL_S`] has passed). Each sample runs every control
-//! probe's fastest configuration (chosen once per run from the calibration's own set) once
-//! after one warm-up. A row's round is priced with the best of the two samples around it
+//! probe's fastest configuration (chosen once per run from the calibration's own set) once,
+//! a share of its pieces sized to about [`TARGET_S`] (the rates are per unit of work, so a
+//! share measures the same figure as the whole). A row's round is priced with the best of the two samples around it
 //! (the less disturbed, as the calibration keeps the best repetition): [`RoundControl`].
 
 use std::time::Instant;
 
-use crate::calibrate::probes::{best_seconds_of, ProbeContext, Timing, PROBES};
+use crate::calibrate::probes::{ProbeContext, Timing, PROBES};
 pub use crate::results::control::{
     best_figures, median_figures, row_figures, speed_factor, Control, ControlSample, Figures,
     Pricing,
@@ -51,41 +52,72 @@ pub fn priced(base: &Calibration, control: &Figures) -> (Calibration, Vec<Figure
     (out, scaled)
 }
 
-/// The control probes prepared for a run: each probe's fastest configuration, kept between
-/// samples (pipelines and buffers are made once).
+/// How long one configuration of a control probe runs in a sample: long enough that a
+/// submission's fixed cost (tens of µs on lavapipe) is a small part of it, short enough that a
+/// sample of every probe stays a fraction of a second.
+pub const TARGET_S: f64 = 0.01;
+
+/// The control probes prepared for a run: each probe's fastest configuration and the share of
+/// its pieces that runs in about [`TARGET_S`], kept between samples (pipelines and buffers are
+/// made once).
 pub struct ControlBench<'g> {
     chosen: Vec<Chosen<'g>>,
 }
 
 struct Chosen<'g> {
     probe: &'static crate::calibrate::probes::Probe,
-    workloads: Vec<crate::calibrate::probes::Workload<'g>>,
+    /// Each kept configuration and how many of its pieces a sample runs.
+    workloads: Vec<(crate::calibrate::probes::Workload<'g>, u32)>,
+}
+
+/// One timed share of a workload: its units, parameter and seconds.
+fn time_part(w: &mut crate::calibrate::probes::Workload, k: u32) -> anyhow::Result<Timing> {
+    let t0 = Instant::now();
+    let units = w.run_part(k)?;
+    Ok(Timing {
+        units,
+        param: w.param,
+        seconds: t0.elapsed().as_secs_f64().max(1e-9),
+    })
 }
 
 impl<'g> ControlBench<'g> {
-    /// Prepares every control probe and keeps its fastest configuration (all of them for the
-    /// rasterisation fit), timing each once after a warm-up. A probe that cannot be prepared
-    /// here is left out (its figures are then scaled, and the row says so).
+    /// Prepares every control probe, times a sixteenth of each configuration (after a warm-up
+    /// of the same), keeps the fastest (all of them for the rasterisation fit) and sizes its
+    /// share to [`TARGET_S`]. A probe that cannot be prepared here is left out (its figures are
+    /// then scaled, and the rows say so).
     pub fn new(ctx: &ProbeContext<'g>) -> ControlBench<'g> {
         let mut chosen = vec![];
         for probe in PROBES.iter().filter(|p| p.in_control) {
-            let Ok(mut workloads) = (probe.prepare)(ctx) else {
+            let Ok(workloads) = (probe.prepare)(ctx) else {
                 continue;
             };
-            if probe.combine == crate::calibrate::probes::Combine::Fastest && workloads.len() > 1 {
-                let mut best = (0, 0.0);
-                for (i, w) in workloads.iter_mut().enumerate() {
-                    let units = w.units;
-                    if let Ok(s) = best_seconds_of(1, || w.run()) {
-                        if units / s > best.1 {
-                            best = (i, units / s);
-                        }
-                    }
-                }
-                let keep = workloads.swap_remove(best.0);
-                workloads = vec![keep];
+            let mut timed = vec![];
+            for mut w in workloads {
+                let k = (w.pieces / 16).max(1);
+                let Ok(t) = time_part(&mut w, k).and_then(|_| time_part(&mut w, k)) else {
+                    continue;
+                };
+                let share = (k as f64 * TARGET_S / t.seconds)
+                    .round()
+                    .clamp(1.0, w.pieces as f64);
+                timed.push((w, share as u32, t.rate()));
             }
-            chosen.push(Chosen { probe, workloads });
+            if probe.combine == crate::calibrate::probes::Combine::Fastest && timed.len() > 1 {
+                let best = timed
+                    .iter()
+                    .enumerate()
+                    .max_by(|a, b| a.1 .2.total_cmp(&b.1 .2))
+                    .map_or(0, |(i, _)| i);
+                let keep = timed.swap_remove(best);
+                timed = vec![keep];
+            }
+            if !timed.is_empty() {
+                chosen.push(Chosen {
+                    probe,
+                    workloads: timed.into_iter().map(|(w, k, _)| (w, k)).collect(),
+                });
+            }
         }
         ControlBench { chosen }
     }
@@ -97,7 +129,7 @@ impl<'g> ControlBench<'g> {
             .collect()
     }
 
-    /// One control measurement: each kept configuration once after one warm-up.
+    /// One control measurement: each kept configuration's share once.
     pub fn sample(
         &mut self,
         dataset: &str,
@@ -108,17 +140,11 @@ impl<'g> ControlBench<'g> {
         let started = Instant::now();
         let mut figures = Figures::new();
         for c in &mut self.chosen {
-            let mut timings = vec![];
-            for w in &mut c.workloads {
-                let (units, param) = (w.units, w.param);
-                if let Ok(seconds) = best_seconds_of(1, || w.run()) {
-                    timings.push(Timing {
-                        units,
-                        param,
-                        seconds,
-                    });
-                }
-            }
+            let timings: Vec<Timing> = c
+                .workloads
+                .iter_mut()
+                .filter_map(|(w, k)| time_part(w, *k).ok())
+                .collect();
             if timings.len() == c.workloads.len() {
                 figures.extend(c.probe.figures_of(&timings));
             }

@@ -106,7 +106,7 @@ pub enum Command {
         /// Result directories (put in order by the date each run started).
         #[arg(required = true, value_name = "DIR")]
         dirs: Vec<PathBuf>,
-        /// Output directory for history.{md,html,json} and the charts.
+        /// Output directory for history.{html,md,csv,json} and the SVG charts.
         #[arg(long, value_name = "DIR", default_value = "history")]
         out: PathBuf,
         /// Factor a median must move by to count as a change.

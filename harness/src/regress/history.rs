@@ -13,15 +13,22 @@
 //!   placed between runs of the same commit (they measured the same code), and a step smaller
 //!   than the threshold factor is not one.
 //! - Runs of different adapters are refused: a step between two machines is not a change.
+//!
+//! Each run is read once and reduced to a [`RunSummary`], each pair to [`PairFindings`];
+//! [`build`] makes the history from those alone, so `tetbench publish` can keep them beside a
+//! run's page and compare only the pair a new run adds. The pages, charts and data files are
+//! [`crate::regress::history_page`]'s.
 
-use std::fmt::Write as _;
+use std::collections::BinaryHeap;
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
+use rayon::prelude::*;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use crate::regress::compare::{adapter_of, CompareOptions, FailOn, ImageVerdict, Verdict};
+use crate::regress::compare::{
+    adapter_of, CompareOptions, FailOn, GroupComparison, ImageVerdict, Verdict,
+};
 use crate::results::aggregate::GroupKey;
 use crate::results::stats::{median, quantile};
 use crate::results::{ResultsFile, Row};
@@ -72,7 +79,7 @@ impl Series {
     }
 }
 
-#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Run {
     pub dir: String,
@@ -100,8 +107,112 @@ pub fn json_schema() -> serde_json::Value {
     serde_json::to_value(schemars::schema_for!(History)).expect("a schema is JSON")
 }
 
-fn group_rows<'a>(f: &'a ResultsFile, g: &GroupKey) -> Vec<&'a Row> {
-    f.rows.iter().filter(|r| g.matches(r) && r.ok()).collect()
+/// A group as history follows it across runs: compare's key, the settings as text.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SeriesKey {
+    pub algorithm: String,
+    pub settings: String,
+    pub dataset: String,
+    pub width: u32,
+    pub height: u32,
+    pub projection: String,
+}
+
+impl SeriesKey {
+    pub fn of(g: &GroupKey) -> SeriesKey {
+        SeriesKey {
+            algorithm: g.algorithm.clone(),
+            settings: g.settings.to_string(),
+            dataset: g.dataset.clone(),
+            width: g.width,
+            height: g.height,
+            projection: g.projection.clone(),
+        }
+    }
+
+    fn of_group_comparison(g: &GroupComparison) -> SeriesKey {
+        SeriesKey {
+            algorithm: g.algorithm.clone(),
+            settings: g.settings.clone(),
+            dataset: g.dataset.clone(),
+            width: g.width,
+            height: g.height,
+            projection: g.projection.clone(),
+        }
+    }
+}
+
+/// One group's numbers in one run (see the module's notes).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GroupValues {
+    pub total_ms: f64,
+    pub band_lo: f64,
+    pub band_hi: f64,
+    pub psnr_db: Option<f64>,
+    pub gpu_bytes: Option<u64>,
+}
+
+/// What history keeps of one run: which run it is, and per group (in the order its rows name
+/// them) its numbers, `None` when no row of the group measured a time. The rows themselves
+/// are not kept, so a history of a thousand runs holds a thousand of these, not the runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    pub run: Run,
+    pub adapter: String,
+    pub groups: Vec<(SeriesKey, Option<GroupValues>)>,
+}
+
+/// The summary of the run `file` read from `dir`.
+pub fn summarise(dir: &Path, file: &ResultsFile) -> RunSummary {
+    let commit = file
+        .machine
+        .git_commit
+        .clone()
+        .unwrap_or_else(|| "?".into());
+    let date = file.machine.date_utc.get(..10).unwrap_or("?").to_string();
+    let groups = GroupKey::distinct(&file.rows)
+        .into_iter()
+        .map(|g| {
+            let rows: Vec<&Row> = file
+                .rows
+                .iter()
+                .filter(|r| g.matches(r) && r.ok())
+                .collect();
+            (SeriesKey::of(&g), group_values(&rows))
+        })
+        .collect();
+    RunSummary {
+        run: Run {
+            dir: dir.display().to_string(),
+            label: format!("{} {date}", &commit[..commit.len().min(7)]),
+            commit,
+            date_utc: file.machine.date_utc.clone(),
+        },
+        adapter: adapter_of(file),
+        groups,
+    }
+}
+
+fn group_values(rows: &[&Row]) -> Option<GroupValues> {
+    let medians: Vec<f64> = rows.iter().filter_map(|r| r.total_ms).collect();
+    if medians.is_empty() {
+        return None;
+    }
+    let t = median(&medians);
+    let noise = pooled(rows, |r| r.total_ms);
+    let (lo, hi) = if noise.is_empty() {
+        (t, t)
+    } else {
+        (t * quantile(&noise, 0.1), t * quantile(&noise, 0.9))
+    };
+    let psnr: Vec<f64> = rows.iter().filter_map(|r| r.psnr_db).collect();
+    Some(GroupValues {
+        total_ms: t,
+        band_lo: lo,
+        band_hi: hi,
+        psnr_db: psnr_mean(&psnr),
+        gpu_bytes: rows.iter().filter_map(|r| r.gpu_bytes).max(),
+    })
 }
 
 /// Pooled frames of a group, each divided by `scale(row)`.
@@ -112,11 +223,188 @@ fn pooled(rows: &[&Row], scale: impl Fn(&Row) -> Option<f64>) -> Vec<f64> {
         .collect()
 }
 
+/// What compare's test found in one row of a pair of runs, as history shows it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RowFinding {
+    pub algorithm: String,
+    pub settings: String,
+    pub dataset: String,
+    pub width: u32,
+    pub height: u32,
+    /// The image got better or worse.
+    pub psnr_moved: bool,
+    /// A GPU byte figure changed.
+    pub memory: bool,
+    /// The work counters that changed exactly, in compare's order.
+    pub work: Vec<String>,
+}
+
+impl RowFinding {
+    /// Whether the row belongs to series `g` (a row comparison keeps no projection).
+    fn in_series(&self, g: &SeriesKey) -> bool {
+        (
+            &self.algorithm,
+            &self.settings,
+            &self.dataset,
+            self.width,
+            self.height,
+        ) == (&g.algorithm, &g.settings, &g.dataset, g.width, g.height)
+    }
+}
+
+/// compare's verdict on one adjacent pair of runs, reduced to what the history's points say:
+/// each group's time verdict (`slower ×r`, `faster ×r`, `too few rounds`, `too noisy`; groups
+/// with no change are left out) and the rows whose image, memory or work changed.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct PairFindings {
+    pub time: Vec<(SeriesKey, String)>,
+    pub rows: Vec<RowFinding>,
+}
+
+/// `compare BASE NEW` as history runs it on each adjacent pair (its heatmaps, if the runs kept
+/// images, in `out`).
+pub fn pair_findings(
+    base: &Path,
+    new: &Path,
+    out: &Path,
+    threshold: f64,
+    alpha: f64,
+) -> anyhow::Result<PairFindings> {
+    let opt = CompareOptions {
+        threshold,
+        alpha,
+        normalised: false,
+        drift_correction: true,
+        paired: false,
+        drift_limit: 1.5,
+        fail_on: FailOn::Never,
+        out: out.to_path_buf(),
+    };
+    let cmp = crate::regress::compare::compare(base, new, &opt)?;
+    let time = cmp
+        .groups
+        .iter()
+        .filter_map(|gc| {
+            let text = match gc.total.verdict {
+                Verdict::Slower => format!("slower ×{:.3}", gc.total.ratio),
+                Verdict::Faster => format!("faster ×{:.3}", gc.total.ratio),
+                Verdict::TooFewSamples => "too few rounds".into(),
+                Verdict::TooNoisy => "too noisy".into(),
+                Verdict::NoChange => return None,
+            };
+            Some((SeriesKey::of_group_comparison(gc), text))
+        })
+        .collect();
+    let rows =
+        cmp.rows
+            .iter()
+            .filter_map(|r| {
+                let psnr_moved = r.image.as_ref().is_some_and(|i| {
+                    matches!(i.verdict, ImageVerdict::Worse | ImageVerdict::Better)
+                });
+                let memory = r.work.iter().any(|w| w.counter.starts_with("gpu_bytes"));
+                let work: Vec<String> = r
+                    .work
+                    .iter()
+                    .filter(|w| !w.counter.starts_with("gpu_bytes"))
+                    .map(|w| w.counter.clone())
+                    .collect();
+                (psnr_moved || memory || !work.is_empty()).then(|| RowFinding {
+                    algorithm: r.algorithm.clone(),
+                    settings: r.settings.clone(),
+                    dataset: r.dataset.clone(),
+                    width: r.width,
+                    height: r.height,
+                    psnr_moved,
+                    memory,
+                    work,
+                })
+            })
+            .collect();
+    Ok(PairFindings { time, rows })
+}
+
+/// An L1 cost kept as values arrive: Σ|v − median| of the values pushed so far, from two heaps
+/// split at the median and their sums (so a segment's cost costs O(log n) to extend, not a sort).
+#[derive(Default)]
+struct L1Cost {
+    /// The lower half (with the median when the count is odd), largest on top.
+    lo: BinaryHeap<Total>,
+    hi: BinaryHeap<std::cmp::Reverse<Total>>,
+    sum_lo: f64,
+    sum_hi: f64,
+}
+
+/// An f64 ordered by `total_cmp`, as [`median`] sorts.
+#[derive(PartialEq, Clone, Copy)]
+struct Total(f64);
+
+impl Eq for Total {}
+
+impl PartialOrd for Total {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Total {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+impl L1Cost {
+    fn push(&mut self, v: f64) {
+        if self.lo.peek().is_none_or(|m| Total(v) <= *m) {
+            self.lo.push(Total(v));
+            self.sum_lo += v;
+        } else {
+            self.hi.push(std::cmp::Reverse(Total(v)));
+            self.sum_hi += v;
+        }
+        if self.lo.len() > self.hi.len() + 1 {
+            let Total(m) = self.lo.pop().expect("not empty");
+            self.sum_lo -= m;
+            self.sum_hi += m;
+            self.hi.push(std::cmp::Reverse(Total(m)));
+        } else if self.hi.len() > self.lo.len() {
+            let std::cmp::Reverse(Total(m)) = self.hi.pop().expect("not empty");
+            self.sum_hi -= m;
+            self.sum_lo += m;
+            self.lo.push(Total(m));
+        }
+    }
+
+    /// Below the median the values sit under it, above it over it: the sum of distances is
+    /// the upper sum minus the lower one, plus the median once when the lower half holds it.
+    fn value(&self) -> f64 {
+        let odd = self.lo.len() > self.hi.len();
+        let m = self.lo.peek().map_or(0.0, |t| t.0);
+        self.sum_hi - self.sum_lo + if odd { m } else { 0.0 }
+    }
+}
+
+/// The least of `costs` and where it is; costs within [`TIE`] of it are equal to it and the
+/// earliest wins (an L1 fit often has exact ties, which rounding would otherwise break either
+/// way).
+fn least(costs: &[f64]) -> (f64, usize) {
+    let min = costs.iter().copied().fold(f64::INFINITY, f64::min);
+    let at = costs
+        .iter()
+        .position(|c| *c <= min + TIE * (1.0 + min.abs()))
+        .unwrap_or(0);
+    (costs[at], at)
+}
+
+/// Relative difference under which two segmentation costs are a tie.
+const TIE: f64 = 1e-9;
+
 /// The change points of `values` (indices where a new level starts) by an L1 piecewise-constant
 /// fit of their logarithms: minimise Σ over segments of Σ|ln v − median| plus `penalty` per
-/// segment, by dynamic programming over every segmentation (O(n³), n is a few hundred runs at
-/// most). `same_as_previous[i]`: run i measured the same code as run i−1, so no step may start
-/// there. Steps whose levels differ by less than `threshold` (a factor) are merged away.
+/// segment, by dynamic programming over every segmentation (O(n² log n): for each end, the
+/// segments ending there are grown backwards with [`L1Cost`]; among equal costs the earliest
+/// start wins, [`least`]). `same_as_previous[i]`: run i measured the same code as run i−1, so no step may
+/// start there. Steps whose levels differ by less than `threshold` (a factor) are merged away.
 pub fn detect_steps(
     values: &[f64],
     same_as_previous: &[bool],
@@ -128,25 +416,21 @@ pub fn detect_steps(
     if n < 2 {
         return vec![];
     }
-    let cost = |a: usize, b: usize| {
-        let m = median(&y[a..b]);
-        y[a..b].iter().map(|v| (v - m).abs()).sum::<f64>()
-    };
     // best[j]: the least cost of y[..j]; from[j]: where its last segment starts.
     let mut best = vec![0.0f64; n + 1];
     let mut from = vec![0usize; n + 1];
+    let mut total = vec![f64::INFINITY; n];
     for j in 1..=n {
-        best[j] = f64::INFINITY;
-        for i in 0..j {
-            if i > 0 && same_as_previous.get(i).copied().unwrap_or(false) {
-                continue; // no step between two runs of one commit
-            }
-            let c = best[i] + cost(i, j) + penalty;
-            if c < best[j] {
-                best[j] = c;
-                from[j] = i;
-            }
+        let mut cost = L1Cost::default();
+        for i in (0..j).rev() {
+            cost.push(y[i]);
+            total[i] = if i > 0 && same_as_previous.get(i).copied().unwrap_or(false) {
+                f64::INFINITY // no step between two runs of one commit
+            } else {
+                best[i] + cost.value() + penalty
+            };
         }
+        (best[j], from[j]) = least(&total[..j]);
     }
     let mut starts = vec![];
     let mut j = n;
@@ -184,120 +468,121 @@ fn step_penalty(values: &[f64], threshold: f64) -> f64 {
     (3.0 * sigma).max(2.0 * threshold.ln()) * ((values.len() as f64).ln().max(1.0))
 }
 
-pub fn history(
-    dirs: &[PathBuf],
-    out: &Path,
-    threshold: f64,
-    alpha: f64,
-) -> anyhow::Result<History> {
-    let mut files: Vec<(PathBuf, ResultsFile)> = dirs
+/// Refuses runs of more than one adapter, naming them; `first` is the run given first.
+pub fn check_one_adapter(first: &RunSummary, runs: &[RunSummary]) -> anyhow::Result<()> {
+    let adapter = &first.adapter;
+    let others: Vec<String> = runs
         .iter()
-        .map(|d| ResultsFile::read(d).map(|f| (d.clone(), f)))
-        .collect::<anyhow::Result<_>>()?;
-    anyhow::ensure!(
-        !files.is_empty(),
-        "history needs at least one results directory"
-    );
-    let adapter = adapter_of(&files[0].1);
-    let others: Vec<String> = files
-        .iter()
-        .filter(|(_, f)| adapter_of(f) != adapter)
-        .map(|(d, f)| format!("{} ({})", d.display(), adapter_of(f)))
+        .filter(|r| &r.adapter != adapter)
+        .map(|r| format!("{} ({})", r.run.dir, r.adapter))
         .collect();
     if !others.is_empty() {
         anyhow::bail!(
             "history: {} ran on {adapter}, but {} on another adapter; a change between two \
              machines is not a change of the code. Give the runs of one adapter only (e.g. \
              reports/baselines/llvmpipe-*)",
-            files[0].0.display(),
+            first.run.dir,
             others.join(", ")
         );
     }
+    Ok(())
+}
+
+/// Puts runs in the order they started (the order given for equal dates).
+pub fn sort_by_date(runs: &mut [RunSummary]) {
+    runs.sort_by(|a, b| a.run.date_utc.cmp(&b.run.date_utc));
+}
+
+pub fn history(
+    dirs: &[PathBuf],
+    out: &Path,
+    threshold: f64,
+    alpha: f64,
+) -> anyhow::Result<History> {
+    anyhow::ensure!(
+        !dirs.is_empty(),
+        "history needs at least one results directory"
+    );
+    // Each run is read and reduced on its own (in parallel), so memory holds summaries only.
+    let mut runs: Vec<RunSummary> = dirs
+        .par_iter()
+        .map(|d| ResultsFile::read(d).map(|f| summarise(d, &f)))
+        .collect::<anyhow::Result<_>>()?;
+    check_one_adapter(&runs[0], &runs)?;
     // The x-axis is time: the date each run started (then the order given, for equal dates).
-    files.sort_by(|a, b| a.1.machine.date_utc.cmp(&b.1.machine.date_utc));
-    let runs: Vec<Run> = files
-        .iter()
-        .map(|(d, f)| {
-            let commit = f.machine.git_commit.clone().unwrap_or_else(|| "?".into());
-            let date = f.machine.date_utc.get(..10).unwrap_or("?").to_string();
-            Run {
-                dir: d.display().to_string(),
-                label: format!("{} {date}", &commit[..commit.len().min(7)]),
-                commit,
-                date_utc: f.machine.date_utc.clone(),
-            }
-        })
-        .collect();
+    sort_by_date(&mut runs);
     // compare's verdicts for each adjacent pair.
-    let mut pairs = vec![None];
-    for (k, w) in files.windows(2).enumerate() {
-        let opt = CompareOptions {
-            threshold,
-            alpha,
-            normalised: false,
-            drift_correction: true,
-            paired: false,
-            drift_limit: 1.5,
-            fail_on: FailOn::Never,
-            out: out.join("pairs").join(format!("{}-{}", k, k + 1)),
-        };
-        pairs.push(Some(crate::regress::compare::compare(
-            &w[0].0, &w[1].0, &opt,
-        )?));
+    let pairs: Vec<Option<PairFindings>> = std::iter::once(Ok(None))
+        .chain(
+            (1..runs.len())
+                .into_par_iter()
+                .map(|k| {
+                    pair_findings(
+                        Path::new(&runs[k - 1].run.dir),
+                        Path::new(&runs[k].run.dir),
+                        &out.join("pairs").join(format!("{}-{}", k - 1, k)),
+                        threshold,
+                        alpha,
+                    )
+                    .map(Some)
+                })
+                .collect::<Vec<_>>(),
+        )
+        .collect::<anyhow::Result<_>>()?;
+    Ok(build(runs, &pairs, threshold))
+}
+
+/// The history of `runs` (one adapter, in date order) from their summaries and compare's
+/// findings on each adjacent pair (`pairs[i]`: run i−1 against run i; `pairs[0]` is `None`).
+pub fn build(runs: Vec<RunSummary>, pairs: &[Option<PairFindings>], threshold: f64) -> History {
+    let adapter = runs.first().map(|r| r.adapter.clone()).unwrap_or_default();
+    // The reports' groups (variant × data set × viewport), matched across the runs in the
+    // order they first appear.
+    let mut groups: Vec<&SeriesKey> = vec![];
+    for r in &runs {
+        for (g, _) in &r.groups {
+            if !groups.contains(&g) {
+                groups.push(g);
+            }
+        }
     }
-    // The reports' groups (variant × data set × viewport), matched across the runs.
-    let groups = GroupKey::distinct(files.iter().flat_map(|(_, f)| &f.rows));
     let mut series = vec![];
     for g in groups {
         let mut points: Vec<Point> = vec![];
-        for (i, (_, f)) in files.iter().enumerate() {
-            let rows = group_rows(f, &g);
-            let medians: Vec<f64> = rows.iter().filter_map(|r| r.total_ms).collect();
-            if medians.is_empty() {
+        for (i, r) in runs.iter().enumerate() {
+            let Some(v) = r
+                .groups
+                .iter()
+                .find(|(k, _)| k == g)
+                .and_then(|(_, v)| v.as_ref())
+            else {
                 continue;
-            }
-            let t = median(&medians);
-            let noise = pooled(&rows, |r| r.total_ms);
-            let (lo, hi) = if noise.is_empty() {
-                (t, t)
-            } else {
-                (t * quantile(&noise, 0.1), t * quantile(&noise, 0.9))
             };
-            let psnr: Vec<f64> = rows.iter().filter_map(|r| r.psnr_db).collect();
             let mut changes = vec![];
             // Only a pair of adjacent runs is judged: a group missing from a run starts afresh.
-            if let Some(cmp) = pairs[i]
-                .as_ref()
+            if let Some(pf) = pairs
+                .get(i)
+                .and_then(|p| p.as_ref())
                 .filter(|_| points.last().is_some_and(|p| p.run + 1 == i))
             {
-                if let Some(gc) = cmp.groups.iter().find(|c| c.is(&g)) {
-                    match gc.total.verdict {
-                        Verdict::Slower => changes.push(format!("slower ×{:.3}", gc.total.ratio)),
-                        Verdict::Faster => changes.push(format!("faster ×{:.3}", gc.total.ratio)),
-                        Verdict::TooFewSamples => changes.push("too few rounds".into()),
-                        Verdict::TooNoisy => changes.push("too noisy".into()),
-                        Verdict::NoChange => {}
-                    }
+                if let Some((_, t)) = pf.time.iter().find(|(k, _)| k == g) {
+                    changes.push(t.clone());
                 }
-                let rows_here = cmp.rows.iter().filter(|r| r.in_group(&g));
                 let mut psnr_moved = false;
                 let mut memory = false;
                 let mut work: Vec<&str> = vec![];
-                for r in rows_here {
-                    psnr_moved |= r.image.as_ref().is_some_and(|i| {
-                        matches!(i.verdict, ImageVerdict::Worse | ImageVerdict::Better)
-                    });
-                    for w in &r.work {
-                        if w.counter.starts_with("gpu_bytes") {
-                            memory = true;
-                        } else if !work.contains(&w.counter.as_str()) {
-                            work.push(&w.counter);
+                for f in pf.rows.iter().filter(|f| f.in_series(g)) {
+                    psnr_moved |= f.psnr_moved;
+                    memory |= f.memory;
+                    for w in &f.work {
+                        if !work.contains(&w.as_str()) {
+                            work.push(w);
                         }
                     }
                 }
                 let last = points.last().expect("checked above");
                 if psnr_moved {
-                    if let (Some(a), Some(b)) = (last.psnr_db, psnr_mean(&psnr)) {
+                    if let (Some(a), Some(b)) = (last.psnr_db, v.psnr_db) {
                         changes.push(format!("psnr {:+.2} dB", b - a));
                     }
                 }
@@ -310,11 +595,11 @@ pub fn history(
             }
             points.push(Point {
                 run: i,
-                total_ms: t,
-                band_lo: lo,
-                band_hi: hi,
-                psnr_db: psnr_mean(&psnr),
-                gpu_bytes: rows.iter().filter_map(|r| r.gpu_bytes).max(),
+                total_ms: v.total_ms,
+                band_lo: v.band_lo,
+                band_hi: v.band_hi,
+                psnr_db: v.psnr_db,
+                gpu_bytes: v.gpu_bytes,
                 changes,
                 step: None,
             });
@@ -325,8 +610,8 @@ pub fn history(
             .enumerate()
             .map(|(k, p)| {
                 k > 0
-                    && runs[points[k - 1].run].commit == runs[p.run].commit
-                    && runs[p.run].commit != "?"
+                    && runs[points[k - 1].run].run.commit == runs[p.run].run.commit
+                    && runs[p.run].run.commit != "?"
             })
             .collect();
         let penalty = step_penalty(&values, threshold);
@@ -338,139 +623,35 @@ pub fn history(
         }
         series.push(Series {
             algorithm: g.algorithm.clone(),
-            settings: g.settings.to_string(),
+            settings: g.settings.clone(),
             dataset: g.dataset.clone(),
             width: g.width,
             height: g.height,
             points,
         });
     }
-    Ok(History {
+    History {
         schema_version: SCHEMA_VERSION,
         adapter,
-        runs,
+        runs: runs.into_iter().map(|r| r.run).collect(),
         series,
-    })
+    }
 }
 
 fn psnr_mean(v: &[f64]) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
-/// One chart per algorithm × data set (drawn by [`crate::plot::history`]): a line per
-/// settings variant of `h`'s series on that pair.
-fn chart(path: &Path, h: &History, alg: &str, dataset: &str) -> anyhow::Result<()> {
-    use crate::plot::history::{Change, Line, LinePoint};
-    let lines: Vec<Line> = h
-        .series
-        .iter()
-        .filter(|s| s.algorithm == alg && s.dataset == dataset)
-        .map(|s| Line {
-            label: s.label(h),
-            points: s
-                .points
-                .iter()
-                .map(|p| LinePoint {
-                    run: p.run,
-                    total_ms: p.total_ms,
-                    band_lo: p.band_lo,
-                    band_hi: p.band_hi,
-                    step: p.step.is_some(),
-                    change: if p.changes.is_empty() {
-                        None
-                    } else if p.changes.iter().any(|c| c.starts_with("slower")) {
-                        Some(Change::Slower)
-                    } else if p.changes.iter().any(|c| c.starts_with("faster")) {
-                        Some(Change::Faster)
-                    } else {
-                        Some(Change::Other)
-                    },
-                })
-                .collect(),
-        })
-        .collect();
-    let runs: Vec<String> = h.runs.iter().map(|r| r.label.clone()).collect();
-    crate::plot::history::chart(
-        path,
-        &format!("{alg} on {dataset}: total ms per run"),
-        &runs,
-        &lines,
-    )
-}
-
-#[derive(Serialize)]
-struct PageSeries<'a> {
-    algorithm: &'a str,
-    settings: String,
-    dataset: &'a str,
-    points: &'a [Point],
-    steps: Vec<String>,
-}
-
-#[derive(Serialize)]
-struct PageChart {
-    title: String,
-    file: String,
-}
-
-fn step_labels(h: &History, s: &Series) -> Vec<String> {
-    s.points
-        .iter()
-        .filter_map(|p| {
-            p.step
-                .map(|r| format!("×{r:.3} at {}", h.runs[p.run].label))
-        })
-        .collect()
-}
-
-/// history.html: the runs, each series with its changes and steps, and the charts.
-pub fn page(h: &History, charts: &[(String, String)]) -> anyhow::Result<String> {
-    let series: Vec<PageSeries> = h
-        .series
-        .iter()
-        .map(|s| PageSeries {
-            algorithm: &s.algorithm,
-            settings: s.label(h),
-            dataset: &s.dataset,
-            points: &s.points,
-            steps: step_labels(h, s),
-        })
-        .collect();
-    let charts: Vec<PageChart> = charts
-        .iter()
-        .map(|(title, file)| PageChart {
-            title: title.clone(),
-            file: file.clone(),
-        })
-        .collect();
-    #[derive(Serialize)]
-    struct Page<'a> {
-        adapter: &'a str,
-        runs: &'a [Run],
-        series: Vec<PageSeries<'a>>,
-        charts: Vec<PageChart>,
-    }
-    let page = Page {
-        adapter: &h.adapter,
-        runs: &h.runs,
-        series,
-        charts,
-    };
-    // templates/history.html: every value HTML-escaped (crate::report::html).
-    crate::report::html::render("history.html", &page)
-}
-
-/// `tetbench history`: history.json, history.md, history.html and one chart per algorithm ×
-/// data set in `out`.
+/// `tetbench history`: history.json, history.csv, history.md, history.html and one chart per
+/// algorithm × data set in `out`.
 pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> anyhow::Result<()> {
     let (_, md) = write_files(dirs, out, threshold, alpha)?;
     print!("{md}");
-    println!("wrote {}/history.{{md,html,json}}", out.display());
+    println!("wrote {}/history.{{md,html,json,csv}}", out.display());
     Ok(())
 }
 
-/// Writes what `tetbench history` writes (also for `tetbench publish`); returns the history and
-/// its Markdown.
+/// Writes what `tetbench history` writes; returns the history and its Markdown.
 pub fn write_files(
     dirs: &[PathBuf],
     out: &Path,
@@ -478,64 +659,7 @@ pub fn write_files(
     alpha: f64,
 ) -> anyhow::Result<(History, String)> {
     let h = history(dirs, out, threshold, alpha)?;
-    let charts_dir = out.join("charts");
-    std::fs::create_dir_all(&charts_dir)
-        .with_context(|| format!("cannot create {}", charts_dir.display()))?;
-    let mut md = format!(
-        "# tetbench history\n\nAdapter: {}\n\nRuns (by start date): ",
-        h.adapter
-    );
-    md.push_str(
-        &h.runs
-            .iter()
-            .map(|r| r.label.as_str())
-            .collect::<Vec<_>>()
-            .join(" → "),
-    );
-    md.push_str(
-        "\n\n| algorithm | settings | data set | ms per run (changes against the run before) | steps |\n|---|---|---|---|---|\n",
-    );
-    let mut pairs: Vec<(String, String)> = vec![];
-    for s in &h.series {
-        let cells: Vec<String> = s
-            .points
-            .iter()
-            .map(|p| {
-                if p.changes.is_empty() {
-                    format!("{:.2}", p.total_ms)
-                } else {
-                    format!("**{:.2} ({})**", p.total_ms, p.changes.join(", "))
-                }
-            })
-            .collect();
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} | {} |",
-            s.algorithm,
-            s.label(&h),
-            s.dataset,
-            cells.join(" → "),
-            step_labels(&h, s).join(", ")
-        );
-        let k = (s.algorithm.clone(), s.dataset.clone());
-        if !pairs.contains(&k) {
-            pairs.push(k);
-        }
-    }
-    let mut charts = vec![];
-    for (alg, ds) in &pairs {
-        let name = format!(
-            "history_{}_{}.png",
-            crate::results::names::slug(alg),
-            crate::results::names::slug(ds)
-        );
-        chart(&charts_dir.join(&name), &h, alg, ds)?;
-        charts.push((format!("{alg} on {ds}"), name));
-    }
-    std::fs::write(out.join("history.md"), &md).context("writing history.md")?;
-    std::fs::write(out.join("history.html"), page(&h, &charts)?).context("writing history.html")?;
-    std::fs::write(out.join("history.json"), serde_json::to_string_pretty(&h)?)
-        .context("writing history.json")?;
+    let md = crate::regress::history_page::write(out, &h)?;
     Ok((h, md))
 }
 
@@ -568,43 +692,86 @@ mod tests {
         assert!(detect_steps(&stepped, &vec![true; stepped.len()], p, 1.10).is_empty());
     }
 
-    /// history.html escapes everything: a data set named with markup lands as text.
+    /// The DP grown backwards with running heaps finds what the direct one (every segment's
+    /// cost from a sorted copy) finds, exact ties included (case 14 has one), on noisy series
+    /// with and without steps.
     #[test]
-    fn the_page_escapes_names() {
-        let hostile = "<img src=x onerror=alert(1)>";
-        let h = History {
-            schema_version: SCHEMA_VERSION,
-            adapter: hostile.into(),
-            runs: vec![Run {
-                dir: hostile.into(),
-                commit: "abc".into(),
-                date_utc: "2026-01-01T00:00:00Z".into(),
-                label: hostile.into(),
-            }],
-            series: vec![Series {
-                algorithm: hostile.into(),
-                settings: hostile.into(),
-                dataset: hostile.into(),
-                width: 64,
-                height: 64,
-                points: vec![Point {
-                    run: 0,
-                    total_ms: 1.0,
-                    band_lo: 1.0,
-                    band_hi: 1.0,
-                    psnr_db: None,
-                    gpu_bytes: None,
-                    changes: vec![hostile.into()],
-                    step: Some(1.5),
-                }],
-            }],
+    fn the_fast_fit_finds_what_the_direct_one_finds() {
+        fn direct(values: &[f64], same: &[bool], penalty: f64, threshold: f64) -> Vec<usize> {
+            let y: Vec<f64> = values.iter().map(|v| v.max(1e-12).ln()).collect();
+            let n = y.len();
+            let cost = |a: usize, b: usize| {
+                let m = median(&y[a..b]);
+                y[a..b].iter().map(|v| (v - m).abs()).sum::<f64>()
+            };
+            let (mut best, mut from) = (vec![0.0f64; n + 1], vec![0usize; n + 1]);
+            for j in 1..=n {
+                let costs: Vec<f64> = (0..j)
+                    .map(|i| {
+                        if i > 0 && same[i] {
+                            f64::INFINITY
+                        } else {
+                            best[i] + cost(i, j) + penalty
+                        }
+                    })
+                    .collect();
+                (best[j], from[j]) = least(&costs);
+            }
+            let mut starts = vec![];
+            let mut j = n;
+            while j > 0 {
+                starts.push(from[j]);
+                j = from[j];
+            }
+            starts.reverse();
+            let (mut steps, mut seg) = (vec![], 0);
+            for (k, &s) in starts.iter().enumerate().skip(1) {
+                let end = starts.get(k + 1).copied().unwrap_or(n);
+                if (median(&y[s..end]) - median(&y[seg..s])).abs() >= threshold.ln() {
+                    steps.push(s);
+                    seg = s;
+                }
+            }
+            steps
+        }
+        // A fixed pseudo-random sequence (an LCG): noise of ±10 %, levels ×1.3 and ×0.7.
+        let mut state = 12345u64;
+        let mut uniform = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
         };
-        let html = page(&h, &[(hostile.into(), hostile.into())]).unwrap();
-        assert!(!html.contains("<img src=x"), "{html}");
-        assert!(
-            html.contains("&lt;img src=x onerror=alert(1)&gt;"),
-            "{html}"
-        );
+        let mut found = 0;
+        for case in 0..40 {
+            let n = 20 + case * 3;
+            let values: Vec<f64> = (0..n)
+                .map(|i| {
+                    let level = match case % 4 {
+                        0 => 1.0,
+                        1 if i >= n / 3 => 1.3,
+                        2 if i >= n / 2 => 0.7,
+                        3 if i >= n / 4 && i < 3 * n / 4 => 1.5,
+                        _ => 1.0,
+                    };
+                    // Every fifth case rounds to few distinct values: ties in the costs.
+                    let v = 10.0 * level * (0.9 + 0.2 * uniform());
+                    if case % 5 == 0 {
+                        v.round()
+                    } else {
+                        v
+                    }
+                })
+                .collect();
+            let same: Vec<bool> = (0..n).map(|i| i % 7 == 3).collect();
+            for threshold in [1.05, 1.10] {
+                let p = step_penalty(&values, threshold);
+                let fast = detect_steps(&values, &same, p, threshold);
+                assert_eq!(fast, direct(&values, &same, p, threshold), "case {case}");
+                found += fast.len();
+            }
+        }
+        assert!(found > 20, "the cases hold steps to find: {found}");
     }
 
     /// Six runs of two groups; the code changes at run 3 (a new commit) and makes alg0 ×1.5

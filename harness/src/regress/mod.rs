@@ -5,7 +5,7 @@
 //! by commit ([`build`]).
 //!
 //! Why interleave: on the shared development VM two runs of one binary a minute apart differed
-//! as a whole by ×0.53–×1.98 (docs/regression.md), far more than the changes worth catching.
+//! as a whole by ×0.53–×1.98 (docs/notes/2026-12-02-compare-gate-detection.md), far more than the changes worth catching.
 //! Rounds of the two builds taken in turns (A B B A A B …) see the same stretches of that drift,
 //! so it falls on both sides alike instead of on one.
 
@@ -28,7 +28,9 @@ pub mod compare_time;
 pub mod compare_work;
 pub mod export;
 pub mod history;
+pub mod history_page;
 pub mod publish;
+pub mod publish_runs;
 
 // The run matrix of `ab` and `bisect` is `tetbench run`'s, handed on to every side's `run` as
 // `MatrixArgs::run_args` (only the options given, so an older build that lacks a newer option

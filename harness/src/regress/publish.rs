@@ -1,14 +1,22 @@
 //! `tetbench publish DIR… --out SITE`: one static site over baselines, runs and reproduced
-//! papers (issue 44), as asv's `publish` makes one over its results — our own, smaller version.
+//! papers, as asv's `publish` makes one over its results — our own, smaller version.
 //!
 //! - `index.html`: per adapter its latest run (by the date it started) and how many runs it
 //!   has, the papers reproduced with their verdicts, every run, and the speed–error charts
 //!   across adapters (the latest run of each);
-//! - `runs/NAME/`: each run's report ([`crate::report::write`], its results and the images it
-//!   kept — a baseline keeps none, and its page says so instead of linking them);
+//! - `runs/NAME/`: the latest run of each adapter with its full report ([`crate::report::write`],
+//!   its results and the images it kept — a baseline keeps none, and its page says so instead
+//!   of linking them), every earlier run with a brief page and its results compressed
+//!   ([`crate::regress::publish_runs`]);
 //! - `history/ADAPTER/`: per adapter with two runs or more, `tetbench history` over them: per
 //!   group the time across commits and the steps found;
 //! - `papers/SOURCE/PAPER/`: each reproduced paper's report as `tetbench reproduce` wrote it.
+//!
+//! Publishing is incremental: an existing site keeps its run folders, and a run whose files, page
+//! kind and neighbours are those its folder's record names is not read again nor redrawn; its
+//! summary and compare's findings against the run before come from that record
+//! ([`crate::regress::publish_runs`]). The histories, the papers and the front page are
+//! written anew each time.
 //!
 //! Every page is written through the escaping templates ([`crate::report::html`]) and links
 //! only files of the site by relative paths: it works from the file system and from any static
@@ -17,11 +25,14 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::papers::reproduce::{PaperSummary, SUMMARY_FILE};
 use crate::plot::speed_error::SpeedAxis;
 use crate::regress::compare::adapter_of;
+use crate::regress::history_page::StepLine;
+use crate::regress::publish_runs::{copy_file, link_pages_to_front, PageKind, PairRecord, SiteRun};
 use crate::results::names::slug;
 use crate::results::{ResultsFile, JSON_FILE};
 
@@ -35,22 +46,13 @@ pub struct PublishArgs {
     /// (e.g. reports/reproduced). A run's `reproduce/` directory joins as its papers.
     #[arg(required = true, value_name = "DIR")]
     pub dirs: Vec<PathBuf>,
-    /// Where the site goes (replaced when it is a site publish wrote; refused when it is
-    /// another non-empty directory).
+    /// Where the site goes (updated when it is a site publish wrote: runs drawn from unchanged
+    /// files are kept, the rest replaced; refused when it is another non-empty directory).
     #[arg(long, value_name = "SITE", default_value = "site")]
     pub out: PathBuf,
     /// Factor a median must move by to count as a change in the histories.
     #[arg(long, default_value_t = 1.10)]
     pub threshold: f64,
-}
-
-/// One run found in the inputs.
-struct RunInput {
-    dir: PathBuf,
-    file: ResultsFile,
-    adapter: String,
-    /// Its folder in the site (`runs/NAME`).
-    name: String,
 }
 
 /// One paper reproduced found in the inputs.
@@ -64,7 +66,8 @@ struct PaperInput {
 
 #[derive(Default)]
 struct Inputs {
-    runs: Vec<RunInput>,
+    /// Each run's directory and its folder in the site (`runs/NAME`).
+    runs: Vec<(PathBuf, String)>,
     papers: Vec<PaperInput>,
 }
 
@@ -102,21 +105,16 @@ fn paper_adapter(dir: &Path) -> String {
 }
 
 impl Inputs {
+    /// Registers a run (read later, by [`crate::regress::publish_runs::scan`]).
     fn add_run(&mut self, dir: &Path) -> anyhow::Result<()> {
-        let file = ResultsFile::read(dir)?;
         let mut name = slug(&dir_name(dir));
         let base = name.clone();
         let mut n = 1;
-        while self.runs.iter().any(|r| r.name == name) {
+        while self.runs.iter().any(|(_, r)| *r == name) {
             n += 1;
             name = format!("{base}-{n}");
         }
-        self.runs.push(RunInput {
-            dir: dir.to_path_buf(),
-            adapter: adapter_of(&file),
-            file,
-            name,
-        });
+        self.runs.push((dir.to_path_buf(), name));
         let reproduce = dir.join("reproduce");
         if reproduce.is_dir() {
             self.add_papers(&reproduce, &dir_name(dir))?;
@@ -203,46 +201,6 @@ fn copy_tree(from: &Path, to: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn copy_file(from: &Path, to: &Path) -> anyhow::Result<()> {
-    if let Some(parent) = to.parent() {
-        std::fs::create_dir_all(parent)
-            .with_context(|| format!("cannot create {}", parent.display()))?;
-    }
-    std::fs::copy(from, to)
-        .with_context(|| format!("cannot copy {} to {}", from.display(), to.display()))?;
-    Ok(())
-}
-
-/// Whether a path a row names stays inside its run's directory (no `..`, not absolute).
-fn is_inside(path: &str) -> bool {
-    let p = Path::new(path);
-    !path.is_empty()
-        && p.components()
-            .all(|c| matches!(c, std::path::Component::Normal(_)))
-}
-
-/// The run's report in `site/runs/NAME/`: its results files, the images it kept, and the
-/// report drawn from them.
-fn write_run(site: &Path, run: &RunInput) -> anyhow::Result<()> {
-    let out = site.join("runs").join(&run.name);
-    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
-    for f in [JSON_FILE, "results.csv", "samples.csv", "calibration.json"] {
-        if has(&run.dir, f) {
-            copy_file(&run.dir.join(f), &out.join(f))?;
-        }
-    }
-    for row in &run.file.rows {
-        for image in [&row.image, &row.heatmap, &row.reference_image] {
-            let src = run.dir.join(image);
-            if is_inside(image) && src.is_file() && !out.join(image).exists() {
-                copy_file(&src, &out.join(image))?;
-            }
-        }
-    }
-    crate::report::write(&out, &run.file)
-        .with_context(|| format!("writing the report of {}", run.dir.display()))
-}
-
 /// What the front page says of one adapter.
 #[derive(Serialize)]
 struct AdapterLine {
@@ -254,6 +212,22 @@ struct AdapterLine {
     /// Series with a step, of all series, in the history.
     series_with_steps: usize,
     series: usize,
+    /// The newest steps of the history (at most [`FRONT_STEPS`]), linked to their charts.
+    steps: Vec<SiteStep>,
+    /// All the steps of the history.
+    steps_total: usize,
+}
+
+/// How many of an adapter's newest steps the front page lists.
+const FRONT_STEPS: usize = 12;
+
+/// A step of a history as the front page lists it.
+#[derive(Serialize)]
+struct SiteStep {
+    #[serde(flatten)]
+    step: StepLine,
+    /// Its chart: `history/NAME/history.html#ID`.
+    link: String,
 }
 
 #[derive(Serialize, Clone)]
@@ -299,25 +273,25 @@ struct SitePage {
     charts_note: String,
 }
 
-fn run_line(run: &RunInput) -> RunLine {
-    let m = &run.file.machine;
-    let commit = m.git_commit.clone().unwrap_or_else(|| "unknown".into());
+fn run_line(run: &SiteRun) -> RunLine {
+    let m = &run.meta;
+    let commit = m.commit.clone().unwrap_or_else(|| "unknown".into());
     RunLine {
         name: run.name.clone(),
         link: format!("runs/{}/index.html", run.name),
-        adapter: run.adapter.clone(),
-        started: m.date_utc.clone(),
+        adapter: m.adapter.clone(),
+        started: m.started.clone(),
         commit: format!(
             "{}{}",
             &commit[..commit.len().min(10)],
-            if m.git_dirty == Some(true) {
+            if m.dirty == Some(true) {
                 " (dirty)"
             } else {
                 ""
             }
         ),
-        rows: run.file.rows.len(),
-        failed: run.file.rows.iter().filter(|r| !r.ok()).count(),
+        rows: m.rows,
+        failed: m.failed,
     }
 }
 
@@ -368,15 +342,16 @@ fn url_name(s: &str) -> String {
 /// tets/s; with several it is the calibration-normalised speed (the share of the row's
 /// calibrated roofline reached, `100 / normalized_time` %), the one measure that compares
 /// adapters of different kinds; rows without a calibration are left out, and counted.
-fn cross_adapter_charts(site: &Path, latest: &[&RunInput]) -> anyhow::Result<SitePage> {
+fn cross_adapter_charts(site: &Path, latest: &[&SiteRun]) -> anyhow::Result<SitePage> {
     let several = latest.len() > 1;
     let mut rows = vec![];
     let mut left_out = 0;
     let mut tags: Vec<String> = vec![];
     for run in latest {
-        let short = adapter_tag(&run.file, &tags);
+        let file = ResultsFile::read(&run.dir)?;
+        let short = adapter_tag(&file, &tags);
         tags.push(short.clone());
-        for row in &run.file.rows {
+        for row in &file.rows {
             let mut row = row.clone();
             if several {
                 row.settings = row.settings.clone().with("adapter", short.as_str());
@@ -449,32 +424,57 @@ fn cross_adapter_charts(site: &Path, latest: &[&RunInput]) -> anyhow::Result<Sit
     })
 }
 
-/// Replaces `site` when it is empty, absent or a site publish wrote; refuses otherwise.
+/// Readies `site` when it is empty, absent or a site publish wrote (everything but its run
+/// folders removed: [`crate::regress::publish_runs`] keeps or replaces each); refuses
+/// otherwise.
 fn prepare(site: &Path) -> anyhow::Result<()> {
     if site.exists() {
-        let empty = std::fs::read_dir(site)
+        let entries: Vec<PathBuf> = std::fs::read_dir(site)
             .with_context(|| format!("cannot read {}", site.display()))?
-            .next()
-            .is_none();
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .collect();
         anyhow::ensure!(
-            empty || site.join(SITE_MARKER).is_file(),
+            entries.is_empty() || site.join(SITE_MARKER).is_file(),
             "{}: not empty and not a site tetbench publish wrote (no {SITE_MARKER}); give \
              another --out",
             site.display()
         );
-        std::fs::remove_dir_all(site)
-            .with_context(|| format!("cannot replace {}", site.display()))?;
+        for p in entries {
+            if p == site.join("runs") && p.is_dir() {
+                continue;
+            }
+            if p.is_dir() {
+                std::fs::remove_dir_all(&p)
+            } else {
+                std::fs::remove_file(&p)
+            }
+            .with_context(|| format!("cannot replace {}", p.display()))?;
+        }
     }
-    std::fs::create_dir_all(site).with_context(|| format!("cannot create {}", site.display()))?;
+    std::fs::create_dir_all(site.join("runs"))
+        .with_context(|| format!("cannot create {}", site.display()))?;
     std::fs::write(
         site.join(SITE_MARKER),
-        "written by tetbench publish; the whole directory is replaced by the next publish\n",
+        "written by tetbench publish; the next publish keeps the runs drawn from unchanged files \
+         and replaces everything else\n",
     )
     .context("writing the site marker")
 }
 
+/// What a publish did, for its last line.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct Published {
+    pub runs: usize,
+    /// Run pages drawn (the others were kept).
+    pub drawn: usize,
+    /// Pairs compared (the others' findings were kept).
+    pub compared: usize,
+    /// Run folders of an earlier publish that no run owns any more.
+    pub removed: usize,
+}
+
 /// `tetbench publish`: writes the site and returns the path of its front page.
-pub fn publish(args: &PublishArgs) -> anyhow::Result<PathBuf> {
+pub fn publish(args: &PublishArgs) -> anyhow::Result<(PathBuf, Published)> {
     anyhow::ensure!(args.threshold >= 1.0, "--threshold must be at least 1");
     let mut inputs = Inputs::default();
     for d in &args.dirs {
@@ -482,125 +482,154 @@ pub fn publish(args: &PublishArgs) -> anyhow::Result<PathBuf> {
     }
     let site = &args.out;
     prepare(site)?;
-    for run in &inputs.runs {
-        write_run(site, run)?;
+    let runs = crate::regress::publish_runs::scan(site, &inputs.runs)?;
+    let mut done = Published {
+        runs: runs.len(),
+        ..Default::default()
+    };
+    let adapters = by_adapter(&runs);
+    let mut lines = vec![];
+    let mut latest = vec![];
+    let mut pages: Vec<(&SiteRun, PageKind, Option<PairRecord>)> = vec![];
+    for adapter_runs in &adapters {
+        let (line, pairs) = write_history(site, adapter_runs, args.threshold, &lines, &mut done)?;
+        let last = adapter_runs[adapter_runs.len() - 1];
+        latest.push(last);
+        for (k, (run, pair)) in adapter_runs.iter().zip(pairs).enumerate() {
+            let kind = if k + 1 == adapter_runs.len() {
+                PageKind::Report
+            } else {
+                PageKind::Brief {
+                    previous: k.checked_sub(1).map(|p| adapter_runs[p].name.clone()),
+                    next: Some(adapter_runs[k + 1].name.clone()),
+                    history: (!line.history.is_empty()).then(|| line.history.clone()),
+                }
+            };
+            pages.push((run, kind, pair));
+        }
+        lines.push(line);
     }
-    let (adapters, latest) = write_histories(site, &inputs.runs, args.threshold)?;
+    // Brief pages in parallel; full reports (charts through plotters) one at a time.
+    let (reports, briefs): (Vec<_>, Vec<_>) = pages
+        .into_iter()
+        .partition(|(_, kind, _)| *kind == PageKind::Report);
+    let drawn: Vec<bool> = briefs
+        .into_par_iter()
+        .map(|(run, kind, pair)| crate::regress::publish_runs::write_run(site, run, &kind, pair))
+        .collect::<anyhow::Result<_>>()?;
+    done.drawn = drawn.iter().filter(|d| **d).count();
+    for (run, kind, pair) in reports {
+        done.drawn += crate::regress::publish_runs::write_run(site, run, &kind, pair)? as usize;
+    }
+    let names: Vec<&str> = runs.iter().map(|r| r.name.as_str()).collect();
+    done.removed = crate::regress::publish_runs::remove_stale(site, &names)?;
     let papers = inputs
         .papers
         .iter()
         .map(|p| write_paper(site, p))
         .collect::<anyhow::Result<Vec<_>>>()?;
+    if site.join("papers").is_dir() {
+        link_pages_to_front(site, &site.join("papers"))?;
+    }
     let mut page = cross_adapter_charts(site, &latest)?;
-    page.adapters = adapters;
+    page.adapters = lines;
     page.papers = papers;
-    page.runs = inputs.runs.iter().map(run_line).collect();
+    page.runs = runs.iter().map(run_line).collect();
     let html = crate::report::html::render("site.html", &page)?;
     let index = site.join("index.html");
     std::fs::write(&index, html).with_context(|| format!("cannot write {}", index.display()))?;
-    link_pages_to_front(site, site)?;
-    Ok(index)
+    Ok((index, done))
 }
 
-/// The line every page below the front page gets after its `<body>`: a link back to
-/// `index.html`, `depth` folders up. Made of constants only (no data set or file name).
-fn front_link(depth: usize) -> String {
-    format!(
-        "<nav class=site><a href=\"{}index.html\">\u{2190} all results</a></nav>",
-        "../".repeat(depth)
-    )
-}
-
-/// Gives every page under `dir` (runs, histories, papers; not the front page itself) a link
-/// back to the site's front page, so that a reader who arrived from a search or a shared link
-/// can reach the rest. The pages' own templates serve stand-alone reports too, where no front
-/// page exists, so the link is added here rather than in them.
-fn link_pages_to_front(site: &Path, dir: &Path) -> anyhow::Result<()> {
-    for e in std::fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))? {
-        let path = e?.path();
-        if path.is_dir() {
-            link_pages_to_front(site, &path)?;
-            continue;
-        }
-        let rel = path
-            .strip_prefix(site)
-            .expect("walked from the site's root");
-        if path.extension().is_none_or(|x| x != "html") || rel == Path::new("index.html") {
-            continue;
-        }
-        let html = std::fs::read_to_string(&path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
-        let Some(at) = html.find("<body>").map(|i| i + "<body>".len()) else {
-            continue;
-        };
-        let depth = rel.components().count() - 1;
-        let linked = format!("{}\n{}{}", &html[..at], front_link(depth), &html[at..]);
-        std::fs::write(&path, linked)
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    Ok(())
-}
-
-/// Per adapter (in order of first appearance) its runs by the date they started: the front
-/// page's line and, with two runs or more, `tetbench history` over them in `history/NAME/`.
-/// Returns the lines and the latest run of each adapter.
-fn write_histories<'a>(
-    site: &Path,
-    all: &'a [RunInput],
-    threshold: f64,
-) -> anyhow::Result<(Vec<AdapterLine>, Vec<&'a RunInput>)> {
+/// The runs per adapter (adapters in order of first appearance), each adapter's by the date
+/// they started (the order given for equal dates).
+fn by_adapter(runs: &[SiteRun]) -> Vec<Vec<&SiteRun>> {
     let mut adapters: Vec<&str> = vec![];
-    for r in all {
-        if !adapters.contains(&r.adapter.as_str()) {
-            adapters.push(&r.adapter);
+    for r in runs {
+        if !adapters.contains(&r.meta.adapter.as_str()) {
+            adapters.push(&r.meta.adapter);
         }
     }
-    let mut lines: Vec<AdapterLine> = vec![];
-    let mut latest = vec![];
-    for adapter in adapters {
-        let mut runs: Vec<&RunInput> = all.iter().filter(|r| r.adapter == adapter).collect();
-        runs.sort_by(|a, b| a.file.machine.date_utc.cmp(&b.file.machine.date_utc));
-        let last = runs[runs.len() - 1];
-        latest.push(last);
-        let (mut history, mut with_steps, mut series) = (String::new(), 0, 0);
-        if runs.len() > 1 {
-            let base = url_name(
-                last.file
-                    .machine
-                    .adapter
-                    .as_ref()
-                    .map_or(adapter, |a| a.name.as_str()),
-            );
-            let (mut name, mut n) = (base.clone(), 1);
-            while lines
-                .iter()
-                .any(|a| a.history == format!("history/{name}/history.html"))
-            {
-                n += 1;
-                name = format!("{base}-{n}");
-            }
-            let dirs: Vec<PathBuf> = runs.iter().map(|r| r.dir.clone()).collect();
-            let out = site.join("history").join(&name);
-            let (h, _) = crate::regress::history::write_files(&dirs, &out, threshold, 0.05)
-                .with_context(|| format!("the history of {adapter}"))?;
-            series = h.series.len();
-            with_steps = h
-                .series
-                .iter()
-                .filter(|s| s.points.iter().any(|p| p.step.is_some()))
-                .count();
-            history = format!("history/{name}/history.html");
-        }
-        lines.push(AdapterLine {
-            adapter: adapter.to_string(),
-            latest: run_line(last),
-            runs: runs.len(),
-            history,
-            series_with_steps: with_steps,
-            series,
-        });
+    adapters
+        .into_iter()
+        .map(|a| {
+            let mut v: Vec<&SiteRun> = runs.iter().filter(|r| r.meta.adapter == a).collect();
+            v.sort_by(|a, b| a.summary.run.date_utc.cmp(&b.summary.run.date_utc));
+            v
+        })
+        .collect()
+}
+
+/// One adapter's line on the front page and, with two runs or more, its history in
+/// `history/NAME/` (`tetbench history` over its runs, from their summaries and compare's
+/// findings, kept or new). Returns the line and each run's findings against the run before.
+fn write_history(
+    site: &Path,
+    runs: &[&SiteRun],
+    threshold: f64,
+    earlier: &[AdapterLine],
+    done: &mut Published,
+) -> anyhow::Result<(AdapterLine, Vec<Option<PairRecord>>)> {
+    let last = runs[runs.len() - 1];
+    let adapter = last.meta.adapter.as_str();
+    let mut line = AdapterLine {
+        adapter: adapter.to_string(),
+        latest: run_line(last),
+        runs: runs.len(),
+        history: String::new(),
+        series_with_steps: 0,
+        series: 0,
+        steps: vec![],
+        steps_total: 0,
+    };
+    if runs.len() < 2 {
+        return Ok((line, vec![None]));
     }
-    Ok((lines, latest))
+    let base = url_name(last.meta.adapter_name.as_deref().unwrap_or(adapter));
+    let (mut name, mut n) = (base.clone(), 1);
+    while earlier
+        .iter()
+        .any(|a| a.history == format!("history/{name}/history.html"))
+    {
+        n += 1;
+        name = format!("{base}-{n}");
+    }
+    let out = site.join("history").join(&name);
+    let pairs =
+        crate::regress::publish_runs::pair_findings(runs, &out.join("pairs"), threshold, 0.05)
+            .with_context(|| format!("the history of {adapter}"))?;
+    done.compared += runs
+        .iter()
+        .zip(&pairs)
+        .filter(|(r, p)| p.is_some() && r.kept.as_ref().and_then(|k| k.pair.as_ref()) != p.as_ref())
+        .count();
+    let findings: Vec<Option<crate::regress::history::PairFindings>> = pairs
+        .iter()
+        .map(|p| p.as_ref().map(|p| p.findings.clone()))
+        .collect();
+    let summaries = runs.iter().map(|r| r.summary.clone()).collect();
+    let h = crate::regress::history::build(summaries, &findings, threshold);
+    crate::regress::history_page::write(&out, &h)
+        .with_context(|| format!("the history of {adapter}"))?;
+    link_pages_to_front(site, &out)?;
+    line.history = format!("history/{name}/history.html");
+    line.series = h.series.len();
+    line.series_with_steps = h
+        .series
+        .iter()
+        .filter(|s| s.points.iter().any(|p| p.step.is_some()))
+        .count();
+    let steps = crate::regress::history_page::steps(&h);
+    line.steps_total = steps.len();
+    line.steps = steps
+        .into_iter()
+        .take(FRONT_STEPS)
+        .map(|step| SiteStep {
+            link: format!("{}#{}", line.history, step.chart),
+            step,
+        })
+        .collect();
+    Ok((line, pairs))
 }
 
 /// A reproduced paper's report, charts and summary in `papers/SOURCE/PAPER/`.
@@ -637,11 +666,17 @@ fn write_paper(site: &Path, p: &PaperInput) -> anyhow::Result<PaperLine> {
 
 /// `tetbench publish …` from the command line.
 pub fn run_command(args: &PublishArgs) -> anyhow::Result<()> {
-    let index = publish(args)?;
+    let (index, done) = publish(args)?;
     println!(
-        "wrote the site {} (open {})",
+        "wrote the site {} (open {}): {} runs, {} page(s) drawn, {} kept; {} pair(s) compared; \
+         {} old run folder(s) removed",
         args.out.display(),
-        index.display()
+        index.display(),
+        done.runs,
+        done.drawn,
+        done.runs - done.drawn,
+        done.compared,
+        done.removed
     );
     Ok(())
 }
@@ -658,6 +693,7 @@ mod tests {
         );
         assert_eq!(url_name("<b>"), "b");
         assert_eq!(url_name("///"), "unnamed");
+        use crate::regress::publish_runs::is_inside;
         assert!(is_inside("images/a/b.png"));
         assert!(!is_inside("../secret.png") && !is_inside("/etc/passwd") && !is_inside(""));
     }
@@ -685,7 +721,10 @@ mod tests {
         let site = dir.path().join("site");
         prepare(&site).unwrap();
         std::fs::write(site.join("old.html"), "old").unwrap();
+        std::fs::create_dir_all(site.join("runs/a")).unwrap();
         prepare(&site).unwrap();
         assert!(!site.join("old.html").exists() && site.join(SITE_MARKER).is_file());
+        // The run folders stay, for the runs to keep or replace.
+        assert!(site.join("runs/a").is_dir());
     }
 }

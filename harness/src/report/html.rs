@@ -1,6 +1,7 @@
 //! Every HTML page tetbench writes comes from one minijinja environment. Its templates
-//! (`harness/templates/*.html`, compiled in) escape every value by default — minijinja turns
-//! auto-escaping on for names ending in `.html` — so a data set, file name, setting or error
+//! (`harness/templates/*.html`, and `*.svg` for charts with tooltips, compiled in) escape every
+//! value by default — minijinja turns auto-escaping on for names ending in `.html`, and this
+//! environment for `.svg` — so a data set, file name, setting or error
 //! message that contains markup lands in a page as text, never as a live tag. Pages pass plain
 //! serialisable data; no page builds HTML text in Rust.
 
@@ -15,8 +16,16 @@ const TEMPLATES: &[(&str, &str)] = &[
     ("charts.html", include_str!("../../templates/charts.html")),
     ("report.html", include_str!("../../templates/report.html")),
     ("history.html", include_str!("../../templates/history.html")),
+    (
+        "history_chart.svg",
+        include_str!("../../templates/history_chart.svg"),
+    ),
     ("compare.html", include_str!("../../templates/compare.html")),
     ("site.html", include_str!("../../templates/site.html")),
+    (
+        "run_brief.html",
+        include_str!("../../templates/run_brief.html"),
+    ),
     (
         "markdown.html",
         include_str!("../../templates/markdown.html"),
@@ -30,6 +39,14 @@ fn environment() -> &'static minijinja::Environment<'static> {
         // Undefined values are template bugs: fail the page instead of printing nothing.
         env.set_undefined_behavior(minijinja::UndefinedBehavior::Strict);
         env.set_formatter(escape_markup);
+        // SVG is XML: its templates escape as the HTML ones do.
+        env.set_auto_escape_callback(|name| {
+            if name.ends_with(".svg") {
+                minijinja::AutoEscape::Html
+            } else {
+                minijinja::default_auto_escape_callback(name)
+            }
+        });
         for (name, source) in TEMPLATES {
             env.add_template(name, source)
                 .unwrap_or_else(|e| panic!("template {name} does not compile: {e:#}"));

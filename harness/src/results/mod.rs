@@ -304,9 +304,18 @@ impl ResultsFile {
         let path = dir.join(JSON_FILE);
         let text = std::fs::read_to_string(&path)
             .with_context(|| format!("cannot read {}", path.display()))?;
-        let value: serde_json::Value = serde_json::from_str(&text)
-            .with_context(|| format!("{} is not JSON", path.display()))?;
-        let version = value.get("schema_version").and_then(|v| v.as_u64());
+        // The version alone first (every other field skipped, not built into a value: a
+        // history reads a thousand of these files).
+        #[derive(Deserialize)]
+        struct Version {
+            schema_version: Option<serde_json::Value>,
+        }
+        let version = match serde_json::from_str::<Version>(&text) {
+            Ok(v) => v.schema_version.and_then(|v| v.as_u64()),
+            // Valid JSON but not an object (or without a usable field): no version.
+            Err(e) if e.is_data() => None,
+            Err(e) => return Err(e).with_context(|| format!("{} is not JSON", path.display())),
+        };
         if !version
             .is_some_and(|v| (OLDEST_READABLE_SCHEMA as u64..=SCHEMA_VERSION as u64).contains(&v))
         {
