@@ -15,6 +15,24 @@ pub use render_core::image_error::{compare, psnr, psnr_from_rmse, ImageError, PS
 #[path = "malformed_vtk.rs"]
 pub mod malformed_vtk;
 
+/// Runs `python3 scripts/NAME ARGS…` from the workspace root: whether it succeeded, and its
+/// stdout and stderr together (the structure checks, `module_cycles.rs` and `code_limits.rs`).
+pub fn run_script(name: &str, args: &[&std::ffi::OsStr]) -> (bool, String) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = std::process::Command::new("python3")
+        .arg(root.join("scripts").join(name))
+        .args(args)
+        .current_dir(&root)
+        .output()
+        .unwrap_or_else(|e| panic!("python3 runs scripts/{name} (install python3): {e}"));
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.success(), text)
+}
+
 /// The data directory of the papers' data sets, or `None` (and a printed reason) when absent;
 /// with `TETBENCH_REQUIRE_DATA=1` a missing directory fails the test instead
 /// (`datasets::registry::test_data_file`).

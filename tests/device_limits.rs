@@ -8,8 +8,9 @@
 //! it, then that the split image equals the whole one.
 
 use datasets::TetMesh;
+use harness::algorithms::REGISTRY;
 use render_core::gpu::DeviceRequest;
-use render_core::{Gpu, Image, Optics, Projection, Renderer};
+use render_core::{Gpu, Image, Optics, Projection, Renderer, Shading};
 use tetbench_tests::{camera, compare, optics, view};
 
 /// The small binding: 256 KiB, the largest fixed-size table an algorithm binds whole
@@ -62,32 +63,34 @@ fn render(
     (image, stats.gpu_ms)
 }
 
-/// The variants each algorithm runs by default (the ray caster's with the 2D table): between them every chunked path (HAVS's CPU
-/// and GPU sorts, fragment PT's three orders and two shadings, GATOR's two cell models, the
-/// ray caster's default tilings, the splatter's CPU and GPU buckets). Not HAVS's race-free
-/// mode: its fragment lists (16 B per fragment, some 40 fragments per pixel here) must fit
-/// one binding, which a binding small enough to split this mesh's faces cannot hold.
+/// The variants every tetbench algorithm of the registry runs by default (the peers draw
+/// through other packages): between them every chunked path (HAVS's CPU and GPU sorts,
+/// fragment PT's three orders and two shadings, GATOR's two cell models, the ray caster's
+/// default tilings, the splatter's CPU and GPU buckets), and an algorithm added to the
+/// registry is checked here without a line of this file. Not HAVS's race-free mode: its
+/// fragment lists (16 B per fragment, some 40 fragments per pixel here) must fit one binding,
+/// which a binding small enough to split this mesh's faces cannot hold. Nor the ray caster's
+/// 3D table (32 MiB, fixed size, bound whole): its 2D-table variants only.
 fn variants() -> Vec<Box<dyn Renderer>> {
-    let mut v = gator_pt::default_variants();
-    v.extend(havs::default_variants());
-    v.extend(fragment_pt::default_variants());
-    // The ray caster's 3D table (32 MiB, fixed size) must fit one binding: its 2D-table
-    // variant only.
-    v.extend(
-        raycast::default_variants()
-            .into_iter()
-            .filter(|r| r.settings().is("table", "2d")),
-    );
-    v.extend(splat::default_variants());
-    v
+    REGISTRY
+        .iter()
+        .filter(|d| !d.is_peer())
+        .flat_map(|d| {
+            d.default_variants()
+                .unwrap_or_else(|e| panic!("{}: {e:#}", d.name))
+        })
+        .filter(|r| !(r.algorithm() == "raycast" && r.settings().is("table", "3d")))
+        .collect()
 }
 
-/// Whether two frames of `renderer` on one device must be bit-identical. HAVS's faithful
-/// single pass (`mode=fragment-race`) races on a GPU that shades one pixel's fragments
-/// concurrently (`renderers/havs/tests/racy_twin.rs`); a CPU adapter shades them in order.
+/// Whether two frames of `renderer` on one device must be bit-identical, as its description
+/// declares for the way the adapter shades (HAVS's faithful single pass races on a GPU).
 fn deterministic(renderer: &dyn Renderer, gpu: &Gpu) -> bool {
-    let racy = renderer.algorithm() == "havs" && renderer.settings().is("mode", "fragment-race");
-    !racy || gpu.adapter.is_cpu()
+    let d = harness::algorithms::description(renderer.algorithm()).unwrap();
+    (d.deterministic)(
+        &renderer.settings(),
+        Shading::of_device_type(&gpu.adapter.device_type),
+    )
 }
 
 /// Lowest PSNR accepted between the splatter's bricked and unbricked images (every other
@@ -237,7 +240,9 @@ fn havs_gpu_sort_over_several_bindings_gives_the_same_image() {
     });
     assert_eq!(low.max_storage_binding(), low_bytes);
     let gpu_sorted = || {
-        havs::default_variants()
+        havs::DESCRIPTION
+            .default_variants()
+            .unwrap()
             .into_iter()
             .filter(|r| r.settings().is("sort", "gpu-radix"))
             .collect::<Vec<_>>()

@@ -128,10 +128,13 @@ fn a_declared_accuracy_is_reported_and_the_right_example_passes_under_it() {
         .any(|c| c.name == "declared accuracy" && c.message.starts_with("20.0 dB")));
 }
 
+/// `tetbench run ARGS` in process; a run either fails or is done (it has no other outcome).
 fn run_tetbench(args: &[&str]) -> anyhow::Result<()> {
     let mut all = vec!["tetbench", "run"];
     all.extend_from_slice(args);
-    harness::cli::main_with_args(all)
+    let outcome = harness::cli::main_with_args(all)?;
+    assert_eq!(outcome, harness::cli::Outcome::Done);
+    Ok(())
 }
 
 #[test]

@@ -8,34 +8,7 @@
 //! Padding members (names starting with `_` or `pad`) may be split differently on the two
 //! sides (`_pad: [u32; 3]` against `_pad0.._pad2`); every other member is matched in order.
 
-use render_core::gpu_layout::RustLayout;
-
-/// The WGSL files of each crate, composed as the crate composes them before compiling.
-fn wgsl_source(file: &str) -> String {
-    match file {
-        "gpu_sort.wgsl" => include_str!("../renderers/core/src/gpu_sort.wgsl").into(),
-        "pass1.wgsl" => include_str!("../renderers/fragment-pt/src/pass1.wgsl").into(),
-        "pass2.wgsl" => include_str!("../renderers/fragment-pt/src/pass2.wgsl").into(),
-        "gator.wgsl" => include_str!("../renderers/gator-pt/src/gator.wgsl").into(),
-        // havs.rs: `const K` in front, the shared k-buffer after (any K: the uniforms do not
-        // depend on it).
-        "havs.wgsl" => format!(
-            "const K: u32 = 6u;\n{}\n{}",
-            include_str!("../renderers/havs/src/havs.wgsl"),
-            include_str!("../renderers/havs/src/kbuffer.wgsl")
-        ),
-        "keys.wgsl" => include_str!("../renderers/havs/src/keys.wgsl").into(),
-        "common.wgsl" => include_str!("../renderers/raycast/src/common.wgsl").into(),
-        "cast.wgsl" => format!(
-            "{}\n{}",
-            include_str!("../renderers/raycast/src/common.wgsl"),
-            include_str!("../renderers/raycast/src/cast.wgsl")
-        ),
-        "frame.wgsl" => include_str!("../renderers/splat/src/frame.wgsl").into(),
-        "splat.wgsl" => include_str!("../renderers/splat/src/splat.wgsl").into(),
-        other => panic!("no WGSL file {other} is known to the layout test"),
-    }
-}
+use render_core::gpu_layout::{GpuLayouts, RustLayout};
 
 #[derive(Debug)]
 struct Member {
@@ -104,13 +77,16 @@ fn is_padding(name: &str) -> bool {
     name.starts_with('_') || name.starts_with("pad")
 }
 
-/// Differences between a Rust layout and its WGSL struct (empty: they agree).
-fn differences(rust: &RustLayout) -> Vec<String> {
+/// Differences between a Rust layout and its WGSL struct in `sources` (empty: they agree).
+fn differences(rust: &RustLayout, sources: &GpuLayouts) -> Vec<String> {
     let (file, name) = rust
         .wgsl
         .split_once("::")
         .unwrap_or_else(|| panic!("{}: wgsl {:?} is not FILE::STRUCT", rust.rust, rust.wgsl));
-    let (size, wgsl) = wgsl_layout(file, &wgsl_source(file), name);
+    let source = sources
+        .source(file)
+        .unwrap_or_else(|| panic!("{}: the crate gives no source of {file}", rust.rust));
+    let (size, wgsl) = wgsl_layout(file, source, name);
     let mut out = vec![];
     if size != rust.size {
         out.push(format!("size: Rust {} bytes, WGSL {size}", rust.size));
@@ -154,11 +130,10 @@ fn differences(rust: &RustLayout) -> Vec<String> {
     out
 }
 
-fn check(crate_name: &str, layouts: Vec<RustLayout>) {
-    assert!(!layouts.is_empty());
+fn check(crate_name: &str, layouts: &GpuLayouts) {
     let mut bad = vec![];
-    for l in &layouts {
-        let d = differences(l);
+    for l in &layouts.structs {
+        let d = differences(l, layouts);
         if !d.is_empty() {
             bad.push(format!(
                 "{crate_name}: {} vs {}: {}",
@@ -173,46 +148,39 @@ fn check(crate_name: &str, layouts: Vec<RustLayout>) {
 
 #[test]
 fn render_core_gpu_sort_structs_match_their_wgsl() {
-    check("render-core", render_core::gpu_sort::gpu_layouts());
+    let layouts = render_core::gpu_sort::gpu_layouts();
+    assert!(!layouts.structs.is_empty());
+    check("render-core", &layouts);
 }
 
+/// Every algorithm of the registry, through its description: a new algorithm is checked
+/// without a line here. Each of tetbench's own uploads at least one struct.
 #[test]
-fn havs_structs_match_their_wgsl() {
-    check("havs", havs::gpu_layouts());
-}
-
-#[test]
-fn gator_pt_structs_match_their_wgsl() {
-    check("gator-pt", gator_pt::gpu_layouts());
-}
-
-#[test]
-fn fragment_pt_structs_match_their_wgsl() {
-    check("fragment-pt", fragment_pt::gpu_layouts());
-}
-
-#[test]
-fn raycast_structs_match_their_wgsl() {
-    check("raycast", raycast::resources::gpu_layouts());
-}
-
-#[test]
-fn splat_structs_match_their_wgsl() {
-    check("splat", splat::gpu_layouts());
+fn every_algorithms_structs_match_their_wgsl() {
+    for d in harness::algorithms::REGISTRY {
+        let layouts = (d.gpu_layouts)();
+        assert!(
+            d.is_peer() || !layouts.structs.is_empty(),
+            "{}: no GPU struct declared",
+            d.name
+        );
+        check(d.name, &layouts);
+    }
 }
 
 /// The check itself sees a moved member, a wrong size and a missing member.
 #[test]
 fn the_check_finds_a_moved_member_a_wrong_size_and_a_missing_member() {
-    let real = havs::gpu_layouts().remove(0);
-    assert!(differences(&real).is_empty());
+    let layouts = havs::gpu_layouts();
+    let real = layouts.structs[0].clone();
+    assert!(differences(&real, &layouts).is_empty());
     let mut moved = real.clone();
     moved.members[3].offset += 4;
-    assert!(!differences(&moved).is_empty());
+    assert!(!differences(&moved, &layouts).is_empty());
     let mut bigger = real.clone();
     bigger.size += 16;
-    assert!(!differences(&bigger).is_empty());
+    assert!(!differences(&bigger, &layouts).is_empty());
     let mut missing = real;
     missing.members.remove(4);
-    assert!(!differences(&missing).is_empty());
+    assert!(!differences(&missing, &layouts).is_empty());
 }

@@ -82,23 +82,14 @@ pub fn nondeterministic_counters(
     })
 }
 
-fn build_all(
-    d: &AlgorithmDescription,
-    grid: &[Settings],
-) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
-    grid.iter().map(|s| (d.build)(s)).collect()
-}
-
 /// The default variants of `name`, built, or an error listing the known names.
 pub fn variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
-    let d = description(name)?;
-    build_all(d, &(d.default_grid)())
+    description(name)?.default_variants()
 }
 
 /// Every variant `name` offers (what `--settings` selects from), built, in grid order.
 pub fn all_variants(name: &str) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
-    let d = description(name)?;
-    build_all(d, &(d.full_grid)())
+    description(name)?.all_variants()
 }
 
 /// The settings of the variants of `name` that `filter` selects
@@ -113,7 +104,7 @@ pub fn selected_variants(
     filter: &SettingsFilter,
 ) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
     let d = description(name)?;
-    build_all(d, &d.select(filter))
+    d.build_each(&d.select(filter))
 }
 
 /// Whether `name` is a peer (another package's renderer, or an external renderer given with

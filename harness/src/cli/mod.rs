@@ -227,28 +227,63 @@ impl RunArgs {
     }
 }
 
-/// The exit status of a bad option or argument: 1, as every other error (docs/regression.md,
-/// "Exit codes"), so that 3 alone means a regression. clap's own is 2.
-pub const EXIT_USAGE: i32 = 1;
+/// The exit status of an error, and of a bad option or argument: 1 (docs/regression.md, "Exit
+/// codes"), so that 3 alone means a regression. clap's own usage status is 2.
+pub const EXIT_ERROR: u8 = 1;
 
-/// `--help` and `--version` print and exit 0; a bad option prints clap's message and exits
-/// [`EXIT_USAGE`].
-fn exit_on_parse_error(e: clap::Error) -> ! {
-    if !e.use_stderr() {
-        e.exit();
-    }
-    let _ = e.print();
-    std::process::exit(EXIT_USAGE)
+/// How a command ended when it did not fail; `main` turns it into the exit status (an error is
+/// [`EXIT_ERROR`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// Status 0; also `--help` and `--version`.
+    Done,
+    /// `compare --fail-on` or `ab` met its gate: status
+    /// [`EXIT_REGRESSION`](crate::regress::compare::EXIT_REGRESSION), the documented CI gate.
+    Regression,
+    /// A bad option or argument, clap's message printed: status [`EXIT_ERROR`].
+    Usage,
 }
 
-/// Parses `args` (program name first) and runs the command.
-pub fn main_with_args<I, T>(args: I) -> anyhow::Result<()>
+impl Outcome {
+    /// [`Outcome::Regression`] when a command's gate was met, else [`Outcome::Done`].
+    pub fn gate(met: bool) -> Outcome {
+        if met {
+            Outcome::Regression
+        } else {
+            Outcome::Done
+        }
+    }
+
+    /// The process's exit status for this outcome.
+    pub fn exit_code(self) -> std::process::ExitCode {
+        std::process::ExitCode::from(match self {
+            Outcome::Done => 0,
+            Outcome::Regression => crate::regress::compare::EXIT_REGRESSION as u8,
+            Outcome::Usage => EXIT_ERROR,
+        })
+    }
+}
+
+/// Parses `args` (program name first) and runs the command. `--help` and `--version` print and
+/// are [`Outcome::Done`]; a bad option prints clap's message and is [`Outcome::Usage`].
+pub fn main_with_args<I, T>(args: I) -> anyhow::Result<Outcome>
 where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
 {
     let args: Vec<std::ffi::OsString> = args.into_iter().map(Into::into).collect();
-    let cli = Cli::try_parse_from(&args).unwrap_or_else(|e| exit_on_parse_error(e));
+    let cli = match Cli::try_parse_from(&args) {
+        Ok(cli) => cli,
+        Err(e) => {
+            e.print()
+                .context("printing the command line's help or error")?;
+            return Ok(if e.use_stderr() {
+                Outcome::Usage
+            } else {
+                Outcome::Done
+            });
+        }
+    };
     let command_line = args
         .iter()
         .map(|a| a.to_string_lossy().into_owned())
@@ -256,133 +291,36 @@ where
     execute(cli, command_line)
 }
 
-pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
+pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<Outcome> {
+    let done = |r: anyhow::Result<()>| r.map(|()| Outcome::Done);
     match cli.command {
-        Command::Run(args) => {
-            let config = args.to_config(cli.data_dir, command_line)?;
-            let filter = config.settings_filter.clone();
-            let outcome = run::run(&config, &|name: &str| args.matrix.variants(name, &filter))?;
-            println!(
-                "{} rows in {:.1} s; results in {} (open {})",
-                outcome.rows,
-                outcome.seconds,
-                config.out.join("results.csv").display(),
-                config.out.join("index.html").display()
-            );
-            if !outcome.suspect_rows.is_empty() {
-                eprintln!(
-                    "{} suspect row(s) — image error far out of line with the other algorithms \
-                     on the same image (see the `suspect` column and {}):",
-                    outcome.suspect_rows.len(),
-                    config.out.join("index.html").display()
-                );
-                for s in &outcome.suspect_rows {
-                    eprintln!("  {s}");
-                }
-            }
-            if let Some(what) = &outcome.recalibrated {
-                eprintln!("tetbench: {what}");
-            }
-            if !outcome.beaten_bounds.is_empty() {
-                eprintln!(
-                    "{} row(s) beat their roofline bound — a defect of the bound (a calibrated \
-                     figure that is not the backend's peak, or a counter of work not done; \
-                     docs/roofline.md):",
-                    outcome.beaten_bounds.len()
-                );
-                for s in &outcome.beaten_bounds {
-                    eprintln!("  {s}");
-                }
-            }
-            if outcome.rows == 0 && !outcome.errors.is_empty() {
-                anyhow::bail!("nothing was measured:\n  {}", outcome.errors.join("\n  "));
-            }
-            if !outcome.all_ok() {
-                let mut msg = format!("{} of {} rows failed", outcome.failed_rows, outcome.rows);
-                for e in &outcome.errors {
-                    msg.push_str(&format!("\n  {e}"));
-                }
-                anyhow::bail!("{msg} (finished rows are in {})", config.out.display());
-            }
-            if config.strict && !outcome.suspect_rows.is_empty() {
-                anyhow::bail!(
-                    "--strict: {} suspect row(s) (listed above)",
-                    outcome.suspect_rows.len()
-                );
-            }
-            Ok(())
-        }
-        Command::Datasets(cmd) => self::datasets::run(cmd, cli.data_dir),
-        Command::Analyze(AnalyzeAny::Tool(cmd)) => analyze::run(
+        Command::Run(args) => done(run_command(&args, cli.data_dir, command_line)),
+        Command::Datasets(cmd) => done(self::datasets::run(cmd, cli.data_dir)),
+        Command::Analyze(AnalyzeAny::Tool(cmd)) => done(analyze::run(
             cmd,
             &analyze::Context {
                 data_dir: cli.data_dir,
             },
-        ),
-        Command::Analyze(AnalyzeAny::Paper(cmd)) => crate::papers::from_run::run(cmd),
-        Command::Reproduce(args) => crate::papers::reproduce::run(args, cli.data_dir),
+        )),
+        Command::Analyze(AnalyzeAny::Paper(cmd)) => done(crate::papers::from_run::run(cmd)),
+        Command::Reproduce(args) => done(crate::papers::reproduce::run(args, cli.data_dir)),
         Command::Report {
             dir,
             merge,
             out,
             allow_missing,
-        } => {
-            if !merge.is_empty() {
-                let out = out.context("report --merge needs --out OUT")?;
-                let merged = crate::run::shard::merge(&merge, &out, allow_missing)?;
-                for gap in merged.errors.iter().filter(|e| e.starts_with(INCOMPLETE)) {
-                    eprintln!("tetbench: {gap}");
-                }
-                crate::report::write(&out, &merged)
-                    .with_context(|| format!("writing the report in {}", out.display()))?;
-                println!(
-                    "merged {} rows from {} directories into {}",
-                    merged.rows.len(),
-                    merge.len(),
-                    out.join("results.json").display()
-                );
-                return Ok(());
-            }
-            let out = dir.context("tetbench report needs a directory")?;
-            crate::report::rewrite(&out)
-                .with_context(|| format!("re-rendering the report in {}", out.display()))?;
-            println!("wrote {}", out.join("index.html").display());
-            Ok(())
-        }
-        Command::Compare(args) => {
-            let opt = crate::regress::compare::CompareOptions {
-                threshold: args.threshold,
-                alpha: args.alpha,
-                normalised: args.normalised,
-                drift_correction: !args.no_drift_correction,
-                drift_limit: args.drift_limit,
-                paired: args.paired,
-                fail_on: args.fail_on,
-                out: args.out.clone().unwrap_or_else(|| args.new.join("compare")),
-            };
-            anyhow::ensure!(args.threshold >= 1.0, "--threshold must be at least 1");
-            anyhow::ensure!(args.drift_limit >= 1.0, "--drift-limit must be at least 1");
-            if crate::regress::compare_report::run_command(
-                &args.base,
-                &args.new,
-                &opt,
-                args.format,
-            )? {
-                // The documented CI gate: status 3 (1 is an error or a refusal).
-                std::process::exit(crate::regress::compare::EXIT_REGRESSION);
-            }
-            Ok(())
-        }
+        } => done(report_command(dir, &merge, out, allow_missing)),
+        Command::Compare(args) => compare_command(&args),
         Command::Calibrate {
             floor: true,
             resolution,
             json,
             ..
-        } => crate::calibrate::floor::run_command(
+        } => done(crate::calibrate::floor::run_command(
             resolution,
             crate::calibrate::floor::FLOOR_REPS,
             json,
-        ),
+        )),
         Command::Calibrate {
             cache_dir,
             force,
@@ -390,28 +328,139 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<()> {
             ..
         } => {
             let cache = cache_dir.unwrap_or_else(|| default_cache_dir(std::path::Path::new(".")));
-            crate::calibrate::run_command(&cache, force, json)
+            done(crate::calibrate::run_command(&cache, force, json))
         }
         Command::History {
             dirs,
             out,
             threshold,
-        } => crate::regress::history::run_command(&dirs, &out, threshold, 0.05),
+        } => done(crate::regress::history::run_command(
+            &dirs, &out, threshold, 0.05,
+        )),
         Command::Export { format, results } => {
             print!("{}", crate::regress::export::run_command(&results, format)?);
-            Ok(())
+            Ok(Outcome::Done)
         }
-        Command::Plot(args) => crate::cli::plot::run(args, cli.data_dir, command_line),
-        Command::External(cmd) => crate::cli::external::run(cmd),
-        Command::Ab(args) => {
-            if crate::regress::run_ab_command(args, cli.data_dir)? {
-                std::process::exit(crate::regress::compare::EXIT_REGRESSION);
-            }
-            Ok(())
-        }
-        Command::Bisect(args) => crate::regress::run_bisect_command(args, cli.data_dir),
-        Command::Publish(args) => crate::regress::publish::run_command(&args),
+        Command::Plot(args) => done(crate::cli::plot::run(args, cli.data_dir, command_line)),
+        Command::External(cmd) => done(crate::cli::external::run(cmd)),
+        Command::Ab(args) => Ok(Outcome::gate(crate::regress::run_ab_command(
+            args,
+            cli.data_dir,
+        )?)),
+        Command::Bisect(args) => done(crate::regress::run_bisect_command(args, cli.data_dir)),
+        Command::Publish(args) => done(crate::regress::publish::run_command(&args)),
     }
+}
+
+/// `tetbench run`: the run, then what it found that the user must see (suspect rows, a
+/// recalibration, rows beating their bound); failed rows, or suspect ones with `--strict`,
+/// are an error.
+fn run_command(
+    args: &RunArgs,
+    data_dir: Option<PathBuf>,
+    command_line: Vec<String>,
+) -> anyhow::Result<()> {
+    let config = args.to_config(data_dir, command_line)?;
+    let filter = config.settings_filter.clone();
+    let outcome = run::run(&config, &|name: &str| args.matrix.variants(name, &filter))?;
+    println!(
+        "{} rows in {:.1} s; results in {} (open {})",
+        outcome.rows,
+        outcome.seconds,
+        config.out.join("results.csv").display(),
+        config.out.join("index.html").display()
+    );
+    if !outcome.suspect_rows.is_empty() {
+        eprintln!(
+            "{} suspect row(s) — image error far out of line with the other algorithms \
+             on the same image (see the `suspect` column and {}):",
+            outcome.suspect_rows.len(),
+            config.out.join("index.html").display()
+        );
+        for s in &outcome.suspect_rows {
+            eprintln!("  {s}");
+        }
+    }
+    if let Some(what) = &outcome.recalibrated {
+        eprintln!("tetbench: {what}");
+    }
+    if !outcome.beaten_bounds.is_empty() {
+        eprintln!(
+            "{} row(s) beat their roofline bound — a defect of the bound (a calibrated \
+             figure that is not the backend's peak, or a counter of work not done; \
+             docs/roofline.md):",
+            outcome.beaten_bounds.len()
+        );
+        for s in &outcome.beaten_bounds {
+            eprintln!("  {s}");
+        }
+    }
+    if outcome.rows == 0 && !outcome.errors.is_empty() {
+        anyhow::bail!("nothing was measured:\n  {}", outcome.errors.join("\n  "));
+    }
+    if !outcome.all_ok() {
+        let mut msg = format!("{} of {} rows failed", outcome.failed_rows, outcome.rows);
+        for e in &outcome.errors {
+            msg.push_str(&format!("\n  {e}"));
+        }
+        anyhow::bail!("{msg} (finished rows are in {})", config.out.display());
+    }
+    if config.strict && !outcome.suspect_rows.is_empty() {
+        anyhow::bail!(
+            "--strict: {} suspect row(s) (listed above)",
+            outcome.suspect_rows.len()
+        );
+    }
+    Ok(())
+}
+
+/// `tetbench report`: `--merge` shards or runs into `--out`, else re-render `DIR`'s report.
+fn report_command(
+    dir: Option<PathBuf>,
+    merge: &[PathBuf],
+    out: Option<PathBuf>,
+    allow_missing: bool,
+) -> anyhow::Result<()> {
+    if !merge.is_empty() {
+        let out = out.context("report --merge needs --out OUT")?;
+        let merged = crate::run::shard::merge(merge, &out, allow_missing)?;
+        for gap in merged.errors.iter().filter(|e| e.starts_with(INCOMPLETE)) {
+            eprintln!("tetbench: {gap}");
+        }
+        crate::report::write(&out, &merged)
+            .with_context(|| format!("writing the report in {}", out.display()))?;
+        println!(
+            "merged {} rows from {} directories into {}",
+            merged.rows.len(),
+            merge.len(),
+            out.join("results.json").display()
+        );
+        return Ok(());
+    }
+    let out = dir.context("tetbench report needs a directory")?;
+    crate::report::rewrite(&out)
+        .with_context(|| format!("re-rendering the report in {}", out.display()))?;
+    println!("wrote {}", out.join("index.html").display());
+    Ok(())
+}
+
+/// `tetbench compare`: [`Outcome::Regression`] when its `--fail-on` gate is met.
+fn compare_command(args: &CompareArgs) -> anyhow::Result<Outcome> {
+    let opt = crate::regress::compare::CompareOptions {
+        threshold: args.threshold,
+        alpha: args.alpha,
+        normalised: args.normalised,
+        drift_correction: !args.no_drift_correction,
+        drift_limit: args.drift_limit,
+        paired: args.paired,
+        fail_on: args.fail_on,
+        out: args.out.clone().unwrap_or_else(|| args.new.join("compare")),
+    };
+    anyhow::ensure!(args.threshold >= 1.0, "--threshold must be at least 1");
+    anyhow::ensure!(args.drift_limit >= 1.0, "--drift-limit must be at least 1");
+    let regressed =
+        crate::regress::compare_report::run_command(&args.base, &args.new, &opt, args.format)?;
+    Ok(Outcome::gate(regressed))
 }
 
 #[cfg(test)]
@@ -423,6 +472,29 @@ mod tests {
     fn cli_definition_is_consistent() {
         use clap::CommandFactory;
         Cli::command().debug_assert();
+    }
+
+    /// `--help` and `--version` are done (status 0); a bad option is a usage error (status 1,
+    /// not clap's 2), and so is a bad option of a subcommand.
+    #[test]
+    fn help_is_done_and_a_bad_option_is_status_1() {
+        use std::process::ExitCode;
+        for (args, outcome, code) in [
+            (&["tetbench", "--version"][..], Outcome::Done, 0),
+            (&["tetbench", "compare", "--help"][..], Outcome::Done, 0),
+            (&["tetbench", "--no-such-option"][..], Outcome::Usage, 1),
+            (
+                &["tetbench", "compare", "--threshold"][..],
+                Outcome::Usage,
+                1,
+            ),
+        ] {
+            let got = main_with_args(args).unwrap();
+            assert_eq!(got, outcome, "{args:?}");
+            assert_eq!(got.exit_code(), ExitCode::from(code), "{args:?}");
+        }
+        assert_eq!(Outcome::gate(true).exit_code(), ExitCode::from(3));
+        assert_eq!(Outcome::gate(false), Outcome::Done);
     }
 
     fn run_algorithms(args: &[&str]) -> anyhow::Result<Vec<String>> {

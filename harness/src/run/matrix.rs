@@ -1,8 +1,8 @@
 //! The options of every command that runs a matrix: [`MatrixArgs`] (what is measured, flattened
 //! into `run`, `plot --sweep`, `analyze resolution`, `ab` and `bisect`) and [`ExternalArgs`]
 //! (external renderers on the command line, `--external NAME=COMMAND`, the protocol of
-//! `docs/external-renderers.md`; also `reproduce`'s). [`MatrixArgs::plan`] is the one place a
-//! [`RunPlan`] is built.
+//! `docs/external-renderers.md`; also `reproduce`'s). A [`RunPlan`](crate::run::plan::RunPlan) is built from them in
+//! `plan.rs` (`MatrixArgs::plan`), which imports this module and not the other way round.
 //!
 //! It lives in `run`, not `cli`, so that the commands' argument structs in other wings
 //! (`papers`, `regress`) can flatten it without depending on the command line.
@@ -14,7 +14,6 @@ use external_peer::ExternalSpec;
 use render_core::Renderer;
 
 use crate::algorithms::{self, SettingsFilter};
-use crate::run::plan::RunPlan;
 
 /// `--external` and `--external-timeout`, flattened into every command that runs a matrix.
 #[derive(Debug, Clone, Default, PartialEq, clap::Args)]
@@ -67,7 +66,7 @@ pub(crate) fn timeout(seconds: Option<f64>) -> anyhow::Result<Duration> {
 /// --sweep`, `analyze resolution`, `ab`, `bisect`), flattened into each. A value left out is
 /// `None` or empty: the command's default, filled in by [`MatrixArgs::or`] with typed values,
 /// then the run's in [`RunPlan::to_config`] (the default suite's when no data set is named,
-/// the papers' standard otherwise). [`RunPlan`] is built from it in one place,
+/// the papers' standard otherwise). [`RunPlan`](crate::run::plan::RunPlan) is built from it in one place,
 /// [`MatrixArgs::plan`].
 #[derive(Debug, Clone, Default, PartialEq, clap::Args)]
 pub struct MatrixArgs {
@@ -173,18 +172,6 @@ impl MatrixArgs {
         }
     }
 
-    /// The run these options ask for, written to `out`, without a report (the one place a
-    /// [`RunPlan`] is built; `tetbench run` then sets its own output options).
-    pub fn plan(&self, out: PathBuf) -> RunPlan {
-        RunPlan {
-            matrix: self.clone(),
-            out,
-            no_report: true,
-            strict: false,
-            shard: None,
-        }
-    }
-
     /// The `tetbench run` options these stand for, only those given (so an older build that
     /// lacks a newer option still runs a matrix that does not use it): `ab` and `bisect` hand
     /// them to each side's binary.
@@ -272,8 +259,5 @@ mod tests {
         assert_eq!(m.datasets, ["box:1k"]);
         assert_eq!(m.algorithms, ["fragment-pt"]);
         assert!(m.no_reference);
-        let plan = m.plan(PathBuf::from("out"));
-        assert_eq!(plan.matrix, m);
-        assert!(plan.no_report);
     }
 }

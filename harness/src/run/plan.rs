@@ -41,6 +41,21 @@ pub fn default_cache_dir(out: &std::path::Path) -> PathBuf {
         .unwrap_or_else(|| out.join(".reference-cache"))
 }
 
+impl MatrixArgs {
+    /// The run these options ask for, written to `out`, without a report (the one place a
+    /// [`RunPlan`] is built; `tetbench run` then sets its own output options). It is here, not
+    /// in `matrix.rs`, so that the imports run one way: the plan holds the matrix.
+    pub fn plan(&self, out: PathBuf) -> RunPlan {
+        RunPlan {
+            matrix: self.clone(),
+            out,
+            no_report: true,
+            strict: false,
+            shard: None,
+        }
+    }
+}
+
 impl RunPlan {
     /// Checks the plan and fills in defaults: the default suite's when no data set is
     /// named, the papers' standard otherwise. Errors name the `tetbench run` option at fault.
@@ -177,5 +192,24 @@ impl RunPlan {
             resume: false,
             externals,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A matrix's plan holds the matrix and writes no report until `run` asks for one.
+    #[test]
+    fn a_matrix_plans_without_a_report() {
+        let m = MatrixArgs {
+            frames: Some(3),
+            datasets: vec!["box:1k".into()],
+            ..Default::default()
+        };
+        let plan = m.plan(PathBuf::from("out"));
+        assert_eq!(plan.matrix, m);
+        assert_eq!(plan.out, PathBuf::from("out"));
+        assert!(plan.no_report && !plan.strict && plan.shard.is_none());
     }
 }

@@ -48,6 +48,8 @@ pub static PT: AlgorithmDescription = AlgorithmDescription {
     },
     counters: &[],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    deterministic: render_core::description::always_deterministic,
+    gpu_layouts: render_core::gpu_layout::GpuLayouts::none,
 };
 
 pub static RAYCAST: AlgorithmDescription = AlgorithmDescription {
@@ -93,6 +95,8 @@ pub static RAYCAST: AlgorithmDescription = AlgorithmDescription {
     },
     counters: &[],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    deterministic: render_core::description::always_deterministic,
+    gpu_layouts: render_core::gpu_layout::GpuLayouts::none,
 };
 
 pub static ZSWEEP: AlgorithmDescription = AlgorithmDescription {
@@ -122,6 +126,8 @@ pub static ZSWEEP: AlgorithmDescription = AlgorithmDescription {
     },
     counters: &[],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    deterministic: render_core::description::always_deterministic,
+    gpu_layouts: render_core::gpu_layout::GpuLayouts::none,
 };
 
 pub(crate) fn settings_of(

@@ -4,6 +4,7 @@
 //! counters it reports. One [`AlgorithmDescription`] per algorithm crate; the harness lists
 //! them in one table.
 
+use crate::gpu_layout::GpuLayouts;
 use crate::renderer::Renderer;
 use crate::settings::{Settings, SettingsError, SettingsFilter, ValueKind};
 
@@ -77,6 +78,12 @@ pub fn all_counters_exact(_: &Settings, _: Shading) -> &'static [&'static str] {
     &[]
 }
 
+/// For [`AlgorithmDescription::deterministic`]: every variant draws the same image, bit for
+/// bit, frame after frame, on any adapter.
+pub fn always_deterministic(_: &Settings, _: Shading) -> bool {
+    true
+}
+
 /// What the harness knows of one algorithm.
 pub struct AlgorithmDescription {
     /// Name on the command line and in result rows (`havs`).
@@ -100,6 +107,12 @@ pub struct AlgorithmDescription {
     /// from frame to frame — a race decides them. `tetbench compare` tests these
     /// statistically; every other counter must match exactly.
     pub nondeterministic_counters: fn(&Settings, Shading) -> &'static [&'static str],
+    /// Whether two frames of a variant, on an adapter that shades this way, give the same
+    /// image bit for bit (where not, a race decides it); tests compare images only where so.
+    pub deterministic: fn(&Settings, Shading) -> bool,
+    /// The `#[repr(C)]` structs the algorithm uploads to the GPU and the WGSL they mirror
+    /// (`tests/gpu_layouts.rs`); [`GpuLayouts::none`] for a renderer without any.
+    pub gpu_layouts: fn() -> GpuLayouts,
 }
 
 impl std::fmt::Debug for AlgorithmDescription {
@@ -112,6 +125,21 @@ impl std::fmt::Debug for AlgorithmDescription {
 }
 
 impl AlgorithmDescription {
+    /// The variants of `grid`, built.
+    pub fn build_each(&self, grid: &[Settings]) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+        grid.iter().map(|s| (self.build)(s)).collect()
+    }
+
+    /// The variants run when no `--settings` is given, built.
+    pub fn default_variants(&self) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+        self.build_each(&(self.default_grid)())
+    }
+
+    /// Every variant `--settings` selects from, built, in grid order.
+    pub fn all_variants(&self) -> anyhow::Result<Vec<Box<dyn Renderer>>> {
+        self.build_each(&(self.full_grid)())
+    }
+
     pub fn is_peer(&self) -> bool {
         matches!(self.origin, Origin::Peer(_))
     }

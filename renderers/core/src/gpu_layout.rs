@@ -3,7 +3,9 @@
 //! naga: `tests/gpu_layouts.rs`) instead of a "keep in step" comment.
 //!
 //! Each crate lists its structs with [`rust_layout!`] in a `#[doc(hidden)] pub fn
-//! gpu_layouts()`; the macro fails to compile when a field of the struct is left out.
+//! gpu_layouts()` returning [`GpuLayouts`] (the structs and the WGSL they name), which an
+//! algorithm's description hands on (`AlgorithmDescription::gpu_layouts`), so the test walks
+//! the registry; the macro fails to compile when a field of the struct is left out.
 
 /// One member of a Rust struct: name, byte offset, byte size.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -22,6 +24,30 @@ pub struct RustLayout {
     pub wgsl: &'static str,
     pub size: usize,
     pub members: Vec<RustMember>,
+}
+
+/// A crate's GPU structs and the WGSL files they mirror.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct GpuLayouts {
+    pub structs: Vec<RustLayout>,
+    /// Each file named by a struct's `wgsl` (`FILE` of `FILE::STRUCT`), composed as the crate
+    /// composes it before compiling, generated declarations aside.
+    pub sources: Vec<(&'static str, String)>,
+}
+
+impl GpuLayouts {
+    /// For a renderer that uploads no struct of its own (the peers).
+    pub fn none() -> GpuLayouts {
+        GpuLayouts::default()
+    }
+
+    /// The composed source of WGSL file `file`.
+    pub fn source(&self, file: &str) -> Option<&str> {
+        self.sources
+            .iter()
+            .find(|(f, _)| *f == file)
+            .map(|(_, s)| s.as_str())
+    }
 }
 
 /// Size of the field that `_field` projects to (type inference only; never called).

@@ -397,13 +397,17 @@ struct KeyParams {
 /// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
 /// for the layout test (`tests/gpu_layouts.rs`).
 #[doc(hidden)]
-pub fn gpu_layouts() -> Vec<crate::gpu_layout::RustLayout> {
-    vec![
+pub fn gpu_layouts() -> crate::gpu_layout::GpuLayouts {
+    let structs = vec![
         crate::rust_layout!(Params => "gpu_sort.wgsl::Params" { n, shift, num_tiles, flags }),
         crate::rust_layout!(KeyParams => "gpu_sort.wgsl::KeyParams" {
             eye, perspective, forward, count, point_stride, verts, value_base, out_base
         }),
-    ]
+    ];
+    crate::gpu_layout::GpuLayouts {
+        structs,
+        sources: vec![("gpu_sort.wgsl", include_str!("gpu_sort.wgsl").into())],
+    }
 }
 
 /// Computes sort keys on the GPU, the pass before [`GpuRadixSort::encode`]: for each primitive

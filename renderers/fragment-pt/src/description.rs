@@ -40,6 +40,8 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
         "gpu_sort_keys",
     ],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    deterministic: render_core::description::always_deterministic,
+    gpu_layouts: crate::gpu_layouts,
 };
 
 fn grid(sorts: &[SortMode]) -> Vec<Settings> {

@@ -151,13 +151,20 @@ struct Pass2Params {
 }
 
 /// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
-/// for the layout test (`tests/gpu_layouts.rs`).
+/// for the layout test (`tests/gpu_layouts.rs`, through [`DESCRIPTION`]).
 #[doc(hidden)]
-pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
-    vec![
+pub fn gpu_layouts() -> render_core::gpu_layout::GpuLayouts {
+    let structs = vec![
         render_core::rust_layout!(Pass1Params => "pass1.wgsl::Params" { view_proj, eye, forward, misc, counts }),
         render_core::rust_layout!(Pass2Params => "pass2.wgsl::Params" { view_proj, misc, sizes }),
-    ]
+    ];
+    render_core::gpu_layout::GpuLayouts {
+        structs,
+        sources: vec![
+            ("pass1.wgsl", include_str!("pass1.wgsl").into()),
+            ("pass2.wgsl", include_str!("pass2.wgsl").into()),
+        ],
+    }
 }
 
 /// Everything uploaded by `prepare`.
@@ -278,26 +285,6 @@ impl FragmentPt {
             .ok_or_else(|| anyhow!("fragment-pt: prepare first"))?;
         Ok(project_params(st, camera))
     }
-}
-
-/// The variants `tetbench run` measures by default ([`DESCRIPTION`]'s default grid).
-pub fn default_variants() -> Vec<Box<dyn Renderer>> {
-    build_all((DESCRIPTION.default_grid)())
-}
-
-/// Every variant `--settings` selects from ([`DESCRIPTION`]'s full grid).
-pub fn all_variants() -> Vec<Box<dyn Renderer>> {
-    build_all((DESCRIPTION.full_grid)())
-}
-
-fn build_all(grid: Vec<render_core::Settings>) -> Vec<Box<dyn Renderer>> {
-    grid.iter()
-        .map(|s| {
-            Box::new(FragmentPt::new(
-                description::from_settings(s).expect("declared grid"),
-            )) as Box<dyn Renderer>
-        })
-        .collect()
 }
 
 fn project_params(st: &State, camera: &Camera) -> classify::ProjectParams {

@@ -41,9 +41,11 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
         "gpu_sort_keys",
     ],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    deterministic: render_core::description::always_deterministic,
+    gpu_layouts: crate::gpu_layouts,
 };
 
-/// Both cell models with each sort (constant first), the order [`crate::variants`] runs.
+/// Both cell models with each sort (constant first), the order the harness runs them.
 fn grid(sorts: &[GatorSort]) -> Vec<Settings> {
     sorts
         .iter()

@@ -700,7 +700,7 @@ fn gpu_radix_over_several_tet_bindings_draws_the_same_image() {
 
 #[test]
 fn settings_and_variants() {
-    let v = gator_pt::default_variants();
+    let v = gator_pt::DESCRIPTION.default_variants().unwrap();
     let rows: Vec<String> = v.iter().map(|r| r.settings().to_string()).collect();
     assert_eq!(
         rows,

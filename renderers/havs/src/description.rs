@@ -92,7 +92,17 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
         "gpu_sort_keys",
     ],
     nondeterministic_counters,
+    deterministic,
+    gpu_layouts: crate::gpu_layouts,
 };
+
+/// The racy single pass (`mode=fragment-race`, §4) draws a different image from frame to
+/// frame where a pixel's fragments are shaded concurrently (`tests/racy_twin.rs`); in order
+/// (lavapipe) it is its CPU twin exactly, and the race-free mode is exact everywhere.
+fn deterministic(s: &Settings, shading: Shading) -> bool {
+    let racy = s.text("mode").as_deref() == Some(Mode::FragmentRace.name());
+    !(racy && shading == Shading::Concurrent)
+}
 
 /// The racy single pass (`mode=fragment-race`, §4) on an adapter that shades a pixel's
 /// fragments concurrently: which read-modify-writes of a pixel's k-buffer another fragment
@@ -101,8 +111,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
 /// (lavapipe) the racy pass is its CPU twin exactly (`tests/racy_twin.rs`), so every counter is
 /// exact there.
 fn nondeterministic_counters(s: &Settings, shading: Shading) -> &'static [&'static str] {
-    let racy = s.text("mode").as_deref() == Some(Mode::FragmentRace.name());
-    if racy && shading == Shading::Concurrent {
+    if !deterministic(s, shading) {
         &[
             "fragments",
             "kbuffer_out_of_order",

@@ -106,26 +106,6 @@ impl Default for HavsSettings {
 /// Largest k the shaders are built for (the k-buffer lives in registers during a fragment).
 pub const MAX_K: u32 = 16;
 
-/// The variants `tetbench run` measures by default ([`DESCRIPTION`]'s default grid).
-pub fn default_variants() -> Vec<Box<dyn Renderer>> {
-    build_all((DESCRIPTION.default_grid)())
-}
-
-/// Every variant `tetbench run --settings …` selects from ([`DESCRIPTION`]'s full grid).
-pub fn all_variants() -> Vec<Box<dyn Renderer>> {
-    build_all((DESCRIPTION.full_grid)())
-}
-
-fn build_all(grid: Vec<render_core::Settings>) -> Vec<Box<dyn Renderer>> {
-    grid.iter()
-        .map(|s| {
-            Box::new(Havs::new(
-                description::from_settings(s).expect("declared grid"),
-            )) as Box<dyn Renderer>
-        })
-        .collect()
-}
-
 /// The HAVS renderer.
 pub struct Havs {
     pub settings: HavsSettings,
@@ -258,16 +238,32 @@ struct KeyUniforms {
 }
 
 /// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
-/// for the layout test (`tests/gpu_layouts.rs`).
+/// for the layout test (`tests/gpu_layouts.rs`, through [`DESCRIPTION`]).
 #[doc(hidden)]
-pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
-    vec![
+pub fn gpu_layouts() -> render_core::gpu_layout::GpuLayouts {
+    let structs = vec![
         render_core::rust_layout!(Uniforms => "havs.wgsl::Uniforms" {
             view_proj, eye, forward, width, height, flags, base_face, max_len, n_s, n_l,
             node_capacity, et_alpha, rect_x0, rect_y0, _pad
         }),
         render_core::rust_layout!(KeyUniforms => "keys.wgsl::KeyUniforms" { eye, forward, faces, _pad }),
-    ]
+    ];
+    render_core::gpu_layout::GpuLayouts {
+        structs,
+        sources: vec![
+            // `const K` in front, the shared k-buffer after, as `pipelines` composes it (any K:
+            // the uniforms do not depend on it).
+            (
+                "havs.wgsl",
+                format!(
+                    "const K: u32 = 6u;\n{}\n{}",
+                    include_str!("havs.wgsl"),
+                    include_str!("kbuffer.wgsl")
+                ),
+            ),
+            ("keys.wgsl", include_str!("keys.wgsl").into()),
+        ],
+    }
 }
 
 /// Per-frame buffers for one viewport size.

@@ -52,6 +52,8 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     tolerance,
     counters: &["ray_steps", "triangles"],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    deterministic: render_core::description::always_deterministic,
+    gpu_layouts: crate::resources::gpu_layouts,
 };
 
 /// Measured on the check scene (`tests/vs_reference.rs`, lavapipe): the 3D table 96.5 dB, the

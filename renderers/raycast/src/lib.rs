@@ -38,22 +38,6 @@ pub use description::DESCRIPTION;
 pub use render::{PassData, Raycast};
 pub use settings::{Mode, RaycastSettings, TableKind};
 
-/// The default variants ([`settings::default_settings`]) as renderers.
-pub fn default_variants() -> Vec<Box<dyn render_core::Renderer>> {
-    settings::default_settings()
-        .into_iter()
-        .map(|s| Box::new(Raycast::new(s)) as Box<dyn render_core::Renderer>)
-        .collect()
-}
-
-/// Every variant ([`settings::all_settings`]) as renderers.
-pub fn all_variants() -> Vec<Box<dyn render_core::Renderer>> {
-    settings::all_settings()
-        .into_iter()
-        .map(|s| Box::new(Raycast::new(s)) as Box<dyn render_core::Renderer>)
-        .collect()
-}
-
 /// Opacity at which a ray stops when early termination is on (the paper's shader uses 0.95).
 pub const ET_OPACITY: f32 = 0.95;
 /// The termination test (an atomic count of active rays per tile) runs in every k-th pass; the

@@ -40,15 +40,29 @@ pub struct TileRect {
 }
 
 /// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
-/// for the layout test (`tests/gpu_layouts.rs`).
+/// for the layout test (`tests/gpu_layouts.rs`, through [`crate::DESCRIPTION`]).
 #[doc(hidden)]
-pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
-    vec![
+pub fn gpu_layouts() -> render_core::gpu_layout::GpuLayouts {
+    let structs = vec![
         render_core::rust_layout!(FrameParams => "common.wgsl::Frame" {
             o0, ox, oy, d0, dx, dy, view_proj, size, counts, misc, table
         }),
         render_core::rust_layout!(TileRect => "cast.wgsl::TileRect" { origin, end }),
-    ]
+    ];
+    render_core::gpu_layout::GpuLayouts {
+        structs,
+        sources: vec![
+            ("common.wgsl", include_str!("common.wgsl").into()),
+            (
+                "cast.wgsl",
+                format!(
+                    "{}\n{}",
+                    include_str!("common.wgsl"),
+                    include_str!("cast.wgsl")
+                ),
+            ),
+        ],
+    }
 }
 
 /// Every stage the ray caster's bind groups are visible to.

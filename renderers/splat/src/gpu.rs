@@ -51,10 +51,10 @@ pub struct SlabParams {
 }
 
 /// The `#[repr(C)]` structs this crate uploads to the GPU and the WGSL structs they mirror,
-/// for the layout test (`tests/gpu_layouts.rs`).
+/// for the layout test (`tests/gpu_layouts.rs`, through [`crate::DESCRIPTION`]).
 #[doc(hidden)]
-pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
-    vec![
+pub fn gpu_layouts() -> render_core::gpu_layout::GpuLayouts {
+    let structs = vec![
         render_core::rust_layout!(FrameParams => "frame.wgsl::Frame" {
             view_proj, depth_row, viewport, tan_half, focal_px, perspective, d0, inv_delta,
             delta_world, num_slabs, n, padded, radius_slabs, subslices, footprint, tf_entries,
@@ -64,7 +64,14 @@ pub fn gpu_layouts() -> Vec<render_core::gpu_layout::RustLayout> {
         render_core::rust_layout!(SlabParams => "frame.wgsl::Slab" {
             first, count, first_slab, last_slab, slot, lanes, pad1, pad2
         }),
-    ]
+    ];
+    render_core::gpu_layout::GpuLayouts {
+        structs,
+        sources: vec![
+            ("frame.wgsl", include_str!("frame.wgsl").into()),
+            ("splat.wgsl", include_str!("splat.wgsl").into()),
+        ],
+    }
 }
 
 pub const IMAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
