@@ -4,6 +4,7 @@
 
 use super::*;
 use crate::papers::claims::{self, ClaimResult};
+use crate::papers::claims_report;
 use crate::papers::evidence::evaluate_claims;
 use crate::papers::session::{Extra, Measured};
 use crate::papers::transcription;
@@ -553,7 +554,7 @@ fn claims_by_construction_and_derived_ones_are_counted_apart_with_their_own_word
     assert_eq!(s3.evaluation.verdict, Verdict::Holds);
     assert_eq!(s3.word(), "as constructed");
     // The headline counts measured claims only.
-    let holds = claims::tally(&r)
+    let holds = claims_report::tally(&r)
         .into_iter()
         .find(|(v, _)| *v == Verdict::Holds)
         .unwrap()
@@ -564,7 +565,7 @@ fn claims_by_construction_and_derived_ones_are_counted_apart_with_their_own_word
         apart.contains("by construction: 1 as constructed"),
         "{apart}"
     );
-    assert!(claims::markdown(&r).contains("| by construction |"));
+    assert!(claims_report::markdown(&r).contains("| by construction |"));
     // A changed construction flips it to its own negative word.
     let mut m2 = m.clone();
     m2.rows[0].counters = "effective_voxels=232000".into();
@@ -650,7 +651,7 @@ fn h7_and_f1_rejudged_from_the_committed_h200_rows_show_their_old_rules_beside()
         assert_eq!(old[0], ("16f45b8", Verdict::DoesNotHold), "{d}: {old:?}");
         assert_eq!(old[1].1, Verdict::Holds, "{d}: {old:?}");
     }
-    let md = claims::markdown(&r);
+    let md = claims_report::markdown(&r);
     assert!(
         md.contains("by the rule before 16f45b8: does not hold") && md.contains("Rule history"),
         "{md}"

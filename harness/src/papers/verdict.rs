@@ -42,7 +42,8 @@ impl Verdict {
 }
 
 /// What a claim's verdict depends on besides the method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(try_from = "String")]
 pub enum Hardware {
     /// Geometry and counts: the same on every machine.
     None,
@@ -51,6 +52,18 @@ pub enum Hardware {
     /// GPU hardware: its speed, or what its concurrency does (HAVS's fragment race):
     /// meaningless on a software rasteriser.
     Gpu,
+}
+
+impl TryFrom<String> for Hardware {
+    type Error = String;
+    fn try_from(s: String) -> Result<Hardware, String> {
+        match s.as_str() {
+            "none" => Ok(Hardware::None),
+            "cpu" => Ok(Hardware::Cpu),
+            "gpu" => Ok(Hardware::Gpu),
+            s => Err(format!("hardware {s:?} is not none, cpu or gpu")),
+        }
+    }
 }
 
 /// One measurement of one side: a viewpoint's (or one run's) median and its frames' range.
