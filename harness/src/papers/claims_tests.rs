@@ -618,13 +618,27 @@ fn h200(paper: &str) -> Measured {
     m
 }
 
+/// `m` with five frames behind every row (the numbers unchanged).
+fn five_frames(m: &Measured) -> Measured {
+    let mut m = m.clone();
+    for r in &mut m.rows {
+        r.frames = r.frames.max(5);
+    }
+    m
+}
+
 #[test]
 fn h7_and_f1_rejudged_from_the_committed_h200_rows_show_their_old_rules_beside() {
-    let m = h200("havs");
+    let committed = h200("havs");
     assert!(
-        m.calibration.is_some(),
+        committed.calibration.is_some(),
         "the H200 runs carry their calibration"
     );
+    // The committed rows are quick-mode rows, one frame each: too few to decide a rate.
+    let r = eval("havs", &committed, &Extra::default());
+    assert_eq!(verdict_of(&r, "H7", Some("f117")), Verdict::TooFewFrames);
+    // The same numbers as if each row had five frames (their spread still zero) decide.
+    let m = five_frames(&committed);
     let r = eval("havs", &m, &Extra::default());
     for d in ["f117", "kew", "spx2", "torso", "fighter"] {
         let h7 = r
@@ -679,7 +693,7 @@ fn h7_and_f1_rejudged_from_the_committed_h200_rows_show_their_old_rules_beside()
     assert_eq!(verdict_of(&r, "H7", Some("f117")), Verdict::NotCheckable);
 
     // F1 on the H200: whole frames of fragment PT against 2.0 M tets/s, normalised.
-    let f = h200("fragment-pt");
+    let f = five_frames(&h200("fragment-pt"));
     let r = eval("fragment-pt", &f, &Extra::default());
     for d in ["bluntfin", "comb", "post", "spx2"] {
         assert_eq!(verdict_of(&r, "F1", Some(d)), Verdict::Holds, "{d}");

@@ -158,6 +158,12 @@ impl Rule {
         if self.normalise != Normalise::None {
             s.push_str(&format!(", normalised by {}", self.normalise.label()));
         }
+        if self.metric.is_timed() {
+            s.push_str(&format!(
+                ", decided only on at least {} frames a side beyond their spread",
+                verdict::MIN_FRAMES
+            ));
+        }
         s
     }
 

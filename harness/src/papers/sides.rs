@@ -230,12 +230,22 @@ pub fn side_from_rows(
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
                 (l.min(v), h.max(v))
             });
+        // A spread of timings keeps the fewest frames behind them: too few decide nothing.
+        let frames = rows
+            .iter()
+            .filter_map(|r| row_sample(inner, r).ok())
+            .map(|s| s.frames)
+            .min()
+            .unwrap_or(0);
         return Ok(Side::new(
             format!(
                 "{label}, {inner} range/mean over {} viewpoints",
                 values.len()
             ),
-            vec![Sample::exact("views", (hi - lo) / mean)],
+            vec![Sample {
+                frames,
+                ..Sample::exact("views", (hi - lo) / mean)
+            }],
         ));
     }
     let mut samples = vec![];

@@ -158,7 +158,7 @@ impl Metric {
     }
 
     /// Whether its value comes from timed frames (a time, a rate from a time, a stage), so
-    /// that a verdict on it needs enough frames a side.
+    /// that a verdict on it needs enough frames a side ([`super::verdict::MIN_FRAMES`]).
     pub fn is_timed(&self) -> bool {
         matches!(
             self,
