@@ -213,7 +213,35 @@ pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
 pub fn all() -> anyhow::Result<Vec<Claim>> {
     let mut claims = parse(CLAIMS_CSV, FILE)?;
     attach_history(&mut claims, history()?, HISTORY_FILE)?;
+    check_counter_evidence(&claims, FILE)?;
     Ok(claims)
+}
+
+/// A claim on a counter that its renderer's description declares not measured (the bytes a
+/// data layout reserves, the triangles a draw call issues by its own arguments) cannot be
+/// `measured`: it can only be as constructed, so it never counts as a hold.
+pub fn check_counter_evidence(claims: &[Claim], file: &str) -> anyhow::Result<()> {
+    for c in claims.iter().filter(|c| c.evidence == Evidence::Measured) {
+        let Some(name) = c.metric.counter() else {
+            continue;
+        };
+        for spec in [Some(&c.a), c.b.as_ref()].into_iter().flatten() {
+            let Some(d) = crate::algorithms::describe(&spec.algorithm) else {
+                continue;
+            };
+            let e = d.evidence_of(name);
+            if e != render_core::CounterEvidence::Measured {
+                bail!(
+                    "{file}: {} {}: counter {name} of {} {} (its description), so the claim cannot be measured: write evidence construction",
+                    c.paper,
+                    c.id,
+                    spec.algorithm,
+                    e.label()
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Gives each claim its earlier rules; a change naming no claim is an error, and a derived
@@ -446,6 +474,34 @@ mod tests {
     use crate::papers::sides::row_sample;
     use crate::results::Row;
     use render_core::Settings;
+
+    #[test]
+    fn a_claim_on_a_layout_or_draw_call_counter_cannot_be_measured() {
+        let head = HEADER.join(",");
+        let with = |evidence: &str| {
+            parse(
+                &format!(
+                    "{head}\nraycast,R4,paper,§3.1,x,counter:mesh_bytes_per_tet,spx1,raycast:tiles=5x5,,a=144,0,none,{evidence},none\ngator,G9,paper,§3.4,x,counter_per_tet:triangles_drawn,post,gator-pt:variant=linear,,a=4,0,none,{evidence},none\nraycast,R9,paper,§3.1,x,counter:steps_max,spx1,raycast:tiles=5x5,,a=144,0,none,measured,none\n"
+                ),
+                "claims.csv",
+            )
+            .unwrap()
+        };
+        let e = check_counter_evidence(&with("measured"), "claims.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("R4") && e.contains("mesh_bytes_per_tet") && e.contains("data layout"),
+            "{e}"
+        );
+        let only_g9 = with("measured").split_off(1);
+        let e = check_counter_evidence(&only_g9, "claims.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("G9") && e.contains("draw call"), "{e}");
+        // As constructed they load; a measured counter (the longest walk) stays measured.
+        check_counter_evidence(&with("construction"), "claims.csv").unwrap();
+    }
 
     #[test]
     fn a_bad_claims_file_is_refused_with_file_and_line() {

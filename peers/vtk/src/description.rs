@@ -48,6 +48,7 @@ pub static PT: AlgorithmDescription = AlgorithmDescription {
     },
     counters: &[],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    counter_evidence: &[],
 };
 
 pub static RAYCAST: AlgorithmDescription = AlgorithmDescription {
@@ -93,6 +94,7 @@ pub static RAYCAST: AlgorithmDescription = AlgorithmDescription {
     },
     counters: &[],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    counter_evidence: &[],
 };
 
 pub static ZSWEEP: AlgorithmDescription = AlgorithmDescription {
@@ -122,6 +124,7 @@ pub static ZSWEEP: AlgorithmDescription = AlgorithmDescription {
     },
     counters: &[],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    counter_evidence: &[],
 };
 
 pub(crate) fn settings_of(

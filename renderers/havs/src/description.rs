@@ -92,6 +92,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
         "gpu_sort_keys",
     ],
     nondeterministic_counters,
+    counter_evidence: &[],
 };
 
 /// The racy single pass (`mode=fragment-race`, §4) on an adapter that shades a pixel's

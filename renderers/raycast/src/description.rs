@@ -2,7 +2,8 @@
 //! [`render_core::description`]).
 
 use render_core::{
-    AlgorithmDescription, Hue, Origin, Param, Renderer, Settings, Tolerance, ValueKind,
+    AlgorithmDescription, CounterEvidence, Hue, Origin, Param, Renderer, Settings, Tolerance,
+    ValueKind,
 };
 
 use crate::settings::{all_settings, default_settings, RaycastSettings};
@@ -52,6 +53,8 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     tolerance,
     counters: &["ray_steps", "triangles"],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    // The mesh's bytes per tet are the texel layout's size over the tets (§3.1, its Table 1).
+    counter_evidence: &[("mesh_bytes_per_tet", CounterEvidence::Layout)],
 };
 
 /// Measured on the check scene (`tests/vs_reference.rs`, lavapipe): the 3D table 96.5 dB, the

@@ -86,6 +86,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
         "gpu_sort_keys",
     ],
     nondeterministic_counters: render_core::description::all_counters_exact,
+    counter_evidence: &[],
 };
 
 fn full_grid() -> Vec<Settings> {
