@@ -97,6 +97,8 @@ pub struct Paper {
 #[cfg(test)]
 mod claims_flip_tests;
 #[cfg(test)]
+mod claims_paper_figure_tests;
+#[cfg(test)]
 mod claims_tests;
 #[cfg(test)]
 mod rule_history_tests;
