@@ -151,6 +151,38 @@ fn tiny_run_writes_results_images_and_report() {
     assert_same_rows(&json.rows, &rows);
     assert!(json.finished_utc.is_some());
     assert!(json.machine.adapter.is_some() && json.machine.cpu_cores >= 1);
+    // The control beside the rows: a sample before every round of the data set and one after
+    // the last, each with a figure of every control probe, and every row priced by the control
+    // of its own rounds.
+    let control = json
+        .control
+        .as_ref()
+        .expect("a calibrated run has a control");
+    let rounds = json.run.rounds.max(1);
+    let taken: Vec<u32> = control.samples.iter().map(|s| s.round).collect();
+    if rounds > 1 {
+        assert_eq!(taken, (0..=rounds).collect::<Vec<_>>());
+    } else {
+        assert!(taken.len() >= 2 && taken.last() == Some(&1), "{taken:?}");
+    }
+    let figures = control.samples[0].figures.len();
+    assert!(figures >= 8, "{:?}", control.samples[0].figures);
+    for r in &json.rows {
+        assert_eq!(
+            r.round_control.len(),
+            rounds as usize,
+            "{} {}",
+            r.algorithm,
+            r.settings
+        );
+        assert!(r.control_factor.is_some_and(|f| f > 0.0));
+        assert!(
+            r.priced_with.to_string().starts_with("control"),
+            "{}: {}",
+            r.algorithm,
+            r.priced_with
+        );
+    }
 
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     for r in &rows {

@@ -33,6 +33,7 @@ fn template(dir: &Path) -> PathBuf {
         }
     }
     let file = ResultsFile {
+        control: None,
         schema_version: SCHEMA_VERSION,
         machine: MachineInfo::collect(),
         run: RunDescription {

@@ -40,6 +40,7 @@ fn results(dir: &Path, factors: &[f64], rounds: u32, adapter_cpu: &str) {
     let mut machine = MachineInfo::collect();
     machine.cpu_model = adapter_cpu.into();
     let file = ResultsFile {
+        control: None,
         schema_version: SCHEMA_VERSION,
         machine,
         run: RunDescription {

@@ -30,6 +30,9 @@ fn row(algorithm: &str, settings: &str, dataset: &str, viewpoint: &str, i: usize
         cpu_ms: None,
         gpu_ms: None,
         fps: None,
+        control_factor: None,
+        priced_with: Default::default(),
+        round_control: vec![],
         tets_per_sec: Some(speed * if viewpoint == "+x" { 1.1 } else { 1.0 }),
         gpu_bytes: Some(1_000_000),
         bytes_per_tet: Some(100.0),
@@ -92,6 +95,7 @@ fn synthetic_run() -> ResultsFile {
         }
     }
     ResultsFile {
+        control: None,
         schema_version: SCHEMA_VERSION,
         machine: MachineInfo::collect(),
         run: RunDescription {

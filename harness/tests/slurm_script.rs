@@ -291,6 +291,7 @@ fn write_shard(out: &Path, i: usize, finished: bool, exit_status: Option<i32>) {
         })
         .collect();
     let file = ResultsFile {
+        control: None,
         schema_version: results::SCHEMA_VERSION,
         machine: MachineInfo::collect(),
         run,

@@ -1,6 +1,7 @@
 //! The roofline's and the calibration cache's tests (calibrate/mod.rs).
 
 use super::*;
+use crate::calibrate::kernels::{additive_pipeline, calibrate_source, RASTER_LEGS, RASTER_SIZE};
 
 fn cal() -> Calibration {
     Calibration {
@@ -333,11 +334,156 @@ fn raster_triangles_have_the_counted_fragments() {
 /// setting (counter names such as `ray_steps` are the only vocabulary).
 #[test]
 fn calibrate_names_no_algorithm() {
-    let source = include_str!("mod.rs");
-    for name in crate::algorithms::names() {
-        let quoted = format!("\"{name}\"");
-        assert!(!source.contains(&quoted), "calibrate/mod.rs names {quoted}");
+    for (file, source) in [
+        ("mod.rs", include_str!("mod.rs")),
+        ("probes.rs", include_str!("probes.rs")),
+        ("kernels.rs", include_str!("kernels.rs")),
+        ("control.rs", include_str!("control.rs")),
+    ] {
+        for name in crate::algorithms::names() {
+            let quoted = format!("\"{name}\"");
+            assert!(!source.contains(&quoted), "calibrate/{file} names {quoted}");
+        }
+        assert!(!source.contains(concat!(".algo", "rithm")), "{file}");
+        assert!(!source.contains(concat!(".set", "ting")), "{file}");
     }
-    assert!(!source.contains(concat!(".algo", "rithm")));
-    assert!(!source.contains(concat!(".set", "ting")));
+}
+
+/// The control as a run measures it: every figure of `cal()` at `speed` times its rate.
+fn control_at(speed: f64) -> control::Figures {
+    let c = cal();
+    crate::calibrate::probes::PROBES
+        .iter()
+        .filter(|p| p.in_control)
+        .flat_map(|p| p.figures.iter())
+        .map(|&f| (f, f.from_speed(f.speed(f.get(&c)) * speed)))
+        .collect()
+}
+
+/// A row with a control is priced by it, not by the cached calibration: the same row and
+/// counters at a control half as fast has twice the bound, and the fraction moves with it;
+/// a figure the control did not measure is the calibration's times the control's factor, and
+/// the row names it.
+#[test]
+fn a_rows_fraction_uses_its_own_rounds_control() {
+    let counters = "fragments=1000000;ray_steps=20000";
+    let mut rows = vec![row(counters, 80.0), row(counters, 80.0)];
+    rows[0].round_control = vec![control_at(1.0); 3];
+    rows[1].round_control = vec![control_at(0.5); 3];
+    annotate(&mut rows, &cal());
+    assert_eq!(
+        rows[0].priced_with,
+        control::Pricing::Control { scaled: vec![] }
+    );
+    assert_close(
+        rows[1].roofline_ms.unwrap(),
+        2.0 * rows[0].roofline_ms.unwrap(),
+        "half the speed, twice the bound",
+    );
+    assert_close(
+        rows[1].limit_fraction.unwrap(),
+        2.0 * rows[0].limit_fraction.unwrap(),
+        "limit_fraction",
+    );
+    // The fill figure missing from one round's control: the other rounds' median holds it.
+    // Missing from every round: scaled from the calibration by the control's factor (0.5).
+    let mut no_fill = control_at(0.5);
+    no_fill.remove(&crate::results::machine::Figure::FillFragmentsPerSec);
+    rows[1].round_control = vec![no_fill; 3];
+    annotate(&mut rows, &cal());
+    assert_eq!(
+        rows[1].priced_with,
+        control::Pricing::Control {
+            scaled: vec![crate::results::machine::Figure::FillFragmentsPerSec]
+        }
+    );
+    assert_close(
+        rows[1].roofline_ms.unwrap(),
+        2.0 * rows[0].roofline_ms.unwrap(),
+        "the scaled figure",
+    );
+    // Without a control, the cached calibration prices the row, and says so.
+    let mut plain = vec![row(counters, 80.0)];
+    annotate(&mut plain, &cal());
+    assert_eq!(plain[0].priced_with, control::Pricing::Calibration);
+    assert_close(
+        plain[0].roofline_ms.unwrap(),
+        rows[0].roofline_ms.unwrap(),
+        "a control at the calibration's speed",
+    );
+    // `priced_with` reads back what it wrote.
+    for p in [&rows[1].priced_with, &plain[0].priced_with] {
+        assert_eq!(&p.to_string().parse::<control::Pricing>().unwrap(), p);
+    }
+}
+
+/// A row's rounds take the best of the samples around each: before and after the round
+/// (several rounds), or before and after the row in file order (one variant at a time); a
+/// round with no sample around it gives no control.
+#[test]
+fn each_round_is_bracketed_by_its_samples() {
+    use control::{Control, ControlSample};
+    let sample = |dataset: &str, round, rows_before, speed| ControlSample {
+        dataset: dataset.into(),
+        round,
+        rows_before,
+        at_s: 0.0,
+        utc: String::new(),
+        seconds: 0.1,
+        figures: control_at(speed),
+    };
+    let fill = |f: &control::Figures| f[&crate::results::machine::Figure::FillFragmentsPerSec];
+    let c = Control {
+        probes: vec![],
+        setup_seconds: 0.0,
+        samples: vec![
+            sample("a", 0, 0, 1.0),
+            sample("a", 1, 0, 0.5),
+            sample("a", 2, 0, 0.25),
+            sample("b", 0, 0, 0.1),
+        ],
+    };
+    let rounds = c.rounds_of("a", 2, 5);
+    assert_eq!(rounds.len(), 2);
+    assert_close(fill(&rounds[0]), 1e8, "round 0: the faster of 1.0 and 0.5");
+    assert_close(
+        fill(&rounds[1]),
+        0.5e8,
+        "round 1: the faster of 0.5 and 0.25",
+    );
+    assert_eq!(
+        c.rounds_of("a", 3, 5).len(),
+        3,
+        "round 2: the sample before it"
+    );
+    assert!(
+        c.rounds_of("a", 4, 5).is_empty(),
+        "round 3 has no sample around it"
+    );
+    assert!(c.rounds_of("c", 2, 5).is_empty());
+
+    let one_at_a_time = Control {
+        probes: vec![],
+        setup_seconds: 0.0,
+        samples: vec![
+            sample("a", 0, 0, 0.5),
+            sample("a", 0, 3, 1.0),
+            sample("a", 1, 6, 0.25),
+        ],
+    };
+    assert_close(
+        fill(&one_at_a_time.rounds_of("a", 1, 1)[0]),
+        1e8,
+        "rows 0–2",
+    );
+    assert_close(
+        fill(&one_at_a_time.rounds_of("a", 1, 4)[0]),
+        1e8,
+        "rows 3–5",
+    );
+    assert_close(
+        fill(&one_at_a_time.rounds_of("a", 1, 6)[0]),
+        0.25e8,
+        "row 6: only the sample before it",
+    );
 }

@@ -1,40 +1,15 @@
-//! The calibration's work-specific micro-benchmarks (`calibrate.wgsl`), one per counter that
-//! no generic figure prices: a ray step (`walk_main`), a splat fragment (`splat_cs`) and a key
-//! of render-core's GPU radix sort. Each returns its rate per second, best of the
-//! calibration's repetitions; 0 where the adapter cannot run it.
+//! The calibration's work-specific probes (`calibrate.wgsl`), one per counter that no generic
+//! figure prices: a ray step (`walk_main`), a splat fragment (`splat_cs`), a key of
+//! render-core's GPU radix sort and a tet classification. Each prepares its configurations as
+//! [`Workload`]s ([`crate::calibrate::probes`]).
 
+use crate::calibrate::kernels::dispatch;
+use crate::calibrate::probes::{ProbeContext, Workload};
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::gpu_sort::GpuRadixSort;
 use render_core::table_texture::TableTexture;
 use render_core::texel_texture::TexelTexture;
 use render_core::Gpu;
-use std::time::Instant;
-
-/// Timed repetitions after one warm-up (the best is kept: a roofline wants the backend's peak,
-/// and on a busy machine the best repetition is the one least disturbed).
-const REPS: usize = 5;
-
-/// Best seconds of `REPS` runs of `f` after one warm-up.
-pub fn best_seconds(f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Result<f64> {
-    best_seconds_of(REPS, f)
-}
-
-/// Best seconds of `reps` runs of `f` after one warm-up. A short benchmark is better run
-/// often: on a busy machine a short run finds an undisturbed moment more easily than a long
-/// one, and the rows it prices are short frames that find them too.
-pub fn best_seconds_of(
-    reps: usize,
-    mut f: impl FnMut() -> anyhow::Result<()>,
-) -> anyhow::Result<f64> {
-    f()?;
-    let mut t = Vec::with_capacity(reps);
-    for _ in 0..reps {
-        let t0 = Instant::now();
-        f()?;
-        t.push(t0.elapsed().as_secs_f64());
-    }
-    Ok(t.into_iter().fold(f64::INFINITY, f64::min).max(1e-9))
-}
 
 /// Cells of the walk table (144 bytes each: 64 MiB of geometry + 8 MiB of neighbours).
 const WALK_CELLS: u64 = 1 << 19;
@@ -83,7 +58,8 @@ fn storage(
 /// Ray steps per second: `WALK_INVOCATIONS` walks of `WALK_STEPS` dependent cell gathers, the
 /// faster of two layouts: cells and table in storage buffers (`walk_main`), and cells in a
 /// texture with the table a filtered 3D texture (`walk_tex_main`, the ray caster's layout).
-pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Result<f64> {
+pub fn ray_steps<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>> {
+    let (gpu, module) = (ctx.gpu, &ctx.module);
     // Whole rows of the texture walk's 8192 texels (9 a cell, TEXEL_ROW): a multiple of 8192
     // cells.
     let cells = (WALK_CELLS.min(gpu.max_storage_binding() / 128) / 8192 * 8192).max(8192);
@@ -149,20 +125,13 @@ pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Resu
             render_core::bind::whole(6, &out),
         ],
     });
-    let run = |pipeline: &wgpu::ComputePipeline, bind: &wgpu::BindGroup| {
-        best_seconds(|| {
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = enc.begin_compute_pass(&Default::default());
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, bind, &[]);
-                pass.dispatch_workgroups((WALK_INVOCATIONS / 64) as u32, 1, 1);
-            }
-            gpu.queue.submit([enc.finish()]);
-            gpu.wait()
+    let steps = (WALK_INVOCATIONS * WALK_STEPS) as f64;
+    let walk = |pipeline: wgpu::ComputePipeline, bind: wgpu::BindGroup| {
+        Workload::new(steps, move || {
+            dispatch(gpu, &pipeline, &bind, (WALK_INVOCATIONS / 64) as u32)
         })
     };
-    let storage_s = run(&pipeline, &bind)?;
+    let storage_walk = walk(pipeline, bind);
 
     // The texture walk: the same cells, each its 8 geometry texels then its neighbours.
     let mut texels: Vec<[u32; 4]> = Vec::with_capacity(cells as usize * 9);
@@ -238,8 +207,8 @@ pub fn ray_steps_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Resu
         layout: &tex_layout,
         entries: &bind_entries,
     });
-    let texture_s = run(&tex_pipeline, &tex_bind)?;
-    Ok((WALK_INVOCATIONS * WALK_STEPS) as f64 / storage_s.min(texture_s))
+    // The buffers and textures live as long as the bind groups that hold them.
+    Ok(vec![storage_walk, walk(tex_pipeline, tex_bind)])
 }
 
 /// The two tables of the splat benchmark: 8 slices of 32² texels, one with no zero (every
@@ -285,7 +254,8 @@ pub fn splat_grid(side: u32) -> u32 {
 /// one configuration's would otherwise beat its bound), each with the table in a storage
 /// buffer and, where the device filters `R32Float`, in a filtered 3D texture (`splat_tex_cs`,
 /// the splatter's layout there: on lavapipe 1.6 times the storage table's rate).
-pub fn splat_fragments_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Result<f64> {
+pub fn splat_fill<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>> {
+    let (gpu, module) = (ctx.gpu, &ctx.module);
     let mut ledger = MemoryLedger::default();
     let sheet = ledger.buffer(
         gpu,
@@ -298,7 +268,7 @@ pub fn splat_fragments_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow
     let sampler = TableTexture::sampler(gpu, "calibrate splat table", true);
     // The storage table (binding 7) and, where the device filters R32Float, the texture (17,
     // with its sampler at 18), each with both tables.
-    let mut best = 0.0f64;
+    let mut out = vec![];
     let textures = [false, true];
     for texture in textures
         .into_iter()
@@ -354,11 +324,11 @@ pub fn splat_fragments_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow
                     layout: &group,
                     entries: &bind_entries,
                 });
-                best = best.max(splat_fill_rate(gpu, &pipeline, &bind, side)?);
+                out.push(splat_workload(gpu, pipeline.clone(), bind, side));
             }
         }
     }
-    Ok(best)
+    Ok(out)
 }
 
 /// A table of [`splat_tables`] as the benchmark reads it: a storage buffer of its slices, or an
@@ -405,36 +375,28 @@ impl SplatTable {
     }
 }
 
-/// Splat fragments per second of one configuration of the splat benchmark (`side`-pixel
-/// squares): the best of the repetitions.
-fn splat_fill_rate(
+/// One configuration of the splat benchmark (`side`-pixel squares): enough workgroups for
+/// [`SPLAT_FRAGMENTS`] footprint pixels.
+fn splat_workload(
     gpu: &Gpu,
-    pipeline: &wgpu::ComputePipeline,
-    bind: &wgpu::BindGroup,
+    pipeline: wgpu::ComputePipeline,
+    bind: wgpu::BindGroup,
     side: u32,
-) -> anyhow::Result<f64> {
+) -> Workload<'_> {
     let per_splat = side as u64 * side as u64 * SPLAT_RING;
     let groups = SPLAT_FRAGMENTS.div_ceil(per_splat * 256);
-    let s = best_seconds(|| {
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, bind, &[]);
-            pass.dispatch_workgroups(groups as u32, 1, 1);
-        }
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait()
-    })?;
-    Ok((groups * 256 * per_splat) as f64 / s)
+    Workload::new((groups * 256 * per_splat) as f64, move || {
+        dispatch(gpu, &pipeline, &bind, groups as u32)
+    })
 }
 
 /// Keys per second of render-core's GPU radix sort (HAVS' and fragment PT's device sorts):
 /// the fastest of 2^16 and 2^18 f32 keys (an LSD radix sort costs about the same per key at
 /// any size that fills the device, but a small sort pays its passes' fixed costs on fewer
 /// keys, and a peak must hold at the rows' sizes; on lavapipe 2^20 took seconds).
-pub fn gpu_sort_keys_per_sec(gpu: &Gpu) -> anyhow::Result<f64> {
-    let mut best = 0.0f64;
+pub fn gpu_sort<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>> {
+    let gpu = ctx.gpu;
+    let mut out = vec![];
     for size in GPU_SORT_SIZES {
         let n = size.min((gpu.max_storage_binding() / 4) as u32);
         let mut fill = Filler(0xD1B5_4A32_D192_ED03);
@@ -455,26 +417,25 @@ pub fn gpu_sort_keys_per_sec(gpu: &Gpu) -> anyhow::Result<f64> {
             bytemuck::cast_slice(&ids),
         )?;
         // Sorted keys sort no faster: an LSD radix sort does the same passes on any input.
-        let s = best_seconds(|| {
+        out.push(Workload::new(n as f64, move || {
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             sorter.encode(&mut enc, &keys_buf, &ids_buf, n, false)?;
             gpu.queue.submit([enc.finish()]);
             gpu.wait()
-        })?;
-        best = best.max(n as f64 / s);
+        }));
     }
-    Ok(best)
+    Ok(out)
 }
 
-/// Tets of the classification benchmark (a pass as long as a small mesh's, run
-/// `CLASSIFY_REPS` times: see [`best_seconds_of`]).
+/// Tets of the classification benchmark (a pass as long as a small mesh's, run often: see
+/// [`crate::calibrate::probes::best_seconds_of`]).
 const CLASSIFY_TETS: u64 = 1 << 15;
-const CLASSIFY_REPS: usize = 25;
 
 /// Tet classifications per second (`classify_cs`): the projection, orientation tests and
 /// diagonal intersection every projected-tetrahedra classification does, on a jittered
 /// lattice of 2^15 points with tets of nearby vertices (as a mesh numbers them).
-pub fn tet_classifications_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> anyhow::Result<f64> {
+pub fn classification<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>> {
+    let (gpu, module) = (ctx.gpu, &ctx.module);
     let side = 32u64;
     let n = CLASSIFY_TETS;
     let mut fill = Filler(0x6A09_E667_F3BC_C908);
@@ -549,16 +510,7 @@ pub fn tet_classifications_per_sec(gpu: &Gpu, module: &wgpu::ShaderModule) -> an
             render_core::bind::whole(13, &out),
         ],
     });
-    let s = best_seconds_of(CLASSIFY_REPS, || {
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups((n / 64) as u32, 1, 1);
-        }
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait()
-    })?;
-    Ok(n as f64 / s)
+    Ok(vec![Workload::new(n as f64, move || {
+        dispatch(gpu, &pipeline, &bind, (n / 64) as u32)
+    })])
 }

@@ -286,6 +286,7 @@ pub fn merge_rounds(dirs: &[PathBuf], side_dir: &Path) -> anyhow::Result<Results
         let mut merged: Option<Row> = None;
         let mut failures = vec![];
         let mut samples = crate::results::FrameSamples::default();
+        let mut round_control = vec![];
         let mut frames = 0;
         let mut hashes = vec![];
         for (i, (f, d)) in files.iter().zip(dirs).enumerate() {
@@ -301,6 +302,7 @@ pub fn merge_rounds(dirs: &[PathBuf], side_dir: &Path) -> anyhow::Result<Results
             samples.total_ms.extend(&r.samples.total_ms);
             samples.cpu_ms.extend(&r.samples.cpu_ms);
             samples.gpu_ms.extend(&r.samples.gpu_ms);
+            round_control.extend(r.round_control.iter().cloned());
             frames += r.frames;
             hashes.push(r.image_hash.clone());
             if merged.as_ref().is_none_or(|m| !m.ok()) {
@@ -326,6 +328,9 @@ pub fn merge_rounds(dirs: &[PathBuf], side_dir: &Path) -> anyhow::Result<Results
                 row.algorithm, row.settings, row.dataset, row.viewpoint
             ));
         }
+        // A round's control only where every round has one (the rounds then line up).
+        let complete = failures.is_empty() && round_control.len() == files.len();
+        row.round_control = if complete { round_control } else { vec![] };
         row.error = failures.join("; ");
         row.frames = frames;
         summarise_samples(&mut row, samples);
@@ -348,7 +353,16 @@ pub fn merge_rounds(dirs: &[PathBuf], side_dir: &Path) -> anyhow::Result<Results
         .collect();
     let mut machine = first.machine.clone();
     machine.load_average_end = last.machine.load_average_end;
+    let control = merged_control(&files);
+    if let Some(c) = &control {
+        crate::calibrate::set_control_factors(&mut rows, &c.median());
+    }
+    // Each row priced again with all its rounds' control.
+    if let Some(cal) = &machine.calibration {
+        crate::calibrate::annotate(&mut rows, cal);
+    }
     Ok(ResultsFile {
+        control,
         schema_version: crate::results::SCHEMA_VERSION,
         machine,
         run,
@@ -356,6 +370,26 @@ pub fn merge_rounds(dirs: &[PathBuf], side_dir: &Path) -> anyhow::Result<Results
         rows,
         errors,
     })
+}
+
+/// The rounds' controls as one: invocation i's samples become round i's (before it) and
+/// round i + 1's (after it), so that the merged set reads as one run of as many rounds.
+fn merged_control(files: &[ResultsFile]) -> Option<crate::calibrate::control::Control> {
+    let mut out: Option<crate::calibrate::control::Control> = None;
+    for (i, f) in files.iter().enumerate() {
+        let Some(c) = &f.control else { continue };
+        let merged = out.get_or_insert_with(|| crate::calibrate::control::Control {
+            probes: c.probes.clone(),
+            setup_seconds: c.setup_seconds,
+            samples: vec![],
+        });
+        merged.samples.extend(c.samples.iter().map(|s| {
+            let mut s = s.clone();
+            s.round += i as u32;
+            s
+        }));
+    }
+    out
 }
 
 /// Sets a merged row's samples and the summary columns of all of them.

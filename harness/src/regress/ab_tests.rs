@@ -33,6 +33,7 @@ fn row(alg: &str, vp: &str, frames: &[f64]) -> Row {
 
 fn round(dir: &Path, rows: Vec<Row>) -> ResultsFile {
     let file = ResultsFile {
+        control: None,
         schema_version: crate::results::SCHEMA_VERSION,
         machine: crate::results::machine::MachineInfo::collect(),
         run: RunDescription {

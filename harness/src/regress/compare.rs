@@ -204,9 +204,17 @@ pub struct Comparison {
     pub group_spread: Option<f64>,
     pub too_noisy: bool,
     /// NEW / BASE over the whole run: the median of the groups' pooled `total_ms` ratios
-    /// (`None`: too few groups). When `drift_corrected`, every NEW time was divided by it
-    /// before the tests, so a group is judged against the rest of its own run.
+    /// (`None`: too few groups), after the machine was divided out where both runs have a
+    /// control (`machine`). When `drift_corrected`, every NEW time was divided by it before
+    /// the tests, so a group is judged against the rest of its own run (the old rule).
     pub run_factor: Option<f64>,
+    /// The machine's drift between the runs, from the control measured beside the rows: every
+    /// round value of both sides was divided by it before the tests.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<crate::regress::compare_control::MachineDrift>,
+    /// Why the run-wide factor stood in for the control (a side without one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub control_missing: Option<String>,
     pub drift_corrected: bool,
     /// With paired rounds (`ab`): each pair's NEW/BASE factor, divided out of that pair's
     /// NEW round values instead of `run_factor`.
@@ -336,8 +344,8 @@ pub fn compare(
     new_dir: &Path,
     opt: &CompareOptions,
 ) -> anyhow::Result<Comparison> {
-    let base = ResultsFile::read(base_dir)?;
-    let new = ResultsFile::read(new_dir)?;
+    let mut base = ResultsFile::read(base_dir)?;
+    let mut new = ResultsFile::read(new_dir)?;
     let (ba, na) = (adapter_of(&base), adapter_of(&new));
     if ba != na && !opt.normalised {
         anyhow::bail!(
@@ -358,18 +366,25 @@ pub fn compare(
         }
     }
     let rounds = Rounds::of(&base, &new);
+    // The machine divided out by the control measured beside the rows, where both runs have
+    // one (compare_control.rs); otherwise the run-wide factor, as before.
+    let control_missing = crate::regress::compare_control::missing(&base, &new);
+    let machine = (opt.drift_correction && !opt.normalised)
+        .then(|| crate::regress::compare_control::normalise(&mut base, &mut new))
+        .flatten();
+    let by_rows = opt.drift_correction && machine.is_none();
     let unscaled = group_tests(&base.rows, &new.rows, opt, &[1.0], rounds)?;
     let run_factor = run_wide_factor(unscaled.iter().map(|g| &g.total));
     let paired = opt.paired && rounds.base == rounds.new && rounds.base > 1;
-    let pair_factors = (paired && opt.drift_correction)
+    let pair_factors = (paired && by_rows)
         .then(|| pair_factors(&group_pair_ratios(&base.rows, &new.rows, rounds, opt).ok()?))
         .flatten();
     let scale: Vec<f64> = match (&pair_factors, run_factor) {
         (Some(per_pair), _) => per_pair.clone(),
-        (None, Some(f)) if opt.drift_correction => vec![f],
-        // Paired rounds on absolute times (`ab --no-drift-correction`, for a change that moves
-        // most of the matrix): a factor of 1 per pair keeps the paired test.
-        (None, _) if paired && !opt.drift_correction => vec![1.0; rounds.base as usize],
+        (None, Some(f)) if by_rows => vec![f],
+        // Paired rounds on absolute or control-divided times (`ab --no-drift-correction`, or
+        // both sides with a control): a factor of 1 per pair keeps the paired test.
+        (None, _) if paired => vec![1.0; rounds.base as usize],
         _ => vec![1.0],
     };
     let paired_test = scale.len() > 1;
@@ -419,7 +434,13 @@ pub fn compare(
         group_spread,
         too_noisy: noise.is_some(),
         run_factor,
-        drift_corrected: opt.drift_correction && scale != [1.0],
+        drift_corrected: by_rows && scale != [1.0],
+        control_missing: if machine.is_none() && opt.drift_correction && !opt.normalised {
+            control_missing
+        } else {
+            None
+        },
+        machine,
         pair_factors,
         test: format!(
             "work counters and GPU bytes exact; time: Mann–Whitney U (two-sided, α = {}, \

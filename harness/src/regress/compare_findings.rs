@@ -84,12 +84,44 @@ impl Finding {
     }
 }
 
-/// Fills the comparison's regressions, improvements and changes from its run-wide factor,
-/// groups and rows.
-pub fn collect(cmp: &mut Comparison, drift_limit: f64) {
-    let (mut worse, mut better, mut other) = (vec![], vec![], vec![]);
-    if let Some(f) = cmp.run_factor {
-        let finding = |verdict| Finding {
+/// The run-wide finding, if the run as a whole moved. With the machine divided out by the
+/// control, what remains of the run-wide factor is the code: beyond the threshold (and with
+/// time judged at all) it is a change common to every algorithm. Without a control the old
+/// rule stands: a run-wide factor beyond `drift_limit` (machine drift, or a common change).
+fn run_wide(cmp: &Comparison, f: f64, drift_limit: f64) -> Option<(FindingVerdict, Finding)> {
+    let (limit, text) = match &cmp.machine {
+        Some(m) if cmp.time_refused.is_none() => (
+            cmp.threshold,
+            format!(
+                "common to every algorithm: every group's total_ms ×{f:.3} (median over {} \
+                 groups) with the machine's drift (×{:.3}, the control measured beside the \
+                 rows) divided out, beyond --threshold {}",
+                cmp.groups.len(),
+                m.factor,
+                cmp.threshold
+            ),
+        ),
+        Some(_) => return None,
+        None => (
+            drift_limit,
+            format!(
+                "run-wide: every group's total_ms ×{f:.3} (median over {} groups; machine \
+                 drift or a change common to all algorithms, beyond --drift-limit \
+                 {drift_limit}; no control to tell them apart)",
+                cmp.groups.len(),
+            ),
+        ),
+    };
+    let verdict = if f >= limit {
+        FindingVerdict::Slower
+    } else if f <= 1.0 / limit {
+        FindingVerdict::Faster
+    } else {
+        return None;
+    };
+    Some((
+        verdict,
+        Finding {
             group: "run-wide".into(),
             viewpoint: None,
             metric: "total_ms".into(),
@@ -97,16 +129,21 @@ pub fn collect(cmp: &mut Comparison, drift_limit: f64) {
             p: None,
             p_holm: None,
             verdict,
-            text: format!(
-                "run-wide: every group's total_ms ×{f:.3} (median over {} groups; machine drift \
-                 or a change common to all algorithms, beyond --drift-limit {drift_limit})",
-                cmp.groups.len(),
-            ),
-        };
-        if f >= drift_limit {
-            worse.push(finding(FindingVerdict::Slower));
-        } else if f <= 1.0 / drift_limit {
-            better.push(finding(FindingVerdict::Faster));
+            text,
+        },
+    ))
+}
+
+/// Fills the comparison's regressions, improvements and changes from its run-wide factor,
+/// groups and rows.
+pub fn collect(cmp: &mut Comparison, drift_limit: f64) {
+    let (mut worse, mut better, mut other) = (vec![], vec![], vec![]);
+    if let Some(f) = cmp.run_factor {
+        if let Some((verdict, finding)) = run_wide(cmp, f, drift_limit) {
+            match verdict {
+                FindingVerdict::Slower => worse.push(finding),
+                _ => better.push(finding),
+            }
         }
     }
     for g in &cmp.groups {

@@ -38,27 +38,17 @@ fn header(c: &Comparison) -> Vec<String> {
                 c.rounds.base, c.rounds.new
             ),
         },
-        match (c.run_factor, c.drift_corrected, &c.pair_factors) {
-            (f, true, Some(per_pair)) => format!(
-                "drift per pair: NEW/BASE {} (median over the groups of each pair); each NEW \
-                 round was divided by its own pair's factor before the tests (run-wide {})",
-                per_pair
-                    .iter()
-                    .map(|f| format!("×{f:.3}"))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                f.map_or("-".into(), |f| format!("×{f:.3}"))
+        match (&c.machine, c.run_factor) {
+            (Some(m), f) => format!(
+                "machine drift: ×{:.3} (NEW's machine over BASE's, from the control measured \
+                 beside the rows); every round of both sides was divided by its own control \
+                 before the tests. What remains run-wide: {}",
+                m.factor,
+                f.map_or("-".into(), |f| format!("×{f:.3} (median over the groups)"))
             ),
-            (Some(f), true, None) => format!(
-                "run-wide factor: NEW/BASE ×{f:.3} (median over the groups); NEW's total_ms was \
-                 divided by it before the tests, so ratios below are relative to the rest of the \
-                 run (--no-drift-correction: absolute)"
-            ),
-            (Some(f), false, _) => format!(
-                "run-wide factor: NEW/BASE ×{f:.3} (median over the groups); not divided out"
-            ),
-            (None, _, _) => "run-wide factor: too few groups to estimate; absolute times tested".into(),
+            (None, _) => drift_line(c),
         },
+        c.control_missing.clone().unwrap_or_default(),
         format!(
             "outcome: {} — {} regression(s), {} improvement(s), {} other change(s) in {} rows, {} groups",
             c.outcome().to_uppercase(),
@@ -69,8 +59,34 @@ fn header(c: &Comparison) -> Vec<String> {
             c.groups.len()
         ),
     ];
+    lines.retain(|l| !l.is_empty());
     lines.extend(c.warnings.iter().map(|w| format!("WARNING: {w}")));
     lines
+}
+
+/// The line on the run-wide factor, for comparisons without a control on both sides.
+fn drift_line(c: &Comparison) -> String {
+    match (c.run_factor, c.drift_corrected, &c.pair_factors) {
+        (f, true, Some(per_pair)) => format!(
+            "drift per pair: NEW/BASE {} (median over the groups of each pair); each NEW \
+                 round was divided by its own pair's factor before the tests (run-wide {})",
+            per_pair
+                .iter()
+                .map(|f| format!("×{f:.3}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            f.map_or("-".into(), |f| format!("×{f:.3}"))
+        ),
+        (Some(f), true, None) => format!(
+            "run-wide factor: NEW/BASE ×{f:.3} (median over the groups); NEW's total_ms was \
+                 divided by it before the tests, so ratios below are relative to the rest of the \
+                 run (--no-drift-correction: absolute)"
+        ),
+        (Some(f), false, _) => {
+            format!("run-wide factor: NEW/BASE ×{f:.3} (median over the groups); not divided out")
+        }
+        (None, _, _) => "run-wide factor: too few groups to estimate; absolute times tested".into(),
+    }
 }
 
 fn time_cell(t: Option<&TimeTest>) -> String {
@@ -459,6 +475,7 @@ mod tests {
         samples::write_f32_image(&dir.join(&row.image_f32), img).unwrap();
         row.image_hash = samples::image_hash(img);
         let file = ResultsFile {
+            control: None,
             schema_version: crate::results::SCHEMA_VERSION,
             machine: crate::results::machine::MachineInfo::collect(),
             run: Default::default(),

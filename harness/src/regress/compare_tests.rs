@@ -52,6 +52,7 @@ fn run_dir_with_machine(
         }
     }
     let file = ResultsFile {
+        control: None,
         schema_version: crate::results::SCHEMA_VERSION,
         machine: crate::results::machine::MachineInfo::collect(),
         run: crate::results::RunDescription {
@@ -204,6 +205,7 @@ fn one_round_never_gates_on_time_and_five_rounds_find_a_slowdown() {
 #[test]
 fn dirty_or_debug_sides_are_warned() {
     let mut f = ResultsFile {
+        control: None,
         schema_version: crate::results::SCHEMA_VERSION,
         machine: crate::results::machine::MachineInfo::collect(),
         run: Default::default(),
@@ -358,4 +360,89 @@ fn paired_rounds_on_absolute_times_judge_a_change_to_half_the_groups() {
     // noise and time is withheld.
     let separate = compare(&a, &b, &options(&out, false, 1.5)).unwrap();
     assert!(separate.too_noisy);
+}
+
+/// [`run_dir_with_machine`] with a control beside the rows: round r's control measured the
+/// machine at speed `control[r]` (1 = BASE's usual speed) on two figures.
+fn run_dir_controlled(dir: &Path, factors: &[f64], machine: &[f64], control: &[f64], seed: u64) {
+    use crate::calibrate::control::{Control, ControlSample, Figures};
+    use crate::results::machine::Figure;
+    run_dir_with_machine(dir, factors, machine, 1, 0.0, seed);
+    let figures = |speed: f64| -> Figures {
+        [
+            (Figure::FillFragmentsPerSec, 1e9 * speed),
+            (Figure::RayStepsPerSec, 1e8 * speed),
+        ]
+        .into()
+    };
+    let mut file = ResultsFile::read(dir).unwrap();
+    for row in &mut file.rows {
+        row.round_control = control.iter().map(|s| figures(*s)).collect();
+    }
+    file.control = Some(Control {
+        probes: vec!["fill".into(), "ray steps".into()],
+        setup_seconds: 0.0,
+        samples: control
+            .iter()
+            .enumerate()
+            .map(|(r, s)| ControlSample {
+                dataset: "box:1k".into(),
+                round: r as u32,
+                rows_before: 0,
+                at_s: r as f64,
+                utc: String::new(),
+                seconds: 0.1,
+                figures: figures(*s),
+            })
+            .collect(),
+    });
+    crate::results::write_json(dir, &file).unwrap();
+}
+
+/// The same build, NEW on a machine ×2.19 slower (a compile beside it), which its control
+/// shows too: the machine, not a regression (exit 0); and the rule flips when the rows move
+/// alone, every algorithm alike ×1.4 with the control unchanged: a regression common to every
+/// algorithm (exit 3), which the run-wide factor of the old rule divided out as drift.
+#[test]
+fn the_control_tells_the_machine_from_a_change_common_to_every_algorithm() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, busy, slower) = (
+        tmp.path().join("a"),
+        tmp.path().join("busy"),
+        tmp.path().join("slower"),
+    );
+    let ones = [1.0; 5];
+    run_dir_controlled(&a, &[1.0; 8], &ones, &ones, 1);
+    run_dir_controlled(&busy, &[1.0; 8], &[2.19; 5], &[1.0 / 2.19; 5], 2);
+    run_dir_controlled(&slower, &[1.4; 8], &ones, &ones, 3);
+    let opt = options(&tmp.path().join("out"), true, 1.5);
+
+    let machine = compare(&a, &busy, &opt).unwrap();
+    let m = machine.machine.as_ref().expect("both sides have a control");
+    assert!((m.factor - 2.19).abs() < 1e-9, "{}", m.factor);
+    assert!(machine.regressions.is_empty(), "{:#?}", machine.regressions);
+    assert!(!crate::regress::compare_report::gate(&machine, FailOn::Regression).unwrap());
+
+    let code = compare(&a, &slower, &opt).unwrap();
+    assert!((code.machine.as_ref().unwrap().factor - 1.0).abs() < 1e-9);
+    assert!(
+        code.regressions
+            .iter()
+            .any(|r| r.group == "run-wide" && r.text.contains("common to every algorithm")),
+        "{:#?}",
+        code.regressions
+    );
+    assert!(crate::regress::compare_report::gate(&code, FailOn::Regression).unwrap());
+
+    // The old rule, where NEW has no control: ×1.4 is under --drift-limit 1.5 and divided out.
+    let old = tmp.path().join("old");
+    run_dir(&old, &[1.4; 8], 5, 1, 0.0, 3);
+    let without = compare(&a, &old, &opt).unwrap();
+    assert!(without.machine.is_none());
+    assert!(without
+        .control_missing
+        .as_deref()
+        .unwrap()
+        .starts_with("NEW has no control"));
+    assert!(without.regressions.is_empty(), "{:#?}", without.regressions);
 }

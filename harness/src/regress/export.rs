@@ -131,6 +131,7 @@ mod tests {
             ..Default::default()
         };
         ResultsFile {
+            control: None,
             schema_version: crate::results::SCHEMA_VERSION,
             machine: crate::results::machine::MachineInfo::collect(),
             run: crate::results::RunDescription {

@@ -641,6 +641,7 @@ mod tests {
             machine.git_commit = Some(commit.into());
             machine.date_utc = format!("2026-01-0{}T00:00:00Z", k + 1);
             let file = ResultsFile {
+                control: None,
                 schema_version: crate::results::SCHEMA_VERSION,
                 machine,
                 run: crate::results::RunDescription {

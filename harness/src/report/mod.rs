@@ -14,6 +14,7 @@ use crate::algorithms::is_peer;
 use crate::results::metrics::{HEATMAP_MAX_ERROR, ONE_STEP, PSNR_CAP_DB};
 use crate::results::{ResultsFile, Row};
 
+pub mod control;
 pub mod html;
 pub mod progress;
 
@@ -193,6 +194,8 @@ struct ReportPage<'a> {
     psnr_cap_db: f64,
     one_step: String,
     views: Vec<View>,
+    /// The control over the run (absent without one).
+    control: Option<control::ControlView>,
     /// Images the rows name that are not in the report's directory (not linked).
     images_absent: usize,
     /// The run's data files that are in the report's directory (linked).
@@ -444,6 +447,14 @@ fn row_lines(file: &ResultsFile, suspect: &[bool]) -> Vec<RowLine> {
         .collect()
 }
 
+/// Seconds from the run's start to its end, where both are known.
+fn run_seconds(file: &ResultsFile) -> Option<f64> {
+    let parse = |t: &str| humantime::parse_rfc3339(t).ok();
+    let start = parse(&file.machine.date_utc)?;
+    let end = parse(file.finished_utc.as_deref()?)?;
+    end.duration_since(start).ok().map(|d| d.as_secs_f64())
+}
+
 fn html(
     file: &ResultsFile,
     aggs: &[Aggregate],
@@ -466,6 +477,10 @@ fn html(
             psnr_cap_db: PSNR_CAP_DB,
             one_step: format!("{ONE_STEP:.4}"),
             views,
+            control: file
+                .control
+                .as_ref()
+                .and_then(|c| control::view(c, run_seconds(file))),
             images_absent: images.absent.borrow().len(),
             raw_files: [
                 crate::results::CSV_FILE,
@@ -550,6 +565,7 @@ mod tests {
         failed.tets_per_sec = None;
         rows.push(failed);
         ResultsFile {
+            control: None,
             schema_version: SCHEMA_VERSION,
             machine: MachineInfo::collect(),
             run: RunDescription::default(),

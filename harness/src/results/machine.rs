@@ -219,43 +219,135 @@ pub struct Calibration {
     pub raster_seconds_per_fragment: f64,
 }
 
+/// One figure of a [`Calibration`]: a rate (larger is faster) or a cost (smaller is faster).
+/// The calibration's probes, the control measured beside every run's rows and the roofline's
+/// pricing all name figures by this type.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Figure {
+    TrianglesPerSec,
+    FillFragmentsPerSec,
+    ComputeGflops,
+    CopyBytesPerSec,
+    SortKeysPerSec,
+    RayStepsPerSec,
+    SplatFragmentsPerSec,
+    GpuSortKeysPerSec,
+    TetClassificationsPerSec,
+    RasterSecondsPerTriangle,
+    RasterSecondsPerFragment,
+}
+
+impl Figure {
+    pub const ALL: [Figure; 11] = [
+        Figure::TrianglesPerSec,
+        Figure::FillFragmentsPerSec,
+        Figure::ComputeGflops,
+        Figure::CopyBytesPerSec,
+        Figure::SortKeysPerSec,
+        Figure::RayStepsPerSec,
+        Figure::SplatFragmentsPerSec,
+        Figure::GpuSortKeysPerSec,
+        Figure::TetClassificationsPerSec,
+        Figure::RasterSecondsPerTriangle,
+        Figure::RasterSecondsPerFragment,
+    ];
+
+    /// The field's name in `results.json` (and the calibration cache).
+    pub fn name(self) -> &'static str {
+        match self {
+            Figure::TrianglesPerSec => "triangles_per_sec",
+            Figure::FillFragmentsPerSec => "fill_fragments_per_sec",
+            Figure::ComputeGflops => "compute_gflops",
+            Figure::CopyBytesPerSec => "copy_bytes_per_sec",
+            Figure::SortKeysPerSec => "sort_keys_per_sec",
+            Figure::RayStepsPerSec => "ray_steps_per_sec",
+            Figure::SplatFragmentsPerSec => "splat_fragments_per_sec",
+            Figure::GpuSortKeysPerSec => "gpu_sort_keys_per_sec",
+            Figure::TetClassificationsPerSec => "tet_classifications_per_sec",
+            Figure::RasterSecondsPerTriangle => "raster_seconds_per_triangle",
+            Figure::RasterSecondsPerFragment => "raster_seconds_per_fragment",
+        }
+    }
+
+    /// Whether a larger value is a faster machine (a rate); otherwise it is a cost.
+    pub fn is_rate(self) -> bool {
+        !matches!(
+            self,
+            Figure::RasterSecondsPerTriangle | Figure::RasterSecondsPerFragment
+        )
+    }
+
+    /// The figure as a speed: the rate, or 1 / the cost (0 where not measured). Ratios of
+    /// speeds compare two measurements of a figure the same way for rates and costs.
+    pub fn speed(self, value: f64) -> f64 {
+        match (self.is_rate(), value > 0.0) {
+            (_, false) => 0.0,
+            (true, true) => value,
+            (false, true) => 1.0 / value,
+        }
+    }
+
+    /// A figure's value at `speed` (the inverse of [`Figure::speed`]).
+    pub fn from_speed(self, speed: f64) -> f64 {
+        self.speed(speed)
+    }
+
+    pub fn get(self, c: &Calibration) -> f64 {
+        match self {
+            Figure::TrianglesPerSec => c.triangles_per_sec,
+            Figure::FillFragmentsPerSec => c.fill_fragments_per_sec,
+            Figure::ComputeGflops => c.compute_gflops,
+            Figure::CopyBytesPerSec => c.copy_bytes_per_sec,
+            Figure::SortKeysPerSec => c.sort_keys_per_sec,
+            Figure::RayStepsPerSec => c.ray_steps_per_sec,
+            Figure::SplatFragmentsPerSec => c.splat_fragments_per_sec,
+            Figure::GpuSortKeysPerSec => c.gpu_sort_keys_per_sec,
+            Figure::TetClassificationsPerSec => c.tet_classifications_per_sec,
+            Figure::RasterSecondsPerTriangle => c.raster_seconds_per_triangle,
+            Figure::RasterSecondsPerFragment => c.raster_seconds_per_fragment,
+        }
+    }
+
+    pub fn set(self, c: &mut Calibration, value: f64) {
+        *match self {
+            Figure::TrianglesPerSec => &mut c.triangles_per_sec,
+            Figure::FillFragmentsPerSec => &mut c.fill_fragments_per_sec,
+            Figure::ComputeGflops => &mut c.compute_gflops,
+            Figure::CopyBytesPerSec => &mut c.copy_bytes_per_sec,
+            Figure::SortKeysPerSec => &mut c.sort_keys_per_sec,
+            Figure::RayStepsPerSec => &mut c.ray_steps_per_sec,
+            Figure::SplatFragmentsPerSec => &mut c.splat_fragments_per_sec,
+            Figure::GpuSortKeysPerSec => &mut c.gpu_sort_keys_per_sec,
+            Figure::TetClassificationsPerSec => &mut c.tet_classifications_per_sec,
+            Figure::RasterSecondsPerTriangle => &mut c.raster_seconds_per_triangle,
+            Figure::RasterSecondsPerFragment => &mut c.raster_seconds_per_fragment,
+        } = value;
+    }
+}
+
+impl std::fmt::Display for Figure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 impl Calibration {
     /// Figure by figure the faster of `self` and `other` (two measurements of the same
     /// backend): the larger rate, the smaller cost where both were measured (0 = not
-    /// measured). The rest (date, seconds) is `self`'s.
+    /// measured). The rest (date, seconds) is `self`'s. For the rasterisation fit, each of its
+    /// two costs the smaller: the bound at any triangle size is then at most either fit's.
     pub fn peak_with(&self, other: &Calibration) -> Calibration {
-        let cost = |a: f64, b: f64| match (a > 0.0, b > 0.0) {
-            (true, true) => a.min(b),
-            (true, false) => a,
-            _ => b,
-        };
-        Calibration {
-            triangles_per_sec: self.triangles_per_sec.max(other.triangles_per_sec),
-            fill_fragments_per_sec: self
-                .fill_fragments_per_sec
-                .max(other.fill_fragments_per_sec),
-            compute_gflops: self.compute_gflops.max(other.compute_gflops),
-            copy_bytes_per_sec: self.copy_bytes_per_sec.max(other.copy_bytes_per_sec),
-            sort_keys_per_sec: self.sort_keys_per_sec.max(other.sort_keys_per_sec),
-            ray_steps_per_sec: self.ray_steps_per_sec.max(other.ray_steps_per_sec),
-            splat_fragments_per_sec: self
-                .splat_fragments_per_sec
-                .max(other.splat_fragments_per_sec),
-            gpu_sort_keys_per_sec: self.gpu_sort_keys_per_sec.max(other.gpu_sort_keys_per_sec),
-            tet_classifications_per_sec: self
-                .tet_classifications_per_sec
-                .max(other.tet_classifications_per_sec),
-            // Each the smaller: the bound at any triangle size is then at most either fit's.
-            raster_seconds_per_triangle: cost(
-                self.raster_seconds_per_triangle,
-                other.raster_seconds_per_triangle,
-            ),
-            raster_seconds_per_fragment: cost(
-                self.raster_seconds_per_fragment,
-                other.raster_seconds_per_fragment,
-            ),
-            ..self.clone()
+        let mut out = self.clone();
+        for figure in Figure::ALL {
+            let speed = figure
+                .speed(figure.get(self))
+                .max(figure.speed(figure.get(other)));
+            figure.set(&mut out, figure.from_speed(speed));
         }
+        out
     }
 
     /// The lines `tetbench calibrate` prints.

@@ -135,6 +135,17 @@ pub struct Row {
     pub bound_by: String,
     #[serde(default)]
     pub normalized_time: Option<f64>,
+    /// The machine's speed at this row's rounds against the whole run: the geometric mean over
+    /// the control's figures of the row's control (the median of its rounds') over the run's
+    /// median control ([`crate::calibrate::control`]). 0.8: the machine ran at 80 % of the
+    /// run's typical speed while this row was measured. Empty without a control.
+    #[serde(default)]
+    pub control_factor: Option<f64>,
+    /// What priced the roofline: `control` (the row's own rounds' control), `control, scaled
+    /// FIGURE…` (figures the control did not measure, from the calibration times the
+    /// control's factor), `calibration` (the cached calibration: results without a control).
+    #[serde(default)]
+    pub priced_with: crate::calibrate::control::Pricing,
     /// Peak resident host memory of the process during the row (bytes): the kernel's VmHWM,
     /// reset before the row (the first row of a variant includes its prepare). On a software
     /// adapter (lavapipe) GPU buffers live in host memory and are counted here too. Empty where
@@ -152,6 +163,10 @@ pub struct Row {
     /// Per-frame samples: in `results.json` only (`samples.csv` has them one per line).
     #[serde(default, skip_serializing_if = "FrameSamples::is_empty")]
     pub samples: FrameSamples,
+    /// The control of each of the row's rounds (the best of the samples around it): in
+    /// `results.json` only.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub round_control: Vec<crate::calibrate::control::Figures>,
 }
 
 /// The settings as JSON Schema sees them: a map of integers and words, or the text form of
@@ -185,6 +200,7 @@ fn serialize_csv_row<W: Write>(csv: &mut csv::Writer<W>, row: &Row) -> csv::Resu
     named::AS_TEXT.set(true);
     let written = csv.serialize(Row {
         samples: FrameSamples::default(),
+        round_control: vec![],
         ..row.clone()
     });
     named::AS_TEXT.set(false);
@@ -276,6 +292,10 @@ pub struct ResultsFile {
     /// Failures that are not one row: a data set that could not be loaded, a renderer that
     /// could not be prepared (its rows are also recorded, with `error` set).
     pub errors: Vec<String>,
+    /// The control measured beside the rows ([`crate::calibrate::control`]); absent in
+    /// results without one (`--no-calibrate`, files written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub control: Option<crate::calibrate::control::Control>,
 }
 
 impl ResultsFile {
@@ -341,6 +361,7 @@ impl ResultsWriter {
             csv,
             samples: SamplesWriter::create(dir)?,
             file: ResultsFile {
+                control: None,
                 schema_version: SCHEMA_VERSION,
                 machine,
                 run,

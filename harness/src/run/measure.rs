@@ -12,7 +12,7 @@ pub(super) struct DatasetContext<'a> {
     /// reference).
     data: &'a LazyDataset,
     optics: &'a Optics,
-    label: String,
+    pub(super) label: String,
     /// Reference image per viewpoint with its PNG path and lost-ray count (or why there is
     /// none), rendered on first need.
     references: HashMap<String, Result<(Image, String, u64), String>>,
@@ -154,6 +154,7 @@ impl<'a> DatasetContext<'a> {
         writer: &mut ResultsWriter,
         progress: &mut Progress,
         outcome: &mut RunOutcome,
+        control: &mut Option<super::control::RunControl>,
     ) -> anyhow::Result<()> {
         let c = self.config;
         let rounds = c.rounds.max(1);
@@ -213,6 +214,9 @@ impl<'a> DatasetContext<'a> {
         // loading and preparing.
         let _profiled = super::perf_control::ProfiledSection::begin();
         for round in 0..rounds {
+            if let Some(control) = control.as_mut() {
+                control.take(&self.label, round, writer, progress);
+            }
             let last = round + 1 == rounds;
             for v in live.iter_mut() {
                 for (i, vp) in c.viewpoints.iter().enumerate() {
@@ -259,6 +263,9 @@ impl<'a> DatasetContext<'a> {
                     }
                 }
             }
+        }
+        if let Some(control) = control.as_mut() {
+            control.take(&self.label, rounds, writer, progress);
         }
         Ok(())
     }

@@ -27,6 +27,7 @@ use crate::results::metrics::{self, summarize};
 use crate::results::{ResultsWriter, Row, RunDescription};
 
 pub mod allocator;
+pub mod control;
 pub mod lock;
 pub mod matrix;
 mod measure;
@@ -256,6 +257,13 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
     // Held until the run returns: a second run into this directory refuses (lock.rs).
     let _lock = lock::acquire(&config.out, &config.command_line)?;
     let (gpu, machine) = open_machine(config)?;
+    // The control beside the rows (with the roofline: `--no-calibrate` turns both off).
+    let probes = config
+        .calibrate
+        .then(|| crate::calibrate::probes::ProbeContext::new(&gpu));
+    let mut control = probes
+        .as_ref()
+        .map(|p| control::RunControl::new(p, started));
     let description = run_description(config);
     let kept = if config.resume {
         resume::finished_rows(&config.out, &description, &machine, config.viewpoints.len())?
@@ -305,11 +313,31 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         let mut ctx = DatasetContext::new(config, &gpu, &dataset, &optics, label);
         if config.rounds <= 1 {
             // One variant at a time: its GPU memory is freed before the next one prepares.
-            for renderer in renderers {
-                ctx.run_variants(vec![renderer], &mut writer, &mut progress, &mut outcome)?;
+            // The control before the first, between variants when it is due, after the last.
+            for (i, renderer) in renderers.into_iter().enumerate() {
+                if let Some(c) = control.as_mut().filter(|c| i == 0 || c.due()) {
+                    c.take(&ctx.label, 0, &mut writer, &progress);
+                }
+                let mut none = None;
+                ctx.run_variants(
+                    vec![renderer],
+                    &mut writer,
+                    &mut progress,
+                    &mut outcome,
+                    &mut none,
+                )?;
+            }
+            if let Some(c) = control.as_mut() {
+                c.take(&ctx.label, 1, &mut writer, &progress);
             }
         } else {
-            ctx.run_variants(renderers, &mut writer, &mut progress, &mut outcome)?;
+            ctx.run_variants(
+                renderers,
+                &mut writer,
+                &mut progress,
+                &mut outcome,
+                &mut control,
+            )?;
         }
     }
     progress.finish();
@@ -505,8 +533,17 @@ fn finish_run(
         })
         .collect();
     if let Some(cal) = writer.file.machine.calibration.clone() {
+        if let Some(control) = writer.file.control.clone() {
+            control::attach(&mut writer.file.rows, &control, config.rounds.max(1));
+        }
         crate::calibrate::annotate(&mut writer.file.rows, &cal);
-        if config.calibrate && writer.file.rows.iter().any(crate::calibrate::beats_bound) {
+        // Rows priced by their own control need no second calibration: a bound they beat is
+        // listed as the defect it is.
+        let uncontrolled = writer.file.control.is_none();
+        if config.calibrate
+            && uncontrolled
+            && writer.file.rows.iter().any(crate::calibrate::beats_bound)
+        {
             recalibrate_after(config, gpu, writer, outcome)?;
         }
     }

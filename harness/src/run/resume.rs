@@ -142,6 +142,7 @@ mod tests {
         let machine = MachineInfo::collect();
         assert!(finished_rows(dir, &plan(), &machine, 2).unwrap().is_empty());
         let file = ResultsFile {
+            control: None,
             schema_version: crate::results::SCHEMA_VERSION,
             machine: machine.clone(),
             run: plan(),

@@ -343,7 +343,16 @@ pub fn merge(dirs: &[PathBuf], out: &Path, allow_missing: bool) -> anyhow::Resul
         .iter()
         .map(|f| f.finished_utc.clone())
         .collect::<Option<Vec<_>>>();
+    // Each shard's control stays beside its rows (each row already holds its rounds').
+    let control = files
+        .iter()
+        .filter_map(|f| f.control.clone())
+        .reduce(|mut a, b| {
+            a.samples.extend(b.samples);
+            a
+        });
     let merged = ResultsFile {
+        control,
         schema_version: results::SCHEMA_VERSION,
         machine: first.machine.clone(),
         run,
@@ -495,6 +504,7 @@ mod tests {
             })
             .collect();
         ResultsFile {
+            control: None,
             schema_version: results::SCHEMA_VERSION,
             machine: crate::results::machine::MachineInfo::collect(),
             run,

@@ -1,0 +1,271 @@
+//! The calibration as a table of named probes ([`PROBES`]). A probe prepares one or more
+//! [`Workload`]s — the same kernel in a few configurations (sizes, layouts) — and turns their
+//! timings into figures of the [`Calibration`]: the fastest configuration's rate, or the
+//! rasterisation's fit of a cost per triangle and per fragment.
+//!
+//! Two users time the same workloads: `tetbench calibrate` (every configuration, best of
+//! several repetitions after a warm-up: the backend's peak, cached per adapter) and the
+//! control measured beside every run's rows ([`crate::calibrate::control`]: the probes the
+//! roofline prices, once each, at the moment of the rows).
+
+use anyhow::Context;
+use render_core::Gpu;
+
+use crate::calibrate::kernels;
+use crate::results::machine::Figure;
+
+/// What every probe is prepared with: the device and the calibration's shader module.
+pub struct ProbeContext<'g> {
+    pub gpu: &'g Gpu,
+    pub module: wgpu::ShaderModule,
+}
+
+impl<'g> ProbeContext<'g> {
+    pub fn new(gpu: &'g Gpu) -> ProbeContext<'g> {
+        ProbeContext {
+            gpu,
+            module: gpu.shader("calibrate", &kernels::calibrate_source()),
+        }
+    }
+}
+
+/// One configuration of a probe, ready to run: each call of `run` submits the whole kernel
+/// and waits for it, doing `units` of the figure's work.
+pub struct Workload<'g> {
+    /// Units of work one run does (triangles, fragments, keys, steps, bytes, GFLOP).
+    pub units: f64,
+    /// A parameter of the configuration the figure needs besides the time (the
+    /// rasterisation's fragments per triangle; 0 elsewhere).
+    pub param: f64,
+    run: Box<dyn FnMut() -> anyhow::Result<()> + 'g>,
+}
+
+impl<'g> Workload<'g> {
+    pub fn new(units: f64, run: impl FnMut() -> anyhow::Result<()> + 'g) -> Workload<'g> {
+        Workload {
+            units,
+            param: 0.0,
+            run: Box::new(run),
+        }
+    }
+
+    pub fn with_param(mut self, param: f64) -> Workload<'g> {
+        self.param = param;
+        self
+    }
+
+    pub fn run(&mut self) -> anyhow::Result<()> {
+        (self.run)()
+    }
+}
+
+/// One timed configuration: its units, parameter and seconds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Timing {
+    pub units: f64,
+    pub param: f64,
+    pub seconds: f64,
+}
+
+impl Timing {
+    pub fn rate(&self) -> f64 {
+        self.units / self.seconds.max(1e-12)
+    }
+}
+
+/// How a probe's timings become figures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Combine {
+    /// One figure: the fastest configuration's rate (a roofline wants the peak at every size
+    /// a row works at).
+    Fastest,
+    /// The rasterisation's two figures: the straight line `t = a + f·b` through (fragments per
+    /// triangle, seconds per triangle) of the two leg lengths ([`raster_costs`]).
+    RasterFit,
+}
+
+/// A named probe of the backend: which figures it measures, how it is prepared, and how its
+/// timings combine.
+pub struct Probe {
+    pub name: &'static str,
+    pub figures: &'static [Figure],
+    pub prepare: for<'g> fn(&ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>>,
+    pub combine: Combine,
+    /// Timed repetitions per configuration in the calibration (after one warm-up).
+    pub reps: usize,
+    /// Whether the control beside the rows measures it: every figure the roofline prices.
+    pub in_control: bool,
+}
+
+impl Probe {
+    /// The figures from one timing per configuration (in the order `prepare` gave them).
+    pub fn figures_of(&self, timings: &[Timing]) -> Vec<(Figure, f64)> {
+        match self.combine {
+            Combine::Fastest => {
+                let best = timings.iter().map(Timing::rate).fold(0.0, f64::max);
+                vec![(self.figures[0], best)]
+            }
+            Combine::RasterFit => {
+                let points: Vec<(f64, f64)> = timings
+                    .iter()
+                    .map(|t| (t.param, t.seconds / t.units.max(1.0)))
+                    .collect();
+                let [small, large] = points[..] else {
+                    return vec![];
+                };
+                let (per_triangle, per_fragment) = raster_costs(small, large);
+                vec![
+                    (Figure::RasterSecondsPerTriangle, per_triangle),
+                    (Figure::RasterSecondsPerFragment, per_fragment),
+                ]
+            }
+        }
+    }
+
+    /// Prepares the probe and times every configuration, best of `reps` after one warm-up.
+    pub fn measure(&self, ctx: &ProbeContext) -> anyhow::Result<Vec<(Figure, f64)>> {
+        let mut timings = vec![];
+        for mut w in (self.prepare)(ctx).with_context(|| format!("preparing {}", self.name))? {
+            let seconds = best_seconds_of(self.reps, || w.run())
+                .with_context(|| format!("running {}", self.name))?;
+            timings.push(Timing {
+                units: w.units,
+                param: w.param,
+                seconds,
+            });
+        }
+        Ok(self.figures_of(&timings))
+    }
+}
+
+/// Timed repetitions after one warm-up (the best is kept: a roofline wants the backend's peak,
+/// and on a busy machine the best repetition is the one least disturbed).
+pub const REPS: usize = 5;
+
+/// Best seconds of `reps` runs of `f` after one warm-up. A short benchmark is better run
+/// often: on a busy machine a short run finds an undisturbed moment more easily than a long
+/// one, and the rows it prices are short frames that find them too.
+pub fn best_seconds_of(
+    reps: usize,
+    mut f: impl FnMut() -> anyhow::Result<()>,
+) -> anyhow::Result<f64> {
+    f()?;
+    let mut best = f64::INFINITY;
+    for _ in 0..reps.max(1) {
+        let t0 = std::time::Instant::now();
+        f()?;
+        best = best.min(t0.elapsed().as_secs_f64());
+    }
+    Ok(best.max(1e-9))
+}
+
+/// Best seconds of [`REPS`] runs of `f` after one warm-up.
+pub fn best_seconds(f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Result<f64> {
+    best_seconds_of(REPS, f)
+}
+
+/// The straight line `t = a + f·b` through two (fragments per triangle, seconds per triangle)
+/// points: `(a, b)`, the cost of a triangle and of each of its fragments. Each is at least 0,
+/// since timing noise can tilt a two-point fit.
+pub fn raster_costs(small: (f64, f64), large: (f64, f64)) -> (f64, f64) {
+    let per_fragment = ((large.1 - small.1) / (large.0 - small.0)).max(0.0);
+    let per_triangle = (small.1 - small.0 * per_fragment).max(0.0);
+    (per_triangle, per_fragment)
+}
+
+/// Every probe, in the order `tetbench calibrate` runs them. The compute figure enters no
+/// row's roofline (no renderer reports an arithmetic count), so the control leaves it out.
+pub const PROBES: [Probe; 10] = [
+    Probe {
+        name: "triangle setup",
+        figures: &[Figure::TrianglesPerSec],
+        prepare: kernels::triangle_setup,
+        combine: Combine::Fastest,
+        reps: REPS,
+        in_control: true,
+    },
+    Probe {
+        name: "fill",
+        figures: &[Figure::FillFragmentsPerSec],
+        prepare: kernels::fill,
+        combine: Combine::Fastest,
+        reps: REPS,
+        in_control: true,
+    },
+    Probe {
+        name: "rasterisation",
+        figures: &[
+            Figure::RasterSecondsPerTriangle,
+            Figure::RasterSecondsPerFragment,
+        ],
+        prepare: kernels::rasterisation,
+        combine: Combine::RasterFit,
+        reps: REPS,
+        in_control: true,
+    },
+    Probe {
+        name: "compute",
+        figures: &[Figure::ComputeGflops],
+        prepare: kernels::compute,
+        combine: Combine::Fastest,
+        reps: REPS,
+        in_control: false,
+    },
+    Probe {
+        name: "storage copy",
+        figures: &[Figure::CopyBytesPerSec],
+        prepare: kernels::storage_copy,
+        combine: Combine::Fastest,
+        reps: REPS,
+        in_control: true,
+    },
+    Probe {
+        name: "CPU radix sort",
+        figures: &[Figure::SortKeysPerSec],
+        prepare: kernels::cpu_sort,
+        combine: Combine::Fastest,
+        reps: REPS,
+        in_control: true,
+    },
+    Probe {
+        name: "ray steps",
+        figures: &[Figure::RayStepsPerSec],
+        prepare: crate::calibrate::work::ray_steps,
+        combine: Combine::Fastest,
+        reps: REPS,
+        in_control: true,
+    },
+    Probe {
+        name: "splat fill",
+        figures: &[Figure::SplatFragmentsPerSec],
+        prepare: crate::calibrate::work::splat_fill,
+        combine: Combine::Fastest,
+        reps: REPS,
+        in_control: true,
+    },
+    Probe {
+        name: "GPU radix sort",
+        figures: &[Figure::GpuSortKeysPerSec],
+        prepare: crate::calibrate::work::gpu_sort,
+        combine: Combine::Fastest,
+        reps: REPS,
+        in_control: true,
+    },
+    // A pass as long as a small mesh's, run often (see `best_seconds_of`).
+    Probe {
+        name: "vertex classification",
+        figures: &[Figure::TetClassificationsPerSec],
+        prepare: crate::calibrate::work::classification,
+        combine: Combine::Fastest,
+        reps: 25,
+        in_control: true,
+    },
+];
+
+/// The probe that measures `figure`.
+pub fn probe_of(figure: Figure) -> &'static Probe {
+    PROBES
+        .iter()
+        .find(|p| p.figures.contains(&figure))
+        .expect("every figure has a probe")
+}
