@@ -78,11 +78,12 @@ pub fn markdown(results: &[ClaimResult]) -> String {
                     .map_or(String::new(), |id| format!(", as {id}")),
                 old.describe_against(&c.rule())
             );
+            // The earlier verdict in the word of the earlier rule's evidence kind.
             let _ = write!(
                 verdict,
                 "; by the rule before {}: {}",
                 h.commit,
-                c.evidence.word(e.verdict)
+                old.evidence.word(e.verdict)
             );
         }
         let _ = writeln!(
