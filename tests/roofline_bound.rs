@@ -1,5 +1,5 @@
-//! The roofline is a lower bound: no row of the default suite beats it (docs/roofline.md, "A
-//! bound that is never beaten").
+//! The roofline is a lower bound: no row of the default suite beats it (docs/roofline.md; the
+//! measurements: docs/notes/2026-12-05-bound-never-beaten.md).
 //!
 //! The default suite (every algorithm's default variants on box:10k and shell:10k, 3
 //! viewpoints, 128², 3 rounds) runs as two runs, one a data set, with the backend calibrated

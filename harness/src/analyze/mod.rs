@@ -38,7 +38,7 @@ pub enum AnalyzeCommand {
     Kbuffer(analysis::KbufferArgs),
     /// Every variant's tets/s against each peer's in the same run (one input a run: run
     /// directories or results CSVs), and targets on those ratios judged by a rule file
-    /// (`--targets docs/targets/issue-43.json`), each beside the ratio its roofline allows.
+    /// (`--targets docs/targets/lavapipe-vs-vtk.json`), each beside the ratio its roofline allows.
     Peers(peers::Args),
 }
 

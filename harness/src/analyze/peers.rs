@@ -1,6 +1,6 @@
 //! `tetbench analyze peers INPUT…`: every variant's speed against each peer's, on the same data
 //! set and in the same run, and targets judged on those ratios by rules read from a file written
-//! before the runs (`--targets`, e.g. `docs/targets/issue-43.json`).
+//! before the runs (`--targets`, e.g. `docs/targets/lavapipe-vs-vtk.json`).
 //!
 //! A ratio is the median over viewpoints of the variant's tets/s divided by the peer's median in
 //! the same input: the two sides met the same machine at the same moment, which is what a ratio

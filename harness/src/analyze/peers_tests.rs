@@ -206,14 +206,14 @@ fn bad_rule_files_name_the_file() {
     assert!(format!("{e:#}").contains("rules-0.json"), "{e:#}");
 }
 
-/// The committed rules on the committed runs of 76a9a9f give the ratios docs/peers.md tabled
-/// by hand for that run (its "Issue 43's targets" table), and the same verdicts. Two cells
-/// read 0.01 higher here: the hand table divided rates already rounded to three figures
+/// The committed rules on the committed runs of 76a9a9f give the ratios tabled by hand for that
+/// run (docs/notes/2026-12-06-vtk-targets-judged-by-the-tool.md), and the same verdicts. Two
+/// cells read 0.01 higher here: the hand table divided rates already rounded to three figures
 /// (1.47 M / 900.0 K = 1.63, 4.02 M / 1.07 M = 3.76), the tool divides the medians.
 #[test]
 fn committed_rules_reproduce_the_hand_table_of_76a9a9f() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let file = TargetFile::read(&root.join("docs/targets/issue-43.json")).unwrap();
+    let file = TargetFile::read(&root.join("docs/targets/lavapipe-vs-vtk.json")).unwrap();
     let inputs: Vec<(String, Vec<Aggregate>)> = ["spx", "bluntfin", "spx2"]
         .iter()
         .map(|d| {

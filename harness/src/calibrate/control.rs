@@ -11,228 +11,22 @@
 //! How: the run takes a [`ControlSample`] before every round of a data set and after its last
 //! (one variant at a time, `--rounds 1`: before the data set's first variant, after its last,
 //! and between variants when [`INTERVAL_S`] has passed). Each sample runs every control
-//! probe's fastest configuration (chosen once per run from the calibration's own set) once
-//! after one warm-up. A row's round is priced with the best of the two samples around it
+//! probe's fastest configuration (chosen once per run from the calibration's own set) once,
+//! a share of its pieces sized to about [`TARGET_S`] (the rates are per unit of work, so a
+//! share measures the same figure as the whole). A row's round is priced with the best of the two samples around it
 //! (the less disturbed, as the calibration keeps the best repetition): [`RoundControl`].
 
-use std::collections::BTreeMap;
 use std::time::Instant;
 
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
-
-use crate::calibrate::probes::{best_seconds_of, ProbeContext, Timing, PROBES};
+use crate::calibrate::probes::{ProbeContext, Timing, PROBES};
+pub use crate::results::control::{
+    best_figures, median_figures, row_figures, speed_factor, Control, ControlSample, Figures,
+    Pricing,
+};
 use crate::results::machine::{Calibration, Figure};
-use crate::results::stats::median;
 
 /// Between two samples of a data set measured one variant at a time, at most this long.
 pub const INTERVAL_S: f64 = 20.0;
-
-/// The figures of one control measurement (rates, or the rasterisation's costs).
-pub type Figures = BTreeMap<Figure, f64>;
-
-/// One control measurement, as `results.json` keeps it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct ControlSample {
-    /// The data set whose rounds it brackets.
-    pub dataset: String,
-    /// Taken before this round of the data set (the number of rounds: after the last).
-    pub round: u32,
-    /// Rows in the results when it was taken (with one variant at a time, what orders the
-    /// samples between the variants' rows).
-    pub rows_before: usize,
-    /// Seconds since the run started.
-    pub at_s: f64,
-    /// When it was taken (ISO 8601 UTC).
-    pub utc: String,
-    /// Wall time the control took (s).
-    pub seconds: f64,
-    pub figures: Figures,
-}
-
-/// The run's control (`results.json`'s `control`).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct Control {
-    /// The probes it times ([`crate::calibrate::probes::Probe::name`]).
-    pub probes: Vec<String>,
-    /// Wall time (s) preparing the probes took, once per run (choosing each probe's fastest
-    /// configuration included).
-    #[serde(default)]
-    pub setup_seconds: f64,
-    pub samples: Vec<ControlSample>,
-}
-
-impl Control {
-    /// The per-figure median over every sample: what `control_factor` compares a row with.
-    pub fn median(&self) -> Figures {
-        median_figures(self.samples.iter().map(|s| &s.figures))
-    }
-
-    /// Seconds the control took over the run, its preparation included.
-    pub fn seconds(&self) -> f64 {
-        self.setup_seconds + self.samples.iter().map(|s| s.seconds).sum::<f64>()
-    }
-
-    /// The control of each round of a row: `rounds` rounds of `dataset`, the row `index`-th in
-    /// the results (one variant at a time: the samples around it in file order). Empty when
-    /// a round has no sample around it.
-    pub fn rounds_of(&self, dataset: &str, rounds: u32, index: usize) -> Vec<Figures> {
-        let of_set: Vec<&ControlSample> = self
-            .samples
-            .iter()
-            .filter(|s| s.dataset == dataset)
-            .collect();
-        let around: Vec<Vec<&ControlSample>> = if rounds > 1 {
-            (0..rounds)
-                .map(|r| {
-                    of_set
-                        .iter()
-                        .copied()
-                        .filter(|s| s.round == r || s.round == r + 1)
-                        .collect()
-                })
-                .collect()
-        } else {
-            let before = of_set.iter().rev().find(|s| s.rows_before <= index);
-            let after = of_set.iter().find(|s| s.rows_before > index);
-            vec![before.into_iter().chain(after).copied().collect()]
-        };
-        if around.iter().any(Vec::is_empty) {
-            return vec![];
-        }
-        around
-            .iter()
-            .map(|samples| best_figures(samples.iter().map(|s| &s.figures)))
-            .collect()
-    }
-}
-
-/// Figure by figure the fastest of several measurements.
-pub fn best_figures<'a>(all: impl Iterator<Item = &'a Figures>) -> Figures {
-    let mut out = Figures::new();
-    for figures in all {
-        for (&f, &v) in figures {
-            let speed = f.speed(v);
-            let e = out.entry(f).or_insert(v);
-            if speed > f.speed(*e) {
-                *e = v;
-            }
-        }
-    }
-    out
-}
-
-/// Figure by figure the median (of speeds) over several measurements.
-pub fn median_figures<'a>(all: impl Iterator<Item = &'a Figures>) -> Figures {
-    let mut speeds: BTreeMap<Figure, Vec<f64>> = BTreeMap::new();
-    for figures in all {
-        for (&f, &v) in figures {
-            if f.speed(v) > 0.0 {
-                speeds.entry(f).or_default().push(f.speed(v));
-            }
-        }
-    }
-    speeds
-        .into_iter()
-        .map(|(f, s)| (f, f.from_speed(median(&s))))
-        .collect()
-}
-
-/// How much faster `a` is than `b`: the geometric mean over the figures both measured of
-/// speed(a) / speed(b) (`None`: no figure in common). One number for "the machine".
-pub fn speed_factor(a: &Figures, b: &Figures) -> Option<f64> {
-    let logs: Vec<f64> = a
-        .iter()
-        .filter_map(|(f, &va)| {
-            let (sa, sb) = (f.speed(va), f.speed(*b.get(f)?));
-            (sa > 0.0 && sb > 0.0).then(|| (sa / sb).ln())
-        })
-        .collect();
-    (!logs.is_empty()).then(|| (logs.iter().sum::<f64>() / logs.len() as f64).exp())
-}
-
-/// A row's figures over its rounds: per figure the median of its rounds' controls.
-pub fn row_figures(rounds: &[Figures]) -> Figures {
-    median_figures(rounds.iter())
-}
-
-/// What a row's roofline was priced with (`priced_with` in the results).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub enum Pricing {
-    /// Not priced (no calibration, or no work counted).
-    #[default]
-    None,
-    /// The cached calibration: a results set without a control.
-    Calibration,
-    /// The control of the row's own rounds; `scaled`: the priced figures the control did not
-    /// measure, taken from the calibration times the control's factor.
-    Control { scaled: Vec<Figure> },
-}
-
-impl std::fmt::Display for Pricing {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Pricing::None => Ok(()),
-            Pricing::Calibration => f.write_str("calibration"),
-            Pricing::Control { scaled } if scaled.is_empty() => f.write_str("control"),
-            Pricing::Control { scaled } => {
-                let names: Vec<&str> = scaled.iter().map(|s| s.name()).collect();
-                write!(f, "control, scaled {}", names.join(" "))
-            }
-        }
-    }
-}
-
-impl std::str::FromStr for Pricing {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        let figure = |name: &str| {
-            Figure::ALL
-                .into_iter()
-                .find(|f| f.name() == name)
-                .ok_or_else(|| format!("priced_with: unknown figure {name:?}"))
-        };
-        match s {
-            "" => Ok(Pricing::None),
-            "calibration" => Ok(Pricing::Calibration),
-            "control" => Ok(Pricing::Control { scaled: vec![] }),
-            other => match other.strip_prefix("control, scaled ") {
-                Some(list) => Ok(Pricing::Control {
-                    scaled: list.split(' ').map(figure).collect::<Result<_, _>>()?,
-                }),
-                None => Err(format!("priced_with: {other:?} is not a pricing")),
-            },
-        }
-    }
-}
-
-impl Serialize for Pricing {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_str(self)
-    }
-}
-
-impl<'de> Deserialize<'de> for Pricing {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let text = String::deserialize(d)?;
-        text.parse().map_err(serde::de::Error::custom)
-    }
-}
-
-impl JsonSchema for Pricing {
-    fn schema_name() -> std::borrow::Cow<'static, str> {
-        "Pricing".into()
-    }
-    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
-        schemars::json_schema!({
-            "type": "string",
-            "description": "What priced the roofline: empty, `calibration`, `control`, or \
-                            `control, scaled FIGURE…`"
-        })
-    }
-}
 
 /// The calibration a row is priced with: `base` with every figure the control measured
 /// replaced by the control's, and every other figure the roofline prices scaled by the
@@ -258,41 +52,72 @@ pub fn priced(base: &Calibration, control: &Figures) -> (Calibration, Vec<Figure
     (out, scaled)
 }
 
-/// The control probes prepared for a run: each probe's fastest configuration, kept between
-/// samples (pipelines and buffers are made once).
+/// How long one configuration of a control probe runs in a sample: long enough that a
+/// submission's fixed cost (tens of µs on lavapipe) is a small part of it, short enough that a
+/// sample of every probe stays a fraction of a second.
+pub const TARGET_S: f64 = 0.01;
+
+/// The control probes prepared for a run: each probe's fastest configuration and the share of
+/// its pieces that runs in about [`TARGET_S`], kept between samples (pipelines and buffers are
+/// made once).
 pub struct ControlBench<'g> {
     chosen: Vec<Chosen<'g>>,
 }
 
 struct Chosen<'g> {
     probe: &'static crate::calibrate::probes::Probe,
-    workloads: Vec<crate::calibrate::probes::Workload<'g>>,
+    /// Each kept configuration and how many of its pieces a sample runs.
+    workloads: Vec<(crate::calibrate::probes::Workload<'g>, u32)>,
+}
+
+/// One timed share of a workload: its units, parameter and seconds.
+fn time_part(w: &mut crate::calibrate::probes::Workload, k: u32) -> anyhow::Result<Timing> {
+    let t0 = Instant::now();
+    let units = w.run_part(k)?;
+    Ok(Timing {
+        units,
+        param: w.param,
+        seconds: t0.elapsed().as_secs_f64().max(1e-9),
+    })
 }
 
 impl<'g> ControlBench<'g> {
-    /// Prepares every control probe and keeps its fastest configuration (all of them for the
-    /// rasterisation fit), timing each once after a warm-up. A probe that cannot be prepared
-    /// here is left out (its figures are then scaled, and the row says so).
+    /// Prepares every control probe, times a sixteenth of each configuration (after a warm-up
+    /// of the same), keeps the fastest (all of them for the rasterisation fit) and sizes its
+    /// share to [`TARGET_S`]. A probe that cannot be prepared here is left out (its figures are
+    /// then scaled, and the rows say so).
     pub fn new(ctx: &ProbeContext<'g>) -> ControlBench<'g> {
         let mut chosen = vec![];
         for probe in PROBES.iter().filter(|p| p.in_control) {
-            let Ok(mut workloads) = (probe.prepare)(ctx) else {
+            let Ok(workloads) = (probe.prepare)(ctx) else {
                 continue;
             };
-            if probe.combine == crate::calibrate::probes::Combine::Fastest && workloads.len() > 1 {
-                let mut best = (0, 0.0);
-                for (i, w) in workloads.iter_mut().enumerate() {
-                    let units = w.units;
-                    if let Ok(s) = best_seconds_of(1, || w.run()) {
-                        if units / s > best.1 {
-                            best = (i, units / s);
-                        }
-                    }
-                }
-                let keep = workloads.swap_remove(best.0);
-                workloads = vec![keep];
+            let mut timed = vec![];
+            for mut w in workloads {
+                let k = (w.pieces / 16).max(1);
+                let Ok(t) = time_part(&mut w, k).and_then(|_| time_part(&mut w, k)) else {
+                    continue;
+                };
+                let share = (k as f64 * TARGET_S / t.seconds)
+                    .round()
+                    .clamp(1.0, w.pieces as f64);
+                timed.push((w, share as u32, t.rate()));
             }
-            chosen.push(Chosen { probe, workloads });
+            if probe.combine == crate::calibrate::probes::Combine::Fastest && timed.len() > 1 {
+                let best = timed
+                    .iter()
+                    .enumerate()
+                    .max_by(|a, b| a.1 .2.total_cmp(&b.1 .2))
+                    .map_or(0, |(i, _)| i);
+                let keep = timed.swap_remove(best);
+                timed = vec![keep];
+            }
+            if !timed.is_empty() {
+                chosen.push(Chosen {
+                    probe,
+                    workloads: timed.into_iter().map(|(w, k, _)| (w, k)).collect(),
+                });
+            }
         }
         ControlBench { chosen }
     }
@@ -304,7 +129,7 @@ impl<'g> ControlBench<'g> {
             .collect()
     }
 
-    /// One control measurement: each kept configuration once after one warm-up.
+    /// One control measurement: each kept configuration's share once.
     pub fn sample(
         &mut self,
         dataset: &str,
@@ -315,17 +140,11 @@ impl<'g> ControlBench<'g> {
         let started = Instant::now();
         let mut figures = Figures::new();
         for c in &mut self.chosen {
-            let mut timings = vec![];
-            for w in &mut c.workloads {
-                let (units, param) = (w.units, w.param);
-                if let Ok(seconds) = best_seconds_of(1, || w.run()) {
-                    timings.push(Timing {
-                        units,
-                        param,
-                        seconds,
-                    });
-                }
-            }
+            let timings: Vec<Timing> = c
+                .workloads
+                .iter_mut()
+                .filter_map(|(w, k)| time_part(w, *k).ok())
+                .collect();
             if timings.len() == c.workloads.len() {
                 figures.extend(c.probe.figures_of(&timings));
             }

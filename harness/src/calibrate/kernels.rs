@@ -111,9 +111,11 @@ pub fn triangle_setup<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload
         wgpu::ColorWrites::ALL,
     );
     let view = target(gpu, format, GRID as u32);
-    Ok(vec![Workload::new(TRIANGLES as f64, move || {
-        draw(gpu, &pipeline, &view, (TRIANGLES * 3) as u32, 0..1)
-    })])
+    Ok(vec![Workload::split(
+        TRIANGLES as f64,
+        TRIANGLES as u32,
+        move |k| draw(gpu, &pipeline, &view, k * 3, 0..1),
+    )])
 }
 
 fn empty_layout(gpu: &Gpu, label: &str) -> wgpu::PipelineLayout {
@@ -132,9 +134,11 @@ pub fn fill<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>> {
     let pipeline = additive_pipeline(gpu, &ctx.module, "calibrate fill", "fill_vs", format);
     let view = target(gpu, format, FILL_SIZE);
     let fragments = (FILL_SIZE as u64 * FILL_SIZE as u64 * FILL_LAYERS) as f64;
-    Ok(vec![Workload::new(fragments, move || {
-        draw(gpu, &pipeline, &view, 3, 0..FILL_LAYERS as u32)
-    })])
+    Ok(vec![Workload::split(
+        fragments,
+        FILL_LAYERS as u32,
+        move |k| draw(gpu, &pipeline, &view, 3, 0..k),
+    )])
 }
 
 /// Rasterisation of covering triangles in the same format and blend, one workload per leg
@@ -147,9 +151,8 @@ pub fn rasterisation<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<
     Ok(RASTER_LEGS
         .map(|leg| {
             let (pipeline, view) = (pipeline.clone(), view.clone());
-            let vertices = (RASTER_TRIANGLES * 3) as u32;
-            Workload::new(RASTER_TRIANGLES as f64, move || {
-                draw(gpu, &pipeline, &view, vertices, leg..leg + 1)
+            Workload::split(RASTER_TRIANGLES as f64, RASTER_TRIANGLES as u32, move |k| {
+                draw(gpu, &pipeline, &view, k * 3, leg..leg + 1)
             })
             .with_param(raster_fragments_per_triangle(leg))
         })
@@ -176,8 +179,9 @@ pub fn compute<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>> 
         entries: &[render_core::bind::whole(0, &out)],
     });
     let gflop = (FMA_INVOCATIONS * FMA_ITERS * 4 * 4 * 2) as f64 * 1e-9;
-    Ok(vec![Workload::new(gflop, move || {
-        dispatch(gpu, &pipeline, &bind, (FMA_INVOCATIONS / 64) as u32)
+    let groups = (FMA_INVOCATIONS / 64) as u32;
+    Ok(vec![Workload::split(gflop, groups, move |k| {
+        dispatch(gpu, &pipeline, &bind, k)
     })])
 }
 
@@ -204,9 +208,12 @@ pub fn storage_copy<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'
         groups <= gpu.limits.max_compute_workgroups_per_dimension as u64,
         "calibration copy needs {groups} workgroups, more than the adapter allows"
     );
-    Ok(vec![Workload::new((2 * bytes) as f64, move || {
-        dispatch(gpu, &pipeline, &bind, groups as u32)
-    })])
+    // Each workgroup copies 64 × 16 bytes (the last may copy fewer: counted as many).
+    Ok(vec![Workload::split(
+        (2 * bytes) as f64,
+        groups as u32,
+        move |k| dispatch(gpu, &pipeline, &bind, k),
+    )])
 }
 
 /// The CPU radix sort of `render_core::sort` (what HAVS' and the PT algorithms' CPU orders

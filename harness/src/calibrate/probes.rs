@@ -29,22 +29,37 @@ impl<'g> ProbeContext<'g> {
     }
 }
 
-/// One configuration of a probe, ready to run: each call of `run` submits the whole kernel
-/// and waits for it, doing `units` of the figure's work.
+/// One configuration of a probe, ready to run: `run(k)` submits `k` of its `pieces` equal
+/// parts (triangles, instances, workgroups) and waits for them; all of them do `units` of the
+/// figure's work. The calibration runs every piece; the control runs a share of them sized to
+/// take a few milliseconds.
 pub struct Workload<'g> {
-    /// Units of work one run does (triangles, fragments, keys, steps, bytes, GFLOP).
+    /// Units of work all the pieces do (triangles, fragments, keys, steps, bytes, GFLOP).
     pub units: f64,
     /// A parameter of the configuration the figure needs besides the time (the
     /// rasterisation's fragments per triangle; 0 elsewhere).
     pub param: f64,
-    run: Box<dyn FnMut() -> anyhow::Result<()> + 'g>,
+    /// How many equal parts the work splits into (1: it does not split, as a sort).
+    pub pieces: u32,
+    run: Box<dyn FnMut(u32) -> anyhow::Result<()> + 'g>,
 }
 
 impl<'g> Workload<'g> {
-    pub fn new(units: f64, run: impl FnMut() -> anyhow::Result<()> + 'g) -> Workload<'g> {
+    /// Work that runs whole.
+    pub fn new(units: f64, mut run: impl FnMut() -> anyhow::Result<()> + 'g) -> Workload<'g> {
+        Workload::split(units, 1, move |_| run())
+    }
+
+    /// Work of `pieces` equal parts; `run(k)` runs the first `k`.
+    pub fn split(
+        units: f64,
+        pieces: u32,
+        run: impl FnMut(u32) -> anyhow::Result<()> + 'g,
+    ) -> Workload<'g> {
         Workload {
             units,
             param: 0.0,
+            pieces: pieces.max(1),
             run: Box::new(run),
         }
     }
@@ -54,8 +69,16 @@ impl<'g> Workload<'g> {
         self
     }
 
+    /// Runs every piece.
     pub fn run(&mut self) -> anyhow::Result<()> {
-        (self.run)()
+        (self.run)(self.pieces)
+    }
+
+    /// Runs `k` pieces (at least one, at most all); returns the units they do.
+    pub fn run_part(&mut self, k: u32) -> anyhow::Result<f64> {
+        let k = k.clamp(1, self.pieces);
+        (self.run)(k)?;
+        Ok(self.units * k as f64 / self.pieces as f64)
     }
 }
 

@@ -127,8 +127,8 @@ pub fn ray_steps<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>
     });
     let steps = (WALK_INVOCATIONS * WALK_STEPS) as f64;
     let walk = |pipeline: wgpu::ComputePipeline, bind: wgpu::BindGroup| {
-        Workload::new(steps, move || {
-            dispatch(gpu, &pipeline, &bind, (WALK_INVOCATIONS / 64) as u32)
+        Workload::split(steps, (WALK_INVOCATIONS / 64) as u32, move |k| {
+            dispatch(gpu, &pipeline, &bind, k)
         })
     };
     let storage_walk = walk(pipeline, bind);
@@ -385,8 +385,8 @@ fn splat_workload(
 ) -> Workload<'_> {
     let per_splat = side as u64 * side as u64 * SPLAT_RING;
     let groups = SPLAT_FRAGMENTS.div_ceil(per_splat * 256);
-    Workload::new((groups * 256 * per_splat) as f64, move || {
-        dispatch(gpu, &pipeline, &bind, groups as u32)
+    Workload::split((groups * 256 * per_splat) as f64, groups as u32, move |k| {
+        dispatch(gpu, &pipeline, &bind, k)
     })
 }
 

@@ -22,19 +22,18 @@
 //! are not compared pixel by pixel (adapters legitimately differ), and every output says so.
 //! What the comparison found is a list of [`Finding`]s ([`crate::regress::compare_findings`]).
 
-use render_core::Settings;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
-
-pub use crate::regress::compare_findings::{Finding, FindingVerdict};
 use crate::regress::compare_image::{image_change, image_note};
 pub use crate::regress::compare_image::{
     image_difference, ImageChange, ImageDifference, ImageVerdict, PSNR_TOLERANCE_DB,
 };
+pub use crate::regress::compare_model::{
+    json_schema, Comparison, Finding, FindingVerdict, RowComparison, RowStatus, SCHEMA_VERSION,
+};
 use crate::regress::compare_rounds::{group_pair_ratios, group_tests, round_test};
-pub use crate::regress::compare_rounds::{round_values, Rounds, MIN_ROUNDS};
+pub use crate::regress::compare_rounds::{round_values, GroupComparison, Rounds, MIN_ROUNDS};
+pub use crate::regress::compare_setup::{key, CompareOptions, FailOn, Key, EXIT_REGRESSION};
 pub use crate::regress::compare_time::{
     adjust_family, fmt_p, pair_factors, pooled_t_tests, run_wide_factor, scaled, time_test,
     TimeTest, Verdict, MIN_GROUPS_FOR_DRIFT,
@@ -43,208 +42,6 @@ pub use crate::regress::compare_work::{WorkChange, WorkRule, WorkVerdict};
 use crate::results::aggregate::GroupKey;
 use crate::results::stats::{holm_adjust, mann_whitney_p, median};
 use crate::results::{ResultsFile, Row};
-
-/// The layout of `compare.json` (`docs/compare.schema.json`); bumped when a field changes
-/// meaning or is removed.
-pub const SCHEMA_VERSION: u32 = 1;
-
-/// `compare --fail-on` met: the exit status, distinct from 1 (an error, or a comparison
-/// refused: other adapters, unreadable results) so that CI can tell a regression from a
-/// broken job.
-pub const EXIT_REGRESSION: i32 = 3;
-
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize, JsonSchema,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum FailOn {
-    /// Always exit 0 (the report is the product).
-    Never,
-    /// Exit 3 when anything got slower, less exact, bigger, did more work, or failed.
-    Regression,
-    /// Exit 3 on any change at all, including improvements and changed pixels.
-    Change,
-}
-
-#[derive(Debug, Clone)]
-pub struct CompareOptions {
-    pub threshold: f64,
-    pub alpha: f64,
-    pub normalised: bool,
-    /// Divide NEW's times by the run-wide factor before testing ([`run_wide_factor`]).
-    pub drift_correction: bool,
-    /// A run-wide factor beyond this is a regression (or improvement) of its own.
-    pub drift_limit: f64,
-    /// BASE's round i and NEW's round i ran side by side (`tetbench ab`): with drift
-    /// correction, each pair's own factor is divided out ([`pair_factors`]) instead of the
-    /// run-wide one.
-    pub paired: bool,
-    pub fail_on: FailOn,
-    pub out: PathBuf,
-}
-
-/// What became of one row.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-pub enum RowStatus {
-    /// Slower, less exact, more work or bytes, or fails now.
-    #[serde(rename = "regression")]
-    Regression,
-    #[serde(rename = "improvement")]
-    Improvement,
-    /// Changed pixels or a counter only one side reports, neither better nor worse.
-    #[serde(rename = "changed")]
-    Changed,
-    #[serde(rename = "no change")]
-    NoChange,
-    #[serde(rename = "only in base")]
-    OnlyInBase,
-    #[serde(rename = "only in new")]
-    OnlyInNew,
-}
-
-impl RowStatus {
-    pub fn label(self) -> &'static str {
-        match self {
-            RowStatus::Regression => "regression",
-            RowStatus::Improvement => "improvement",
-            RowStatus::Changed => "changed",
-            RowStatus::NoChange => "no change",
-            RowStatus::OnlyInBase => "only in base",
-            RowStatus::OnlyInNew => "only in new",
-        }
-    }
-}
-
-impl std::fmt::Display for RowStatus {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.label())
-    }
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct RowComparison {
-    pub algorithm: String,
-    pub settings: String,
-    pub dataset: String,
-    pub viewpoint: String,
-    pub width: u32,
-    pub height: u32,
-    pub status: RowStatus,
-    pub notes: Vec<String>,
-    pub times: Vec<TimeTest>,
-    pub image: Option<ImageChange>,
-    /// Every work counter and GPU byte figure that differs ([`crate::regress::compare_work`]).
-    pub work: Vec<WorkChange>,
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct GroupComparison {
-    pub algorithm: String,
-    pub settings: String,
-    pub dataset: String,
-    /// The group's viewport ([`GroupKey`]): one variant at two sizes is two groups.
-    #[serde(default)]
-    pub width: u32,
-    #[serde(default)]
-    pub height: u32,
-    #[serde(default)]
-    pub projection: String,
-    pub viewpoints: usize,
-    /// Pooled `total_ms` test over the viewpoints.
-    pub total: TimeTest,
-}
-
-impl GroupComparison {
-    /// Whether this is the comparison of the reports' group `g`.
-    pub fn is(&self, g: &GroupKey) -> bool {
-        (&self.algorithm, &self.settings, &self.dataset)
-            == (&g.algorithm, &g.settings.to_string(), &g.dataset)
-            && (self.width, self.height, &self.projection) == (g.width, g.height, &g.projection)
-    }
-}
-
-impl RowComparison {
-    /// Whether the row belongs to group `g` (a row comparison keeps no projection: matched on
-    /// the rest).
-    pub fn in_group(&self, g: &GroupKey) -> bool {
-        (&self.algorithm, &self.settings, &self.dataset)
-            == (&g.algorithm, &g.settings.to_string(), &g.dataset)
-            && (self.width, self.height) == (g.width, g.height)
-    }
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct Comparison {
-    /// [`SCHEMA_VERSION`].
-    pub schema_version: u32,
-    pub base: String,
-    pub new: String,
-    pub base_adapter: String,
-    pub new_adapter: String,
-    pub base_commit: Option<String>,
-    pub new_commit: Option<String>,
-    pub normalised: bool,
-    pub threshold: f64,
-    pub alpha: f64,
-    /// Rounds per row on each side; time is judged only with [`MIN_ROUNDS`] or more on both.
-    pub rounds: Rounds,
-    /// What makes the comparison less trustworthy: a side built from a dirty tree or as a
-    /// debug build ([`provenance_warnings`]).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub warnings: Vec<String>,
-    /// Why time was not judged, when it was not (too few rounds, or too noisy).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub time_refused: Option<String>,
-    /// Separate runs too noisy to gate on time ([`time_noise`]): the spread of the groups'
-    /// ratios around the run-wide factor, as a factor (`None`: not estimated).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub group_spread: Option<f64>,
-    pub too_noisy: bool,
-    /// NEW / BASE over the whole run: the median of the groups' pooled `total_ms` ratios
-    /// (`None`: too few groups), after the machine was divided out where both runs have a
-    /// control (`machine`). When `drift_corrected`, every NEW time was divided by it before
-    /// the tests, so a group is judged against the rest of its own run (the old rule).
-    pub run_factor: Option<f64>,
-    /// The machine's drift between the runs, from the control measured beside the rows: every
-    /// round value of both sides was divided by it before the tests.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub machine: Option<crate::regress::compare_control::MachineDrift>,
-    /// Why the run-wide factor stood in for the control (a side without one).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub control_missing: Option<String>,
-    pub drift_corrected: bool,
-    /// With paired rounds (`ab`): each pair's NEW/BASE factor, divided out of that pair's
-    /// NEW round values instead of `run_factor`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pair_factors: Option<Vec<f64>>,
-    pub test: String,
-    pub groups: Vec<GroupComparison>,
-    pub rows: Vec<RowComparison>,
-    pub regressions: Vec<Finding>,
-    pub improvements: Vec<Finding>,
-    pub changes: Vec<Finding>,
-}
-
-impl Comparison {
-    /// One word for the whole comparison.
-    pub fn outcome(&self) -> &'static str {
-        if !self.regressions.is_empty() {
-            "regression"
-        } else if !self.improvements.is_empty() || !self.changes.is_empty() {
-            "changed"
-        } else {
-            "no change"
-        }
-    }
-}
-
-/// The JSON Schema of `compare.json` (`docs/compare.schema.json`).
-pub fn json_schema() -> serde_json::Value {
-    serde_json::to_value(schemars::schema_for!(Comparison)).expect("a schema is JSON")
-}
 
 /// The adapter a results set ran on, as compare matches them (a software rasteriser with its CPU).
 pub fn adapter_of(f: &ResultsFile) -> String {
@@ -261,20 +58,6 @@ pub fn adapter_of(f: &ResultsFile) -> String {
     } else {
         name
     }
-}
-
-/// A row's place in the matrix: algorithm, settings, data set, viewpoint, viewport.
-pub(crate) type Key = (String, Settings, String, String, u32, u32);
-
-pub(crate) fn key(r: &Row) -> Key {
-    (
-        r.algorithm.clone(),
-        r.settings.clone(),
-        r.dataset.clone(),
-        r.viewpoint.clone(),
-        r.width,
-        r.height,
-    )
 }
 
 /// Separate runs of a busy machine: the groups of one unchanged build scatter around the

@@ -2,58 +2,12 @@
 //! change names its group (and row), the metric, the ratio, the p-values and the verdict, with
 //! the sentence the reports print beside them.
 
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
-
-use crate::regress::compare::{Comparison, ImageVerdict, RowComparison, RowStatus};
+use crate::regress::compare_image::ImageVerdict;
+use crate::regress::compare_model::{
+    Comparison, Finding, FindingVerdict, RowComparison, RowStatus,
+};
 use crate::regress::compare_time::{TimeTest, Verdict};
 use crate::regress::compare_work::WorkVerdict;
-
-/// Which way a finding goes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "kebab-case")]
-pub enum FindingVerdict {
-    /// Time: the group (or row, or the whole run) got slower / faster.
-    Slower,
-    Faster,
-    /// Work: a counter or byte figure grew / shrank (exact).
-    More,
-    Less,
-    /// A counter only one side reports.
-    Added,
-    Removed,
-    /// Image: PSNR dropped / rose beyond the tolerance, or the pixels changed.
-    Worse,
-    Better,
-    Changed,
-    /// The row failed in NEW only / in BASE only.
-    FailsNow,
-    NoLongerFails,
-    /// The row exists on one side only.
-    OnlyInBase,
-    OnlyInNew,
-}
-
-/// One regression, improvement or other change.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct Finding {
-    /// `algorithm settings on dataset` (the group), or `run-wide` for the run as a whole.
-    pub group: String,
-    /// The row's viewpoint; `None` for a group's pooled test or the run-wide factor.
-    pub viewpoint: Option<String>,
-    /// What moved: `total_ms`, a counter (`fragments`), a byte figure (`gpu_bytes`), `image`,
-    /// `error`, `row`.
-    pub metric: String,
-    /// NEW / BASE, where there is one.
-    pub ratio: Option<f64>,
-    /// The test's p-value (time only) and the Holm-adjusted one that decided.
-    pub p: Option<f64>,
-    pub p_holm: Option<f64>,
-    pub verdict: FindingVerdict,
-    /// The finding as the reports print it.
-    pub text: String,
-}
 
 fn group_label(algorithm: &str, settings: &str, dataset: &str) -> String {
     format!("{algorithm} {settings} on {dataset}")

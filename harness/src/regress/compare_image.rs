@@ -9,7 +9,7 @@ use anyhow::Context;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use crate::regress::compare::CompareOptions;
+use crate::regress::compare_setup::CompareOptions;
 use crate::results::samples;
 use crate::results::Row;
 

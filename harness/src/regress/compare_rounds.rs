@@ -2,13 +2,41 @@
 //! side holds ([`Rounds`]), and the pooled test per group of viewpoints ([`group_tests`]) that
 //! gates (see [`crate::regress::compare`] for why rounds, not frames, are the samples).
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use crate::regress::compare::{key, CompareOptions, GroupComparison};
+use crate::regress::compare_setup::{key, CompareOptions};
 use crate::regress::compare_time::{paired_t_tests, scaled, time_test, TimeTest, Verdict};
 use crate::results::aggregate::GroupKey;
 use crate::results::stats::median;
 use crate::results::{ResultsFile, Row};
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GroupComparison {
+    pub algorithm: String,
+    pub settings: String,
+    pub dataset: String,
+    /// The group's viewport ([`GroupKey`]): one variant at two sizes is two groups.
+    #[serde(default)]
+    pub width: u32,
+    #[serde(default)]
+    pub height: u32,
+    #[serde(default)]
+    pub projection: String,
+    pub viewpoints: usize,
+    /// Pooled `total_ms` test over the viewpoints.
+    pub total: TimeTest,
+}
+
+impl GroupComparison {
+    /// Whether this is the comparison of the reports' group `g`.
+    pub fn is(&self, g: &GroupKey) -> bool {
+        (&self.algorithm, &self.settings, &self.dataset)
+            == (&g.algorithm, &g.settings.to_string(), &g.dataset)
+            && (self.width, self.height, &self.projection) == (g.width, g.height, &g.projection)
+    }
+}
 
 /// Fewer rounds than this on either side and time is not judged: 2 vs 2 values cannot reach
 /// p < 0.05 even pooled over a few viewpoints, and one round is one moment of the machine.

@@ -5,7 +5,7 @@
 //! by commit ([`build`]).
 //!
 //! Why interleave: on the shared development VM two runs of one binary a minute apart differed
-//! as a whole by ×0.53–×1.98 (docs/regression.md), far more than the changes worth catching.
+//! as a whole by ×0.53–×1.98 (docs/notes/2026-12-02-compare-gate-detection.md), far more than the changes worth catching.
 //! Rounds of the two builds taken in turns (A B B A A B …) see the same stretches of that drift,
 //! so it falls on both sides alike instead of on one.
 
@@ -20,8 +20,10 @@ pub mod compare;
 pub mod compare_control;
 pub mod compare_findings;
 pub mod compare_image;
+pub mod compare_model;
 pub mod compare_report;
 pub mod compare_rounds;
+pub mod compare_setup;
 pub mod compare_time;
 pub mod compare_work;
 pub mod export;

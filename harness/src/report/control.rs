@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use crate::calibrate::control::{speed_factor, Control};
+use crate::results::control::{speed_factor, Control};
 
 /// One sample as the report shows it.
 #[derive(Serialize)]

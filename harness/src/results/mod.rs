@@ -22,6 +22,7 @@ use crate::results::machine::MachineInfo;
 pub use crate::results::named::NamedValues;
 
 pub mod aggregate;
+pub mod control;
 pub mod git_state;
 pub mod machine;
 pub mod metrics;
@@ -124,7 +125,7 @@ pub struct Row {
     pub image_f32: String,
     #[serde(default)]
     pub image_hash: String,
-    /// Roofline against the backend's calibration ([`crate::calibrate`]): the time the
+    /// Roofline against the backend's calibration (`tetbench calibrate`): the time the
     /// bounding resource alone needs, `roofline_ms / total_ms`, which resource that is, and
     /// `total_ms / roofline_ms` (the machine-independent figure `compare --normalised` uses).
     #[serde(default)]
@@ -137,7 +138,7 @@ pub struct Row {
     pub normalized_time: Option<f64>,
     /// The machine's speed at this row's rounds against the whole run: the geometric mean over
     /// the control's figures of the row's control (the median of its rounds') over the run's
-    /// median control ([`crate::calibrate::control`]). 0.8: the machine ran at 80 % of the
+    /// median control (`results::control`). 0.8: the machine ran at 80 % of the
     /// run's typical speed while this row was measured. Empty without a control.
     #[serde(default)]
     pub control_factor: Option<f64>,
@@ -145,7 +146,7 @@ pub struct Row {
     /// FIGURE…` (figures the control did not measure, from the calibration times the
     /// control's factor), `calibration` (the cached calibration: results without a control).
     #[serde(default)]
-    pub priced_with: crate::calibrate::control::Pricing,
+    pub priced_with: crate::results::control::Pricing,
     /// Peak resident host memory of the process during the row (bytes): the kernel's VmHWM,
     /// reset before the row (the first row of a variant includes its prepare). On a software
     /// adapter (lavapipe) GPU buffers live in host memory and are counted here too. Empty where
@@ -166,7 +167,7 @@ pub struct Row {
     /// The control of each of the row's rounds (the best of the samples around it): in
     /// `results.json` only.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub round_control: Vec<crate::calibrate::control::Figures>,
+    pub round_control: Vec<crate::results::control::Figures>,
 }
 
 /// The settings as JSON Schema sees them: a map of integers and words, or the text form of
@@ -295,7 +296,7 @@ pub struct ResultsFile {
     /// The control measured beside the rows ([`crate::calibrate::control`]); absent in
     /// results without one (`--no-calibrate`, files written before it existed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub control: Option<crate::calibrate::control::Control>,
+    pub control: Option<crate::results::control::Control>,
 }
 
 impl ResultsFile {
