@@ -58,7 +58,7 @@ fn quick_gator_reproduction_end_to_end() {
     // ... the claims are listed with verdicts and the commit is named, and the HTML, charts
     // and the index (written from the same summaries) exist.
     assert!(
-        report.contains("**G1**") && report.contains("| holds |"),
+        report.contains("**G1**") && report.contains("| holds"),
         "{report}"
     );
     assert!(report.contains("Linear cells are slower"), "{report}");

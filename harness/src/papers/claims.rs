@@ -1,347 +1,84 @@
-//! The papers' claims as data (`reports/papers/claims.csv`) and their evaluation with the one
-//! verdict rule of [`super::verdict`].
+//! The papers' claims as data (`reports/papers/claims.csv`, read with serde into [`Claim`]) and
+//! their evaluation with the one verdict rule of [`super::verdict`].
 //!
 //! Each claim names the section or table it rests on, says in our words what the paper
-//! claims, and says what it compares: a metric, the data sets (one verdict per data set), the
-//! variants of each side spelled out (`algorithm:key=value;…`, optionally `@dataset` to pin a
-//! side to one data set), what it expects (`a<b`, `a>b`, `a>N`, `a<N`, `a in LO..HI`,
-//! `a/b in LO..HI`, `a=N`, or `a=TABLE.COLUMN`: the paper's own cell for the data set), its
-//! relative tolerance and what it depends on (`none`, `cpu`, `gpu`). `source` is `paper` for
-//! what the paper states and `ours` for a reading of its numbers that its text does not make.
-//!
-//! Metrics read from a run's rows: `total_ms`, `gpu_ms`, `cpu_ms`, `fps`, `tets_per_sec`,
-//! `gpu_tets_per_sec`, `bytes_per_tet`, `gpu_bytes`, `psnr_db`, `counter:NAME`,
-//! `counter_per_tet:NAME`, `stage:NAME`,
-//! `stage_share:NAME` (the stage over the most expensive other stage), `view_range:METRIC`
-//! (range over the viewpoints divided by their mean) and `view_max:METRIC` / `view_min:METRIC`
-//! (the largest / smallest over the viewpoints); from two sides' images, `pair_psnr_db` and
-//! `pair_bad_pixel_share` (side `a`'s image against side `b`'s, [`super::sides::pair_side`]).
-//! Other metrics (the CPU analyses: sorts,
-//! the k-buffer, the classifier, data set sizes) come from the paper's own measurements.
+//! claims, and says what it compares: a metric ([`Metric`]), the data sets (one verdict per
+//! data set), the variants of each side spelled out (`algorithm:key=value;…`, optionally
+//! `@dataset` to pin a side to one data set), what it expects (`a<b`, `a>b`, `a>N`, `a<N`,
+//! `a in LO..HI`, `a/b in LO..HI`, `a=N`, or `a=TABLE.COLUMN`: the paper's own cell for the data
+//! set), its relative tolerance and what it depends on (`none`, `cpu`, `gpu`). `source` is
+//! `paper` for what the paper states and `ours` for a reading of its numbers that its text does
+//! not make. Its rule and the rule's history are in [`super::rules`].
 
-use anyhow::{bail, Context as _};
-use render_core::Settings;
+use anyhow::bail;
 
-pub use super::claims_report::{markdown, tally, tally_apart};
-use super::sides::{is_pair_metric, pair_side};
-pub use super::sides::{row_sample, side_from_rows};
+#[cfg(test)]
+use super::rules::parse_history;
+use super::rules::{history, Evidence, Normalise, Rule, RuleChange, HISTORY_FILE};
+use super::sides::{pair_side, side_from_rows};
+pub use super::sides::{software_adapter, AnalysisSide, Inputs};
+pub use super::spec::{ExpectSpec, Metric, VariantSpec};
+use super::transcription::deserialize_rows;
 use super::verdict::{self, Check, Evaluation, Expect, Hardware, Side};
-use crate::results::Row;
 
 /// The claims file, compiled in like the tables.
 pub const CLAIMS_CSV: &str = include_str!("../../../reports/papers/claims.csv");
-const FILE: &str = "reports/papers/claims.csv";
+pub const FILE: &str = "reports/papers/claims.csv";
 
-/// The rule history (`reports/papers/rule_history.csv`), compiled in like the claims.
-pub const RULE_HISTORY_CSV: &str = include_str!("../../../reports/papers/rule_history.csv");
-const HISTORY_FILE: &str = "reports/papers/rule_history.csv";
-
-/// What a claim's evidence is: only a measurement can make a claim hold.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Evidence {
-    /// An outcome the code produces and could get wrong.
-    Measured,
-    /// An input chosen to equal the paper's (a stand-in's counts, a fixed layout constant):
-    /// checked, but it cannot fail unless the construction is broken.
-    ByConstruction,
-    /// Arithmetic on other claims' numbers (their ids).
-    Derived(Vec<String>),
-}
-
-impl Evidence {
-    pub fn parse(text: &str) -> Result<Evidence, String> {
-        match text.trim() {
-            "measured" => Ok(Evidence::Measured),
-            "construction" => Ok(Evidence::ByConstruction),
-            t => match t.strip_prefix("derived:") {
-                Some(ids) if !ids.trim().is_empty() => Ok(Evidence::Derived(
-                    ids.split('+').map(|s| s.trim().to_string()).collect(),
-                )),
-                _ => Err(format!(
-                    "evidence {t:?} is not measured, construction or derived:ID[+ID…]"
-                )),
-            },
-        }
-    }
-
-    /// The word of the kind, as reports list it.
-    pub fn label(&self) -> String {
-        match self {
-            Evidence::Measured => "measured".into(),
-            Evidence::ByConstruction => "by construction".into(),
-            Evidence::Derived(ids) => format!("derived from {}", ids.join(", ")),
-        }
-    }
-
-    /// The word a verdict takes for this kind: a measured claim *holds*; one by construction
-    /// is *as constructed*; a derived one *follows*. Verdicts that decide nothing (noise, not
-    /// testable, not checkable) keep their word.
-    pub fn word(&self, v: verdict::Verdict) -> &'static str {
-        use verdict::Verdict::*;
-        match (self, v) {
-            (Evidence::Measured, v) => v.label(),
-            (Evidence::ByConstruction, Holds) => "as constructed",
-            (Evidence::ByConstruction, DoesNotHold) => "not as constructed",
-            (Evidence::Derived(_), Holds) => "follows",
-            (Evidence::Derived(_), DoesNotHold) => "does not follow",
-            (_, v) => v.label(),
-        }
-    }
-}
-
-/// How a rate measured on the paper's GPU is compared across hardware (see
-/// docs/reproduction.md, "Across hardware").
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Normalise {
-    /// Compared as measured.
-    None,
-    /// A rate of the paper's GPU judged relative to the fill rate: the paper's figure is
-    /// scaled by our calibrated fill rate over its GPU's published one
-    /// (`reports/papers/hardware.csv`). A GPU claim so normalised is judged on any adapter,
-    /// a software rasteriser included: its calibration measures the same cores it renders on.
-    Fill,
-}
-
-impl Normalise {
-    pub fn parse(text: &str) -> Result<Normalise, String> {
-        match text.trim() {
-            "none" | "" => Ok(Normalise::None),
-            "fill" => Ok(Normalise::Fill),
-            t => Err(format!("normalise {t:?} is not none or fill")),
-        }
-    }
-
-    pub fn label(self) -> &'static str {
-        match self {
-            Normalise::None => "none",
-            Normalise::Fill => "fill rate",
-        }
-    }
-}
-
-/// A claim's rule: what it expects, its tolerance and its normalisation, as written.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Rule {
-    pub expect: ExpectSpec,
-    pub expect_text: String,
-    pub tolerance: f64,
-    pub normalise: Normalise,
-}
-
-impl Rule {
-    pub fn describe(&self) -> String {
-        let mut s = format!("`{}`", self.expect_text);
-        if self.tolerance > 0.0 {
-            s.push_str(&format!(", tolerance {}", self.tolerance));
-        }
-        if self.normalise != Normalise::None {
-            s.push_str(&format!(", normalised by {}", self.normalise.label()));
-        }
-        s
-    }
-}
-
-/// An earlier rule of a claim, replaced on `date` at `commit` for `reason`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RuleChange {
-    pub paper: String,
-    pub id: String,
-    pub date: String,
-    pub commit: String,
-    pub reason: String,
-    pub old: Rule,
-}
-
-/// Parses a rule history; errors name the file, the line and what is wrong.
-pub fn parse_history(text: &str, file: &str) -> anyhow::Result<Vec<RuleChange>> {
-    let mut reader = super::transcription::reader_with_header(
-        text,
-        file,
-        &[
-            "paper",
-            "id",
-            "date",
-            "commit",
-            "reason",
-            "old_expect",
-            "old_tolerance",
-            "old_normalise",
-        ],
-    )?;
-    let mut out = vec![];
-    for (i, rec) in reader.records().enumerate() {
-        let line = i + 2;
-        let rec = rec.with_context(|| format!("{file}: line {line}"))?;
-        let f = |j: usize| rec.get(j).unwrap_or("").trim().to_string();
-        let err = |what: String| anyhow::anyhow!("{file}: line {line}: {what}");
-        for (name, j) in [
-            ("paper", 0),
-            ("id", 1),
-            ("date", 2),
-            ("commit", 3),
-            ("reason", 4),
-        ] {
-            if f(j).is_empty() {
-                return Err(err(format!("{name} is empty")));
-            }
-        }
-        let tolerance: f64 = f(6)
-            .parse()
-            .map_err(|_| err(format!("old_tolerance {:?} is not a number", f(6))))?;
-        out.push(RuleChange {
-            paper: f(0),
-            id: f(1),
-            date: f(2),
-            commit: f(3),
-            reason: f(4),
-            old: Rule {
-                expect: ExpectSpec::parse(&f(5)).map_err(err)?,
-                expect_text: f(5),
-                tolerance,
-                normalise: Normalise::parse(&f(7)).map_err(err)?,
-            },
-        });
-    }
-    Ok(out)
-}
-
-/// Every rule change of the compiled-in history.
-pub fn history() -> anyhow::Result<Vec<RuleChange>> {
-    parse_history(RULE_HISTORY_CSV, HISTORY_FILE)
-}
+/// The claims file's columns.
+pub const HEADER: &[&str] = &[
+    "paper",
+    "id",
+    "source",
+    "cites",
+    "claim",
+    "metric",
+    "datasets",
+    "a",
+    "b",
+    "expect",
+    "tolerance",
+    "hardware",
+    "evidence",
+    "normalise",
+];
 
 /// Whether the paper states the claim or we read it off its numbers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(try_from = "String")]
 pub enum Source {
     Paper,
     Ours,
 }
 
-/// One side of a claim: an algorithm (or one of the papers' CPU analyses) and the settings
-/// that pick its variant.
-#[derive(Debug, Clone, PartialEq)]
-pub struct VariantSpec {
-    pub algorithm: String,
-    pub settings: Settings,
-    /// Pins the side to one data set whatever the claim's data sets are.
-    pub dataset: Option<String>,
-}
-
-impl VariantSpec {
-    pub fn parse(text: &str) -> Result<VariantSpec, String> {
-        let (body, dataset) = match text.split_once('@') {
-            Some((b, d)) => (b, Some(d.trim().to_string())),
-            None => (text, None),
-        };
-        let (algorithm, settings) = match body.split_once(':') {
-            Some((a, s)) => (a.trim(), s),
-            None => (body.trim(), ""),
-        };
-        if algorithm.is_empty() {
-            return Err(format!("{text:?}: no algorithm"));
+impl TryFrom<String> for Source {
+    type Error = String;
+    fn try_from(s: String) -> Result<Source, String> {
+        match s.as_str() {
+            "paper" => Ok(Source::Paper),
+            "ours" => Ok(Source::Ours),
+            s => Err(format!("source {s:?} is not paper or ours")),
         }
-        // The papers' CPU analyses (`sort-analysis`) are not algorithms: their settings are
-        // typed by inference.
-        let settings = crate::algorithms::parse_settings(algorithm, settings)
-            .map_err(|e| format!("{text:?}: {e}"))?;
-        Ok(VariantSpec {
-            algorithm: algorithm.to_string(),
-            settings,
-            dataset,
-        })
-    }
-
-    pub fn settings_text(&self) -> String {
-        self.settings.to_string()
-    }
-
-    /// `algorithm settings on dataset`: what a verdict names.
-    pub fn label(&self, dataset: Option<&str>) -> String {
-        let mut s = self.algorithm.clone();
-        if !self.settings.is_empty() {
-            s.push(' ');
-            s.push_str(&self.settings_text());
-        }
-        if let Some(d) = dataset {
-            s.push_str(" on ");
-            s.push_str(d);
-        }
-        s
-    }
-
-    /// The value this side asks for a setting, if it pins it.
-    pub fn setting(&self, key: &str) -> Option<String> {
-        self.settings.text(key)
-    }
-
-    pub(crate) fn matches(&self, row: &Row) -> bool {
-        row.algorithm == self.algorithm
-            && self
-                .settings
-                .iter()
-                .all(|(k, v)| row.settings.get(k) == Some(v))
     }
 }
 
-/// What a claim expects, before the paper's cells are looked up.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ExpectSpec {
-    Fixed(Expect),
-    /// `a=TABLE.COLUMN`: equal to the paper's cell of the data set's row.
-    PaperCell {
-        table: String,
-        column: String,
-    },
-}
-
-impl ExpectSpec {
-    pub fn parse(text: &str) -> Result<ExpectSpec, String> {
-        let t = text.replace(' ', "");
-        let num = |s: &str| {
-            s.parse::<f64>()
-                .map_err(|_| format!("expect {text:?}: {s:?} is not a number"))
-        };
-        let band = |s: &str| -> Result<(f64, f64), String> {
-            let (lo, hi) = s
-                .split_once("..")
-                .ok_or_else(|| format!("expect {text:?}: a band is LO..HI"))?;
-            Ok((num(lo)?, num(hi)?))
-        };
-        Ok(ExpectSpec::Fixed(match t.as_str() {
-            "a<b" => Expect::Less,
-            "a>b" => Expect::Greater,
-            _ if t.starts_with("a/bin") => {
-                let (lo, hi) = band(&t[5..])?;
-                Expect::Band(lo, hi)
-            }
-            _ if t.starts_with("ain") => {
-                let (lo, hi) = band(&t[3..])?;
-                Expect::Band(lo, hi)
-            }
-            _ if t.starts_with("a>") => Expect::Above(num(&t[2..])?),
-            _ if t.starts_with("a<") => Expect::Below(num(&t[2..])?),
-            _ if t.starts_with("a=") => {
-                let v = &t[2..];
-                if let Ok(x) = v.parse::<f64>() {
-                    Expect::Equals(x)
-                } else {
-                    let (table, column) = v
-                        .split_once('.')
-                        .ok_or_else(|| format!("expect {text:?}: a=N or a=TABLE.COLUMN"))?;
-                    return Ok(ExpectSpec::PaperCell {
-                        table: table.to_string(),
-                        column: column.to_string(),
-                    });
-                }
-            }
-            _ => return Err(format!("expect {text:?} is not one of a<b, a>b, a>N, a<N, a in LO..HI, a/b in LO..HI, a=N, a=TABLE.COLUMN")),
-        }))
-    }
-
-    /// Whether the claim compares two sides.
-    pub fn needs_b(&self) -> bool {
-        matches!(self, ExpectSpec::Fixed(Expect::Less | Expect::Greater))
-    }
+/// One line of the claims file as serde reads it.
+#[derive(serde::Deserialize)]
+struct Record {
+    paper: String,
+    id: String,
+    source: Source,
+    cites: String,
+    claim: String,
+    metric: Metric,
+    datasets: String,
+    a: VariantSpec,
+    b: Option<VariantSpec>,
+    expect: String,
+    tolerance: f64,
+    hardware: Hardware,
+    evidence: Evidence,
+    normalise: Normalise,
 }
 
 /// One claim of a paper.
@@ -352,7 +89,7 @@ pub struct Claim {
     pub source: Source,
     pub cites: String,
     pub text: String,
-    pub metric: String,
+    pub metric: Metric,
     /// One verdict per data set; empty: one verdict (sides pinned with `@` or no data set).
     pub datasets: Vec<String>,
     pub a: VariantSpec,
@@ -372,9 +109,14 @@ impl Claim {
     /// The claim's rule as it stands.
     pub fn rule(&self) -> Rule {
         Rule {
+            metric: self.metric.clone(),
+            datasets: self.datasets.clone(),
+            a: self.a.clone(),
+            b: self.b.clone(),
             expect: self.expect.clone(),
             expect_text: self.expect_text.clone(),
             tolerance: self.tolerance,
+            evidence: self.evidence.clone(),
             normalise: self.normalise,
         }
     }
@@ -382,9 +124,14 @@ impl Claim {
     /// The claim under another rule (an earlier one of its history).
     pub fn with_rule(&self, rule: &Rule) -> Claim {
         Claim {
+            metric: rule.metric.clone(),
+            datasets: rule.datasets.clone(),
+            a: rule.a.clone(),
+            b: rule.b.clone(),
             expect: rule.expect.clone(),
             expect_text: rule.expect_text.clone(),
             tolerance: rule.tolerance,
+            evidence: rule.evidence.clone(),
             normalise: rule.normalise,
             history: vec![],
             ..self.clone()
@@ -392,110 +139,65 @@ impl Claim {
     }
 }
 
+/// Checks that a rule's parts fit together: a pair metric takes a single expectation, and a
+/// second side is there exactly when the expectation or the metric needs one.
+pub fn check_rule(rule: &Rule) -> Result<(), String> {
+    let ratio = rule.expect_text.replace(' ', "").starts_with("a/b");
+    let pair = rule.metric.is_pair();
+    if pair && (rule.expect.needs_b() || ratio) {
+        return Err(format!(
+            "metric {} compares a's image with b's: expect a>N, a<N, a=N or a in LO..HI, not {:?}",
+            rule.metric, rule.expect_text
+        ));
+    }
+    let needs_b = rule.expect.needs_b() || ratio || pair;
+    if needs_b != rule.b.is_some() {
+        return Err(format!(
+            "expect {:?} {} a second side (column b)",
+            rule.expect_text,
+            if needs_b { "needs" } else { "takes no" }
+        ));
+    }
+    Ok(())
+}
+
 /// Parses a claims file; errors name the file, the line and what is wrong.
 pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
-    let mut reader = super::transcription::reader_with_header(
-        text,
-        file,
-        &[
-            "paper",
-            "id",
-            "source",
-            "cites",
-            "claim",
-            "metric",
-            "datasets",
-            "a",
-            "b",
-            "expect",
-            "tolerance",
-            "hardware",
-            "evidence",
-            "normalise",
-        ],
-    )?;
     let mut claims: Vec<Claim> = vec![];
-    for (i, rec) in reader.records().enumerate() {
-        let line = i + 2;
-        let rec = rec.with_context(|| format!("{file}: line {line}"))?;
-        let f = |j: usize| rec.get(j).unwrap_or("").trim().to_string();
+    for (line, r) in deserialize_rows::<Record>(text, file, HEADER)? {
         let err = |what: String| anyhow::anyhow!("{file}: line {line}: {what}");
-        let source = match f(2).as_str() {
-            "paper" => Source::Paper,
-            "ours" => Source::Ours,
-            s => return Err(err(format!("source {s:?} is not paper or ours"))),
-        };
-        let hardware = match f(11).as_str() {
-            "none" => Hardware::None,
-            "cpu" => Hardware::Cpu,
-            "gpu" => Hardware::Gpu,
-            s => return Err(err(format!("hardware {s:?} is not none, cpu or gpu"))),
-        };
-        let tolerance: f64 = f(10)
-            .parse()
-            .map_err(|_| err(format!("tolerance {:?} is not a number", f(10))))?;
-        if !(0.0..1.0).contains(&tolerance) {
-            return Err(err(format!("tolerance {tolerance} is not in [0, 1)")));
-        }
-        let a = VariantSpec::parse(&f(7)).map_err(err)?;
-        let b = match f(8) {
-            s if s.is_empty() => None,
-            s => Some(VariantSpec::parse(&s).map_err(err)?),
-        };
-        let expect = ExpectSpec::parse(&f(9)).map_err(err)?;
-        let evidence = Evidence::parse(&f(12)).map_err(err)?;
-        let normalise = Normalise::parse(&f(13)).map_err(err)?;
-        let ratio = f(9).replace(' ', "").starts_with("a/b");
-        let pair = is_pair_metric(&f(5));
-        if pair && (expect.needs_b() || ratio) {
-            return Err(err(format!(
-                "metric {} compares a's image with b's: expect a>N, a<N, a=N or a in LO..HI, not {:?}",
-                f(5),
-                f(9)
-            )));
-        }
-        let needs_b = expect.needs_b() || ratio || pair;
-        if needs_b != b.is_some() {
-            return Err(err(format!(
-                "expect {:?} {} a second side (column b)",
-                f(9),
-                if needs_b { "needs" } else { "takes no" }
-            )));
+        if !(0.0..1.0).contains(&r.tolerance) {
+            return Err(err(format!("tolerance {} is not in [0, 1)", r.tolerance)));
         }
         for (name, value) in [
-            ("paper", f(0)),
-            ("id", f(1)),
-            ("cites", f(3)),
-            ("claim", f(4)),
-            ("metric", f(5)),
+            ("paper", &r.paper),
+            ("id", &r.id),
+            ("cites", &r.cites),
+            ("claim", &r.claim),
         ] {
             if value.is_empty() {
                 return Err(err(format!("{name} is empty")));
             }
         }
         let claim = Claim {
-            paper: f(0),
-            id: f(1),
-            source,
-            cites: f(3),
-            text: f(4),
-            metric: f(5),
-            datasets: f(6)
-                .split(';')
-                .map(str::trim)
-                .filter(|s| !s.is_empty())
-                .map(String::from)
-                .collect(),
-            a,
-            b,
-            expect,
-            tolerance,
-            hardware,
-            expect_text: f(9),
-            evidence,
-            normalise,
+            expect: ExpectSpec::parse(&r.expect).map_err(err)?,
+            paper: r.paper,
+            id: r.id,
+            source: r.source,
+            cites: r.cites,
+            text: r.claim,
+            metric: r.metric,
+            datasets: super::rules::split_datasets(&r.datasets),
+            a: r.a,
+            b: r.b,
+            tolerance: r.tolerance,
+            hardware: r.hardware,
+            expect_text: r.expect,
+            evidence: r.evidence,
+            normalise: r.normalise,
             history: vec![],
         };
+        check_rule(&claim.rule()).map_err(err)?;
         if claims
             .iter()
             .any(|c| c.paper == claim.paper && c.id == claim.id)
@@ -511,17 +213,45 @@ pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
 pub fn all() -> anyhow::Result<Vec<Claim>> {
     let mut claims = parse(CLAIMS_CSV, FILE)?;
     attach_history(&mut claims, history()?, HISTORY_FILE)?;
+    check_counter_evidence(&claims, FILE)?;
     Ok(claims)
 }
 
+/// A claim on a counter that its renderer's description declares not measured (the bytes a
+/// data layout reserves, the triangles a draw call issues by its own arguments) cannot be
+/// `measured`: it can only be as constructed, so it never counts as a hold.
+pub fn check_counter_evidence(claims: &[Claim], file: &str) -> anyhow::Result<()> {
+    for c in claims.iter().filter(|c| c.evidence == Evidence::Measured) {
+        let Some(name) = c.metric.counter() else {
+            continue;
+        };
+        for spec in [Some(&c.a), c.b.as_ref()].into_iter().flatten() {
+            let Some(d) = crate::algorithms::describe(&spec.algorithm) else {
+                continue;
+            };
+            let e = d.evidence_of(name);
+            if e != render_core::CounterEvidence::Measured {
+                bail!(
+                    "{file}: {} {}: counter {name} of {} {} (its description), so the claim cannot be measured: write evidence construction",
+                    c.paper,
+                    c.id,
+                    spec.algorithm,
+                    e.label()
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Gives each claim its earlier rules; a change naming no claim is an error, and a derived
-/// claim must name claims that exist.
+/// claim must name claims that exist. Changes of the verdict rule itself name no claim.
 pub fn attach_history(
     claims: &mut [Claim],
     history: Vec<RuleChange>,
     file: &str,
 ) -> anyhow::Result<()> {
-    for h in history {
+    for h in history.into_iter().filter(|h| !h.is_verdict_rule()) {
         let Some(c) = claims
             .iter_mut()
             .find(|c| c.paper == h.paper && c.id == h.id)
@@ -573,35 +303,6 @@ impl ClaimResult {
     }
 }
 
-/// Where the numbers come from: the run's rows, the paper's own analyses, and why an
-/// algorithm has no rows.
-/// A side from the paper's CPU analyses for (metric, variant, data set), or `None` when the
-/// metric is not one of them.
-pub type AnalysisSide<'a> =
-    dyn Fn(&str, &VariantSpec, Option<&str>) -> Option<Result<Side, String>> + 'a;
-
-pub struct Inputs<'a> {
-    pub rows: &'a [Row],
-    /// A side from the paper's CPU analyses (`None`: the metric is not one of them).
-    pub analysis: &'a AnalysisSide<'a>,
-    /// Why `algorithm` has no value on a data set.
-    pub why_missing: &'a dyn Fn(&str, &str) -> String,
-    /// Whether the GPU numbers came from a software rasteriser.
-    pub software_adapter: bool,
-    /// Our adapter's calibrated peaks (`None`: the runs were not calibrated).
-    pub our_peaks: Option<super::hardware::OurPeaks>,
-    /// The run folder each row's image paths are relative to, by the row's index in `rows`
-    /// (`None` or missing: its images cannot be read).
-    pub row_dirs: &'a [Option<std::path::PathBuf>],
-}
-
-/// Whether rows were measured on a software rasteriser (lavapipe, WARP, SwiftShader report a
-/// CPU device type).
-pub fn software_adapter(rows: &[Row]) -> bool {
-    rows.iter()
-        .any(|r| r.device_type.eq_ignore_ascii_case("cpu"))
-}
-
 /// Evaluates every claim of `paper`.
 pub fn evaluate_all(paper: &str, inputs: &Inputs) -> Vec<ClaimResult> {
     of(paper)
@@ -624,11 +325,9 @@ pub fn evaluate(claim: &Claim, inputs: &Inputs) -> Vec<ClaimResult> {
             let earlier = claim
                 .history
                 .iter()
-                .map(|h| {
-                    (
-                        h.clone(),
-                        evaluate_one(&claim.with_rule(&h.old), d.as_deref(), inputs),
-                    )
+                .filter_map(|h| {
+                    let old = claim.with_rule(h.old.as_ref()?);
+                    Some((h.clone(), evaluate_one(&old, d.as_deref(), inputs)))
                 })
                 .collect();
             ClaimResult {
@@ -676,7 +375,7 @@ fn evaluate_one(claim: &Claim, dataset: Option<&str>, inputs: &Inputs) -> Evalua
     };
     let (a, b) = match (&claim.b, dataset) {
         // An image pair is one side: a's image against b's.
-        (Some(b), Some(d)) if is_pair_metric(&claim.metric) => {
+        (Some(b), Some(d)) if claim.metric.is_pair() => {
             (pair_side(&claim.metric, &claim.a, b, d, inputs), None)
         }
         _ => (
@@ -772,31 +471,36 @@ fn side(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::papers::sides::row_sample;
+    use crate::results::Row;
+    use render_core::Settings;
 
     #[test]
-    fn variant_specs_and_expectations_parse() {
-        let v = VariantSpec::parse("havs:k=2;sort=cpu-radix@spx2").unwrap();
-        assert_eq!(v.algorithm, "havs");
-        assert_eq!(v.settings.int("k"), Some(2));
-        assert_eq!(v.dataset.as_deref(), Some("spx2"));
-        assert_eq!(v.label(Some("spx2")), "havs k=2;sort=cpu-radix on spx2");
-        assert!(VariantSpec::parse("havs:k2").is_err());
-        assert_eq!(
-            ExpectSpec::parse("a/b in 2..2.5").unwrap(),
-            ExpectSpec::Fixed(Expect::Band(2.0, 2.5))
+    fn a_claim_on_a_layout_or_draw_call_counter_cannot_be_measured() {
+        let head = HEADER.join(",");
+        let with = |evidence: &str| {
+            parse(
+                &format!(
+                    "{head}\nraycast,R4,paper,§3.1,x,counter:mesh_bytes_per_tet,spx1,raycast:tiles=5x5,,a=144,0,none,{evidence},none\ngator,G9,paper,§3.4,x,counter_per_tet:triangles_drawn,post,gator-pt:variant=linear,,a=4,0,none,{evidence},none\nraycast,R9,paper,§3.1,x,counter:steps_max,spx1,raycast:tiles=5x5,,a=144,0,none,measured,none\n"
+                ),
+                "claims.csv",
+            )
+            .unwrap()
+        };
+        let e = check_counter_evidence(&with("measured"), "claims.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("R4") && e.contains("mesh_bytes_per_tet") && e.contains("data layout"),
+            "{e}"
         );
-        assert_eq!(
-            ExpectSpec::parse("a>15000000").unwrap(),
-            ExpectSpec::Fixed(Expect::Above(15e6))
-        );
-        assert_eq!(
-            ExpectSpec::parse("a=havs_table2.fragments_count").unwrap(),
-            ExpectSpec::PaperCell {
-                table: "havs_table2".into(),
-                column: "fragments_count".into()
-            }
-        );
-        assert!(ExpectSpec::parse("a≈b").is_err());
+        let only_g9 = with("measured").split_off(1);
+        let e = check_counter_evidence(&only_g9, "claims.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("G9") && e.contains("draw call"), "{e}");
+        // As constructed they load; a measured counter (the longest walk) stays measured.
+        check_counter_evidence(&with("construction"), "claims.csv").unwrap();
     }
 
     #[test]
@@ -811,7 +515,8 @@ mod tests {
         );
         let bad =
             format!("{head}havs,H1,maybe,§5.1,x,total_ms,spx2,havs,,a>1,0,gpu,measured,none\n");
-        assert!(parse(&bad, "c").unwrap_err().to_string().contains("source"));
+        let e = parse(&bad, "c").unwrap_err().to_string();
+        assert!(e.contains("source") && e.contains("line 2"), "{e}");
         let bad =
             format!("{head}havs,H1,paper,§5.1,x,total_ms,spx2,havs,,a>1,0,gpu,guessed,none\n");
         assert!(parse(&bad, "c")
@@ -832,7 +537,10 @@ mod tests {
         let e = attach_history(&mut c, vec![], "h").unwrap_err().to_string();
         assert!(e.contains("derived from H9"), "{e}");
         let h = parse_history(
-            "paper,id,date,commit,reason,old_expect,old_tolerance,old_normalise\nhavs,H2,2026-12-04,abc,why,a>2,0,none\n",
+            &format!(
+                "{}\nhavs,H2,2026-12-04,abc,why,,total_ms,,havs,,a>2,0,measured,none\n",
+                crate::papers::rules::HISTORY_HEADER.join(",")
+            ),
             "h.csv",
         )
         .unwrap();
@@ -843,6 +551,22 @@ mod tests {
         .unwrap();
         let e = attach_history(&mut c, h, "h.csv").unwrap_err().to_string();
         assert!(e.contains("havs H2 is not a claim"), "{e}");
+        // A metric outside the language fails the load, naming the file, the line and the
+        // column; the same line with a known metric loads.
+        let metric = |m: &str| {
+            format!(
+                "{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none\nhavs,H2,paper,§5.1,x,{m},,havs,,a>1,0,gpu,measured,none\n"
+            )
+        };
+        let e = parse(&metric("stage_shar:sort"), "claims.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("claims.csv: line 3: metric \"stage_shar:sort\" is not one of"),
+            "{e}"
+        );
+        let ok = parse(&metric("stage_share:sort"), "claims.csv").unwrap();
+        assert_eq!(ok[1].metric, Metric::StageShare("sort".into()));
     }
 
     fn row(settings: &str, viewpoint: &str, total: f64, frames: u32) -> Row {
@@ -880,10 +604,10 @@ mod tests {
             row("tiles=1x1;table=2d;mode=passes", "+x", 200.0, 5),
         ];
         let loose = VariantSpec::parse("raycast:tiles=5x5").unwrap();
-        let e = side_from_rows("total_ms", &loose, "spx1", &inputs(&rows)).unwrap_err();
+        let e = side_from_rows(&Metric::TotalMs, &loose, "spx1", &inputs(&rows)).unwrap_err();
         assert!(e.contains("2 variants match"), "{e}");
         let pinned = VariantSpec::parse("raycast:tiles=5x5;mode=passes").unwrap();
-        let s = side_from_rows("total_ms", &pinned, "spx1", &inputs(&rows)).unwrap();
+        let s = side_from_rows(&Metric::TotalMs, &pinned, "spx1", &inputs(&rows)).unwrap();
         assert!(s.label.contains("mode=passes"), "{}", s.label);
         assert_eq!(s.centre(), 100.0);
         // Pinned to the loop variant the ordering flips.
@@ -893,7 +617,7 @@ mod tests {
             source: Source::Ours,
             cites: "§4".into(),
             text: "t".into(),
-            metric: "total_ms".into(),
+            metric: Metric::TotalMs,
             datasets: vec!["spx1".into()],
             a: VariantSpec::parse(a).unwrap(),
             b: Some(VariantSpec::parse("raycast:tiles=1x1").unwrap()),
@@ -917,13 +641,18 @@ mod tests {
     #[test]
     fn rates_invert_the_frame_range_and_stage_shares_name_missing_stages() {
         let mut r = row("tiles=1x1", "+x", 100.0, 3);
-        let fps = row_sample("fps", &r).unwrap();
+        let fps = row_sample(&Metric::Fps, &r).unwrap();
         assert_eq!(fps.value, 10.0);
         assert!(fps.min < 10.0 && fps.max > 10.0);
         r.stages = "wait=9;buckets=3;splat=1".into();
-        let e = row_sample("stage_share:sort", &r).unwrap_err();
+        let e = row_sample(&Metric::StageShare("sort".into()), &r).unwrap_err();
         assert!(e.contains("wait, buckets, splat"), "{e}");
-        assert_eq!(row_sample("stage_share:wait", &r).unwrap().value, 3.0);
-        assert!(row_sample("no-such-metric", &r).is_err());
+        assert_eq!(
+            row_sample(&Metric::StageShare("wait".into()), &r)
+                .unwrap()
+                .value,
+            3.0
+        );
+        assert!(row_sample(&Metric::PairPsnrDb, &r).is_err());
     }
 }

@@ -5,8 +5,9 @@
 //! of H1 and H2. The counts and image claims have their own flip tests (`claims_tests.rs`,
 //! `sides.rs`); the normalised rates H7 and F1 are re-judged from the H200's rows there.
 
-use crate::papers::claims::{self, Claim, Evidence, ExpectSpec, Normalise, VariantSpec};
+use crate::papers::claims::{self, Claim, ExpectSpec, Metric, VariantSpec};
 use crate::papers::evidence::{evaluate_claims, no_analyses};
+use crate::papers::rules::{Evidence, Normalise};
 use crate::papers::session::{Extra, Measured};
 use crate::papers::verdict::{Expect, Verdict};
 use crate::results::Row;
@@ -14,11 +15,11 @@ use crate::results::Row;
 const TETS: u64 = 100_000;
 
 /// The frame time (ms) that gives `metric` the value `v` on a row of [`TETS`] tets.
-fn time_for(metric: &str, v: f64) -> Option<f64> {
+fn time_for(metric: &Metric, v: f64) -> Option<f64> {
     match metric {
-        "total_ms" | "gpu_ms" | "cpu_ms" => Some(v),
-        "fps" => Some(1e3 / v),
-        "tets_per_sec" | "gpu_tets_per_sec" => Some(TETS as f64 * 1e3 / v),
+        Metric::TotalMs | Metric::GpuMs | Metric::CpuMs => Some(v),
+        Metric::Fps => Some(1e3 / v),
+        Metric::TetsPerSec | Metric::GpuTetsPerSec => Some(TETS as f64 * 1e3 / v),
         _ => None,
     }
 }

@@ -2,7 +2,8 @@
 //! ([`tally`]), the claims by construction and derived ones apart ([`tally_apart`]), and the
 //! Markdown table of every verdict ([`markdown`]).
 
-use super::claims::{ClaimResult, Evidence, RuleChange, Source};
+use super::claims::{ClaimResult, Source};
+use super::rules::{Evidence, RuleChange};
 use super::verdict;
 
 /// Counts of each verdict of the measured claims, in [`verdict::Verdict::ALL`]'s order:
@@ -66,18 +67,23 @@ pub fn markdown(results: &[ClaimResult]) -> String {
         let mut rule = c.rule().describe();
         let mut verdict = r.word().to_string();
         for (h, e) in &r.earlier {
+            let Some(old) = &h.old else { continue };
             let _ = write!(
                 rule,
-                "; until {} ({}): {}",
+                "; until {} ({}{}): {}",
                 h.date,
                 h.commit,
-                h.old.describe()
+                h.old_id
+                    .as_ref()
+                    .map_or(String::new(), |id| format!(", as {id}")),
+                old.describe_against(&c.rule())
             );
+            // The earlier verdict in the word of the earlier rule's evidence kind.
             let _ = write!(
                 verdict,
                 "; by the rule before {}: {}",
                 h.commit,
-                c.evidence.word(e.verdict)
+                old.evidence.word(e.verdict)
             );
         }
         let _ = writeln!(
@@ -101,17 +107,29 @@ pub fn markdown(results: &[ClaimResult]) -> String {
         }
         v
     };
-    if !changes.is_empty() {
+    let verdict_rule = super::rules::verdict_rule_changes();
+    if !changes.is_empty() || !verdict_rule.is_empty() {
         md.push_str("\nRule history (`reports/papers/rule_history.csv`):\n\n");
-        for h in changes {
+        for h in verdict_rule {
             let _ = writeln!(
                 md,
-                "- {} {}: until {} (commit {}) the rule was {}. Why it changed: {}",
+                "- Every claim: the verdict rule changed on {} (commit {}): {}",
+                h.date, h.commit, h.reason
+            );
+        }
+        for h in changes {
+            let Some(old) = &h.old else { continue };
+            let _ = writeln!(
+                md,
+                "- {} {}: until {} (commit {}) the rule was {}{}. Why it changed: {}",
                 h.paper,
                 h.id,
                 h.date,
                 h.commit,
-                h.old.describe(),
+                old.describe(),
+                h.old_id
+                    .as_ref()
+                    .map_or(String::new(), |id| format!(" (as {id})")),
                 h.reason
             );
         }

@@ -3,11 +3,11 @@
 //! this file names no paper).
 
 use super::session::{Extra, Measured};
-use crate::papers::claims::{self, AnalysisSide, ClaimResult, VariantSpec};
+use crate::papers::claims::{self, AnalysisSide, ClaimResult, Metric, VariantSpec};
 use crate::papers::verdict::{Sample, Side};
 
 /// For papers without CPU analyses of their own.
-pub fn no_analyses(_: &str, _: &VariantSpec, _: Option<&str>) -> Option<Result<Side, String>> {
+pub fn no_analyses(_: &Metric, _: &VariantSpec, _: Option<&str>) -> Option<Result<Side, String>> {
     None
 }
 
@@ -24,7 +24,7 @@ pub fn evaluate_claims(
     x: &Extra,
     own: &AnalysisSide,
 ) -> Vec<ClaimResult> {
-    let analysis = |metric: &str, spec: &VariantSpec, d: Option<&str>| {
+    let analysis = |metric: &Metric, spec: &VariantSpec, d: Option<&str>| {
         own(metric, spec, d).or_else(|| analysis_side(x, metric, spec, d))
     };
     let why = |a: &str, d: &str| m.why(a, d);
@@ -47,7 +47,7 @@ pub fn evaluate_claims(
 /// A claim's side from the data set sizes (`None`: not one; the rows answer).
 fn analysis_side(
     x: &Extra,
-    metric: &str,
+    metric: &Metric,
     spec: &VariantSpec,
     dataset: Option<&str>,
 ) -> Option<Result<Side, String>> {
@@ -65,7 +65,7 @@ fn analysis_side(
                 .iter()
                 .find(|(n, _, _)| *n == d)
                 .ok_or_else(|| format!("data set {d}: not loaded"))?;
-            match metric {
+            match metric.analysis_name().unwrap_or_default() {
                 "dataset_tets" => exact(format!("{d} as loaded, tets"), &d, *tets as f64),
                 // The split's own count: what we load plus the zero-volume tets we drop.
                 "dataset_tets_split" => {

@@ -19,8 +19,10 @@ pub mod evidence;
 pub mod from_run;
 pub mod hardware;
 pub mod reproduce;
+pub mod rules;
 pub mod session;
 pub mod sides;
+pub mod spec;
 pub mod table;
 pub mod transcription;
 pub mod verdict;
@@ -95,4 +97,8 @@ pub struct Paper {
 #[cfg(test)]
 mod claims_flip_tests;
 #[cfg(test)]
+mod claims_paper_figure_tests;
+#[cfg(test)]
 mod claims_tests;
+#[cfg(test)]
+mod rule_history_tests;

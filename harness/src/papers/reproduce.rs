@@ -17,7 +17,8 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 
-use super::claims::{self, ClaimResult};
+use super::claims::ClaimResult;
+use super::claims_report;
 pub use super::session::SourceState;
 use super::session::{
     not_built_reason, Measured, Report, Session, FULL_FRAMES, FULL_WARMUP, QUICK_FRAMES,
@@ -280,7 +281,7 @@ fn our_conditions(machine: Option<&MachineInfo>) -> String {
 
 /// Counts of each verdict of the measured claims, as one line (the headline).
 pub fn tally_text(results: &[ClaimResult]) -> String {
-    let parts: Vec<String> = claims::tally(results)
+    let parts: Vec<String> = claims_report::tally(results)
         .into_iter()
         .filter(|(_, n)| *n > 0)
         .map(|(v, n)| format!("{n} {}", v.label()))
@@ -294,7 +295,7 @@ pub fn tally_text(results: &[ClaimResult]) -> String {
 
 /// Counts of the claims that are not measured, by kind, as one line (`–` when none).
 pub fn tally_apart_text(results: &[ClaimResult]) -> String {
-    let parts: Vec<String> = claims::tally_apart(results)
+    let parts: Vec<String> = claims_report::tally_apart(results)
         .into_iter()
         .map(|(kind, words)| {
             let w: Vec<String> = words.iter().map(|(w, n)| format!("{n} {w}")).collect();
@@ -367,7 +368,7 @@ pub(crate) fn write_report(
             tally_text(&report.claims),
             tally_apart_text(&report.claims)
         );
-        md.push_str(&claims::markdown(&report.claims));
+        md.push_str(&claims_report::markdown(&report.claims));
         md.push('\n');
     }
     let _ = writeln!(md, "## Tables\n");

@@ -7,21 +7,38 @@ use std::path::Path;
 
 use render_core::Settings;
 
-use super::claims::{Inputs, VariantSpec};
+use super::spec::{Metric, VariantSpec};
 use super::verdict::{Sample, Side};
 use crate::results::metrics::{compare, ImageError};
 use crate::results::Row;
 
-/// PSNR (dB) of side `a`'s image against side `b`'s, the lowest over the viewpoints.
-pub const PAIR_PSNR_DB: &str = "pair_psnr_db";
-/// Share of covered pixels of `a` off by more than one 8-bit step from `b`, the largest over
-/// the viewpoints.
-pub const PAIR_BAD_PIXEL_SHARE: &str = "pair_bad_pixel_share";
+/// A side from the paper's CPU analyses for (metric, variant, data set), or `None` when the
+/// metric is not one of them.
+pub type AnalysisSide<'a> =
+    dyn Fn(&Metric, &VariantSpec, Option<&str>) -> Option<Result<Side, String>> + 'a;
 
-/// Whether a metric compares the images of the claim's two sides (its `b` is then the image
-/// compared with, not a second value).
-pub fn is_pair_metric(metric: &str) -> bool {
-    metric == PAIR_PSNR_DB || metric == PAIR_BAD_PIXEL_SHARE
+/// Where a claim's numbers come from: the run's rows, the paper's own analyses, and why an
+/// algorithm has no rows.
+pub struct Inputs<'a> {
+    pub rows: &'a [Row],
+    /// A side from the paper's CPU analyses (`None`: the metric is not one of them).
+    pub analysis: &'a AnalysisSide<'a>,
+    /// Why `algorithm` has no value on a data set.
+    pub why_missing: &'a dyn Fn(&str, &str) -> String,
+    /// Whether the GPU numbers came from a software rasteriser.
+    pub software_adapter: bool,
+    /// Our adapter's calibrated peaks (`None`: the runs were not calibrated).
+    pub our_peaks: Option<super::hardware::OurPeaks>,
+    /// The run folder each row's image paths are relative to, by the row's index in `rows`
+    /// (`None` or missing: its images cannot be read).
+    pub row_dirs: &'a [Option<std::path::PathBuf>],
+}
+
+/// Whether rows were measured on a software rasteriser (lavapipe, WARP, SwiftShader report a
+/// CPU device type).
+pub fn software_adapter(rows: &[Row]) -> bool {
+    rows.iter()
+        .any(|r| r.device_type.eq_ignore_ascii_case("cpu"))
 }
 
 /// The label naming one variant, and its rows with their indices in `inputs.rows`.
@@ -92,12 +109,12 @@ fn row_image(inputs: &Inputs, i: usize, row: &Row) -> Result<render_core::Image,
     crate::results::samples::read_f32_image(&path).map_err(|e| format!("{}: {e:#}", path.display()))
 }
 
-/// A side from two variants' images (`metric` is [`PAIR_PSNR_DB`] or
-/// [`PAIR_BAD_PIXEL_SHARE`]): for every viewpoint `a` was rendered at, its image against `b`'s
+/// A side from two variants' images (`metric` is [`Metric::PairPsnrDb`] or
+/// [`Metric::PairBadPixelShare`]): for every viewpoint `a` was rendered at, its image against `b`'s
 /// at the same viewpoint and viewport; the worst viewpoint is the side's one value (lowest PSNR,
 /// largest bad-pixel share), every viewpoint's figures are in the label.
 pub fn pair_side(
-    metric: &str,
+    metric: &Metric,
     a: &VariantSpec,
     b: &VariantSpec,
     dataset: &str,
@@ -120,7 +137,7 @@ pub fn pair_side(
             .map_err(|e| format!("{a_label} against {b_label} at {}: {e:#}", ra.viewpoint))?;
         views.push((ra.viewpoint.clone(), e));
     }
-    let worst_psnr = metric == PAIR_PSNR_DB;
+    let worst_psnr = *metric == Metric::PairPsnrDb;
     let value = |e: &ImageError| {
         if worst_psnr {
             e.psnr_db
@@ -163,17 +180,19 @@ pub fn pair_side(
 /// A side from a run's rows: exactly one variant must match the spec (a claim that does not
 /// pin its variant is refused, never decided by whichever variant came first).
 pub fn side_from_rows(
-    metric: &str,
+    metric: &Metric,
     spec: &VariantSpec,
     dataset: &str,
     inputs: &Inputs,
 ) -> Result<Side, String> {
     let (label, indexed) = one_variant(spec, dataset, inputs)?;
     let rows: Vec<&Row> = indexed.into_iter().map(|(_, r)| r).collect();
-    for (prefix, largest) in [("view_max:", true), ("view_min:", false)] {
-        let Some(inner) = metric.strip_prefix(prefix) else {
-            continue;
-        };
+    let (inner, largest) = match metric {
+        Metric::ViewMax(inner) => (Some(inner), true),
+        Metric::ViewMin(inner) => (Some(inner), false),
+        _ => (None, false),
+    };
+    if let Some(inner) = inner {
         let values: Vec<(String, f64)> = rows
             .iter()
             .filter_map(|r| Some((r.viewpoint.clone(), row_sample(inner, r).ok()?.value)))
@@ -194,7 +213,7 @@ pub fn side_from_rows(
             vec![Sample::exact(view, v)],
         ));
     }
-    if let Some(inner) = metric.strip_prefix("view_range:") {
+    if let Metric::ViewRange(inner) = metric {
         let values: Vec<f64> = rows
             .iter()
             .filter_map(|r| row_sample(inner, r).ok().map(|s| s.value))
@@ -211,12 +230,22 @@ pub fn side_from_rows(
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
                 (l.min(v), h.max(v))
             });
+        // A spread of timings keeps the fewest frames behind them: too few decide nothing.
+        let frames = rows
+            .iter()
+            .filter_map(|r| row_sample(inner, r).ok())
+            .map(|s| s.frames)
+            .min()
+            .unwrap_or(0);
         return Ok(Side::new(
             format!(
                 "{label}, {inner} range/mean over {} viewpoints",
                 values.len()
             ),
-            vec![Sample::exact("views", (hi - lo) / mean)],
+            vec![Sample {
+                frames,
+                ..Sample::exact("views", (hi - lo) / mean)
+            }],
         ));
     }
     let mut samples = vec![];
@@ -239,7 +268,7 @@ pub fn side_from_rows(
 }
 
 /// One row's value of a metric, with its frames' range where the row has one.
-pub fn row_sample(metric: &str, r: &Row) -> Result<Sample, String> {
+pub fn row_sample(metric: &Metric, r: &Row) -> Result<Sample, String> {
     let key = r.viewpoint.clone();
     let timed = |v: Option<f64>, lo: Option<f64>, hi: Option<f64>| -> Result<Sample, String> {
         let v = v.ok_or_else(|| format!("no {metric} in its rows"))?;
@@ -262,54 +291,40 @@ pub fn row_sample(metric: &str, r: &Row) -> Result<Sample, String> {
         v.map(|v| Sample::exact(key.clone(), v))
             .ok_or_else(|| format!("no {metric} in its rows"))
     };
+    let total = || timed(r.total_ms, r.total_ms_min, r.total_ms_max);
+    let gpu = || timed(r.gpu_ms, r.gpu_ms_min, r.gpu_ms_max);
     match metric {
-        "total_ms" => timed(r.total_ms, r.total_ms_min, r.total_ms_max),
-        "gpu_ms" => timed(r.gpu_ms, r.gpu_ms_min, r.gpu_ms_max),
-        "cpu_ms" => timed(r.cpu_ms, r.cpu_ms_min, r.cpu_ms_max),
-        "fps" => Ok(rate(
-            1e3,
-            timed(r.total_ms, r.total_ms_min, r.total_ms_max)?,
-        )),
-        "tets_per_sec" => Ok(rate(
-            r.tets as f64 * 1e3,
-            timed(r.total_ms, r.total_ms_min, r.total_ms_max)?,
-        )),
-        "gpu_tets_per_sec" => Ok(rate(
-            r.tets as f64 * 1e3,
-            timed(r.gpu_ms, r.gpu_ms_min, r.gpu_ms_max)?,
-        )),
-        "bytes_per_tet" => exact(r.bytes_per_tet),
-        // Every device byte the row's renderer allocated (persistent and per frame).
-        "gpu_bytes" => exact(r.gpu_bytes.map(|b| b as f64)),
-        "psnr_db" => exact(r.psnr_db),
-        _ => {
-            if let Some(name) = metric.strip_prefix("counter:") {
-                return exact(r.counter(name));
+        Metric::TotalMs => total(),
+        Metric::GpuMs => gpu(),
+        Metric::CpuMs => timed(r.cpu_ms, r.cpu_ms_min, r.cpu_ms_max),
+        Metric::Fps => Ok(rate(1e3, total()?)),
+        Metric::TetsPerSec => Ok(rate(r.tets as f64 * 1e3, total()?)),
+        Metric::GpuTetsPerSec => Ok(rate(r.tets as f64 * 1e3, gpu()?)),
+        Metric::BytesPerTet => exact(r.bytes_per_tet),
+        Metric::GpuBytes => exact(r.gpu_bytes.map(|b| b as f64)),
+        Metric::PsnrDb => exact(r.psnr_db),
+        Metric::Counter(name) => exact(r.counter(name)),
+        Metric::CounterPerTet(name) => {
+            if r.tets == 0 {
+                return Err(format!("{metric}: the row has no tets"));
             }
-            if let Some(name) = metric.strip_prefix("counter_per_tet:") {
-                if r.tets == 0 {
-                    return Err(format!("{metric}: the row has no tets"));
-                }
-                return exact(r.counter(name).map(|v| v / r.tets as f64));
-            }
-            if let Some(name) = metric.strip_prefix("stage:") {
-                return timed(r.stage_ms(name), None, None).map_err(|_| no_stage(name, r));
-            }
-            if let Some(name) = metric.strip_prefix("stage_share:") {
-                let this = r.stage_ms(name).ok_or_else(|| no_stage(name, r))?;
-                let other = r
-                    .stages
-                    .iter()
-                    .filter(|(k, _)| *k != name)
-                    .map(|(_, v)| v)
-                    .fold(0.0f64, f64::max);
-                if other <= 0.0 {
-                    return Err(format!("no stage besides {name} in its rows"));
-                }
-                return timed(Some(this / other), None, None);
-            }
-            Err(format!("unknown metric {metric:?}"))
+            exact(r.counter(name).map(|v| v / r.tets as f64))
         }
+        Metric::Stage(name) => timed(r.stage_ms(name), None, None).map_err(|_| no_stage(name, r)),
+        Metric::StageShare(name) => {
+            let this = r.stage_ms(name).ok_or_else(|| no_stage(name, r))?;
+            let other = r
+                .stages
+                .iter()
+                .filter(|(k, _)| *k != name)
+                .map(|(_, v)| v)
+                .fold(0.0f64, f64::max);
+            if other <= 0.0 {
+                return Err(format!("no stage besides {name} in its rows"));
+            }
+            timed(Some(this / other), None, None)
+        }
+        _ => Err(format!("{metric} is not a figure of one row")),
     }
 }
 
@@ -414,7 +429,7 @@ mod tests {
         let all: Vec<Claim> = claims::all()
             .unwrap()
             .into_iter()
-            .filter(|c| super::is_pair_metric(&c.metric))
+            .filter(|c| c.metric.is_pair())
             .collect();
         assert!(all.len() >= 6, "{} image-quality claims", all.len());
         all

@@ -145,6 +145,43 @@ pub fn reader_with_header<'t>(
     Ok(reader)
 }
 
+/// The records of a CSV file with the header `expected`, each deserialised into `T` with its
+/// line; an error names the file, the line, the column and what is wrong. Fields are trimmed.
+pub fn deserialize_rows<T: serde::de::DeserializeOwned>(
+    text: &str,
+    file: &str,
+    expected: &[&str],
+) -> anyhow::Result<Vec<(u64, T)>> {
+    reader_with_header(text, file, expected)?;
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let headers = reader.headers()?.clone();
+    let mut out = vec![];
+    for rec in reader.records() {
+        let rec = rec.with_context(|| format!("{file}: a record"))?;
+        let line = rec.position().map_or(0, |p| p.line());
+        match rec.deserialize::<T>(Some(&headers)) {
+            Ok(t) => out.push((line, t)),
+            Err(e) => {
+                let what = match e.kind() {
+                    csv::ErrorKind::Deserialize { err, .. } => {
+                        let column = err
+                            .field()
+                            .and_then(|i| expected.get(i as usize))
+                            .map_or(String::new(), |c| format!("column {c}: "));
+                        format!("{column}{}", err.kind())
+                    }
+                    _ => e.to_string(),
+                };
+                return Err(anyhow!("{file}: line {line}: {what}"));
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// The paper's row name of a registry data set in the tables of `paper` (`havs`, `gator`,
 /// `fragment-pt`, `raycast`), where the paper names it differently.
 pub fn paper_name(paper: &str, dataset: &str) -> Option<&'static str> {

@@ -1,10 +1,11 @@
 //! The one rule that turns measured numbers into a verdict on a paper's claim.
 //!
-//! Five verdicts, nothing else: *holds*, *does not hold*, *within noise* (the difference lies
-//! inside the samples' spread or the claim's tolerance; a side measured with one frame per
-//! viewpoint has no spread, so it never decides an ordering or a ratio), *not testable on this
-//! adapter* (a claim about GPU speed measured on a software rasteriser: the numbers are shown,
-//! the verdict is withheld) and *not checkable* (a side is missing, with why). Every
+//! Six verdicts, nothing else: *holds*, *does not hold*, *within noise* (the difference lies
+//! inside the samples' spread or the claim's tolerance), *too few frames* (a timed side has
+//! fewer than [`MIN_FRAMES`] frames behind a sample: its spread is not known well enough to
+//! decide anything, an ordering, a ratio or a threshold), *not testable on this adapter* (a
+//! claim about GPU speed measured on a software rasteriser: the numbers are shown, the verdict
+//! is withheld) and *not checkable* (a side is missing, with why). Every
 //! [`Evaluation`] carries the numbers it used and the variants (algorithm and settings) of each
 //! side, so a reader can redo it.
 
@@ -16,9 +17,14 @@ pub enum Verdict {
     Holds,
     DoesNotHold,
     WithinNoise,
+    TooFewFrames,
     NotTestableOnThisAdapter,
     NotCheckable,
 }
+
+/// The frames a timed sample needs before a verdict rests on it: a timing or threshold claim
+/// decides only with at least this many frames a side, and a margin beyond their spread.
+pub const MIN_FRAMES: u32 = 5;
 
 impl Verdict {
     pub fn label(self) -> &'static str {
@@ -26,23 +32,26 @@ impl Verdict {
             Verdict::Holds => "holds",
             Verdict::DoesNotHold => "does not hold",
             Verdict::WithinNoise => "within noise",
+            Verdict::TooFewFrames => "too few frames",
             Verdict::NotTestableOnThisAdapter => "not testable on this adapter",
             Verdict::NotCheckable => "not checkable",
         }
     }
 
     /// Every verdict, in the order reports count them.
-    pub const ALL: [Verdict; 5] = [
+    pub const ALL: [Verdict; 6] = [
         Verdict::Holds,
         Verdict::DoesNotHold,
         Verdict::WithinNoise,
+        Verdict::TooFewFrames,
         Verdict::NotTestableOnThisAdapter,
         Verdict::NotCheckable,
     ];
 }
 
 /// What a claim's verdict depends on besides the method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(try_from = "String")]
 pub enum Hardware {
     /// Geometry and counts: the same on every machine.
     None,
@@ -51,6 +60,18 @@ pub enum Hardware {
     /// GPU hardware: its speed, or what its concurrency does (HAVS's fragment race):
     /// meaningless on a software rasteriser.
     Gpu,
+}
+
+impl TryFrom<String> for Hardware {
+    type Error = String;
+    fn try_from(s: String) -> Result<Hardware, String> {
+        match s.as_str() {
+            "none" => Ok(Hardware::None),
+            "cpu" => Ok(Hardware::Cpu),
+            "gpu" => Ok(Hardware::Gpu),
+            s => Err(format!("hardware {s:?} is not none, cpu or gpu")),
+        }
+    }
 }
 
 /// One measurement of one side: a viewpoint's (or one run's) median and its frames' range.
@@ -104,9 +125,14 @@ impl Side {
         self.samples.iter().map(|s| s.max - s.min).sum::<f64>() / self.samples.len().max(1) as f64
     }
 
-    /// Whether every sample is a single timed frame (no spread is known).
-    pub fn single_frame(&self) -> bool {
-        self.samples.iter().all(|s| s.frames == 1)
+    /// The fewest frames behind a timed sample (`None`: no sample is timed; counts and sizes
+    /// have no frames).
+    pub fn fewest_frames(&self) -> Option<u32> {
+        self.samples
+            .iter()
+            .filter(|s| s.frames > 0)
+            .map(|s| s.frames)
+            .min()
     }
 
     fn describe(&self) -> String {
@@ -226,7 +252,18 @@ fn decide(check: &Check, a: &Side, b: Option<&Side>) -> (Verdict, String) {
     if let Some(b) = b {
         let _ = write!(text, " vs {}", b.describe());
     }
-    let one_frame = a.single_frame() || b.is_some_and(Side::single_frame);
+    let fewest = [Some(a), b]
+        .into_iter()
+        .flatten()
+        .filter_map(Side::fewest_frames)
+        .min();
+    if let Some(n) = fewest.filter(|n| *n < MIN_FRAMES) {
+        let _ = write!(
+            text,
+            "; {n} frame(s) behind a sample: a timing decides on at least {MIN_FRAMES} frames a side"
+        );
+        return (Verdict::TooFewFrames, text);
+    }
     match (check.expect, b) {
         (Expect::Less | Expect::Greater, Some(b)) => {
             let want_less = check.expect == Expect::Less;
@@ -240,10 +277,6 @@ fn decide(check: &Check, a: &Side, b: Option<&Side>) -> (Verdict, String) {
                 fmt(noise),
                 fmt(tol * scale)
             );
-            if one_frame {
-                text.push_str("; one frame per side cannot order them");
-                return (Verdict::WithinNoise, text);
-            }
             if diff.abs() <= noise || diff.abs() <= tol * scale {
                 return (Verdict::WithinNoise, text);
             }
@@ -296,10 +329,6 @@ fn decide(check: &Check, a: &Side, b: Option<&Side>) -> (Verdict, String) {
                 fmt(lo),
                 fmt(hi)
             );
-            if b.is_some() && one_frame {
-                text.push_str("; one frame per side cannot decide a ratio");
-                return (Verdict::WithinNoise, text);
-            }
             if r_lo >= lo && r_hi <= hi {
                 (Verdict::Holds, text)
             } else if r_hi < lo || r_lo > hi {
@@ -390,22 +419,43 @@ mod tests {
     }
 
     #[test]
-    fn one_frame_per_side_never_decides_an_ordering() {
+    fn fewer_than_five_frames_a_side_decide_nothing() {
         let c = check(Expect::Less, 0.0, Hardware::Cpu);
         let a = side("a", &[(100.0, 100.0, 100.0)], 1);
         let b = side("b", &[(200.0, 200.0, 200.0)], 1);
         let e = evaluate(&c, Ok(&a), Some(Ok(&b)), false);
-        assert_eq!(e.verdict, Verdict::WithinNoise);
-        assert!(e.numbers.contains("one frame"), "{}", e.numbers);
+        assert_eq!(e.verdict, Verdict::TooFewFrames);
+        assert!(e.numbers.contains("at least 5 frames"), "{}", e.numbers);
         assert_eq!(e.variants, vec!["a".to_string(), "b".to_string()]);
-        // Two frames each, the same medians and no spread: decided.
-        let a2 = side("a", &[(100.0, 99.0, 101.0)], 2);
-        let b2 = side("b", &[(200.0, 199.0, 201.0)], 2);
-        assert_eq!(verdict(&c, &a2, Some(&b2), false), Verdict::Holds);
+        // Four frames a side: still too few; five: decided, the same numbers.
+        let (a4, b4) = (
+            side("a", &[(100.0, 99.0, 101.0)], 4),
+            side("b", &[(200.0, 199.0, 201.0)], 4),
+        );
+        assert_eq!(verdict(&c, &a4, Some(&b4), false), Verdict::TooFewFrames);
+        let (a5, b5) = (
+            side("a", &[(100.0, 99.0, 101.0)], 5),
+            side("b", &[(200.0, 199.0, 201.0)], 5),
+        );
+        assert_eq!(verdict(&c, &a5, Some(&b5), false), Verdict::Holds);
+        // One side short is enough to withhold it.
+        assert_eq!(verdict(&c, &a5, Some(&b4), false), Verdict::TooFewFrames);
         // A ratio band is no different.
         let band = check(Expect::Band(1.5, 2.5), 0.0, Hardware::Cpu);
-        assert_eq!(verdict(&band, &b, Some(&a), false), Verdict::WithinNoise);
-        assert_eq!(verdict(&band, &b2, Some(&a2), false), Verdict::Holds);
+        assert_eq!(verdict(&band, &b, Some(&a), false), Verdict::TooFewFrames);
+        assert_eq!(verdict(&band, &b5, Some(&a5), false), Verdict::Holds);
+        // A threshold on one frame decided with zero margin before; now it waits for five
+        // frames and then needs a margin beyond their spread.
+        let above = check(Expect::Above(100.0), 0.0, Hardware::Cpu);
+        let one = side("a", &[(101.0, 101.0, 101.0)], 1);
+        assert_eq!(verdict(&above, &one, None, false), Verdict::TooFewFrames);
+        let close = side("a", &[(101.0, 99.0, 103.0)], 5);
+        assert_eq!(verdict(&above, &close, None, false), Verdict::WithinNoise);
+        let clear = side("a", &[(110.0, 109.0, 111.0)], 5);
+        assert_eq!(verdict(&above, &clear, None, false), Verdict::Holds);
+        // Counts and sizes have no frames: decided as before.
+        let count = Side::new("bytes", vec![Sample::exact("x", 101.0)]);
+        assert_eq!(verdict(&above, &count, None, false), Verdict::Holds);
     }
 
     #[test]
@@ -440,8 +490,8 @@ mod tests {
 
     #[test]
     fn gpu_claims_on_a_software_adapter_are_not_testable_but_show_their_numbers() {
-        let a = side("a", &[(100.0, 99.0, 101.0)], 3);
-        let b = side("b", &[(200.0, 199.0, 201.0)], 3);
+        let a = side("a", &[(100.0, 99.0, 101.0)], 5);
+        let b = side("b", &[(200.0, 199.0, 201.0)], 5);
         let gpu = check(Expect::Less, 0.0, Hardware::Gpu);
         let e = evaluate(&gpu, Ok(&a), Some(Ok(&b)), true);
         assert_eq!(e.verdict, Verdict::NotTestableOnThisAdapter);
@@ -454,7 +504,7 @@ mod tests {
 
     #[test]
     fn missing_sides_are_not_checkable_with_why() {
-        let a = side("a", &[(1.0, 1.0, 1.0)], 3);
+        let a = side("a", &[(1.0, 1.0, 1.0)], 5);
         let c = check(Expect::Less, 0.0, Hardware::None);
         let e = evaluate(&c, Ok(&a), Some(Err("raycast not measured".into())), false);
         assert_eq!(e.verdict, Verdict::NotCheckable);
@@ -467,10 +517,10 @@ mod tests {
     #[test]
     fn a_band_straddled_by_the_spread_is_noise() {
         let band = check(Expect::Band(2.0, 2.5), 0.0, Hardware::Cpu);
-        let cpu = side("cpu", &[(10.0, 9.9, 10.1)], 3);
-        let inside = side("gpu", &[(22.0, 21.9, 22.1)], 3);
-        let straddling = side("gpu", &[(20.5, 19.0, 22.0)], 3);
-        let outside = side("gpu", &[(40.0, 39.9, 40.1)], 3);
+        let cpu = side("cpu", &[(10.0, 9.9, 10.1)], 5);
+        let inside = side("gpu", &[(22.0, 21.9, 22.1)], 5);
+        let straddling = side("gpu", &[(20.5, 19.0, 22.0)], 5);
+        let outside = side("gpu", &[(40.0, 39.9, 40.1)], 5);
         assert_eq!(verdict(&band, &inside, Some(&cpu), false), Verdict::Holds);
         assert_eq!(
             verdict(&band, &straddling, Some(&cpu), false),

@@ -50,6 +50,7 @@ pub static PT: AlgorithmDescription = AlgorithmDescription {
     nondeterministic_counters: render_core::description::all_counters_exact,
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: render_core::gpu_layout::GpuLayouts::none,
+    counter_evidence: &[],
 };
 
 pub static RAYCAST: AlgorithmDescription = AlgorithmDescription {
@@ -97,6 +98,7 @@ pub static RAYCAST: AlgorithmDescription = AlgorithmDescription {
     nondeterministic_counters: render_core::description::all_counters_exact,
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: render_core::gpu_layout::GpuLayouts::none,
+    counter_evidence: &[],
 };
 
 pub static ZSWEEP: AlgorithmDescription = AlgorithmDescription {
@@ -128,6 +130,7 @@ pub static ZSWEEP: AlgorithmDescription = AlgorithmDescription {
     nondeterministic_counters: render_core::description::all_counters_exact,
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: render_core::gpu_layout::GpuLayouts::none,
+    counter_evidence: &[],
 };
 
 pub(crate) fn settings_of(

@@ -72,6 +72,29 @@ impl Shading {
     }
 }
 
+/// Where a counter's value comes from, when it is not measured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CounterEvidence {
+    /// An outcome of the frame the renderer could get wrong (the default: every counter not
+    /// listed in [`AlgorithmDescription::counter_evidence`]).
+    Measured,
+    /// Follows from the data layout the renderer chose (bytes the layout reserves per tet):
+    /// it equals the layout's arithmetic whatever the frame does.
+    Layout,
+    /// Follows from the draw call's own arguments (a fixed number of vertices per tet).
+    DrawCall,
+}
+
+impl CounterEvidence {
+    pub fn label(self) -> &'static str {
+        match self {
+            CounterEvidence::Measured => "measured",
+            CounterEvidence::Layout => "follows from the data layout",
+            CounterEvidence::DrawCall => "follows from the draw call",
+        }
+    }
+}
+
 /// For [`AlgorithmDescription::nondeterministic_counters`]: every counter is exact on every
 /// adapter.
 pub fn all_counters_exact(_: &Settings, _: Shading) -> &'static [&'static str] {
@@ -113,6 +136,9 @@ pub struct AlgorithmDescription {
     /// The `#[repr(C)]` structs the algorithm uploads to the GPU and the WGSL they mirror
     /// (`tests/gpu_layouts.rs`); [`GpuLayouts::none`] for a renderer without any.
     pub gpu_layouts: fn() -> GpuLayouts,
+    /// The counters of its rows that are not measured, with where they come from (the data
+    /// layout, the draw call); every counter not listed is measured ([`Self::evidence_of`]).
+    pub counter_evidence: &'static [(&'static str, CounterEvidence)],
 }
 
 impl std::fmt::Debug for AlgorithmDescription {
@@ -142,6 +168,14 @@ impl AlgorithmDescription {
 
     pub fn is_peer(&self) -> bool {
         matches!(self.origin, Origin::Peer(_))
+    }
+
+    /// Where the counter `name` of its rows comes from.
+    pub fn evidence_of(&self, name: &str) -> CounterEvidence {
+        self.counter_evidence
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map_or(CounterEvidence::Measured, |(_, e)| *e)
     }
 
     pub fn param(&self, key: &str) -> Option<&Param> {

@@ -22,7 +22,9 @@ pub mod transfer;
 pub mod visibility;
 
 pub use bind::ChunkedBuffer;
-pub use description::{AlgorithmDescription, Hue, Origin, Param, Shading, Tolerance};
+pub use description::{
+    AlgorithmDescription, CounterEvidence, Hue, Origin, Param, Shading, Tolerance,
+};
 pub use frame::{FrameClock, FrameTimes};
 pub use gpu::{AdapterDescription, DeviceRequest, FrameTimer, Gpu, Lifetime, MemoryLedger};
 pub use image::Image;

@@ -1,7 +1,8 @@
 //! What the harness knows of fragment PT without building it (see [`render_core::description`]).
 
 use render_core::{
-    AlgorithmDescription, Hue, Origin, Param, Renderer, Settings, Tolerance, ValueKind,
+    AlgorithmDescription, CounterEvidence, Hue, Origin, Param, Renderer, Settings, Tolerance,
+    ValueKind,
 };
 
 use crate::{FragmentPt, FragmentPtSettings, Shading, SortMode};
@@ -42,6 +43,8 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     nondeterministic_counters: render_core::description::all_counters_exact,
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: crate::gpu_layouts,
+    // The model's bytes per tet are the texel layout's size over the tets (§4).
+    counter_evidence: &[("model_bytes_per_tet", CounterEvidence::Layout)],
 };
 
 fn grid(sorts: &[SortMode]) -> Vec<Settings> {

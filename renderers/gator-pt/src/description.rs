@@ -1,7 +1,8 @@
 //! What the harness knows of GATOR PT without building it (see [`render_core::description`]).
 
 use render_core::{
-    AlgorithmDescription, Hue, Origin, Param, Renderer, Settings, Tolerance, ValueKind,
+    AlgorithmDescription, CounterEvidence, Hue, Origin, Param, Renderer, Settings, Tolerance,
+    ValueKind,
 };
 
 use crate::{CellModel, GatorPt, GatorSort};
@@ -43,6 +44,8 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     nondeterministic_counters: render_core::description::all_counters_exact,
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: crate::gpu_layouts,
+    // Twelve indices per tet, whatever the classifier decides (§3.4).
+    counter_evidence: &[("triangles_drawn", CounterEvidence::DrawCall)],
 };
 
 /// Both cell models with each sort (constant first), the order the harness runs them.

@@ -94,6 +94,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     nondeterministic_counters,
     deterministic,
     gpu_layouts: crate::gpu_layouts,
+    counter_evidence: &[],
 };
 
 /// The racy single pass (`mode=fragment-race`, §4) draws a different image from frame to

@@ -2,7 +2,8 @@
 //! [`render_core::description`]).
 
 use render_core::{
-    AlgorithmDescription, Hue, Origin, Param, Renderer, Settings, Tolerance, ValueKind,
+    AlgorithmDescription, CounterEvidence, Hue, Origin, Param, Renderer, Settings, Tolerance,
+    ValueKind,
 };
 
 use crate::settings::{all_settings, default_settings, RaycastSettings};
@@ -54,6 +55,8 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     nondeterministic_counters: render_core::description::all_counters_exact,
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: crate::resources::gpu_layouts,
+    // The mesh's bytes per tet are the texel layout's size over the tets (§3.1, its Table 1).
+    counter_evidence: &[("mesh_bytes_per_tet", CounterEvidence::Layout)],
 };
 
 /// Measured on the check scene (`tests/vs_reference.rs`, lavapipe): the 3D table 96.5 dB, the

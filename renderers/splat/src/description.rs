@@ -88,6 +88,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     nondeterministic_counters: render_core::description::all_counters_exact,
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: crate::gpu_layouts,
+    counter_evidence: &[],
 };
 
 fn full_grid() -> Vec<Settings> {

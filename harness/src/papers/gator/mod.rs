@@ -11,6 +11,7 @@ pub mod geometry;
 use crate::papers::claims::VariantSpec;
 use crate::papers::evidence::exact_side;
 use crate::papers::session::{find, is_standin, Extra, Measured, Report, RunSpec, Session};
+use crate::papers::spec;
 use crate::papers::table::{Cell, CompRow, Comparison, Metric};
 use crate::papers::transcription;
 use crate::papers::verdict::Side;
@@ -177,7 +178,7 @@ const GEOMETRY_RESOLUTION: u32 = 512;
 /// A claim's side from GATOR's CPU analyses (`classifier-twin`); `None`: not one of them.
 pub fn claim_side(
     x: &Extra,
-    metric: &str,
+    metric: &spec::Metric,
     spec: &VariantSpec,
     dataset: Option<&str>,
 ) -> Option<Result<Side, String>> {
@@ -185,7 +186,7 @@ pub fn claim_side(
         return None;
     }
     let a = analyses_of(x);
-    Some(match metric {
+    Some(match metric.analysis_name().unwrap_or_default() {
         "classifier_mismatches" => match &a.truth_table {
             None => Err("the classifier was not run (`tetbench reproduce gator` runs it)".into()),
             Some(observed) => {

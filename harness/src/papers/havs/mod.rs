@@ -17,6 +17,7 @@ use crate::papers::evidence::exact_side;
 use crate::papers::session::{
     find, find_including, is_standin, Extra, Measured, Report, RunSpec, Session,
 };
+use crate::papers::spec;
 use crate::papers::table::{Cell, CompRow, Comparison, Metric};
 use crate::papers::transcription::{self, PaperTable};
 use crate::papers::verdict::{Sample, Side};
@@ -504,7 +505,7 @@ fn rows_differ_why(t: &transcription::PaperTable, x: &Extra) -> Vec<String> {
 /// Table 2); `None`: not one of them.
 pub fn claim_side(
     x: &Extra,
-    metric: &str,
+    metric: &spec::Metric,
     spec: &VariantSpec,
     dataset: Option<&str>,
 ) -> Option<Result<Side, String>> {
@@ -532,7 +533,7 @@ pub fn claim_side(
                 )));
             };
             let keys = r.keys_per_sec * r.ms * 1e-3;
-            let (value, min, max) = match metric {
+            let (value, min, max) = match metric.analysis_name().unwrap_or_default() {
                 "sort_ms" => (r.ms, r.min_ms, r.max_ms),
                 "sort_keys_per_sec" => (
                     r.keys_per_sec,
@@ -565,7 +566,7 @@ pub fn claim_side(
                     format!("k-buffer analysis of {d}: not run (`tetbench reproduce havs` runs it)")
                 })?;
             let pixels = f64::from(analysis::of(x).kbuffer_resolution).powi(2);
-            let v = match metric {
+            let v = match metric.analysis_name().unwrap_or_default() {
                 "kbuffer_fragments" => r.fragments as f64,
                 "kbuffer_pixels_k_gt2" => r.pixels_k_gt2 as f64,
                 "kbuffer_pixels_k_gt6" => r.pixels_k_gt6 as f64,
