@@ -4,16 +4,8 @@
 
 use render_core::Gpu;
 
-use crate::calibrate::probes::{ProbeContext, Workload};
-
-/// The calibration's kernels, with render-core's texel-texture addressing (`texel_at`).
-pub fn calibrate_source() -> String {
-    format!(
-        "{}\n{}",
-        include_str!("calibrate.wgsl"),
-        render_core::texel_texture::TEXEL_WGSL
-    )
-}
+pub use crate::calibrate::workload::calibrate_source;
+use crate::calibrate::workload::{ProbeContext, Workload};
 
 const GRID: u64 = 256; // calibrate.wgsl GRID
 const TRIANGLES: u64 = GRID * GRID * 2;

@@ -48,6 +48,7 @@ pub mod floor;
 pub mod kernels;
 pub mod probes;
 pub mod work;
+pub mod workload;
 
 pub use kernels::raster_fragments_per_triangle;
 pub use probes::raster_costs;

@@ -9,92 +9,10 @@
 //! roofline prices, once each, at the moment of the rows).
 
 use anyhow::Context;
-use render_core::Gpu;
 
 use crate::calibrate::kernels;
+pub use crate::calibrate::workload::{ProbeContext, Timing, Workload};
 use crate::results::machine::Figure;
-
-/// What every probe is prepared with: the device and the calibration's shader module.
-pub struct ProbeContext<'g> {
-    pub gpu: &'g Gpu,
-    pub module: wgpu::ShaderModule,
-}
-
-impl<'g> ProbeContext<'g> {
-    pub fn new(gpu: &'g Gpu) -> ProbeContext<'g> {
-        ProbeContext {
-            gpu,
-            module: gpu.shader("calibrate", &kernels::calibrate_source()),
-        }
-    }
-}
-
-/// One configuration of a probe, ready to run: `run(k)` submits `k` of its `pieces` equal
-/// parts (triangles, instances, workgroups) and waits for them; all of them do `units` of the
-/// figure's work. The calibration runs every piece; the control runs a share of them sized to
-/// take a few milliseconds.
-pub struct Workload<'g> {
-    /// Units of work all the pieces do (triangles, fragments, keys, steps, bytes, GFLOP).
-    pub units: f64,
-    /// A parameter of the configuration the figure needs besides the time (the
-    /// rasterisation's fragments per triangle; 0 elsewhere).
-    pub param: f64,
-    /// How many equal parts the work splits into (1: it does not split, as a sort).
-    pub pieces: u32,
-    run: Box<dyn FnMut(u32) -> anyhow::Result<()> + 'g>,
-}
-
-impl<'g> Workload<'g> {
-    /// Work that runs whole.
-    pub fn new(units: f64, mut run: impl FnMut() -> anyhow::Result<()> + 'g) -> Workload<'g> {
-        Workload::split(units, 1, move |_| run())
-    }
-
-    /// Work of `pieces` equal parts; `run(k)` runs the first `k`.
-    pub fn split(
-        units: f64,
-        pieces: u32,
-        run: impl FnMut(u32) -> anyhow::Result<()> + 'g,
-    ) -> Workload<'g> {
-        Workload {
-            units,
-            param: 0.0,
-            pieces: pieces.max(1),
-            run: Box::new(run),
-        }
-    }
-
-    pub fn with_param(mut self, param: f64) -> Workload<'g> {
-        self.param = param;
-        self
-    }
-
-    /// Runs every piece.
-    pub fn run(&mut self) -> anyhow::Result<()> {
-        (self.run)(self.pieces)
-    }
-
-    /// Runs `k` pieces (at least one, at most all); returns the units they do.
-    pub fn run_part(&mut self, k: u32) -> anyhow::Result<f64> {
-        let k = k.clamp(1, self.pieces);
-        (self.run)(k)?;
-        Ok(self.units * k as f64 / self.pieces as f64)
-    }
-}
-
-/// One timed configuration: its units, parameter and seconds.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Timing {
-    pub units: f64,
-    pub param: f64,
-    pub seconds: f64,
-}
-
-impl Timing {
-    pub fn rate(&self) -> f64 {
-        self.units / self.seconds.max(1e-12)
-    }
-}
 
 /// How a probe's timings become figures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

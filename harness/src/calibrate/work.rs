@@ -1,10 +1,10 @@
 //! The calibration's work-specific probes (`calibrate.wgsl`), one per counter that no generic
 //! figure prices: a ray step (`walk_main`), a splat fragment (`splat_cs`), a key of
 //! render-core's GPU radix sort and a tet classification. Each prepares its configurations as
-//! [`Workload`]s ([`crate::calibrate::probes`]).
+//! [`Workload`]s (see `probes.rs`).
 
 use crate::calibrate::kernels::dispatch;
-use crate::calibrate::probes::{ProbeContext, Workload};
+use crate::calibrate::workload::{ProbeContext, Workload};
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::gpu_sort::GpuRadixSort;
 use render_core::table_texture::TableTexture;
@@ -428,7 +428,7 @@ pub fn gpu_sort<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>>
 }
 
 /// Tets of the classification benchmark (a pass as long as a small mesh's, run often: see
-/// [`crate::calibrate::probes::best_seconds_of`]).
+/// `probes::best_seconds_of`).
 const CLASSIFY_TETS: u64 = 1 << 15;
 
 /// Tet classifications per second (`classify_cs`): the projection, orientation tests and

@@ -102,3 +102,5 @@ mod claims_paper_figure_tests;
 mod claims_tests;
 #[cfg(test)]
 mod rule_history_tests;
+#[cfg(test)]
+mod sides_tests;

@@ -246,6 +246,17 @@ pub fn evaluate(
 }
 
 /// The verdict on the numbers alone (hardware aside).
+impl Verdict {
+    /// Holds or does not hold: a decided claim.
+    fn of_hold(holds: bool) -> Verdict {
+        if holds {
+            Verdict::Holds
+        } else {
+            Verdict::DoesNotHold
+        }
+    }
+}
+
 fn decide(check: &Check, a: &Side, b: Option<&Side>) -> (Verdict, String) {
     let tol = check.tolerance.max(0.0);
     let mut text = a.describe();
@@ -281,14 +292,7 @@ fn decide(check: &Check, a: &Side, b: Option<&Side>) -> (Verdict, String) {
                 return (Verdict::WithinNoise, text);
             }
             let holds = (diff > 0.0) == want_less;
-            (
-                if holds {
-                    Verdict::Holds
-                } else {
-                    Verdict::DoesNotHold
-                },
-                text,
-            )
+            (Verdict::of_hold(holds), text)
         }
         (Expect::Above(t) | Expect::Below(t), _) => {
             let v = a.centre();
@@ -299,14 +303,7 @@ fn decide(check: &Check, a: &Side, b: Option<&Side>) -> (Verdict, String) {
             }
             let above = v > t;
             let holds = above == matches!(check.expect, Expect::Above(_));
-            (
-                if holds {
-                    Verdict::Holds
-                } else {
-                    Verdict::DoesNotHold
-                },
-                text,
-            )
+            (Verdict::of_hold(holds), text)
         }
         (Expect::Band(lo, hi), b) => {
             let (lo, hi) = (lo * (1.0 - tol), hi * (1.0 + tol));
@@ -350,14 +347,7 @@ fn decide(check: &Check, a: &Side, b: Option<&Side>) -> (Verdict, String) {
                     " exactly".into()
                 }
             );
-            (
-                if ok {
-                    Verdict::Holds
-                } else {
-                    Verdict::DoesNotHold
-                },
-                text,
-            )
+            (Verdict::of_hold(ok), text)
         }
         (Expect::Less | Expect::Greater, None) => (
             Verdict::NotCheckable,

@@ -421,7 +421,8 @@ fn the_control_tells_the_machine_from_a_change_common_to_every_algorithm() {
     let m = machine.machine.as_ref().expect("both sides have a control");
     assert!((m.factor - 2.19).abs() < 1e-9, "{}", m.factor);
     assert!(machine.regressions.is_empty(), "{:#?}", machine.regressions);
-    assert!(!crate::regress::compare_report::gate(&machine, FailOn::Regression).unwrap());
+    // compare_report::gate: no regression and not too noisy is exit 0.
+    assert!(!machine.too_noisy);
 
     let code = compare(&a, &slower, &opt).unwrap();
     assert!((code.machine.as_ref().unwrap().factor - 1.0).abs() < 1e-9);
@@ -432,7 +433,6 @@ fn the_control_tells_the_machine_from_a_change_common_to_every_algorithm() {
         "{:#?}",
         code.regressions
     );
-    assert!(crate::regress::compare_report::gate(&code, FailOn::Regression).unwrap());
 
     // The old rule, where NEW has no control: ×1.4 is under --drift-limit 1.5 and divided out.
     let old = tmp.path().join("old");

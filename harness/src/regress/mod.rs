@@ -182,6 +182,61 @@ pub fn run_bisect_command(args: BisectArgs, data_dir: Option<PathBuf>) -> anyhow
 
 #[cfg(test)]
 mod tests {
+    /// history puts each run with a control on the first such run's scale: a run on a machine
+    /// half as fast with twice the times reads as the first run; a run without a control keeps
+    /// its times; and with the control at the first run's speed the doubled times stand.
+    #[test]
+    fn history_divides_out_the_machine_run_by_run() {
+        use crate::regress::history::{divide_out_the_machine, GroupValues, Run, RunSummary};
+        use crate::results::machine::Figure;
+        let run = |ms: f64, control: Option<f64>| RunSummary {
+            run: Run {
+                dir: String::new(),
+                commit: String::new(),
+                date_utc: String::new(),
+                label: String::new(),
+                machine: None,
+            },
+            adapter: String::new(),
+            control: control.map(|speed| {
+                [
+                    (Figure::FillFragmentsPerSec, 100.0 * speed),
+                    (Figure::RayStepsPerSec, 10.0 * speed),
+                ]
+                .into()
+            }),
+            groups: vec![(
+                crate::regress::history::SeriesKey {
+                    algorithm: "a".into(),
+                    settings: String::new(),
+                    dataset: "d".into(),
+                    width: 1,
+                    height: 1,
+                    projection: String::new(),
+                },
+                Some(GroupValues {
+                    total_ms: ms,
+                    band_lo: ms,
+                    band_hi: ms,
+                    psnr_db: None,
+                    gpu_bytes: None,
+                }),
+            )],
+        };
+        let time = |r: &RunSummary| r.groups[0].1.as_ref().unwrap().total_ms;
+        let mut runs = vec![run(10.0, Some(1.0)), run(20.0, Some(0.5)), run(20.0, None)];
+        divide_out_the_machine(&mut runs);
+        assert_eq!(
+            runs.iter().map(time).collect::<Vec<_>>(),
+            [10.0, 10.0, 20.0]
+        );
+        assert_eq!(runs[1].run.machine, Some(0.5));
+        assert_eq!(runs[2].run.machine, None);
+        let mut same_machine = vec![run(10.0, Some(1.0)), run(20.0, Some(1.0))];
+        divide_out_the_machine(&mut same_machine);
+        assert_eq!(time(&same_machine[1]), 20.0);
+    }
+
     use super::*;
 
     /// Only the options given travel to the sides' `run`, flags without a value.

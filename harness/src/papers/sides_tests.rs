@@ -1,0 +1,172 @@
+//! Tests of the claims' sides (sides.rs) through the evidence they feed (evidence.rs): kept
+//! apart so that sides.rs, which evidence.rs imports, imports nothing back.
+use std::path::Path;
+
+use render_core::Image;
+
+use crate::papers::claims::{self, Claim};
+use crate::papers::evidence::{evaluate_claims, no_analyses};
+use crate::papers::session::{Extra, Measured};
+use crate::papers::verdict::Verdict;
+use crate::results::samples::write_f32_image;
+use crate::results::Row;
+
+/// A rendering-like image: a soft disc of colour over a transparent background.
+fn disc(size: u32) -> Image {
+    let mut img = Image::new(size, size);
+    let c = size as f32 / 2.0;
+    for y in 0..size {
+        for x in 0..size {
+            let r = ((x as f32 - c).powi(2) + (y as f32 - c).powi(2)).sqrt() / c;
+            let a = (1.0 - r).clamp(0.0, 1.0) * 0.8;
+            img.pixels[(y * size + x) as usize] = [a * 0.9, a * 0.5, a * 0.2, a];
+        }
+    }
+    img
+}
+
+/// One row of `spec`'s variant on `dataset` at `view`, its image written under `dir`.
+fn row_with_image(
+    dir: &Path,
+    spec: &claims::VariantSpec,
+    dataset: &str,
+    view: &str,
+    img: &Image,
+) -> Row {
+    let name = format!(
+        "images/{}-{}-{}.f32.zz",
+        spec.algorithm,
+        crate::results::names::slug(&spec.settings_text()),
+        crate::results::names::slug(view)
+    );
+    std::fs::create_dir_all(dir.join("images")).unwrap();
+    write_f32_image(&dir.join(&name), img).unwrap();
+    Row {
+        algorithm: spec.algorithm.clone(),
+        settings: spec.settings.clone(),
+        dataset: dataset.into(),
+        tets: 1000,
+        viewpoint: view.into(),
+        width: img.width,
+        height: img.height,
+        frames: 1,
+        device_type: "DiscreteGpu".into(),
+        image_f32: name,
+        ..Default::default()
+    }
+}
+
+/// The verdict of `claim` on its first data set, with side `a`'s image at the second of
+/// two viewpoints changed by `change` (the first viewpoint's images agree).
+fn verdict_with(claim: &Claim, change: impl Fn(&mut Image)) -> (Verdict, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let d = claim.datasets[0].as_str();
+    let b = claim.b.as_ref().unwrap();
+    let mut m = Measured::default();
+    for view in ["+x", "-y"] {
+        let reference = disc(32);
+        let mut ours = reference.clone();
+        if view == "-y" {
+            change(&mut ours);
+        }
+        let rows = [
+            row_with_image(dir.path(), &claim.a, d, view, &ours),
+            row_with_image(dir.path(), b, d, view, &reference),
+        ];
+        m.push_run(dir.path(), rows);
+    }
+    let results = evaluate_claims(&claim.paper, &m, &Extra::default(), &no_analyses);
+    let r = results
+        .iter()
+        .find(|r| r.claim.id == claim.id && r.dataset.as_deref() == Some(d))
+        .unwrap();
+    (r.evaluation.verdict, r.evaluation.numbers.clone())
+}
+
+fn image_claims() -> Vec<Claim> {
+    let all: Vec<Claim> = claims::all()
+        .unwrap()
+        .into_iter()
+        .filter(|c| c.metric.is_pair())
+        .collect();
+    assert!(all.len() >= 6, "{} image-quality claims", all.len());
+    all
+}
+
+#[test]
+fn every_image_quality_claim_flips_when_one_viewpoint_of_its_image_changes() {
+    for c in image_claims() {
+        let (v, numbers) = verdict_with(&c, |_| {});
+        assert_eq!(v, Verdict::Holds, "{} {}: {numbers}", c.paper, c.id);
+        // A visible change: every covered pixel 0.05 brighter (PSNR about 27 dB on the
+        // covered share of the image, every covered pixel off by more than 1/255).
+        let (v, numbers) = verdict_with(&c, |img| {
+            for p in &mut img.pixels {
+                if p[3] > 0.01 {
+                    p[0] += 0.05;
+                    p[1] += 0.05;
+                    p[2] += 0.05;
+                }
+            }
+        });
+        assert_eq!(v, Verdict::DoesNotHold, "{} {}: {numbers}", c.paper, c.id);
+        assert!(numbers.contains("at -y"), "{} {}: {numbers}", c.paper, c.id);
+    }
+}
+
+#[test]
+fn a_change_below_the_rules_keeps_the_verdict() {
+    for c in image_claims() {
+        // Half an 8-bit step on every pixel: PSNR about 54 dB, no pixel off by a step.
+        let (v, numbers) = verdict_with(&c, |img| {
+            for p in &mut img.pixels {
+                p[0] += 0.5 / 255.0;
+            }
+        });
+        assert_eq!(v, Verdict::Holds, "{} {}: {numbers}", c.paper, c.id);
+    }
+}
+
+#[test]
+fn a_missing_image_or_a_different_viewport_is_not_checkable_and_says_why() {
+    let c = image_claims().into_iter().next().unwrap();
+    let (v, numbers) = verdict_with(&c, |img| *img = disc(16));
+    assert_eq!(v, Verdict::NotCheckable, "{numbers}");
+    assert!(
+        numbers.contains("has no image at -y and 16x16"),
+        "{numbers}"
+    );
+    // Rows without a run folder (read from elsewhere) name the missing image.
+    let d = c.datasets[0].as_str();
+    let mut m = Measured::default();
+    let row = |spec: &claims::VariantSpec| Row {
+        algorithm: spec.algorithm.clone(),
+        settings: spec.settings.clone(),
+        dataset: d.into(),
+        viewpoint: "+x".into(),
+        width: 8,
+        height: 8,
+        frames: 1,
+        image_f32: "images/gone.f32.zz".into(),
+        ..Default::default()
+    };
+    m.rows = vec![row(&c.a), row(c.b.as_ref().unwrap())];
+    let r = evaluate_claims(&c.paper, &m, &Extra::default(), &no_analyses);
+    let e = &r.iter().find(|r| r.claim.id == c.id).unwrap().evaluation;
+    assert_eq!(e.verdict, Verdict::NotCheckable);
+    assert!(e.numbers.contains("no run folder"), "{}", e.numbers);
+}
+
+#[test]
+fn an_image_pair_refuses_an_expectation_of_two_values() {
+    let header = claims::CLAIMS_CSV.lines().next().unwrap();
+    let line = "havs,X1,paper,§4,t,pair_psnr_db,spx2,havs:k=2,havs:k=6,a<b,0,none,measured,none";
+    let e = claims::parse(&format!("{header}\n{line}\n"), "test.csv").unwrap_err();
+    assert!(
+        format!("{e:#}").contains("compares a's image with b's"),
+        "{e:#}"
+    );
+    let line = "havs,X1,paper,§4,t,pair_psnr_db,spx2,havs:k=2,,a>40,0,none,measured,none";
+    let e = claims::parse(&format!("{header}\n{line}\n"), "test.csv").unwrap_err();
+    assert!(format!("{e:#}").contains("needs a second side"), "{e:#}");
+}
