@@ -90,7 +90,11 @@ fn the_site_grows_by_less_than_the_bound_a_run_and_redraws_only_what_changed() {
     // history.html holds no per-run number: no run is named but the first, the last and the
     // one where the step starts (the charts and the data files hold the rest).
     let page8 = page(&large);
-    assert!(page8.len() < 64 * 1024, "history.html is {} bytes", page8.len());
+    assert!(
+        page8.len() < 64 * 1024,
+        "history.html is {} bytes",
+        page8.len()
+    );
 
     // The step: in the HAVS series at run 5 (its commit), listed before any chart.
     let json_path = std::fs::read_dir(large.join("history"))
