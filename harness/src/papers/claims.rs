@@ -364,6 +364,7 @@ fn evaluate_one(claim: &Claim, dataset: Option<&str>, inputs: &Inputs) -> Evalua
             }
         }
     };
+    let raw_expect = expect;
     let (expect, normalised) = match normalise(claim, expect, inputs) {
         Ok(x) => x,
         Err(why) => return Evaluation::not_checkable(why),
@@ -394,6 +395,28 @@ fn evaluate_one(claim: &Claim, dataset: Option<&str>, inputs: &Inputs) -> Evalua
         if e.verdict != verdict::Verdict::NotCheckable {
             e.numbers.push_str("; ");
             e.numbers.push_str(&n);
+            // Beside the control's verdict, the one the cached calibration would give.
+            if let Some(cached) = &inputs.cached_peaks {
+                let with_cache = Inputs {
+                    our_peaks: Some(cached.clone()),
+                    cached_peaks: None,
+                    ..*inputs
+                };
+                if let Ok((expect, _)) = normalise(claim, raw_expect, &with_cache) {
+                    let c = verdict::evaluate(
+                        &Check { expect, ..check },
+                        a.as_ref().map_err(Clone::clone),
+                        b.as_ref().map(|r| r.as_ref().map_err(Clone::clone)),
+                        false,
+                    );
+                    e.numbers.push_str(&format!(
+                        "; by {} ({:.3e} fragments/s) it would read: {}",
+                        cached.source,
+                        cached.fill_fragments_per_sec,
+                        c.verdict.label()
+                    ));
+                }
+            }
         }
     }
     e
@@ -439,8 +462,8 @@ fn normalise(
             Ok((
                 scaled,
                 Some(format!(
-                    "normalised by the fill rate: the paper's figure ({}) × our calibrated {:.3e} blended fragments/s ({}) / the {}'s published {:.3e} pixels/s = ×{:.3}",
-                    claim.expect_text, ours.fill_fragments_per_sec, ours.adapter, paper.1.gpu, paper.0, f
+                    "normalised by the fill rate: the paper's figure ({}) × our {:.3e} blended fragments/s ({}, {}) / the {}'s published {:.3e} pixels/s = ×{:.3}",
+                    claim.expect_text, ours.fill_fragments_per_sec, ours.adapter, ours.source, paper.1.gpu, paper.0, f
                 )),
             ))
         }
@@ -592,6 +615,7 @@ mod tests {
             why_missing: &|a, d| format!("{a} not measured on {d}"),
             software_adapter: software_adapter(rows),
             our_peaks: None,
+            cached_peaks: None,
             row_dirs: &[],
         }
     }

@@ -143,3 +143,44 @@ fn h7_and_f1_rejudged_from_the_committed_h200_rows_show_their_old_rules_beside()
         assert_eq!(verdict_of(&r, "F1", Some(d)), Verdict::Holds, "{d}");
     }
 }
+
+/// A normalised claim scales by the control of the rows it judges, not by the cached
+/// calibration: the same H200 rows hold with a control at the calibration's fill rate and do
+/// not with one a thousand times faster, while the cached calibration's verdict ("holds") is
+/// printed beside.
+#[test]
+fn normalised_claims_use_the_control_of_their_rows() {
+    use crate::results::machine::Figure;
+    let m = five_frames(&h200("havs"));
+    let fill = m.calibration.as_ref().unwrap().fill_fragments_per_sec;
+    let with_control = |fill: f64| {
+        let mut c = m.clone();
+        for row in &mut c.rows {
+            row.round_control = vec![[(Figure::FillFragmentsPerSec, fill)].into(); 3];
+        }
+        c
+    };
+    let h7 = |m: &Measured| {
+        eval("havs", m, &Extra::default())
+            .into_iter()
+            .find(|r| r.claim.id == "H7" && r.dataset.as_deref() == Some("f117"))
+            .unwrap()
+            .evaluation
+    };
+    let same = h7(&with_control(fill));
+    assert_eq!(same.verdict, Verdict::Holds, "{}", same.numbers);
+    assert!(
+        same.numbers
+            .contains("the control measured beside the judged rows"),
+        "{}",
+        same.numbers
+    );
+    let faster = h7(&with_control(fill * 1000.0));
+    assert_eq!(faster.verdict, Verdict::DoesNotHold, "{}", faster.numbers);
+    assert!(
+        faster.numbers.contains("by the cached calibration")
+            && faster.numbers.contains("it would read: holds"),
+        "{}",
+        faster.numbers
+    );
+}

@@ -38,6 +38,16 @@ pub fn evaluate_claims(
             our_peaks: m
                 .calibration
                 .as_ref()
+                .and_then(|c| crate::papers::hardware::control_peaks(&c.adapter, &m.rows))
+                .or_else(|| {
+                    m.calibration
+                        .as_ref()
+                        .map(crate::papers::hardware::our_peaks)
+                }),
+            cached_peaks: m
+                .calibration
+                .as_ref()
+                .filter(|_| m.rows.iter().any(|r| !r.round_control.is_empty()))
                 .map(crate::papers::hardware::our_peaks),
             row_dirs: &m.row_dirs,
         },

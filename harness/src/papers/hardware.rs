@@ -25,6 +25,9 @@ pub struct PaperGpu {
 #[derive(Debug, Clone, PartialEq)]
 pub struct OurPeaks {
     pub adapter: String,
+    /// Where the figures come from: the control measured beside the judged rows, or the
+    /// cached calibration and its date.
+    pub source: String,
     /// Blended fragments per second into the renderers' `Rgba32Float` targets.
     pub fill_fragments_per_sec: f64,
     pub triangles_per_sec: f64,
@@ -80,13 +83,32 @@ pub fn paper_gpu(paper: &str) -> Option<PaperGpu> {
         .find(|g| g.paper == paper)
 }
 
-/// Our peaks from a run's machine record.
+/// Our peaks from a run's machine record (the cached calibration).
 pub fn our_peaks(c: &crate::results::machine::Calibration) -> OurPeaks {
     OurPeaks {
         adapter: c.adapter.clone(),
+        source: format!("the cached calibration of {}", c.date_utc),
         fill_fragments_per_sec: c.fill_fragments_per_sec,
         triangles_per_sec: c.triangles_per_sec,
     }
+}
+
+/// Our figures at the moment of the judged rows: the per-figure median over every round's
+/// control the rows carry (`None` where no row has one, or the control measured no fill).
+pub fn control_peaks(adapter: &str, rows: &[crate::results::Row]) -> Option<OurPeaks> {
+    use crate::results::machine::Figure;
+    let rounds: Vec<&crate::results::control::Figures> =
+        rows.iter().flat_map(|r| r.round_control.iter()).collect();
+    let median = crate::results::control::median_figures(rounds.iter().copied());
+    Some(OurPeaks {
+        adapter: adapter.to_string(),
+        source: format!(
+            "the control measured beside the judged rows ({} rounds)",
+            rounds.len()
+        ),
+        fill_fragments_per_sec: *median.get(&Figure::FillFragmentsPerSec)?,
+        triangles_per_sec: median.get(&Figure::TrianglesPerSec).copied().unwrap_or(0.0),
+    })
 }
 
 #[cfg(test)]

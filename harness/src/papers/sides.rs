@@ -27,8 +27,11 @@ pub struct Inputs<'a> {
     pub why_missing: &'a dyn Fn(&str, &str) -> String,
     /// Whether the GPU numbers came from a software rasteriser.
     pub software_adapter: bool,
-    /// Our adapter's calibrated peaks (`None`: the runs were not calibrated).
+    /// Our adapter's figures that normalised claims scale by: the control measured beside the
+    /// rows where they carry one, else the cached calibration (`None`: neither).
     pub our_peaks: Option<super::hardware::OurPeaks>,
+    /// The cached calibration, where `our_peaks` is the control: its verdict is printed beside.
+    pub cached_peaks: Option<super::hardware::OurPeaks>,
     /// The run folder each row's image paths are relative to, by the row's index in `rows`
     /// (`None` or missing: its images cannot be read).
     pub row_dirs: &'a [Option<std::path::PathBuf>],
