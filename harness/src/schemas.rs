@@ -210,7 +210,8 @@ mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let (a, b) = two_runs(tmp.path());
         let out = tmp.path().join("history");
-        crate::regress::history::run_command(&[a.clone(), b.clone()], &out, 1.10, 0.05).unwrap();
+        crate::regress::history_page::run_command(&[a.clone(), b.clone()], &out, 1.10, 0.05)
+            .unwrap();
         let history: Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("history.json")).unwrap())
                 .unwrap();

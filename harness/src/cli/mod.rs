@@ -334,7 +334,7 @@ pub fn execute(cli: Cli, command_line: Vec<String>) -> anyhow::Result<Outcome> {
             dirs,
             out,
             threshold,
-        } => done(crate::regress::history::run_command(
+        } => done(crate::regress::history_page::run_command(
             &dirs, &out, threshold, 0.05,
         )),
         Command::Export { format, results } => {

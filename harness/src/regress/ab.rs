@@ -10,8 +10,9 @@
 //! failed invocation leaves is that round alone. The rounds of a side are then merged into
 //! `OUT/base/results.json` and `OUT/new/results.json` — a row's samples are its rounds' frames
 //! one round after the other, `run.rounds` the number of rounds, exactly the layout of one run
-//! with `--rounds N` — and [`crate::regress::compare::compare`] judges them: one value per round, the
-//! run-wide factor divided out, Holm over the groups. Its outputs go to `OUT/compare`, the
+//! with `--rounds N` — and [`crate::regress::compare::compare`] judges them: one value per round, each
+//! round divided by its own control (the run-wide factor where a side has none), Holm over the
+//! groups. The rounds' controls are merged with them: invocation i's samples are round i's. Its outputs go to `OUT/compare`, the
 //! drift each pair saw to `OUT/ab.json` and the terminal.
 
 use crate::regress::compare::{key, Key};

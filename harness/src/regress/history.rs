@@ -17,7 +17,7 @@
 //! Each run is read once and reduced to a [`RunSummary`], each pair to [`PairFindings`];
 //! [`build`] makes the history from those alone, so `tetbench publish` can keep them beside a
 //! run's page and compare only the pair a new run adds. The pages, charts and data files are
-//! [`crate::regress::history_page`]'s.
+//! `history_page.rs`'s.
 
 use std::collections::BinaryHeap;
 use std::path::{Path, PathBuf};
@@ -678,27 +678,6 @@ pub fn build(runs: Vec<RunSummary>, pairs: &[Option<PairFindings>], threshold: f
 
 fn psnr_mean(v: &[f64]) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
-}
-
-/// `tetbench history`: history.json, history.csv, history.md, history.html and one chart per
-/// algorithm × data set in `out`.
-pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> anyhow::Result<()> {
-    let (_, md) = write_files(dirs, out, threshold, alpha)?;
-    print!("{md}");
-    println!("wrote {}/history.{{md,html,json,csv}}", out.display());
-    Ok(())
-}
-
-/// Writes what `tetbench history` writes; returns the history and its Markdown.
-pub fn write_files(
-    dirs: &[PathBuf],
-    out: &Path,
-    threshold: f64,
-    alpha: f64,
-) -> anyhow::Result<(History, String)> {
-    let h = history(dirs, out, threshold, alpha)?;
-    let md = crate::regress::history_page::write(out, &h)?;
-    Ok((h, md))
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 //! - `charts/history_ALGORITHM_DATASET.svg`.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use serde::Serialize;
@@ -381,6 +381,27 @@ pub fn write(out: &Path, h: &History) -> anyhow::Result<String> {
     std::fs::write(out.join("history.json"), serde_json::to_string(h)?)
         .context("writing history.json")?;
     Ok(md)
+}
+
+/// `tetbench history`: history.json, history.csv, history.md, history.html and one chart per
+/// algorithm × data set in `out`.
+pub fn run_command(dirs: &[PathBuf], out: &Path, threshold: f64, alpha: f64) -> anyhow::Result<()> {
+    let (_, md) = write_files(dirs, out, threshold, alpha)?;
+    print!("{md}");
+    println!("wrote {}/history.{{md,html,json,csv}}", out.display());
+    Ok(())
+}
+
+/// Writes what `tetbench history` writes; returns the history and its Markdown.
+pub fn write_files(
+    dirs: &[PathBuf],
+    out: &Path,
+    threshold: f64,
+    alpha: f64,
+) -> anyhow::Result<(History, String)> {
+    let h = crate::regress::history::history(dirs, out, threshold, alpha)?;
+    let md = write(out, &h)?;
+    Ok((h, md))
 }
 
 #[cfg(test)]
