@@ -14,7 +14,9 @@
 #
 #   scripts/control-power.sh [TRIALS]        # default 10
 #
-# Environment: CONTROL_POWER_WORK (default target/control-power), CONTROL_POWER_SEED (a release
+# Environment: CONTROL_POWER_BASE and CONTROL_POWER_SPIN (binaries built already, BASE of HEAD and
+# SPIN of HEAD with the patch below: then nothing is built), CONTROL_POWER_WORK (default
+# target/control-power), CONTROL_POWER_SEED (a release
 # target directory to copy before the first build, so that the dependencies are not built
 # again; default target/release when it exists), CONTROL_POWER_MATRIX (the
 # run options; default three algorithms on box:10k, 3 viewpoints, 128 px, 3 rounds of 1 frame
@@ -35,20 +37,29 @@ load=${CONTROL_POWER_LOAD:-while :; do :; done}
 head=$(git rev-parse HEAD)
 mkdir -p "$work/bin" "$work/trials"
 
-if [ -e "$src/.git" ]; then
-    git -C "$src" checkout --quiet --force --detach "$head"
-else
-    git worktree add --quiet --detach "$src" "$head"
-fi
-if [ ! -d "$target/release" ] && [ -d "$seed" ]; then
-    mkdir -p "$target" && cp -r "$seed" "$target/release"
-fi
+prepare_src() {
+    if [ -e "$src/.git" ]; then
+        git -C "$src" checkout --quiet --force --detach "$head"
+    else
+        git worktree add --quiet --detach "$src" "$head"
+    fi
+    # -a keeps the times cargo's fingerprints compare, so the dependencies are not rebuilt.
+    if [ ! -d "$target/release" ] && [ -d "$seed" ]; then
+        mkdir -p "$target" && cp -a "$seed" "$target/release"
+    fi
+}
 build() {
     (cd "$src" && CARGO_TARGET_DIR="$target" cargo build --release -q -p harness --bin tetbench)
     cp "$target/release/tetbench" "$1"
 }
 stamp="$work/bin/.built-$head"
+if [ -n "${CONTROL_POWER_BASE:-}" ] && [ -n "${CONTROL_POWER_SPIN:-}" ]; then
+    cp "$CONTROL_POWER_BASE" "$work/bin/base"
+    cp "$CONTROL_POWER_SPIN" "$work/bin/spin"
+    touch "$stamp"
+fi
 if [ ! -e "$stamp" ]; then
+    prepare_src
     echo "control-power: building BASE ($head)" >&2
     build "$work/bin/base"
     python3 - "$src/renderers/core/src/frame.rs" <<'EOF'

@@ -57,6 +57,12 @@ pub fn priced(base: &Calibration, control: &Figures) -> (Calibration, Vec<Figure
 /// sample of every probe stays a fraction of a second.
 pub const TARGET_S: f64 = 0.01;
 
+/// The fewest pieces a share runs (all of them where there are fewer): a share must still
+/// spread over the device's threads as the whole does. Measured: the splat probe's widest
+/// footprints make 2 workgroups in all, and one of them ran on one of lavapipe's two threads,
+/// at half the rate, so six splat rows of the default suite beat a bound priced by it.
+pub const MIN_PIECES: u32 = 256;
+
 /// The control probes prepared for a run: each probe's fastest configuration and the share of
 /// its pieces that runs in about [`TARGET_S`], kept between samples (pipelines and buffers are
 /// made once).
@@ -82,8 +88,8 @@ fn time_part(w: &mut crate::calibrate::probes::Workload, k: u32) -> anyhow::Resu
 }
 
 impl<'g> ControlBench<'g> {
-    /// Prepares every control probe, times a sixteenth of each configuration (after a warm-up
-    /// of the same), keeps the fastest (all of them for the rasterisation fit) and sizes its
+    /// Prepares every control probe, times a sixteenth of each configuration (at least
+    /// [`MIN_PIECES`]; after a warm-up of the same), keeps the fastest (all of them for the rasterisation fit) and sizes its
     /// share to [`TARGET_S`]. A probe that cannot be prepared here is left out (its figures are
     /// then scaled, and the rows say so).
     pub fn new(ctx: &ProbeContext<'g>) -> ControlBench<'g> {
