@@ -159,7 +159,7 @@ fn hex(c: plotters::style::RGBColor) -> String {
 
 /// 1, 2 or 5 × 10ᵏ, the smallest at least `raw`.
 fn nice_step(raw: f64) -> f64 {
-    if !(raw > 0.0) || !raw.is_finite() {
+    if raw.is_nan() || raw <= 0.0 || !raw.is_finite() {
         return 1.0;
     }
     let p = 10f64.powf(raw.log10().floor());

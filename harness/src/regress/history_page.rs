@@ -72,7 +72,7 @@ pub fn steps(h: &History) -> Vec<StepLine> {
             })
         })
         .collect();
-    v.sort_by(|a, b| b.run.cmp(&a.run));
+    v.sort_by_key(|c| std::cmp::Reverse(c.run));
     v
 }
 
