@@ -1,4 +1,4 @@
-//! Embeds the build's provenance in the binary (issue 25): the commit, whether the tracked
+//! Embeds the build's provenance in the binary: the commit, whether the tracked
 //! files differed from it, the build profile and the compiler. Read at run time these were
 //! wrong for a copied binary (no commit) and for a stale one (whatever is checked out now).
 //!

@@ -1,4 +1,4 @@
-//! docs/github-actions-shards.yml, the workflow users copy (issue 28): valid YAML, a matrix
+//! docs/github-actions-shards.yml, the workflow users copy: valid YAML, a matrix
 //! job that runs `--shard i/N` with N taken from the matrix, and a merge job after it that
 //! runs `report --merge` also when a shard failed (so the merge names the missing one).
 

@@ -1,5 +1,5 @@
 //! `docs/dependencies.md` names every crate the repository's `Cargo.toml` files depend on, and
-//! no other (issue 44): its table of crates is read (the backticked names of each row's first
+//! no other: its table of crates is read (the backticked names of each row's first
 //! cell) and compared with the dependencies of every manifest — the workspace's, each
 //! member's, and the fuzz crate's — in every dependency table (normal, dev, build, per target).
 //! Crates of the repository itself (path dependencies, workspace members) are not listed.

@@ -1,4 +1,4 @@
-//! What differs between GPUs, forced on the one at hand (issue 29): the device requested with
+//! What differs between GPUs, forced on the one at hand: the device requested with
 //! small storage bindings against the adapter's own (lavapipe 128 MiB, a data-centre GPU about
 //! 2 GiB), and with timestamp queries off against the adapter's.
 //!
@@ -217,8 +217,7 @@ fn gpu_time_appears_exactly_with_timestamp_queries() {
     }
 }
 
-/// HAVS's GPU sort split over storage bindings (issue 43: a 20 M-tet mesh's ~40 M face keys
-/// are 160 MB, over lavapipe's 128 MiB binding). With the binding at 64 KiB (16,384 keys) the
+/// HAVS's GPU sort split over storage bindings. With the binding at 64 KiB (16,384 keys) the
 /// mesh's face keys need four bindings; the device refuses any binding past the limit, so a
 /// frame proves the key pass and the sort were split, and its image equals the one sorted in
 /// a single binding, bit for bit (the split sort's order equals the CPU radix sort's:

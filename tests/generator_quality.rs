@@ -1,6 +1,6 @@
 //! Every quality generator (`box`, `shell`, `tunnels`) gives, at every size of the sweep, a mesh
 //! of the shape it promises with no slivers (aspect ratio ≤ `generate::MAX_ASPECT`); `onion` is
-//! the sliver stress case on purpose. Issue 15: `shell:10k` used to be 10,008 slivers.
+//! the sliver stress case on purpose. `shell:10k` used to be 10,008 slivers.
 
 use datasets::generate::{from_spec, shell_cells, Kind, MAX_ASPECT};
 use datasets::TetMesh;

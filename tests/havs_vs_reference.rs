@@ -170,7 +170,7 @@ fn havs_k6_on_spx_is_close_to_the_reference() {
     }
 }
 
-/// Issue 15: `onion:10k` (nested sliver shells, every tet a sliver) is built to break a small
+/// `onion:10k` (nested sliver shells, every tet a sliver) is built to break a small
 /// k-buffer. The exact A-buffer analysis finds the k it needs; the k-buffer's CPU model with
 /// that k is out of order nowhere and close to the reference, while k = 2 is out of order
 /// somewhere and further from it. (CPU only: the model is the twin of the race-free GPU mode.)

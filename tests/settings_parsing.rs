@@ -1,4 +1,4 @@
-//! Settings text is parsed in one place, `render_core::Settings` (issue 23): no other code of
+//! Settings text is parsed in one place, `render_core::Settings`: no other code of
 //! the harness, the renderers or the peers splits a settings string or looks a key up in one.
 //! A grep, so it can fail: the patterns below are what the hand-written parsers it replaced
 //! looked like (`settings.split(';')`, `value_of(&row.settings, …)`, `settings.contains("k=")`).

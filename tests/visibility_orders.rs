@@ -1,4 +1,4 @@
-//! Visibility orders (issue 5 item 4 and 7): MPVONC gives a valid back-to-front order across
+//! Visibility orders: MPVONC gives a valid back-to-front order across
 //! every interior face on convex acyclic meshes, from many viewpoints and both projections; the
 //! centroid orders (radix, bucket, merge) satisfy their sort invariants; on non-convex meshes
 //! MPVONC stays valid across interior faces.

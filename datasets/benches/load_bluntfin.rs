@@ -1,6 +1,6 @@
 //! Time to load Blunt Fin (PLOT3D XYZ + Q, 40,960 points → 187,395 tets) through
 //! `datasets::load::load`: file reads, layout sniffing, bulk big-endian conversion, the 5-tet
-//! split and the mesh checks of `TetMesh::new`. Goal (issue 2): well under 0.2 s in release.
+//! split and the mesh checks of `TetMesh::new`. Goal: well under 0.2 s in release.
 //! Needs the data directory (`TETBENCH_DATA`, default ../shared/datasets); without it the
 //! bench prints why and measures nothing.
 

@@ -402,7 +402,7 @@ impl TetMesh {
     /// Every triangle once: interior faces from the lower-numbered tet, boundary faces outward.
     /// Built on each call and not kept (unlike the adjacency it is made from): its one user,
     /// HAVS's prepare, turns it into its own face array at once, and a cached copy would hold
-    /// 13 bytes a face (520 MB at 20 M tets) for the rest of the run (issue 27, item 6).
+    /// 13 bytes a face (520 MB at 20 M tets) for the rest of the run.
     pub fn unique_faces(&self) -> UniqueFaces {
         let adj = self.adjacency();
         let mut faces = Vec::with_capacity(self.tets.len() * 2 + 64);

@@ -280,7 +280,7 @@ fn missing_dataset_is_a_clear_error() {
     assert!(!out.join("results.json").exists());
 }
 
-/// Issue 18: a `--settings` value that no variant of an asked-for algorithm has is an error
+/// a `--settings` value that no variant of an asked-for algorithm has is an error
 /// naming the algorithm, the key, the value and what it offers — never a silently dropped
 /// algorithm.
 #[test]
@@ -329,7 +329,7 @@ fn a_settings_typo_never_drops_an_algorithm() {
     }
 }
 
-/// Issue 18: an allocation past the adapter's limits fails its rows with the bytes needed and
+/// an allocation past the adapter's limits fails its rows with the bytes needed and
 /// the limit (checked before wgpu sees it), and the run exits non-zero.
 #[test]
 fn an_oversized_viewport_fails_rows_with_the_limit() {
@@ -425,7 +425,7 @@ fn killed_run_keeps_finished_rows() {
     assert!(csv.iter().all(|r| r.ok() && r.tets_per_sec.unwrap() > 0.0));
 }
 
-/// Issue 15: on the default suite's non-convex mesh (`shell:10k`, rebuilt without slivers)
+/// on the default suite's non-convex mesh (`shell:10k`, rebuilt without slivers)
 /// every default variant of every algorithm is at least 40 dB from the exact reference (RMSE ≤
 /// 1 %: `suspect::FINE_DB`, so none is suspect), and the ray caster with the 3D table and no
 /// early termination — exact order, exact segments — reaches 90 dB.

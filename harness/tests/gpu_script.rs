@@ -1,5 +1,5 @@
 //! `scripts/gpu.sh --allow-software` runs the scale and floor steps at reduced sizes on
-//! lavapipe (issue 43), and its output has the shape a GPU run's will have: a scale run per
+//! lavapipe, and its output has the shape a GPU run's will have: a scale run per
 //! resolution with every default algorithm on every data set, a floor per resolution with
 //! every step, every algorithm on the tiny mesh, and gpu.md's tables of both.
 

@@ -1,4 +1,4 @@
-//! Every chart is drawn under `harness/src/plot/` (issue 23, item 4): no other module of the
+//! Every chart is drawn under `harness/src/plot/`: no other module of the
 //! harness uses plotters, and no colour is defined outside `plot/style.rs`, the one palette.
 //! Callers elsewhere (history, compare, the papers) pass data to a `plot` module. A grep, so it
 //! can fail: the second test feeds it what the drawing code it replaced looked like.

@@ -1,5 +1,5 @@
 //! `tetbench publish` over the committed baselines and reproduced papers, plus one run whose
-//! data set is named with markup and which kept one image (issue 44), walked in headless
+//! data set is named with markup and which kept one image, walked in headless
 //! Chromium by `scripts/check-site.sh` (which installs Debian's chromium when none is on the
 //! PATH): every page loads with no console error, every link and image resolves, the name
 //! stays text. Then a copy of the site with one image deleted, one link broken and one live tag

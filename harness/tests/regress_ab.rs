@@ -1,4 +1,4 @@
-//! `tetbench ab` and `tetbench bisect` from the command line (issue 25).
+//! `tetbench ab` and `tetbench bisect` from the command line.
 //!
 //! Most sides are stand-in "binaries": a Python script that answers `run … --out DIR` with a
 //! results.json made from a template, its frame times multiplied by a chosen slowdown for one
@@ -137,7 +137,7 @@ fn ab_of_two_binaries_gates_like_compare() {
     let out = String::from_utf8_lossy(&same.stdout);
     assert!(out.contains("pair  1 (BASE, NEW): NEW/BASE ×"), "{out}");
     assert!(out.contains("pair  4 (NEW, BASE)"), "{out}");
-    // Piped: a line per round with its count, the ETA until the last (issue 44).
+    // Piped: a line per round with its count, the ETA until the last.
     let err = String::from_utf8_lossy(&same.stderr);
     assert!(err.contains("tetbench ab: [1/8, ETA "), "{err}");
     assert!(err.contains("tetbench ab: [8/8] pair 4"), "{err}");

@@ -1,4 +1,4 @@
-//! Regression tracking from the command line (issue 25): `compare`'s exit status, the CI gate
+//! Regression tracking from the command line: `compare`'s exit status, the CI gate
 //! (0 no regression, 3 a regression with `--fail-on regression`, 1 an error or a refused
 //! comparison) and its stdout formats, `export`, and one run per output directory.
 //! The compare and export tests use synthetic results sets (no GPU): eight groups of three
@@ -234,7 +234,7 @@ fn compare_formats_and_exports_go_to_stdout() {
     assert_eq!(gab[0]["unit"], "ms");
 }
 
-/// Two runs into one directory at once (issue 25): the second refuses, naming the first by
+/// Two runs into one directory at once: the second refuses, naming the first by
 /// its pid, and the first finishes with all its rows.
 #[test]
 fn a_second_run_into_a_busy_directory_refuses_and_nothing_is_lost() {

@@ -1,4 +1,4 @@
-//! Regression tracking end to end (issue 12): two shards merged give the rows of one unsharded
+//! Regression tracking end to end: two shards merged give the rows of one unsharded
 //! run (timings aside), the shards partition the rows exactly, `compare` of the two finds no
 //! image or memory change, and runs from different adapters are refused unless normalised.
 //! Tiny meshes at 16² with the deterministic cell-projection algorithms, on any adapter.

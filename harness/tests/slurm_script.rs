@@ -1,4 +1,4 @@
-//! `scripts/slurm-run.sh` without a cluster (issue 28): its refusals (no sbatch, an output
+//! `scripts/slurm-run.sh` without a cluster: its refusals (no sbatch, an output
 //! directory that is not shared) flip with their input; the jobs it submits (stand-in `sbatch`
 //! and `sinfo` that record their arguments); and its merge job run by hand over shard
 //! directories: a missing, a killed and a failed shard are each named, and nothing incomplete
@@ -113,7 +113,7 @@ fn refuses_without_sbatch() {
 }
 
 /// /tmp is node-local: refused on a cluster with other nodes than this host, accepted on a
-/// one-node cluster whose node is this host (CI's own, issue 44: a clone under /tmp). A local
+/// one-node cluster whose node is this host (CI's own: a clone under /tmp). A local
 /// disk is likewise refused when the cluster has other nodes, accepted when this host is the
 /// only one; --shared-ok accepts anything.
 #[test]

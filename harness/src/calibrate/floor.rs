@@ -1,5 +1,5 @@
 //! `tetbench calibrate --floor`: what one frame costs before any algorithm does any work, step
-//! by step (issue 43). On a GPU a frame of a small mesh is mostly this floor: a submission,
+//! by step. On a GPU a frame of a small mesh is mostly this floor: a submission,
 //! the wait for the device, the readbacks of a frame's counters and timestamps. Each step is
 //! timed on its own, `FLOOR_REPS` times after warming up, and reported as the median and the
 //! fastest; the report stands beside the rows (`scripts/gpu.sh`), never subtracted from them.

@@ -448,7 +448,7 @@ mod tests {
         );
     }
 
-    /// Issue 23: markup in a data set's name, in an image's alt text or path, lands as text.
+    /// Markup in a data set's name, in an image's alt text or path, lands as text.
     #[test]
     fn markup_in_a_report_lands_as_text() {
         use crate::report::html::{assert_no_live_markup, HOSTILE_NAME};

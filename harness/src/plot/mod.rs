@@ -1,4 +1,4 @@
-//! Comparison charts that answer the questions users bring (issue 17): speed vs error per
+//! Comparison charts that answer the questions users bring: speed vs error per
 //! data set, scaling with mesh size, throughput vs viewport size, and bar charts per metric.
 //!
 //! Every chart is written as PNG and SVG with its data as CSV beside it (`STEM.{png,svg,csv}`),

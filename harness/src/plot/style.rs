@@ -162,7 +162,7 @@ fn hue_family(hue: render_core::Hue) -> Family {
 /// algorithms may then share a family).
 const SPARE_FAMILIES: [Family; 2] = [BROWNS, TEALS];
 
-/// Whether `algorithm` is an outside peer (VTK's mappers, issue 13) rather than one of
+/// Whether `algorithm` is an outside peer (VTK's mappers) rather than one of
 /// tetbench's own renderers. Peers are drawn in greys with hollow markers.
 /// Names outside the algorithm table that start with `vtk-` (rows from other builds) count too.
 pub fn is_peer(algorithm: &str) -> bool {

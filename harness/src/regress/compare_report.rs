@@ -500,7 +500,7 @@ mod tests {
         }
     }
 
-    /// Issue 23: a data set named with markup lands in compare.html as text.
+    /// a data set named with markup lands in compare.html as text.
     #[test]
     fn markup_in_names_is_escaped() {
         use crate::report::html::{assert_no_live_markup, HOSTILE_NAME};

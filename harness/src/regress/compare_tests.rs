@@ -152,7 +152,7 @@ fn rounds_are_the_samples() {
     assert_eq!(round_values(&row, "total_ms", 4, false).unwrap(), [6.5]);
 }
 
-/// Issue 25: one round of 15 frames, NEW's frames drifting up by 2 % per frame and one
+/// one round of 15 frames, NEW's frames drifting up by 2 % per frame and one
 /// group even ×1.5 slower: frames of one round are one sample, so no time verdict and no
 /// time regression; the same slowdown in 5 rounds is found, and 5 rounds without it are
 /// clean (the input flips the verdict).

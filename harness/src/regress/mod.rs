@@ -1,4 +1,4 @@
-//! Regression hunting across builds (issue 25): `tetbench ab BASE NEW` runs two builds
+//! Regression hunting across builds: `tetbench ab BASE NEW` runs two builds
 //! interleaved on one machine and compares them with compare's test ([`ab`]); `tetbench bisect
 //! GOOD BAD` searches the commits between for the first one an A/B calls a regression
 //! ([`bisect`]). A side is a tetbench binary or a git revision, built in a worktree and cached

@@ -78,7 +78,7 @@ impl<'a> Images<'a> {
     }
 }
 
-/// CSS classes of a table row: failed, suspect (issue 15's rule) and peer rows are marked.
+/// CSS classes of a table row: failed, suspect (the rule) and peer rows are marked.
 fn row_classes(failed: bool, suspect: bool, algorithm: &str) -> Vec<&'static str> {
     let mut c = vec![];
     if failed {
@@ -586,7 +586,7 @@ mod tests {
         assert!(markdown_summary(&a).contains("| test | variant=a;sort=radix | box:1k | 1000 |"));
     }
 
-    /// Issue 23: markup in a data set's name, a setting, an error or the command line lands in
+    /// markup in a data set's name, a setting, an error or the command line lands in
     /// the page as text.
     #[test]
     fn markup_in_names_is_escaped() {

@@ -1,4 +1,4 @@
-//! The one aggregation every report reads (issue 23, item 4): rows grouped per variant
+//! The one aggregation every report reads: rows grouped per variant
 //! (algorithm + typed settings) × data set × viewport (width × height, projection), over their
 //! viewpoints (the papers average over the 14 fixed viewpoints, HAVS §6), with the spreads the
 //! HTML and Markdown summaries, the charts, the papers' tables and `analyze` show, and the

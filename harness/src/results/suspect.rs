@@ -1,6 +1,6 @@
 //! Suspect rows: a rendering whose error is far out of line with the other algorithms on the
-//! same image, so that a broken renderer cannot hide in a green run (issue 15: HAVS at 13.7 dB on
-//! a mesh where GATOR and fragment PT reach 52 dB went unnoticed).
+//! same image, so that a broken renderer cannot hide in a green run (HAVS at 13.7 dB on a mesh where GATOR and
+//! fragment PT reach 52 dB once went unnoticed).
 //!
 //! Rows are compared per image: same data set, viewpoint and viewport. A row is suspect when
 //! its PSNR is below [`FLOOR_DB`] outright, or below [`FINE_DB`] and more than [`GAP_DB`] below

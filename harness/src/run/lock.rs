@@ -1,7 +1,7 @@
 //! One run per output directory at a time.
 //!
 //! Two `tetbench run --out same` at once used to both succeed while the second's
-//! `results.json` replaced the first's rows without a word (issue 25). A run now holds an
+//! `results.json` replaced the first's rows without a word. A run now holds an
 //! advisory lock (`flock` through the `fs4` crate) on `OUT/.tetbench-run.lock` for its whole
 //! life, and writes who it is into the file; a second run finds the lock taken and refuses,
 //! naming the holder. The kernel drops the lock when the holding process ends, however it

@@ -168,7 +168,7 @@ fn plan_variants(
         );
     }
     // A value no variant of an asked-for algorithm has is a typo that would silently drop the
-    // algorithm from the run (issue 18): refuse it, naming what the algorithm offers. An
+    // algorithm from the run: refuse it, naming what the algorithm offers. An
     // algorithm without the key at all keeps its defaults.
     for (name, n) in &kept {
         let Ok(all) = crate::algorithms::all_variants(name) else {

@@ -1,5 +1,5 @@
 //! The wgpu boilerplate every renderer repeated: bind-group layout entries, bind-group entries,
-//! render targets, and arrays split across storage bindings ([`ChunkedBuffer`], issue 14).
+//! render targets, and arrays split across storage bindings ([`ChunkedBuffer`]).
 //!
 //! A storage binding covers at most `max_storage_buffer_binding_size` bytes (128 MiB on
 //! lavapipe), so a 20 M-tet mesh's arrays (320 MB of tet indices, 640 MB of pass-1 records)

@@ -1,5 +1,5 @@
 //! The one clock every renderer times its frames with, so that `cpu_ms`, `gpu_ms` and
-//! `total_ms` mean the same in every row (issue 14).
+//! `total_ms` mean the same in every row.
 //!
 //! * `total_ms`: wall time from [`FrameClock::start`] (before the frame's first host work) until
 //!   the GPU finished the frame ([`FrameClock::finish`], called right after the last wait).

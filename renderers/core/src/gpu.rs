@@ -42,7 +42,7 @@ pub struct Gpu {
     pub triangles_per_pass: u32,
     /// Mappable buffers of earlier readbacks, reused by the next ([`Gpu::read_buffer`]): a
     /// frame that reads its counters back would otherwise allocate one every frame, which a
-    /// real application keeps (issue 43, the per-frame floor).
+    /// real application keeps.
     staging: std::sync::Mutex<Vec<wgpu::Buffer>>,
     /// Mappable buffers created for readbacks so far (what the reuse saves; tests read it).
     staging_created: std::sync::atomic::AtomicU64,
@@ -696,7 +696,7 @@ pub fn chunk_ranges(count: u64, element_bytes: u64, max_binding: u64) -> Vec<std
 /// optionally of its parts, split at marks between them ([`FrameTimer::with_marks`]). The
 /// timestamps are resolved and copied into a mappable buffer by the frame's own last command
 /// buffer ([`FrameTimer::end`]), so reading them ([`FrameTimer::gpu_ms`]) is one map: no
-/// further submission and no buffer created per frame (issue 43, the per-frame floor).
+/// further submission and no buffer created per frame.
 pub struct FrameTimer {
     query_set: Option<wgpu::QuerySet>,
     resolve: Option<wgpu::Buffer>,
@@ -931,7 +931,7 @@ mod device_tests {
         );
     }
 
-    /// Readbacks reuse their mappable buffers (issue 43: none created per frame) and still
+    /// Readbacks reuse their mappable buffers and still
     /// return exactly the bytes asked for: a smaller read after a larger one, an offset read,
     /// and a larger one that needs a new buffer.
     #[test]

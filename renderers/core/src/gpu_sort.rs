@@ -1,6 +1,6 @@
 //! GPU LSD radix sort of (f32 key, u32 payload) pairs, in place in storage buffers the caller
-//! owns, so that HAVS (its "GPU sort" setting, issue 4 item 1) and fragment PT (its GPU-resident
-//! order, issue 5 item 2) can compute keys, sort and draw with no readback.
+//! owns, so that HAVS (its "GPU sort" setting) and fragment PT (its GPU-resident
+//! order) can compute keys, sort and draw with no readback.
 //!
 //! Algorithm (`gpu_sort.wgsl`): four passes of 8 bits, each a per-tile histogram, a scan over
 //! tiles per digit, and a stable scatter. Keys are written by the caller as f32 (bits in a

@@ -52,7 +52,7 @@ pub trait Renderer {
     /// Uploads the mesh and every view-independent table. The mesh is shared: a renderer that
     /// reads it every frame (a CPU visibility sort, work counters) keeps a clone of the `Arc`,
     /// never a copy of the mesh, so that a run holds each mesh once (at 20 M tets a copy is
-    /// 385 MB; issue 27).
+    /// 385 MB).
     fn prepare(
         &mut self,
         gpu: &Gpu,

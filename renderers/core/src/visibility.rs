@@ -245,7 +245,7 @@ impl Eye {
 struct MeshCache {
     hash: String,
     /// In f32, like the points they average and the keys made of them: f64 would add 12 B per
-    /// tet (240 MB at 20 M tets) for digits the f32 sort keys drop (issue 27, item 6).
+    /// tet (240 MB at 20 M tets) for digits the f32 sort keys drop.
     centroids: Vec<[f32; 3]>,
     graph: Option<FaceGraph>,
 }

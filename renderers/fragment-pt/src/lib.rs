@@ -179,7 +179,7 @@ struct State {
     records: ChunkedBuffer,
     /// Pass 1's 2D dispatch (workgroups per row, rows).
     dispatch: (u32, u32),
-    /// Storage bindings the model and records take (issue 14's split).
+    /// Storage bindings the model and records take.
     mesh_bindings: u32,
     depths: wgpu::Buffer,
     order: wgpu::Buffer,
@@ -336,7 +336,7 @@ impl Renderer for FragmentPt {
             None => gpu.max_storage_binding(),
         }
         .max(256);
-        // Vertices, tets and pass-1 records are split over storage bindings (issue 14); the
+        // Vertices, tets and pass-1 records are split over storage bindings; the
         // centroid depths and the order stay one binding each, because the GPU radix sort and
         // the CPU upload take them whole (4 B/tet: 33 M tets at lavapipe's 128 MiB).
         let adapter_binding = gpu.max_storage_binding();

@@ -422,7 +422,7 @@ impl Renderer for Havs {
             None => gpu.max_storage_binding(),
         }
         .max(256);
-        // Vertex and face arrays split over as many storage bindings as they need (issue 14);
+        // Vertex and face arrays split over as many storage bindings as they need;
         // the shaders read them through the generated `verts_at` / `faces_at`.
         let storage = wgpu::BufferUsages::STORAGE;
         let verts_buf = ChunkedBuffer::with_data(

@@ -79,7 +79,7 @@ fn render(
 #[test]
 fn the_racy_single_pass_counts_what_its_cpu_twin_counts_per_pixel() {
     let gpu = gpu();
-    // The sliver onion breaks a k = 2 buffer almost everywhere (issue 15), so the counts to
+    // The sliver onion breaks a k = 2 buffer almost everywhere, so the counts to
     // compare are not all zero; 48² keeps the per-pixel lists short enough to check quickly.
     let mesh = std::sync::Arc::new(datasets::generate::from_spec("onion:4k", 1).unwrap());
     let optics = Optics::for_mesh(TransferFunction::preset("low-opacity").unwrap(), &mesh);

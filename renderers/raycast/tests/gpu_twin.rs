@@ -329,7 +329,7 @@ fn images_match_the_reference_on_a_non_convex_mesh_in_both_modes_and_across_bind
         "shell:20k 3D table, et=off: {p:.2} dB, counters {:?}",
         stats.counters
     );
-    // Empirical floor, issue 9's acceptance bound for the exact-order 3D table: what remains
+    // Empirical floor, the acceptance bound for the exact-order 3D table: what remains
     // is table resolution and f32 (measured 65–99 dB over 14 views at 512² on spx, Blunt Fin
     // and Post, docs/reproduction.md). It catches a broken walk or table; single steps are
     // checked exactly against the CPU twin above, pass counts per pixel too.
@@ -416,6 +416,6 @@ fn spx_matches_the_reference() {
         "spx 3D table, et=off: {p:.2} dB, counters {:?}",
         stats.counters
     );
-    // The same empirical floor as on the shell (issue 9's 45 dB for the exact-order image).
+    // The same empirical floor as on the shell (the 45 dB for the exact-order image).
     assert!(p >= 45.0, "{p:.2} dB");
 }

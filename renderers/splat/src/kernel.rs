@@ -313,7 +313,7 @@ mod tests {
         }
     }
 
-    /// Issue 10, tests: the slice footprints of one voxel sum to the kernel's integral over
+    /// tests: the slice footprints of one voxel sum to the kernel's integral over
     /// each slab, and over all the slabs it touches to 1, within 1e-4.
     #[test]
     fn slice_footprints_sum_to_the_slab_integrals() {

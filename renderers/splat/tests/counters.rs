@@ -1,4 +1,4 @@
-//! The splatter's work counters against the GPU's own counts (issue 23, item 6):
+//! The splatter's work counters against the GPU's own counts:
 //! `splat_fragments` (derived on the CPU, `coverage.rs`) against the fragments the compute
 //! pass visited, counted by the early-splat-elimination atomic with every fragment dropped;
 //! `splats` against the bucket table's ranges; the composite's fragments and the triangles.

@@ -1,5 +1,5 @@
 //! The splatter against its CPU twins, an analytic single-voxel image and the exact reference
-//! of the same data's tet split (issue 10, "Tests").
+//! of the same data's tet split.
 //!
 //! PSNR as the harness reports it: RGB of the premultiplied image over black, clamped to
 //! [0, 1], every pixel, peak 1.
@@ -65,7 +65,7 @@ fn volume(spec: &str) -> TetMesh {
     datasets::gen_volume::from_volume_spec(spec).unwrap()
 }
 
-/// Issue 10: GPU bucket boundaries equal the CPU twin's on the GPU-sorted depths, for both GPU
+/// GPU bucket boundaries equal the CPU twin's on the GPU-sorted depths, for both GPU
 /// sorts, and the CPU-bucket pipeline builds the same table.
 #[test]
 fn gpu_bucket_boundaries_equal_the_cpu_twin() {
@@ -115,7 +115,7 @@ fn count_unused(mesh: &TetMesh) -> usize {
     used.iter().filter(|u| !**u).count()
 }
 
-/// Issue 10: one voxel's image equals its analytic projection: colour c·(1 − exp(−κ·P(ρ)/L))
+/// one voxel's image equals its analytic projection: colour c·(1 − exp(−κ·P(ρ)/L))
 /// with P the kernel's line integral at distance ρ from the voxel (orthographic, so every
 /// slab's opacity multiplies up to the exponential of the whole integral).
 #[test]
@@ -182,7 +182,7 @@ fn single_voxel_matches_its_analytic_projection() {
     assert!(worst < 5e-3, "worst channel error {worst}");
 }
 
-/// Issue 10: a smooth generated volume against the exact reference of its tet split, both
+/// a smooth generated volume against the exact reference of its tet split, both
 /// projections; CPU and GPU buckets give the same image; bricking changes the image only at
 /// brick faces.
 #[test]

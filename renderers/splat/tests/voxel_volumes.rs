@@ -1,4 +1,4 @@
-//! Voxel data sets without tets (issue 27, item 4): the splatter draws a generated volume from
+//! Voxel data sets without tets: the splatter draws a generated volume from
 //! its grid alone — the same voxels, counters and image as from the volume's split mesh — and
 //! nothing splits the volume into tets on the way.
 

@@ -202,7 +202,7 @@ fn cpu_name() -> String {
 #[derive(Debug, clap::Args)]
 pub struct KbufferArgs {
     /// Data sets (registry names or files), comma-separated.
-    /// (`onion:10k` is the sliver stress case of issue 15: nested sliver shells.)
+    /// (`onion:10k` is the sliver stress case: nested sliver shells.)
     #[arg(
         long,
         value_delimiter = ',',
