@@ -251,7 +251,8 @@ fn a_key_pass_over_split_primitives_equals_one_over_the_whole() -> anyhow::Resul
     Ok(())
 }
 
-/// Arrays larger than one storage binding sort in one piece: with the binding limited to 256 KiB (65,536 keys), 65,537 and 150,000 keys span
+/// Arrays larger than one storage binding sort in one piece (HAVS's 20 M-tet
+/// faces): with the binding limited to 256 KiB (65,536 keys), 65,537 and 150,000 keys span
 /// two and three bindings, and the order equals the CPU radix sort's exactly, ascending
 /// and descending; a sort of fewer keys than the sorter holds binds its unused chunks
 /// harmlessly.
