@@ -78,7 +78,7 @@ impl<'a> Images<'a> {
     }
 }
 
-/// CSS classes of a table row: failed, suspect (the rule) and peer rows are marked.
+/// CSS classes of a table row: failed, suspect (`results::suspect`'s rule) and peer rows are marked.
 fn row_classes(failed: bool, suspect: bool, algorithm: &str) -> Vec<&'static str> {
     let mut c = vec![];
     if failed {

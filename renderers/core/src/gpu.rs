@@ -931,7 +931,7 @@ mod device_tests {
         );
     }
 
-    /// Readbacks reuse their mappable buffers and still
+    /// Readbacks reuse their mappable buffers (none created per frame) and still
     /// return exactly the bytes asked for: a smaller read after a larger one, an offset read,
     /// and a larger one that needs a new buffer.
     #[test]

@@ -1,6 +1,6 @@
 //! HAVS per frame: the GPU key pass of the `gpu-radix` sort, the per-viewport targets, and
 //! one frame (object-space sort, face raster into the k-buffers, drain), timed with
-//! [`FrameClock`].
+//! [`FrameClock`] (one definition of `cpu_ms` for every renderer).
 
 use std::time::Instant;
 
