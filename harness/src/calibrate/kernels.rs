@@ -5,7 +5,7 @@
 use render_core::Gpu;
 
 pub use crate::calibrate::workload::calibrate_source;
-use crate::calibrate::workload::{ProbeContext, Workload};
+use crate::calibrate::workload::{Filler, ProbeContext, Workload};
 
 const GRID: u64 = 256; // calibrate.wgsl GRID
 const TRIANGLES: u64 = GRID * GRID * 2;
@@ -212,17 +212,9 @@ pub fn storage_copy<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'
 /// run on) at several sizes: the rows sort from a few thousand keys (in cache) to millions,
 /// and a peak must hold at every size a row sorts. Each size is checked to sort once here.
 pub fn cpu_sort<'g>(_ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>> {
-    let mut state = 0x9E37_79B9_7F4A_7C15u64;
-    let keys: std::sync::Arc<Vec<f32>> = std::sync::Arc::new(
-        (0..SORT_KEYS)
-            .map(|_| {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                (state >> 40) as f32 / (1u64 << 24) as f32
-            })
-            .collect(),
-    );
+    let mut fill = Filler(0x9E37_79B9_7F4A_7C15);
+    let keys: std::sync::Arc<Vec<f32>> =
+        std::sync::Arc::new((0..SORT_KEYS).map(|_| fill.unit()).collect());
     let mut out = vec![];
     for n in SORT_SIZES {
         let keys = keys.clone();

@@ -4,7 +4,7 @@
 //! [`Workload`]s (see `probes.rs`).
 
 use crate::calibrate::kernels::dispatch;
-use crate::calibrate::workload::{ProbeContext, Workload};
+use crate::calibrate::workload::{Filler, ProbeContext, Workload};
 use render_core::gpu::{Lifetime, MemoryLedger};
 use render_core::gpu_sort::GpuRadixSort;
 use render_core::table_texture::TableTexture;
@@ -28,17 +28,6 @@ pub const SPLAT_SIDES: [u32; 4] = [4, 8, 16, 32];
 /// Splat fragments per timed dispatch at every side (the squares are repeated to reach it).
 const SPLAT_FRAGMENTS: u64 = 2 << 20;
 const GPU_SORT_SIZES: [u32; 2] = [1 << 16, 1 << 18];
-
-/// xorshift64: reproducible filler for the tables.
-struct Filler(u64);
-impl Filler {
-    fn unit(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
 
 fn storage(
     gpu: &Gpu,

@@ -5,6 +5,17 @@
 
 use render_core::Gpu;
 
+/// xorshift64: reproducible filler for the tables.
+pub struct Filler(pub u64);
+impl Filler {
+    pub fn unit(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
 /// What every probe is prepared with: the device and the calibration's shader module.
 pub struct ProbeContext<'g> {
     pub gpu: &'g Gpu,
