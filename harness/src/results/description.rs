@@ -62,7 +62,10 @@ fn one_round() -> u32 {
     1
 }
 
-fn as_text<T: fmt::Display, S: Serializer>(value: &T, s: S) -> Result<S::Ok, S::Error> {
+/// Writes a value as its text (`Display`): the command line's form of a run's fields, and
+/// `key=value;…` for a variant's [`render_core::Settings`] in the JSON outputs that keep them
+/// as text (`#[serde(serialize_with = "as_text")]`).
+pub fn as_text<T: fmt::Display, S: Serializer>(value: &T, s: S) -> Result<S::Ok, S::Error> {
     s.collect_str(value)
 }
 
