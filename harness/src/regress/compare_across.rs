@@ -11,12 +11,14 @@
 //! (caches, a driver's shader compiler), so a change on one adapter is never judged against
 //! a run on another.
 
+use render_core::Settings;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::calibrate::control::speed_factor;
 use crate::regress::compare_control::has_control;
 use crate::results::aggregate::GroupKey;
+use crate::results::description::as_text;
 use crate::results::{ResultsFile, Row};
 
 /// compare.json's `across`: the two runs' machines differ.
@@ -39,7 +41,9 @@ pub struct AcrossMachines {
 #[serde(deny_unknown_fields)]
 pub struct AcrossGroup {
     pub algorithm: String,
-    pub settings: String,
+    #[serde(serialize_with = "as_text")]
+    #[schemars(with = "String")]
+    pub settings: Settings,
     pub dataset: String,
     pub width: u32,
     pub height: u32,
@@ -114,7 +118,7 @@ fn group(g: &GroupKey, base: &[Row], new: &[Row], machine_factor: f64) -> Option
     let raw_ratio = (logs.iter().sum::<f64>() / logs.len() as f64).exp();
     Some(AcrossGroup {
         algorithm: g.algorithm.clone(),
-        settings: g.settings.to_string(),
+        settings: g.settings.clone(),
         dataset: g.dataset.clone(),
         width: g.width,
         height: g.height,
