@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::calibrate::control::speed_factor;
 use crate::regress::compare_control::has_control;
+use crate::regress::compare_setup::key;
 use crate::results::aggregate::GroupKey;
 use crate::results::description::as_text;
 use crate::results::{ResultsFile, Row};
@@ -105,9 +106,7 @@ fn group(g: &GroupKey, base: &[Row], new: &[Row], machine_factor: f64) -> Option
         .iter()
         .filter(|b| g.matches(b))
         .filter_map(|b| {
-            let n = new
-                .iter()
-                .find(|n| crate::regress::compare::key(n) == crate::regress::compare::key(b))?;
+            let n = new.iter().find(|n| key(n) == key(b))?;
             let (tb, tn) = (b.total_ms?, n.total_ms?);
             (tb > 0.0 && tn > 0.0).then(|| (tn / tb).ln())
         })
