@@ -88,7 +88,7 @@ fn merged_shards_equal_one_run_and_compare_finds_no_change() {
     let s2 = run("s2", Some("2/2"));
     assert!(full.rows.len() >= 16, "{}", full.rows.len());
     assert!(!s1.rows.is_empty() && !s2.rows.is_empty());
-    assert_eq!(s1.run.shard.as_deref(), Some("1/2"));
+    assert_eq!(s1.run.shard.map(|s| s.to_string()).as_deref(), Some("1/2"));
     // Exact partition: every row of the full run in exactly one shard.
     let mut union: Vec<String> = s1.rows.iter().chain(&s2.rows).map(untimed).collect();
     let mut all: Vec<String> = full.rows.iter().map(untimed).collect();

@@ -267,12 +267,12 @@ fn write_shard(out: &Path, i: usize, finished: bool, exit_status: Option<i32>) {
     let run = RunDescription {
         algorithms: vec!["gator-pt".into()],
         datasets: vec!["box:1k".into(), "shell:1k".into()],
-        viewpoints: "+x".into(),
+        viewpoints: "+x".parse().unwrap(),
         width: 8,
         height: 8,
         frames: 1,
         rounds: 1,
-        shard: Some(format!("{i}/3")),
+        shard: Some(Shard { index: i, count: 3 }),
         ..RunDescription::default()
     };
     let all = units_of(&run);

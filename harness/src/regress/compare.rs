@@ -347,7 +347,7 @@ fn compare_all_rows(
 fn only(r: &Row, status: RowStatus) -> RowComparison {
     RowComparison {
         algorithm: r.algorithm.clone(),
-        settings: r.settings.to_string(),
+        settings: r.settings.clone(),
         dataset: r.dataset.clone(),
         viewpoint: r.viewpoint.clone(),
         width: r.width,

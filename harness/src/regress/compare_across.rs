@@ -13,6 +13,7 @@
 
 use std::path::Path;
 
+use render_core::Settings;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -20,6 +21,7 @@ use crate::calibrate::control::speed_factor;
 use crate::regress::compare_control::has_control;
 use crate::regress::compare_setup::key;
 use crate::results::aggregate::GroupKey;
+use crate::results::description::as_text;
 use crate::results::{ResultsFile, Row};
 
 /// compare.json's `across`: the two runs' machines differ.
@@ -42,7 +44,9 @@ pub struct AcrossMachines {
 #[serde(deny_unknown_fields)]
 pub struct AcrossGroup {
     pub algorithm: String,
-    pub settings: String,
+    #[serde(serialize_with = "as_text")]
+    #[schemars(with = "String")]
+    pub settings: Settings,
     pub dataset: String,
     pub width: u32,
     pub height: u32,
@@ -140,7 +144,7 @@ fn group(g: &GroupKey, base: &[Row], new: &[Row], machine_factor: f64) -> Option
     let raw_ratio = (logs.iter().sum::<f64>() / logs.len() as f64).exp();
     Some(AcrossGroup {
         algorithm: g.algorithm.clone(),
-        settings: g.settings.to_string(),
+        settings: g.settings.clone(),
         dataset: g.dataset.clone(),
         width: g.width,
         height: g.height,

@@ -2,6 +2,8 @@
 //! change names its group (and row), the metric, the ratio, the p-values and the verdict, with
 //! the sentence the reports print beside them.
 
+use render_core::Settings;
+
 use crate::regress::compare_image::ImageVerdict;
 use crate::regress::compare_model::{
     Comparison, Finding, FindingVerdict, RowComparison, RowStatus,
@@ -9,7 +11,7 @@ use crate::regress::compare_model::{
 use crate::regress::compare_time::{TimeTest, Verdict};
 use crate::regress::compare_work::WorkVerdict;
 
-fn group_label(algorithm: &str, settings: &str, dataset: &str) -> String {
+fn group_label(algorithm: &str, settings: &Settings, dataset: &str) -> String {
     format!("{algorithm} {settings} on {dataset}")
 }
 

@@ -2,6 +2,7 @@
 //! findings, and the comparison as a whole. Types only (and their small methods): the driver
 //! that fills them is [`crate::regress::compare`].
 
+use render_core::Settings;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -10,6 +11,7 @@ use crate::regress::compare_rounds::{GroupComparison, Rounds};
 use crate::regress::compare_time::TimeTest;
 use crate::regress::compare_work::WorkChange;
 use crate::results::aggregate::GroupKey;
+use crate::results::description::as_text;
 
 /// The layout of `compare.json` (`docs/compare.schema.json`); bumped when a field changes
 /// meaning or is removed.
@@ -57,7 +59,9 @@ impl std::fmt::Display for RowStatus {
 #[serde(deny_unknown_fields)]
 pub struct RowComparison {
     pub algorithm: String,
-    pub settings: String,
+    #[serde(serialize_with = "as_text")]
+    #[schemars(with = "String")]
+    pub settings: Settings,
     pub dataset: String,
     pub viewpoint: String,
     pub width: u32,
@@ -74,8 +78,7 @@ impl RowComparison {
     /// Whether the row belongs to group `g` (a row comparison keeps no projection: matched on
     /// the rest).
     pub fn in_group(&self, g: &GroupKey) -> bool {
-        (&self.algorithm, &self.settings, &self.dataset)
-            == (&g.algorithm, &g.settings.to_string(), &g.dataset)
+        (&self.algorithm, &self.settings, &self.dataset) == (&g.algorithm, &g.settings, &g.dataset)
             && (self.width, self.height) == (g.width, g.height)
     }
 }

@@ -311,7 +311,7 @@ fn html(c: &Comparison) -> anyhow::Result<String> {
                 class: r.status.label().replace(' ', "-"),
                 status: r.status.to_string(),
                 algorithm: r.algorithm.clone(),
-                settings: r.settings.clone(),
+                settings: r.settings.to_string(),
                 dataset: r.dataset.clone(),
                 viewpoint: r.viewpoint.clone(),
                 total_ms: time_cell(metric(r, "total_ms")),

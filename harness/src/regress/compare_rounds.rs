@@ -2,12 +2,14 @@
 //! side holds ([`Rounds`]), and the pooled test per group of viewpoints ([`group_tests`]) that
 //! gates (see [`crate::regress::compare`] for why rounds, not frames, are the samples).
 
+use render_core::Settings;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::regress::compare_setup::{key, CompareOptions};
 use crate::regress::compare_time::{paired_t_tests, scaled, time_test, TimeTest, Verdict};
 use crate::results::aggregate::GroupKey;
+use crate::results::description::as_text;
 use crate::results::stats::median;
 use crate::results::{ResultsFile, Row};
 
@@ -15,7 +17,9 @@ use crate::results::{ResultsFile, Row};
 #[serde(deny_unknown_fields)]
 pub struct GroupComparison {
     pub algorithm: String,
-    pub settings: String,
+    #[serde(serialize_with = "as_text")]
+    #[schemars(with = "String")]
+    pub settings: Settings,
     pub dataset: String,
     /// The group's viewport ([`GroupKey`]): one variant at two sizes is two groups.
     #[serde(default)]
@@ -32,8 +36,7 @@ pub struct GroupComparison {
 impl GroupComparison {
     /// Whether this is the comparison of the reports' group `g`.
     pub fn is(&self, g: &GroupKey) -> bool {
-        (&self.algorithm, &self.settings, &self.dataset)
-            == (&g.algorithm, &g.settings.to_string(), &g.dataset)
+        (&self.algorithm, &self.settings, &self.dataset) == (&g.algorithm, &g.settings, &g.dataset)
             && (self.width, self.height, &self.projection) == (g.width, g.height, &g.projection)
     }
 }
@@ -182,7 +185,7 @@ pub(crate) fn group_tests(
         out.push(GroupComparison {
             total: round_test("total_ms", &bs, &ns, opt, rounds),
             algorithm: group.algorithm,
-            settings: group.settings.to_string(),
+            settings: group.settings,
             dataset: group.dataset,
             width: group.width,
             height: group.height,

@@ -23,6 +23,7 @@ use std::collections::BinaryHeap;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
+use render_core::Settings;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -113,11 +114,11 @@ pub fn json_schema() -> serde_json::Value {
     serde_json::to_value(schemars::schema_for!(History)).expect("a schema is JSON")
 }
 
-/// A group as history follows it across runs: compare's key, the settings as text.
+/// A group as history follows it across runs: compare's key.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SeriesKey {
     pub algorithm: String,
-    pub settings: String,
+    pub settings: Settings,
     pub dataset: String,
     pub width: u32,
     pub height: u32,
@@ -128,7 +129,7 @@ impl SeriesKey {
     pub fn of(g: &GroupKey) -> SeriesKey {
         SeriesKey {
             algorithm: g.algorithm.clone(),
-            settings: g.settings.to_string(),
+            settings: g.settings.clone(),
             dataset: g.dataset.clone(),
             width: g.width,
             height: g.height,
@@ -264,7 +265,7 @@ fn pooled(rows: &[&Row], scale: impl Fn(&Row) -> Option<f64>) -> Vec<f64> {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RowFinding {
     pub algorithm: String,
-    pub settings: String,
+    pub settings: Settings,
     pub dataset: String,
     pub width: u32,
     pub height: u32,
@@ -661,7 +662,7 @@ pub fn build(runs: Vec<RunSummary>, pairs: &[Option<PairFindings>], threshold: f
         }
         series.push(Series {
             algorithm: g.algorithm.clone(),
-            settings: g.settings.clone(),
+            settings: g.settings.to_string(),
             dataset: g.dataset.clone(),
             width: g.width,
             height: g.height,

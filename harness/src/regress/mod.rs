@@ -209,7 +209,7 @@ mod tests {
             groups: vec![(
                 crate::regress::history::SeriesKey {
                     algorithm: "a".into(),
-                    settings: String::new(),
+                    settings: render_core::Settings::new(),
                     dataset: "d".into(),
                     width: 1,
                     height: 1,

@@ -298,7 +298,7 @@ fn machine_lines(file: &ResultsFile) -> Vec<(&'static str, String)> {
                 .unwrap_or_else(|| "not finished (interrupted?)".into()),
         ),
         ("command", r.command_line.join(" ")),
-        ("viewpoints", r.viewpoints.clone()),
+        ("viewpoints", r.viewpoints.to_string()),
         (
             "viewport",
             format!("{}×{}, {}", r.width, r.height, r.projection),

@@ -18,11 +18,13 @@ use serde::{Deserialize, Serialize};
 
 use render_core::Settings;
 
+pub use crate::results::description::{MergedRun, RunDescription, Shard, Viewpoints};
 use crate::results::machine::MachineInfo;
 pub use crate::results::named::NamedValues;
 
 pub mod aggregate;
 pub mod control;
+pub mod description;
 pub mod git_state;
 pub mod machine;
 pub mod metrics;
@@ -234,50 +236,6 @@ impl Row {
     pub fn ok(&self) -> bool {
         self.error.is_empty()
     }
-}
-
-/// How the run was asked for, stored with the results so a report says what it shows.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct RunDescription {
-    pub command_line: Vec<String>,
-    pub algorithms: Vec<String>,
-    pub datasets: Vec<String>,
-    pub viewpoints: String,
-    pub width: u32,
-    pub height: u32,
-    /// Timed frames per viewpoint in each round.
-    pub frames: u32,
-    pub warmup: u32,
-    /// Passes over each data set's variants (`run --rounds`; files from before it: 1).
-    #[serde(default = "one_round")]
-    pub rounds: u32,
-    pub transfer_function: String,
-    pub projection: String,
-    pub settings_filter: String,
-    pub reference: bool,
-    /// `i/N` when this run is one shard of a larger matrix (`run --shard`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub shard: Option<String>,
-    /// The runs `report --merge` put together (empty for a plain run).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub merged_from: Vec<MergedRun>,
-}
-
-/// Where the rows of a merged results set came from.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct MergedRun {
-    pub dir: String,
-    pub shard: Option<String>,
-    pub adapter: Option<String>,
-    pub git_commit: Option<String>,
-    pub date_utc: String,
-    pub rows: usize,
-}
-
-fn one_round() -> u32 {
-    1
 }
 
 /// The whole of `results.json`.

@@ -24,7 +24,7 @@ use crate::algorithms::SettingsFilter;
 use crate::report::progress::Progress;
 use crate::results::machine::MachineInfo;
 use crate::results::metrics::{self, summarize};
-use crate::results::{ResultsWriter, Row, RunDescription};
+use crate::results::{ResultsWriter, Row, RunDescription, Viewpoints};
 
 pub mod allocator;
 pub mod control;
@@ -43,8 +43,7 @@ use measure::DatasetContext;
 pub struct RunConfig {
     pub algorithms: Vec<String>,
     pub datasets: Vec<String>,
-    pub viewpoint_spec: String,
-    pub viewpoints: Vec<Viewpoint>,
+    pub viewpoints: Viewpoints,
     pub width: u32,
     pub height: u32,
     pub frames: u32,
@@ -420,7 +419,7 @@ fn run_description(config: &RunConfig) -> RunDescription {
         command_line: config.command_line.clone(),
         algorithms: config.algorithms.clone(),
         datasets: config.datasets.clone(),
-        viewpoints: config.viewpoint_spec.clone(),
+        viewpoints: config.viewpoints.clone(),
         width: config.width,
         height: config.height,
         frames: config.frames,
@@ -428,9 +427,9 @@ fn run_description(config: &RunConfig) -> RunDescription {
         rounds: config.rounds,
         transfer_function: config.tf_spec.clone(),
         projection: projection_name(&config.projection),
-        settings_filter: config.settings_filter.to_string(),
+        settings_filter: config.settings_filter.clone(),
         reference: config.reference,
-        shard: config.shard.map(|s| s.to_string()),
+        shard: config.shard,
         merged_from: vec![],
     }
 }

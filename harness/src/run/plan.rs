@@ -10,6 +10,7 @@ use std::path::PathBuf;
 use render_core::{Projection, TransferFunction};
 
 use crate::algorithms::{self, SettingsFilter};
+use crate::results::Viewpoints;
 use crate::run::matrix::{MatrixArgs, DEFAULT_TF};
 use crate::run::suite::{self, DEFAULT_SUITE};
 use crate::run::RunConfig;
@@ -85,15 +86,12 @@ impl RunPlan {
         let pick = |given: Option<u32>, suite: u32, standard: u32| {
             given.unwrap_or(if suite_mode { suite } else { standard })
         };
-        let viewpoint_spec = m.viewpoints.clone().unwrap_or_else(|| {
-            if suite_mode {
-                DEFAULT_SUITE.viewpoints
-            } else {
-                suite::STANDARD_VIEWPOINTS
-            }
-            .to_string()
-        });
-        let viewpoints = suite::parse_viewpoints(&viewpoint_spec)?;
+        let standard = if suite_mode {
+            DEFAULT_SUITE.viewpoints
+        } else {
+            suite::STANDARD_VIEWPOINTS
+        };
+        let viewpoints: Viewpoints = flag("--viewpoints", m.viewpoints.as_deref(), standard)?;
         let resolution = pick(
             m.resolution,
             DEFAULT_SUITE.resolution,
@@ -161,7 +159,6 @@ impl RunPlan {
         Ok(RunConfig {
             algorithms,
             datasets,
-            viewpoint_spec,
             viewpoints,
             width: resolution,
             height: resolution,
@@ -187,12 +184,27 @@ impl RunPlan {
             command_line,
             report: !self.no_report,
             strict: self.strict,
-            shard: self.shard.as_deref().map(str::parse).transpose()?,
+            shard: self
+                .shard
+                .as_deref()
+                .map(|s| flag("--shard", Some(s), ""))
+                .transpose()?,
             calibrate: !m.no_calibrate,
             resume: false,
             externals,
         })
     }
+}
+
+/// A flag's text (`given`, else `default`) parsed into its type; a failure names the flag
+/// and the text.
+fn flag<T>(name: &str, given: Option<&str>, default: &str) -> anyhow::Result<T>
+where
+    T: std::str::FromStr<Err = anyhow::Error>,
+{
+    let text = given.unwrap_or(default);
+    text.parse()
+        .map_err(|e| anyhow::anyhow!("{name} {text:?}: {e}"))
 }
 
 #[cfg(test)]

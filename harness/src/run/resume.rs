@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use crate::results::machine::MachineInfo;
-use crate::results::{ResultsFile, Row, RunDescription, JSON_FILE};
+use crate::results::{ResultsFile, Row, RunDescription, Shard, JSON_FILE};
 
 /// A unit of the run matrix: (data set label, algorithm, settings).
 pub type Unit = (String, String, render_core::Settings);
@@ -29,7 +29,11 @@ pub fn plan_differences(old: &RunDescription, new: &RunDescription) -> Vec<Strin
         new.algorithms.join(","),
     );
     check("data sets", old.datasets.join(","), new.datasets.join(","));
-    check("viewpoints", old.viewpoints.clone(), new.viewpoints.clone());
+    check(
+        "viewpoints",
+        old.viewpoints.to_string(),
+        new.viewpoints.to_string(),
+    );
     check(
         "size",
         format!("{}x{}", old.width, old.height),
@@ -46,19 +50,16 @@ pub fn plan_differences(old: &RunDescription, new: &RunDescription) -> Vec<Strin
     check("projection", old.projection.clone(), new.projection.clone());
     check(
         "settings filter",
-        old.settings_filter.clone(),
-        new.settings_filter.clone(),
+        old.settings_filter.to_string(),
+        new.settings_filter.to_string(),
     );
     check(
         "reference",
         old.reference.to_string(),
         new.reference.to_string(),
     );
-    check(
-        "shard",
-        format!("{:?}", old.shard),
-        format!("{:?}", new.shard),
-    );
+    let shard = |s: Option<Shard>| s.map_or("none".to_string(), |s| s.to_string());
+    check("shard", shard(old.shard), shard(new.shard));
     out
 }
 
@@ -116,7 +117,7 @@ mod tests {
         RunDescription {
             algorithms: vec!["havs".into()],
             datasets: vec!["box:1k".into()],
-            viewpoints: "+x,-x".into(),
+            viewpoints: "+x,-x".parse().unwrap(),
             frames: 3,
             rounds: 3,
             ..Default::default()

@@ -12,40 +12,13 @@ use render_core::Settings;
 use std::collections::{HashMap, HashSet};
 use std::fmt;
 use std::path::{Path, PathBuf};
-use std::str::FromStr;
 
-use anyhow::{anyhow, Context};
+use anyhow::Context;
 
+use crate::algorithms::describe;
 use crate::results::names::stable_hash;
-pub use crate::results::MergedRun;
 use crate::results::{self, ResultsFile, Row, RunDescription};
-
-/// Shard `index` (1-based) of `count`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Shard {
-    pub index: usize,
-    pub count: usize,
-}
-
-impl FromStr for Shard {
-    type Err = anyhow::Error;
-    fn from_str(s: &str) -> anyhow::Result<Shard> {
-        let bad = || anyhow!("--shard {s:?}: expected i/N with 1 ≤ i ≤ N, e.g. 2/4");
-        let (i, n) = s.split_once('/').ok_or_else(bad)?;
-        let index: usize = i.trim().parse().map_err(|_| bad())?;
-        let count: usize = n.trim().parse().map_err(|_| bad())?;
-        if index == 0 || index > count {
-            return Err(bad());
-        }
-        Ok(Shard { index, count })
-    }
-}
-
-impl fmt::Display for Shard {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
-    }
-}
+pub use crate::results::{MergedRun, Shard};
 
 /// One unit of the run matrix: (data set label, algorithm, settings).
 pub type Unit = (String, String, render_core::Settings);
@@ -151,29 +124,18 @@ impl fmt::Display for Gap {
 /// Every (data set, algorithm, settings) unit `run` asks for, in the order it runs them (the
 /// units `--shard` deals out).
 pub fn units_of(run: &RunDescription) -> Vec<Unit> {
-    let filter = crate::algorithms::SettingsFilter::parse(&run.settings_filter).unwrap_or_default();
     let mut units = vec![];
     for spec in &run.datasets {
         let label = crate::results::names::dataset_label(spec);
-        for a in &run.algorithms {
-            for settings in crate::algorithms::selected_settings(a, &filter).unwrap_or_default() {
-                units.push((label.clone(), a.clone(), settings));
+        // An external renderer (`--external`) is not in the registry: the file does not
+        // say its variants, so it has no units here.
+        for d in run.algorithms.iter().filter_map(|a| describe(a)) {
+            for settings in d.select(&run.settings_filter) {
+                units.push((label.clone(), d.name.to_string(), settings));
             }
         }
     }
     units
-}
-
-/// The shard a results file records, if it is one.
-fn shard_of(f: &ResultsFile, dir: &Path) -> anyhow::Result<Option<Shard>> {
-    f.run
-        .shard
-        .as_deref()
-        .map(|s| {
-            s.parse::<Shard>()
-                .with_context(|| format!("{}: run.shard in results.json", dir.display()))
-        })
-        .transpose()
 }
 
 /// What `files` (read from `dirs`) lack of the matrices they are parts of: every run that did
@@ -181,14 +143,14 @@ fn shard_of(f: &ResultsFile, dir: &Path) -> anyhow::Result<Option<Shard>> {
 /// for, and every shard `i/N` of a split (same algorithms and N) that fewer files hold than
 /// another shard of that split — none, or once where the others came from two machines.
 /// Empty when the parts are complete.
-pub fn gaps(files: &[ResultsFile], dirs: &[PathBuf]) -> anyhow::Result<Vec<Gap>> {
+pub fn gaps(files: &[ResultsFile], dirs: &[PathBuf]) -> Vec<Gap> {
     let mut gaps = vec![];
     // Split (algorithms, N) → how many files hold each shard, and one of its files. Not keyed
     // by adapter: the shards of one split may run on different GPUs of a cluster.
     type Split<'f> = ((Vec<String>, usize), HashMap<usize, usize>, &'f ResultsFile);
     let mut splits: Vec<Split> = vec![];
     for (f, d) in files.iter().zip(dirs) {
-        let shard = shard_of(f, d)?;
+        let shard = f.run.shard;
         if f.finished_utc.is_none() {
             let own: Vec<Unit> = match shard {
                 Some(s) => {
@@ -247,7 +209,7 @@ pub fn gaps(files: &[ResultsFile], dirs: &[PathBuf]) -> anyhow::Result<Vec<Gap>>
             });
         }
     }
-    Ok(gaps)
+    gaps
 }
 
 /// Merges the results in `dirs` into one set written to `out` (results, samples, copied
@@ -263,7 +225,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path, allow_missing: bool) -> anyhow::Resul
         .iter()
         .map(|d| ResultsFile::read(d))
         .collect::<anyhow::Result<_>>()?;
-    let gaps = gaps(&files, dirs)?;
+    let gaps = gaps(&files, dirs);
     if !gaps.is_empty() && !allow_missing {
         let list: Vec<String> = gaps.iter().map(|g| format!("  {g}")).collect();
         anyhow::bail!(
@@ -328,7 +290,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path, allow_missing: bool) -> anyhow::Resul
         }
         merged_from.push(MergedRun {
             dir: d.display().to_string(),
-            shard: f.run.shard.clone(),
+            shard: f.run.shard,
             adapter: f.machine.adapter.as_ref().map(|a| a.name.clone()),
             git_commit: f.machine.git_commit.clone(),
             date_utc: f.machine.date_utc.clone(),
@@ -395,24 +357,19 @@ pub fn sort_like_a_run(rows: &mut [Row], run: &RunDescription) {
         .iter()
         .map(|d| crate::results::names::dataset_label(d))
         .collect();
-    let viewpoints: Vec<String> = crate::run::suite::parse_viewpoints(&run.viewpoints)
-        .map(|v| v.into_iter().map(|v| v.name).collect())
-        .unwrap_or_default();
-    let filter = crate::algorithms::SettingsFilter::parse(&run.settings_filter).ok();
-    let mut variant_order: HashMap<String, Vec<Settings>> = HashMap::new();
-    for a in &run.algorithms {
-        let order = filter
-            .as_ref()
-            .and_then(|f| crate::algorithms::selected_settings(a, f).ok())
-            .unwrap_or_default();
-        variant_order.insert(a.clone(), order);
-    }
+    let viewpoints = run.viewpoints.names();
+    let variant_order: HashMap<&str, Vec<Settings>> = run
+        .algorithms
+        .iter()
+        .filter_map(|a| describe(a))
+        .map(|d| (d.name, d.select(&run.settings_filter)))
+        .collect();
     rows.sort_by_cached_key(|r| {
         (
             pos(&labels, &r.dataset),
             pos(&run.algorithms, &r.algorithm),
             variant_order
-                .get(&r.algorithm)
+                .get(r.algorithm.as_str())
                 .map(|v| {
                     v.iter()
                         .position(|s| *s == r.settings)
@@ -481,12 +438,12 @@ mod tests {
         let run = RunDescription {
             algorithms: vec!["gator-pt".into()],
             datasets: vec!["box:1k".into(), "shell:1k".into()],
-            viewpoints: "+x".into(),
+            viewpoints: "+x".parse().unwrap(),
             width: 8,
             height: 8,
             frames: 1,
             rounds: 1,
-            shard: Some(format!("{i}/{n}")),
+            shard: Some(Shard { index: i, count: n }),
             ..RunDescription::default()
         };
         let mine = select(Shard { index: i, count: n }, &units_of(&run));
@@ -526,10 +483,10 @@ mod tests {
     fn a_missing_shard_is_named_with_its_units() {
         let all: Vec<ResultsFile> = (1..=3).map(|i| shard_file(i, 3)).collect();
         assert!(units_of(&all[0].run).len() >= 3, "every shard has a unit");
-        assert_eq!(gaps(&all, &dirs(&[1, 2, 3])).unwrap(), vec![]);
+        assert_eq!(gaps(&all, &dirs(&[1, 2, 3])), vec![]);
 
         let some = vec![all[0].clone(), all[2].clone()];
-        let found = gaps(&some, &dirs(&[1, 3])).unwrap();
+        let found = gaps(&some, &dirs(&[1, 3]));
         assert_eq!(found.len(), 1, "{found:?}");
         assert!(found[0].what.contains("shard 2/3"), "{}", found[0]);
         let expected = select(Shard { index: 2, count: 3 }, &units_of(&all[0].run));
@@ -544,9 +501,9 @@ mod tests {
     fn an_unfinished_shard_is_a_gap() {
         let mut files: Vec<ResultsFile> = (1..=2).map(|i| shard_file(i, 2)).collect();
         let lost = files[1].rows.pop().unwrap();
-        assert_eq!(gaps(&files, &dirs(&[1, 2])).unwrap(), vec![]);
+        assert_eq!(gaps(&files, &dirs(&[1, 2])), vec![]);
         files[1].finished_utc = None;
-        let found = gaps(&files, &dirs(&[1, 2])).unwrap();
+        let found = gaps(&files, &dirs(&[1, 2]));
         assert_eq!(found.len(), 1, "{found:?}");
         assert!(found[0]
             .what
@@ -566,9 +523,9 @@ mod tests {
         }
         let mut files: Vec<ResultsFile> = (1..=2).map(|i| shard_file(i, 2)).collect();
         files.extend(other.clone());
-        assert_eq!(gaps(&files, &dirs(&[1, 2, 3, 4])).unwrap(), vec![]);
+        assert_eq!(gaps(&files, &dirs(&[1, 2, 3, 4])), vec![]);
         files.pop();
-        let found = gaps(&files, &dirs(&[1, 2, 3])).unwrap();
+        let found = gaps(&files, &dirs(&[1, 2, 3]));
         assert_eq!(found.len(), 1, "{found:?}");
         assert!(found[0]
             .what
@@ -579,9 +536,9 @@ mod tests {
     #[test]
     fn splits_of_different_sizes_are_checked_apart() {
         let files = vec![shard_file(1, 2), shard_file(2, 2), shard_file(1, 1)];
-        assert_eq!(gaps(&files, &dirs(&[1, 2, 3])).unwrap(), vec![]);
+        assert_eq!(gaps(&files, &dirs(&[1, 2, 3])), vec![]);
         let files = vec![shard_file(1, 2), shard_file(1, 1)];
-        let found = gaps(&files, &dirs(&[1, 3])).unwrap();
+        let found = gaps(&files, &dirs(&[1, 3]));
         assert_eq!(found.len(), 1);
         assert!(found[0].what.starts_with("shard 2/2 is missing"));
     }
@@ -613,16 +570,5 @@ mod tests {
         assert_eq!(gaps.len(), 1, "{:?}", merged.errors);
         assert!(gaps[0].contains("shard 2/3"));
         assert_eq!(ResultsFile::read(&out).unwrap().errors, merged.errors);
-    }
-
-    #[test]
-    fn shard_syntax() {
-        assert_eq!(
-            "2/4".parse::<Shard>().unwrap(),
-            Shard { index: 2, count: 4 }
-        );
-        for bad in ["0/2", "3/2", "x", "1/", "/2"] {
-            assert!(bad.parse::<Shard>().is_err(), "{bad}");
-        }
     }
 }
