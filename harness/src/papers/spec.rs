@@ -285,12 +285,24 @@ impl VariantSpec {
         self.settings.text(key)
     }
 
+    /// Whether `row` is of this side's variant: every pinned setting equal, and no
+    /// perturbation (a positive control's setting) on the row that the side does not name.
     pub(crate) fn matches(&self, row: &Row) -> bool {
-        row.algorithm == self.algorithm
+        self.matches_variant(&row.algorithm, &row.settings)
+    }
+
+    /// [`Self::matches`] on a variant's algorithm and settings.
+    pub(crate) fn matches_variant(&self, algorithm: &str, settings: &Settings) -> bool {
+        let perturbations =
+            crate::algorithms::describe(&self.algorithm).map_or(&[][..], |d| d.perturbations);
+        algorithm == self.algorithm
             && self
                 .settings
                 .iter()
-                .all(|(k, v)| row.settings.get(k) == Some(v))
+                .all(|(k, v)| settings.get(k) == Some(v))
+            && perturbations
+                .iter()
+                .all(|k| settings.get(k).is_none() || self.settings.get(k).is_some())
     }
 }
 

@@ -97,6 +97,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     deterministic,
     gpu_layouts: crate::gpu_layouts,
     counter_evidence: &[],
+    perturbations: &[],
 };
 
 /// The racy single pass (`mode=fragment-race`, §4) draws a different image from frame to
