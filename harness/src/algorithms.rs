@@ -209,6 +209,15 @@ mod tests {
         assert_eq!(race.len(), 1, "{race:?}");
         let frag = settings_of("fragment-pt", "sort=mpvonc");
         assert_eq!(frag.len(), 2, "{frag:?}");
+        // A perturbation (the splatter's misaligned bricks) is selected only where named.
+        let control = settings_of("splat", "sort=bitonic;brick=1000000;misalign=1");
+        assert_eq!(control.len(), 1, "{control:?}");
+        assert!(control[0].ends_with("brick=1000000;ese=on;misalign=1"));
+        let bricked = settings_of("splat", "sort=bitonic;brick=1000000");
+        assert!(!bricked.is_empty() && bricked.iter().all(|s| !s.contains("misalign")));
+        assert!(settings_of("splat", "buckets=gpu|cpu")
+            .iter()
+            .all(|s| !s.contains("misalign")));
     }
 
     /// Every grid point builds a renderer that reports exactly the settings it was built

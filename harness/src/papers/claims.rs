@@ -17,7 +17,7 @@ use super::rules::parse_history;
 use super::rules::{history, Evidence, Normalise, Rule, RuleChange, HISTORY_FILE};
 use super::sides::{pair_side, side_from_rows};
 pub use super::sides::{software_adapter, AnalysisSide, Inputs};
-pub use super::spec::{ExpectSpec, Metric, VariantSpec};
+pub use super::spec::{Discriminates, ExpectSpec, Metric, VariantSpec};
 use super::transcription::deserialize_rows;
 use super::verdict::{self, Check, Evaluation, Expect, Hardware, Side};
 
@@ -41,6 +41,8 @@ pub const HEADER: &[&str] = &[
     "hardware",
     "evidence",
     "normalise",
+    "discriminates",
+    "control",
 ];
 
 /// Whether the paper states the claim or we read it off its numbers.
@@ -79,6 +81,8 @@ struct Record {
     hardware: Hardware,
     evidence: Evidence,
     normalise: Normalise,
+    discriminates: Option<Discriminates>,
+    control: Option<VariantSpec>,
 }
 
 /// One claim of a paper.
@@ -101,6 +105,10 @@ pub struct Claim {
     pub expect_text: String,
     pub evidence: Evidence,
     pub normalise: Normalise,
+    /// Where the two sides can differ at all (`None`: on every data set).
+    pub discriminates: Option<Discriminates>,
+    /// A known perturbation replacing side `a` that the rule must reject (`None`: none).
+    pub control: Option<VariantSpec>,
     /// Earlier rules of this claim, oldest first (`reports/papers/rule_history.csv`).
     pub history: Vec<RuleChange>,
 }
@@ -118,6 +126,8 @@ impl Claim {
             tolerance: self.tolerance,
             evidence: self.evidence.clone(),
             normalise: self.normalise,
+            discriminates: self.discriminates.clone(),
+            control: self.control.clone(),
         }
     }
 
@@ -133,6 +143,8 @@ impl Claim {
             tolerance: rule.tolerance,
             evidence: rule.evidence.clone(),
             normalise: rule.normalise,
+            discriminates: rule.discriminates.clone(),
+            control: rule.control.clone(),
             history: vec![],
             ..self.clone()
         }
@@ -195,6 +207,8 @@ pub fn parse(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
             expect_text: r.expect,
             evidence: r.evidence,
             normalise: r.normalise,
+            discriminates: r.discriminates,
+            control: r.control,
             history: vec![],
         };
         check_rule(&claim.rule()).map_err(err)?;
@@ -292,6 +306,9 @@ pub struct ClaimResult {
     pub claim: Claim,
     pub dataset: Option<String>,
     pub evaluation: Evaluation,
+    /// The claim's positive control on this data set, where it has one: the rule applied with
+    /// side `a` replaced by a known perturbation, which it must reject.
+    pub control: Option<Evaluation>,
     /// The same numbers under each earlier rule of the claim's history.
     pub earlier: Vec<(RuleChange, Evaluation)>,
 }
@@ -321,23 +338,101 @@ pub fn evaluate(claim: &Claim, inputs: &Inputs) -> Vec<ClaimResult> {
     datasets
         .into_iter()
         .map(|d| {
-            let evaluation = evaluate_one(claim, d.as_deref(), inputs);
+            let (evaluation, control) = judge(claim, d.as_deref(), inputs);
             let earlier = claim
                 .history
                 .iter()
                 .filter_map(|h| {
                     let old = claim.with_rule(h.old.as_ref()?);
-                    Some((h.clone(), evaluate_one(&old, d.as_deref(), inputs)))
+                    Some((h.clone(), judge(&old, d.as_deref(), inputs).0))
                 })
                 .collect();
             ClaimResult {
                 claim: claim.clone(),
                 dataset: d,
                 evaluation,
+                control,
                 earlier,
             }
         })
         .collect()
+}
+
+/// The claim's verdict on one data set: its rule on the measured sides, then whether the two
+/// sides can differ there at all (a failed `discriminates` bound reads *not discriminating*),
+/// then its positive control (a hold whose control passes too reads *insensitive*). The
+/// control's own evaluation comes back beside it.
+fn judge(
+    claim: &Claim,
+    dataset: Option<&str>,
+    inputs: &Inputs,
+) -> (Evaluation, Option<Evaluation>) {
+    let mut e = evaluate_one(claim, dataset, inputs);
+    if let Some(d) = &claim.discriminates {
+        let found = side_of(&d.metric, &d.spec, dataset, inputs);
+        let side = match found {
+            Ok(side) if !side.samples.is_empty() => side,
+            Ok(side) => {
+                return (
+                    Evaluation::not_checkable(format!(
+                        "whether the sides can differ here is not known: {} has no value",
+                        side.label
+                    )),
+                    None,
+                )
+            }
+            Err(why) => {
+                return (
+                    Evaluation::not_checkable(format!(
+                        "whether the sides can differ here is not known: {why}"
+                    )),
+                    None,
+                )
+            }
+        };
+        let value = side.centre();
+        if !d.admits(value) {
+            e.numbers = format!(
+                "{} = {value}: the two sides cannot differ here (they can only where `{d}`), so the pair decides nothing; measured all the same: {} (it would read \"{}\")",
+                side.label,
+                e.numbers,
+                e.verdict.label()
+            );
+            e.verdict = verdict::Verdict::NotDiscriminating;
+            return (e, None);
+        }
+    }
+    let Some(perturbed) = claim
+        .control
+        .as_ref()
+        .filter(|c| c.dataset.is_none() || c.dataset.as_deref() == dataset)
+    else {
+        return (e, None);
+    };
+    let control = evaluate_one(
+        &Claim {
+            a: perturbed.clone(),
+            discriminates: None,
+            control: None,
+            ..claim.clone()
+        },
+        dataset,
+        inputs,
+    );
+    use verdict::Verdict::{DoesNotHold, Holds, Insensitive, NotCheckable};
+    let outcome = match control.verdict {
+        DoesNotHold => "the rule rejects it, as it must",
+        NotCheckable => "not run, so the rule's sensitivity is not shown here",
+        _ => "the rule does not reject it: the rule is insensitive here",
+    };
+    e.numbers.push_str(&format!(
+        "; positive control (side a = `{perturbed}`): {}, {outcome}",
+        control.verdict.label()
+    ));
+    if e.verdict == Holds && !matches!(control.verdict, DoesNotHold | NotCheckable) {
+        e.verdict = Insensitive;
+    }
+    (e, Some(control))
 }
 
 fn evaluate_one(claim: &Claim, dataset: Option<&str>, inputs: &Inputs) -> Evaluation {
@@ -477,18 +572,28 @@ fn side(
     dataset: Option<&str>,
     inputs: &Inputs,
 ) -> Result<Side, String> {
+    side_of(&claim.metric, spec, dataset, inputs)
+}
+
+/// The samples of `metric` for one side on one data set: the paper's analyses first, then
+/// the run's rows.
+fn side_of(
+    metric: &Metric,
+    spec: &VariantSpec,
+    dataset: Option<&str>,
+    inputs: &Inputs,
+) -> Result<Side, String> {
     let d = spec.dataset.as_deref().or(dataset);
-    if let Some(s) = (inputs.analysis)(&claim.metric, spec, d) {
+    if let Some(s) = (inputs.analysis)(metric, spec, d) {
         return s;
     }
     let Some(d) = d else {
         return Err(format!(
-            "{}: metric {} needs a data set",
+            "{}: metric {metric} needs a data set",
             spec.label(None),
-            claim.metric
         ));
     };
-    side_from_rows(&claim.metric, spec, d, inputs)
+    side_from_rows(metric, spec, d, inputs)
 }
 
 #[cfg(test)]
@@ -504,7 +609,7 @@ mod tests {
         let with = |evidence: &str| {
             parse(
                 &format!(
-                    "{head}\nraycast,R4,paper,§3.1,x,counter:mesh_bytes_per_tet,spx1,raycast:tiles=5x5,,a=144,0,none,{evidence},none\ngator,G9,paper,§3.4,x,counter_per_tet:triangles_drawn,post,gator-pt:variant=linear,,a=4,0,none,{evidence},none\nraycast,R9,paper,§3.1,x,counter:steps_max,spx1,raycast:tiles=5x5,,a=144,0,none,measured,none\n"
+                    "{head}\nraycast,R4,paper,§3.1,x,counter:mesh_bytes_per_tet,spx1,raycast:tiles=5x5,,a=144,0,none,{evidence},none,,\ngator,G9,paper,§3.4,x,counter_per_tet:triangles_drawn,post,gator-pt:variant=linear,,a=4,0,none,{evidence},none,,\nraycast,R9,paper,§3.1,x,counter:steps_max,spx1,raycast:tiles=5x5,,a=144,0,none,measured,none,,\n"
                 ),
                 "claims.csv",
             )
@@ -528,26 +633,27 @@ mod tests {
 
     #[test]
     fn a_bad_claims_file_is_refused_with_file_and_line() {
-        let head = "paper,id,source,cites,claim,metric,datasets,a,b,expect,tolerance,hardware,evidence,normalise\n";
-        let bad =
-            format!("{head}havs,H1,paper,§5.1,x,total_ms,spx2,havs:k=2,,a<b,0,gpu,measured,none\n");
+        let head = format!("{}\n", HEADER.join(","));
+        let bad = format!(
+            "{head}havs,H1,paper,§5.1,x,total_ms,spx2,havs:k=2,,a<b,0,gpu,measured,none,,\n"
+        );
         let e = parse(&bad, "claims.csv").unwrap_err().to_string();
         assert!(
             e.contains("claims.csv: line 2") && e.contains("second side"),
             "{e}"
         );
         let bad =
-            format!("{head}havs,H1,maybe,§5.1,x,total_ms,spx2,havs,,a>1,0,gpu,measured,none\n");
+            format!("{head}havs,H1,maybe,§5.1,x,total_ms,spx2,havs,,a>1,0,gpu,measured,none,,\n");
         let e = parse(&bad, "c").unwrap_err().to_string();
         assert!(e.contains("source") && e.contains("line 2"), "{e}");
         let bad =
-            format!("{head}havs,H1,paper,§5.1,x,total_ms,spx2,havs,,a>1,0,gpu,guessed,none\n");
+            format!("{head}havs,H1,paper,§5.1,x,total_ms,spx2,havs,,a>1,0,gpu,guessed,none,,\n");
         assert!(parse(&bad, "c")
             .unwrap_err()
             .to_string()
             .contains("evidence"));
         let twice = format!(
-            "{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none\nhavs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none\n"
+            "{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none,,\nhavs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none,,\n"
         );
         assert!(parse(&twice, "c")
             .unwrap_err()
@@ -555,20 +661,20 @@ mod tests {
             .contains("twice"));
         // A derived claim must name claims that exist; a rule change must name a claim.
         let derived =
-            format!("{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,derived:H9,none\n");
+            format!("{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,derived:H9,none,,\n");
         let mut c = parse(&derived, "c").unwrap();
         let e = attach_history(&mut c, vec![], "h").unwrap_err().to_string();
         assert!(e.contains("derived from H9"), "{e}");
         let h = parse_history(
             &format!(
-                "{}\nhavs,H2,2026-12-04,abc,why,,total_ms,,havs,,a>2,0,measured,none\n",
+                "{}\nhavs,H2,2026-12-04,abc,why,,total_ms,,havs,,a>2,0,measured,none,,\n",
                 crate::papers::rules::HISTORY_HEADER.join(",")
             ),
             "h.csv",
         )
         .unwrap();
         let mut c = parse(
-            &format!("{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none\n"),
+            &format!("{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none,,\n"),
             "c",
         )
         .unwrap();
@@ -578,7 +684,7 @@ mod tests {
         // column; the same line with a known metric loads.
         let metric = |m: &str| {
             format!(
-                "{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none\nhavs,H2,paper,§5.1,x,{m},,havs,,a>1,0,gpu,measured,none\n"
+                "{head}havs,H1,paper,§5.1,x,total_ms,,havs,,a>1,0,gpu,measured,none,,\nhavs,H2,paper,§5.1,x,{m},,havs,,a>1,0,gpu,measured,none,,\n"
             )
         };
         let e = parse(&metric("stage_shar:sort"), "claims.csv")
@@ -651,6 +757,8 @@ mod tests {
             expect_text: "a<b".into(),
             evidence: Evidence::Measured,
             normalise: Normalise::None,
+            discriminates: None,
+            control: None,
             history: vec![],
         };
         let v = |a: &str| evaluate(&claim(a), &inputs(&rows))[0].evaluation.verdict;

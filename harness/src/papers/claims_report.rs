@@ -66,6 +66,9 @@ pub fn markdown(results: &[ClaimResult]) -> String {
         };
         let mut rule = c.rule().describe();
         let mut verdict = r.word().to_string();
+        if let Some(control) = &r.control {
+            let _ = write!(verdict, " (positive control: {})", control.verdict.label());
+        }
         for (h, e) in &r.earlier {
             let Some(old) = &h.old else { continue };
             let _ = write!(

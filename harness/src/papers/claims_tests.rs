@@ -432,7 +432,7 @@ fn quick_plans_run_a_subset_of_the_full_variants_and_every_variant_a_claim_names
         }
     }
     assert!(narrowed > 0, "no plan narrows its quick run");
-    // Every side of a claim picks exactly one variant that one of its paper's runs measures in
+    // Every side of a claim (its positive control included) picks exactly one variant that one of its paper's runs measures in
     // quick mode on each of the claim's data sets: none leaves it not checkable, two make it
     // ambiguous (a run added for one claim must not capture another's side).
     for module in PAPERS.iter() {
@@ -459,7 +459,11 @@ fn quick_plans_run_a_subset_of_the_full_variants_and_every_variant_a_claim_names
             })
             .collect();
         for c in all.iter().filter(|c| c.paper == p.id) {
-            for v in [Some(&c.a), c.b.as_ref()].into_iter().flatten() {
+            // A positive control is a side too: the plan must run it, unambiguously.
+            for v in [Some(&c.a), c.b.as_ref(), c.control.as_ref()]
+                .into_iter()
+                .flatten()
+            {
                 if crate::algorithms::describe(&v.algorithm).is_none() {
                     continue;
                 }
@@ -470,9 +474,7 @@ fn quick_plans_run_a_subset_of_the_full_variants_and_every_variant_a_claim_names
                 for d in datasets {
                     let mut matching: Vec<&render_core::Settings> = quick
                         .iter()
-                        .filter(|(a, q, ds)| {
-                            *a == v.algorithm && q.includes(&v.settings) && ds.contains(d)
-                        })
+                        .filter(|(a, q, ds)| v.matches_variant(a, q) && ds.contains(d))
                         .map(|(_, q, _)| q)
                         .collect();
                     matching.sort();

@@ -95,6 +95,8 @@ pub struct Paper {
 }
 
 #[cfg(test)]
+mod claims_control_tests;
+#[cfg(test)]
 mod claims_flip_tests;
 #[cfg(test)]
 mod claims_paper_figure_tests;

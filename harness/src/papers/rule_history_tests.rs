@@ -9,11 +9,11 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::papers::claims::{Metric, VariantSpec};
+use crate::papers::claims::{Discriminates, Metric, VariantSpec};
 use crate::papers::rules::{self, Evidence, Normalise, RuleChange};
 
 /// The rule fields compared between versions, as the claims file names its columns.
-const FIELDS: [&str; 8] = [
+const FIELDS: [&str; 10] = [
     "metric",
     "datasets",
     "a",
@@ -22,6 +22,8 @@ const FIELDS: [&str; 8] = [
     "tolerance",
     "evidence",
     "normalise",
+    "discriminates",
+    "control",
 ];
 
 type Key = (String, String);
@@ -33,11 +35,14 @@ fn canon(field: &str, text: &str) -> String {
     let t = text.trim();
     match field {
         "metric" => Metric::parse(t).map_or(t.to_string(), |m| m.to_string()),
-        "a" | "b" if !t.is_empty() => {
+        "a" | "b" | "control" if !t.is_empty() => {
             VariantSpec::parse(t).map_or(t.to_string(), |v| v.to_string())
         }
         "datasets" => rules::split_datasets(t).join(";"),
         "expect" => t.replace(' ', ""),
+        "discriminates" if !t.is_empty() => {
+            Discriminates::parse(t).map_or(t.to_string(), |d| d.to_string())
+        }
         "tolerance" => t.parse::<f64>().map_or(t.to_string(), |v| v.to_string()),
         "evidence" if t.is_empty() => "measured".into(),
         "evidence" => Evidence::parse(t).map_or(t.to_string(), |e| evidence_text(&e)),
@@ -98,6 +103,11 @@ fn old_value(h: &RuleChange, field: &str) -> Option<String> {
         "tolerance" => o.tolerance.to_string(),
         "evidence" => evidence_text(&o.evidence),
         "normalise" => format!("{:?}", o.normalise),
+        "discriminates" => o
+            .discriminates
+            .as_ref()
+            .map_or(String::new(), |d| d.to_string()),
+        "control" => o.control.as_ref().map_or(String::new(), |c| c.to_string()),
         _ => return None,
     };
     Some(canon(field, &text))
@@ -287,7 +297,7 @@ fn a_rule_change_without_its_row_is_found() {
     let row = |id: &str, old_id: &str, tol: &str, commit: &str| {
         rules::parse_history(
             &format!(
-                "{}\nhavs,{id},2026-12-03,{commit},why,{old_id},kbuffer_pixels_k_gt2,spx2,kbuffer-analysis,,a=havs_table2.pixels_needing_k_gt_2,{tol},measured,none\n",
+                "{}\nhavs,{id},2026-12-03,{commit},why,{old_id},kbuffer_pixels_k_gt2,spx2,kbuffer-analysis,,a=havs_table2.pixels_needing_k_gt_2,{tol},measured,none,,\n",
                 rules::HISTORY_HEADER.join(",")
             ),
             "h.csv",

@@ -3,7 +3,7 @@
 //! the date, the commit and the reason it changed (`reports/papers/rule_history.csv`,
 //! docs/reproduction.md, "Rules and their history").
 
-use super::spec::{ExpectSpec, Metric, VariantSpec};
+use super::spec::{Discriminates, ExpectSpec, Metric, VariantSpec};
 use super::transcription::deserialize_rows;
 use super::verdict;
 
@@ -27,6 +27,8 @@ pub const HISTORY_HEADER: &[&str] = &[
     "old_tolerance",
     "old_evidence",
     "old_normalise",
+    "old_discriminates",
+    "old_control",
 ];
 
 /// The `paper` and `id` of a history row that changes the verdict rule itself, for every
@@ -145,6 +147,11 @@ pub struct Rule {
     pub tolerance: f64,
     pub evidence: Evidence,
     pub normalise: Normalise,
+    /// Where the two sides can differ at all (`None`: everywhere).
+    pub discriminates: Option<Discriminates>,
+    /// The positive control: a known perturbation that replaces side `a` and that the rule
+    /// must reject (`None`: none).
+    pub control: Option<VariantSpec>,
 }
 
 impl Rule {
@@ -162,6 +169,14 @@ impl Rule {
             s.push_str(&format!(
                 ", decided only on at least {} frames a side beyond their spread",
                 verdict::MIN_FRAMES
+            ));
+        }
+        if let Some(d) = &self.discriminates {
+            s.push_str(&format!(", not discriminating where `{d}` fails"));
+        }
+        if let Some(c) = &self.control {
+            s.push_str(&format!(
+                ", positive control `{c}` as side a must not hold (else insensitive)"
             ));
         }
         s
@@ -189,6 +204,12 @@ impl Rule {
         }
         if self.evidence != now.evidence {
             s.push_str(&format!(", evidence {}", self.evidence.label()));
+        }
+        if self.discriminates.is_none() && now.discriminates.is_some() {
+            s.push_str(", judged on every data set");
+        }
+        if self.control.is_none() && now.control.is_some() {
+            s.push_str(", no positive control");
         }
         s
     }
@@ -247,6 +268,8 @@ struct HistoryRecord {
     old_tolerance: Option<f64>,
     old_evidence: Option<Evidence>,
     old_normalise: Normalise,
+    old_discriminates: Option<Discriminates>,
+    old_control: Option<VariantSpec>,
 }
 
 /// Parses a rule history; errors name the file, the line and what is wrong.
@@ -270,7 +293,9 @@ pub fn parse_history(text: &str, file: &str) -> anyhow::Result<Vec<RuleChange>> 
                 || r.old_a.is_some()
                 || !r.old_expect.is_empty()
                 || r.old_tolerance.is_some()
-                || r.old_evidence.is_some();
+                || r.old_evidence.is_some()
+                || r.old_discriminates.is_some()
+                || r.old_control.is_some();
             if any || r.id != EVERY_CLAIM {
                 return Err(err(format!(
                     "a change of the verdict rule ({EVERY_CLAIM},{EVERY_CLAIM}) has no old rule of one claim"
@@ -289,6 +314,8 @@ pub fn parse_history(text: &str, file: &str) -> anyhow::Result<Vec<RuleChange>> 
                 tolerance: r.old_tolerance.ok_or_else(|| need("old_tolerance"))?,
                 evidence: r.old_evidence.ok_or_else(|| need("old_evidence"))?,
                 normalise: r.old_normalise,
+                discriminates: r.old_discriminates,
+                control: r.old_control,
             })
         };
         out.push(RuleChange {

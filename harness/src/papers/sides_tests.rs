@@ -5,14 +5,14 @@ use std::path::Path;
 use render_core::Image;
 
 use crate::papers::claims::{self, Claim};
-use crate::papers::evidence::{evaluate_claims, no_analyses};
+use crate::papers::evidence::evaluate_claims;
 use crate::papers::session::{Extra, Measured};
 use crate::papers::verdict::Verdict;
 use crate::results::samples::write_f32_image;
 use crate::results::Row;
 
 /// A rendering-like image: a soft disc of colour over a transparent background.
-fn disc(size: u32) -> Image {
+pub(crate) fn disc(size: u32) -> Image {
     let mut img = Image::new(size, size);
     let c = size as f32 / 2.0;
     for y in 0..size {
@@ -26,7 +26,7 @@ fn disc(size: u32) -> Image {
 }
 
 /// One row of `spec`'s variant on `dataset` at `view`, its image written under `dir`.
-fn row_with_image(
+pub(crate) fn row_with_image(
     dir: &Path,
     spec: &claims::VariantSpec,
     dataset: &str,
@@ -75,12 +75,37 @@ fn verdict_with(claim: &Claim, change: impl Fn(&mut Image)) -> (Verdict, String)
         ];
         m.push_run(dir.path(), rows);
     }
-    let results = evaluate_claims(&claim.paper, &m, &Extra::default(), &no_analyses);
+    let results = evaluate_claims(&claim.paper, &m, &Extra::default(), &discriminating);
     let r = results
         .iter()
         .find(|r| r.claim.id == claim.id && r.dataset.as_deref() == Some(d))
         .unwrap();
     (r.evaluation.verdict, r.evaluation.numbers.clone())
+}
+
+/// Our own analysis, answering only where a claim's sides discriminate: every such figure
+/// on the bound's side that lets them differ (H12: max k 7, over the 6 of its side a).
+pub(crate) fn discriminating(
+    metric: &claims::Metric,
+    spec: &claims::VariantSpec,
+    d: Option<&str>,
+) -> Option<Result<crate::papers::verdict::Side, String>> {
+    use crate::papers::verdict::Expect;
+    let c = claims::all()
+        .unwrap()
+        .into_iter()
+        .filter_map(|c| c.discriminates)
+        .find(|x| &x.metric == metric && &x.spec == spec)?;
+    let v = match c.bound {
+        Expect::Above(n) => n + 1.0,
+        Expect::Below(n) => n - 1.0,
+        _ => unreachable!(),
+    };
+    Some(crate::papers::evidence::exact_side(
+        format!("{spec} on {}", d.unwrap_or("–")),
+        d.unwrap_or("–"),
+        v,
+    ))
 }
 
 fn image_claims() -> Vec<Claim> {
@@ -151,7 +176,7 @@ fn a_missing_image_or_a_different_viewport_is_not_checkable_and_says_why() {
         ..Default::default()
     };
     m.rows = vec![row(&c.a), row(c.b.as_ref().unwrap())];
-    let r = evaluate_claims(&c.paper, &m, &Extra::default(), &no_analyses);
+    let r = evaluate_claims(&c.paper, &m, &Extra::default(), &discriminating);
     let e = &r.iter().find(|r| r.claim.id == c.id).unwrap().evaluation;
     assert_eq!(e.verdict, Verdict::NotCheckable);
     assert!(e.numbers.contains("no run folder"), "{}", e.numbers);
@@ -160,13 +185,13 @@ fn a_missing_image_or_a_different_viewport_is_not_checkable_and_says_why() {
 #[test]
 fn an_image_pair_refuses_an_expectation_of_two_values() {
     let header = claims::CLAIMS_CSV.lines().next().unwrap();
-    let line = "havs,X1,paper,§4,t,pair_psnr_db,spx2,havs:k=2,havs:k=6,a<b,0,none,measured,none";
+    let line = "havs,X1,paper,§4,t,pair_psnr_db,spx2,havs:k=2,havs:k=6,a<b,0,none,measured,none,,";
     let e = claims::parse(&format!("{header}\n{line}\n"), "test.csv").unwrap_err();
     assert!(
         format!("{e:#}").contains("compares a's image with b's"),
         "{e:#}"
     );
-    let line = "havs,X1,paper,§4,t,pair_psnr_db,spx2,havs:k=2,,a>40,0,none,measured,none";
+    let line = "havs,X1,paper,§4,t,pair_psnr_db,spx2,havs:k=2,,a>40,0,none,measured,none,,";
     let e = claims::parse(&format!("{header}\n{line}\n"), "test.csv").unwrap_err();
     assert!(format!("{e:#}").contains("needs a second side"), "{e:#}");
 }

@@ -285,12 +285,24 @@ impl VariantSpec {
         self.settings.text(key)
     }
 
+    /// Whether `row` is of this side's variant: every pinned setting equal, and no
+    /// perturbation (a positive control's setting) on the row that the side does not name.
     pub(crate) fn matches(&self, row: &Row) -> bool {
-        row.algorithm == self.algorithm
+        self.matches_variant(&row.algorithm, &row.settings)
+    }
+
+    /// [`Self::matches`] on a variant's algorithm and settings.
+    pub(crate) fn matches_variant(&self, algorithm: &str, settings: &Settings) -> bool {
+        let perturbations =
+            crate::algorithms::describe(&self.algorithm).map_or(&[][..], |d| d.perturbations);
+        algorithm == self.algorithm
             && self
                 .settings
                 .iter()
-                .all(|(k, v)| row.settings.get(k) == Some(v))
+                .all(|(k, v)| settings.get(k) == Some(v))
+            && perturbations
+                .iter()
+                .all(|k| settings.get(k).is_none() || self.settings.get(k).is_some())
     }
 }
 
@@ -304,6 +316,77 @@ impl fmt::Display for VariantSpec {
             write!(f, "@{d}")?;
         }
         Ok(())
+    }
+}
+
+/// Where a pair claim's two sides can differ at all, decided from our own analysis of the data
+/// set: `SPEC METRIC>N` or `SPEC METRIC<N` (HAVS H12: `kbuffer-analysis kbuffer_max_k>6`, k = 6
+/// and k = 16 draw the same image where no pixel needs more than 6 entries). Where the bound
+/// fails the claim reads *not discriminating* there.
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+#[serde(try_from = "String")]
+pub struct Discriminates {
+    /// What answers the figure (one of the papers' analyses, or a variant whose rows do).
+    pub spec: VariantSpec,
+    pub metric: Metric,
+    /// [`Expect::Above`] or [`Expect::Below`].
+    pub bound: Expect,
+}
+
+impl TryFrom<String> for Discriminates {
+    type Error = String;
+    fn try_from(s: String) -> Result<Discriminates, String> {
+        Discriminates::parse(&s)
+    }
+}
+
+impl Discriminates {
+    pub fn parse(text: &str) -> Result<Discriminates, String> {
+        let bad = |why: &str| {
+            format!("discriminates {text:?}: {why} (write SPEC METRIC>N or SPEC METRIC<N)")
+        };
+        let (spec, cond) = text
+            .trim()
+            .split_once(' ')
+            .ok_or_else(|| bad("no space after the spec"))?;
+        let (at, above) = match (cond.find('>'), cond.find('<')) {
+            (Some(i), None) => (i, true),
+            (None, Some(i)) => (i, false),
+            _ => return Err(bad("needs one > or <")),
+        };
+        let n: f64 = cond[at + 1..]
+            .trim()
+            .parse()
+            .map_err(|_| bad("the bound is not a number"))?;
+        Ok(Discriminates {
+            spec: VariantSpec::parse(spec.trim())?,
+            metric: Metric::parse(&cond[..at])?,
+            bound: if above {
+                Expect::Above(n)
+            } else {
+                Expect::Below(n)
+            },
+        })
+    }
+
+    /// Whether `value` lets the sides differ.
+    pub fn admits(&self, value: f64) -> bool {
+        match self.bound {
+            Expect::Below(n) => value < n,
+            Expect::Above(n) => value > n,
+            _ => unreachable!("parse makes only Above or Below"),
+        }
+    }
+}
+
+impl fmt::Display for Discriminates {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (op, n) = match self.bound {
+            Expect::Below(n) => ('<', n),
+            Expect::Above(n) => ('>', n),
+            _ => unreachable!("parse makes only Above or Below"),
+        };
+        write!(f, "{} {}{op}{n}", self.spec, self.metric)
     }
 }
 

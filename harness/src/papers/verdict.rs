@@ -1,9 +1,11 @@
 //! The one rule that turns measured numbers into a verdict on a paper's claim.
 //!
-//! Six verdicts, nothing else: *holds*, *does not hold*, *within noise* (the difference lies
+//! Eight verdicts, nothing else: *holds*, *does not hold*, *within noise* (the difference lies
 //! inside the samples' spread or the claim's tolerance), *too few frames* (a timed side has
 //! fewer than [`MIN_FRAMES`] frames behind a sample: its spread is not known well enough to
-//! decide anything, an ordering, a ratio or a threshold), *not testable on this adapter* (a
+//! decide anything, an ordering, a ratio or a threshold), *not discriminating* (our own
+//! analysis of the data set says the two sides cannot differ there), *insensitive* (the claim's
+//! positive control, a known perturbation, passes the rule too), *not testable on this adapter* (a
 //! claim about GPU speed measured on a software rasteriser: the numbers are shown, the verdict
 //! is withheld) and *not checkable* (a side is missing, with why). Every
 //! [`Evaluation`] carries the numbers it used and the variants (algorithm and settings) of each
@@ -18,6 +20,12 @@ pub enum Verdict {
     DoesNotHold,
     WithinNoise,
     TooFewFrames,
+    /// The two sides cannot differ on this data set (the claim's `discriminates` bound fails
+    /// on our own analysis of it): whatever they read is no evidence.
+    NotDiscriminating,
+    /// The rule would have held, but its positive control (a known perturbation run on the
+    /// same data) passes it too: the rule cannot tell a fault here.
+    Insensitive,
     NotTestableOnThisAdapter,
     NotCheckable,
 }
@@ -33,17 +41,21 @@ impl Verdict {
             Verdict::DoesNotHold => "does not hold",
             Verdict::WithinNoise => "within noise",
             Verdict::TooFewFrames => "too few frames",
+            Verdict::NotDiscriminating => "not discriminating",
+            Verdict::Insensitive => "insensitive",
             Verdict::NotTestableOnThisAdapter => "not testable on this adapter",
             Verdict::NotCheckable => "not checkable",
         }
     }
 
     /// Every verdict, in the order reports count them.
-    pub const ALL: [Verdict; 6] = [
+    pub const ALL: [Verdict; 8] = [
         Verdict::Holds,
         Verdict::DoesNotHold,
         Verdict::WithinNoise,
         Verdict::TooFewFrames,
+        Verdict::NotDiscriminating,
+        Verdict::Insensitive,
         Verdict::NotTestableOnThisAdapter,
         Verdict::NotCheckable,
     ];

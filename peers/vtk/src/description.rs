@@ -51,6 +51,7 @@ pub static PT: AlgorithmDescription = AlgorithmDescription {
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: render_core::gpu_layout::GpuLayouts::none,
     counter_evidence: &[],
+    perturbations: &[],
 };
 
 pub static RAYCAST: AlgorithmDescription = AlgorithmDescription {
@@ -99,6 +100,7 @@ pub static RAYCAST: AlgorithmDescription = AlgorithmDescription {
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: render_core::gpu_layout::GpuLayouts::none,
     counter_evidence: &[],
+    perturbations: &[],
 };
 
 pub static ZSWEEP: AlgorithmDescription = AlgorithmDescription {
@@ -131,6 +133,7 @@ pub static ZSWEEP: AlgorithmDescription = AlgorithmDescription {
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: render_core::gpu_layout::GpuLayouts::none,
     counter_evidence: &[],
+    perturbations: &[],
 };
 
 pub(crate) fn settings_of(

@@ -139,6 +139,10 @@ pub struct AlgorithmDescription {
     /// The counters of its rows that are not measured, with where they come from (the data
     /// layout, the draw call); every counter not listed is measured ([`Self::evidence_of`]).
     pub counter_evidence: &'static [(&'static str, CounterEvidence)],
+    /// Keys that only perturb a variant on purpose, as the positive controls of the papers'
+    /// image claims (the splatter's misaligned bricks): written only when set, selected by a
+    /// filter and matched by a claim's side only where named ([`Self::select`]).
+    pub perturbations: &'static [&'static str],
 }
 
 impl std::fmt::Debug for AlgorithmDescription {
@@ -212,8 +216,16 @@ impl AlgorithmDescription {
             return defaults;
         }
         let default_has = |key: &str, value: &str| defaults.iter().any(|d| d.is(key, value));
+        // A filter naming a perturbation selects only the variants that carry it.
+        let perturbs = |s: &Settings| {
+            filter
+                .terms
+                .iter()
+                .all(|(k, _)| !self.perturbations.contains(&k.as_str()) || s.get(k).is_some())
+        };
         (self.full_grid)()
             .into_iter()
+            .filter(|s| perturbs(s))
             .filter(|s| {
                 s.iter().all(|(k, v)| {
                     let v = v.to_string();

@@ -45,6 +45,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     gpu_layouts: crate::gpu_layouts,
     // The model's bytes per tet are the texel layout's size over the tets (§4).
     counter_evidence: &[("model_bytes_per_tet", CounterEvidence::Layout)],
+    perturbations: &[],
 };
 
 fn grid(sorts: &[SortMode]) -> Vec<Settings> {

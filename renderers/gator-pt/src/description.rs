@@ -46,6 +46,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     gpu_layouts: crate::gpu_layouts,
     // Twelve indices per tet, whatever the classifier decides (§3.4).
     counter_evidence: &[("triangles_drawn", CounterEvidence::DrawCall)],
+    perturbations: &[],
 };
 
 /// Both cell models with each sort (constant first), the order the harness runs them.

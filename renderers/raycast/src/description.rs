@@ -57,6 +57,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     gpu_layouts: crate::resources::gpu_layouts,
     // The mesh's bytes per tet are the texel layout's size over the tets (§3.1, its Table 1).
     counter_evidence: &[("mesh_bytes_per_tet", CounterEvidence::Layout)],
+    perturbations: &[],
 };
 
 /// Measured on the check scene (`tests/vs_reference.rs`, lavapipe): the 3D table 96.5 dB, the

@@ -60,6 +60,12 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
             meaning: "early splat elimination behind opaque pixels (on/off)",
             section: "§3.3",
         },
+        Param {
+            key: "misalign",
+            kind: ValueKind::Int,
+            meaning: "a perturbation, not a configuration: every other brick drawn this many grid spacings off along x (the positive control of the bricks' image claim)",
+            section: "ours (positive control of §4's claim)",
+        },
     ],
     // The paper's pair (Table 1): CPU and GPU buckets.
     default_grid: || {
@@ -89,6 +95,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     deterministic: render_core::description::always_deterministic,
     gpu_layouts: crate::gpu_layouts,
     counter_evidence: &[],
+    perturbations: &["misalign"],
 };
 
 fn full_grid() -> Vec<Settings> {
@@ -119,11 +126,18 @@ fn full_grid() -> Vec<Settings> {
             }
         }
     }
+    // The positive control of the bricks' claim: the bricked GPU variant with every other
+    // brick one voxel off.
+    out.push(settings_of(&SplatSettings {
+        brick: Some(1_000_000),
+        misalign: 1,
+        ..Default::default()
+    }));
     out
 }
 
 pub(crate) fn settings_of(s: &SplatSettings) -> Settings {
-    Settings::new()
+    let settings = Settings::new()
         .with(
             "buckets",
             match s.buckets {
@@ -147,7 +161,13 @@ pub(crate) fn settings_of(s: &SplatSettings) -> Settings {
             "brick",
             s.brick.map_or("auto".to_string(), |b| b.to_string()),
         )
-        .with("ese", s.ese)
+        .with("ese", s.ese);
+    // A perturbation is written only where set: every other variant keeps its settings.
+    if s.misalign > 0 {
+        settings.with("misalign", i64::from(s.misalign))
+    } else {
+        settings
+    }
 }
 
 /// The typed settings of a variant.
@@ -183,6 +203,13 @@ pub fn from_settings(s: &Settings) -> anyhow::Result<SplatSettings> {
         ),
     };
     let grid = s.require_int("grid")?;
+    let misalign = match s.get("misalign") {
+        None => 0,
+        Some(_) => {
+            let m = s.require_int("misalign")?;
+            u32::try_from(m).map_err(|_| anyhow::anyhow!("splat: misalign={m} is negative"))?
+        }
+    };
     Ok(SplatSettings {
         buckets,
         sort,
@@ -194,6 +221,7 @@ pub fn from_settings(s: &Settings) -> anyhow::Result<SplatSettings> {
             .map_err(|_| anyhow::anyhow!("splat: grid={grid} is negative"))?,
         brick,
         ese: s.require_switch("ese")?,
+        misalign,
     })
 }
 

@@ -93,6 +93,9 @@ pub struct SplatSettings {
     pub brick: Option<usize>,
     /// Early splat elimination.
     pub ese: bool,
+    /// A perturbation, never a configuration: every other brick's voxels drawn this many grid
+    /// spacings off along x ([`voxels::VoxelSet::misalign`]); 0 draws them where they are.
+    pub misalign: u32,
 }
 
 impl Default for SplatSettings {
@@ -107,6 +110,7 @@ impl Default for SplatSettings {
             grid: 32,
             brick: None,
             ese: true,
+            misalign: 0,
         }
     }
 }

@@ -37,6 +37,7 @@ impl Splat {
         let cap = (binding / 16) as usize;
         let cap = s.brick.map_or(cap, |b| b.min(cap));
         let mut set = voxels(cap);
+        set.misalign(s.misalign);
         set.border_voxels = set.count_border_voxels(s.radius);
         let table = FootprintTable::new(
             Kernel::new(s.radius, SIGMA),

@@ -193,6 +193,25 @@ impl VoxelSet {
         }
     }
 
+    /// A perturbation for the positive control of the bricks' image claim: every other brick
+    /// (the second, the fourth, …) drawn `voxels` grid spacings off along x; its bounds grow
+    /// with it. Nothing moves with one brick or `voxels` = 0.
+    pub fn misalign(&mut self, voxels: u32) {
+        if voxels == 0 {
+            return;
+        }
+        let dx = (f64::from(voxels) * self.spacing[0]) as f32;
+        for b in self.bricks.iter().skip(1).step_by(2) {
+            for v in &mut self.voxels[b.range.clone()] {
+                v[0] += dx;
+            }
+        }
+        for v in &self.voxels {
+            self.min[0] = self.min[0].min(v[0] as f64);
+            self.max[0] = self.max[0].max(v[0] as f64);
+        }
+    }
+
     /// Voxels within `radius` kernel units of an inner brick face.
     pub fn count_border_voxels(&self, radius: f64) -> u64 {
         if self.bricks.len() <= 1 {
@@ -334,5 +353,43 @@ mod tests {
             assert_eq!(a.voxels, b.voxels);
             assert_eq!(a.bricks, b.bricks);
         }
+    }
+
+    /// The positive control's perturbation moves exactly every other brick, by one grid
+    /// spacing along x, and nothing else; with one brick or 0 it moves nothing.
+    #[test]
+    fn misalign_moves_every_other_brick_by_whole_voxels() {
+        let grid = datasets::standins::splat_volume([21, 17, 13], 700, 9);
+        let bounds = datasets::Aabb {
+            min: grid.point(0, 0, 0),
+            max: grid.point(20, 16, 12),
+        };
+        let optics = Optics::for_extent(
+            TransferFunction::preset("zero-floor").unwrap(),
+            &bounds,
+            (0.0, 700.0),
+        );
+        let set = VoxelSet::select(&grid, |_| true, 0, false, &optics, 256);
+        assert!(set.bricks.len() >= 4, "{} bricks", set.bricks.len());
+        let mut moved = set.clone();
+        moved.misalign(1);
+        let dx = grid.spacing[0] as f32;
+        for (i, b) in set.bricks.iter().enumerate() {
+            for j in b.range.clone() {
+                let (was, now) = (set.voxels[j], moved.voxels[j]);
+                let shift = if i % 2 == 1 { dx } else { 0.0 };
+                assert_eq!(now[0], was[0] + shift, "brick {i}");
+                assert_eq!(&now[1..], &was[1..]);
+            }
+        }
+        assert!(moved.max[0] >= set.max[0] && moved.min[0] <= set.min[0]);
+        let mut same = set.clone();
+        same.misalign(0);
+        assert_eq!(same.voxels, set.voxels);
+        let mut one = VoxelSet::select(&grid, |_| true, 0, false, &optics, usize::MAX);
+        let before = one.voxels.clone();
+        one.misalign(1);
+        assert_eq!(one.bricks.len(), 1);
+        assert_eq!(one.voxels, before);
     }
 }

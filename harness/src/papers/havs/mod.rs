@@ -59,6 +59,10 @@ const HAVS_SETTINGS: &str = "k=2|6;sort=cpu-radix;et=off";
 /// Claims H12 and H13 (image quality): the race-free pass at the hardware's k and at k = 16,
 /// rendered at the main run's viewpoints and viewport so that each image pairs with one of it.
 const RACE_FREE_SETTINGS: &str = "k=6|16;sort=cpu-radix;et=off;mode=race-free";
+/// H12's positive control: the race-free pass at k = 1 on spx2 (the paper's own mesh, where
+/// pixels need up to 15 entries), which H12's rule must reject against k = 16.
+const CONTROL_SETTINGS: &str = "k=1;sort=cpu-radix;et=off;mode=race-free";
+const CONTROL_DATASET: &str = "spx2";
 
 /// The HAVS paper.
 pub struct Havs;
@@ -85,6 +89,12 @@ impl PaperModule for Havs {
         plan.push(RunSpec {
             name: "havs-race-free".into(),
             settings: Some(RACE_FREE_SETTINGS.into()),
+            ..plan[0].clone()
+        });
+        plan.push(RunSpec {
+            name: "havs-control".into(),
+            datasets: vec![CONTROL_DATASET.into()],
+            settings: Some(CONTROL_SETTINGS.into()),
             ..plan[0].clone()
         });
         // Table 5's other rows.

@@ -39,6 +39,9 @@ pub const TABLE1_QUICK_SETTINGS: &str = "sort=cpu-radix|bitonic";
 /// Claim S5: GPU buckets in bricks of at most 1 M voxels.
 const BRICKS_SETTINGS: &str = "sort=bitonic;brick=1000000";
 const BRICKED_VOLUMES: [&str; 3] = ["engine", "teapot", "bonsai"];
+/// S5's positive control: the bricked variant with every other brick one voxel off, which the
+/// claim's 40 dB rule must reject.
+const CONTROL_SETTINGS: &str = "sort=bitonic;brick=1000000;misalign=1";
 
 /// Table 1 rows: paper name → registry name of the stand-in volume.
 const VOLUMES: [(&str, &str); 6] = [
@@ -80,7 +83,12 @@ impl PaperModule for Splat {
             quick_settings: None,
             ..table1.clone()
         };
-        vec![table1, bricks]
+        let control = RunSpec {
+            name: "splat-control".into(),
+            settings: Some(CONTROL_SETTINGS.into()),
+            ..bricks.clone()
+        };
+        vec![table1, bricks, control]
     }
 
     fn tables(&self, m: &Measured, x: &Extra) -> Report {

@@ -1,0 +1,184 @@
+//! Flip tests of the two verdicts that say a pair claim could not have failed: *not
+//! discriminating* (our own analysis of the data set says the sides cannot differ there) and
+//! *insensitive* (the claim's positive control passes its rule too). HAVS H12 is the claim: k =
+//! 6 against k = 16, which can only differ where some pixel needs more than 6 entries, with k =
+//! 1 on spx2 as the perturbation its 40 dB rule must reject.
+
+use render_core::Image;
+
+use crate::papers::claims::{self, Claim, ClaimResult, Metric, VariantSpec};
+use crate::papers::claims_report;
+use crate::papers::evidence::{evaluate_claims, exact_side};
+use crate::papers::session::{Extra, Measured};
+use crate::papers::sides_tests::{disc, row_with_image};
+use crate::papers::verdict::{Side, Verdict};
+
+fn h12() -> Claim {
+    claims::all()
+        .unwrap()
+        .into_iter()
+        .find(|c| c.paper == "havs" && c.id == "H12")
+        .unwrap()
+}
+
+/// Every pixel of the covered image brighter by `by` (0: the image itself).
+fn brighter(by: f32) -> Image {
+    let mut img = disc(32);
+    for p in &mut img.pixels {
+        if p[3] > 0.01 {
+            p[0] += by;
+            p[1] += by;
+            p[2] += by;
+        }
+    }
+    img
+}
+
+/// H12's verdicts on spx2 and f117 with k = 6 and k = 16 drawing the same image, `max_k` our
+/// analysis of each data set, and (where given) the k = 1 control's image on spx2.
+fn judge(max_k: &[(&str, f64)], control: Option<&Image>) -> Vec<ClaimResult> {
+    let c = h12();
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = Measured::default();
+    for d in ["spx2", "f117"] {
+        let mut rows = vec![
+            row_with_image(dir.path(), &c.a, d, "+x", &disc(32)),
+            row_with_image(dir.path(), c.b.as_ref().unwrap(), d, "+x", &disc(32)),
+        ];
+        if let (Some(img), "spx2") = (control, d) {
+            rows.push(row_with_image(
+                dir.path(),
+                c.control.as_ref().unwrap(),
+                d,
+                "+x",
+                img,
+            ));
+        }
+        m.push_run(dir.path(), rows);
+    }
+    let analysis =
+        |metric: &Metric, spec: &VariantSpec, d: Option<&str>| -> Option<Result<Side, String>> {
+            if spec.algorithm != "kbuffer-analysis" || metric.to_string() != "kbuffer_max_k" {
+                return None;
+            }
+            let d = d?;
+            let (_, k) = max_k.iter().find(|(n, _)| *n == d)?;
+            Some(exact_side(format!("k analysis of {d}"), d, *k))
+        };
+    evaluate_claims("havs", &m, &Extra::default(), &analysis)
+        .into_iter()
+        .filter(|r| r.claim.id == "H12")
+        .collect()
+}
+
+fn on<'r>(results: &'r [ClaimResult], d: &str) -> &'r ClaimResult {
+    results
+        .iter()
+        .find(|r| r.dataset.as_deref() == Some(d))
+        .unwrap()
+}
+
+#[test]
+fn a_pair_whose_sides_cannot_differ_reads_not_discriminating() {
+    let c = h12();
+    assert!(c.discriminates.is_some() && c.control.is_some());
+    // Our analysis: spx2 needs up to 15 entries, the f117 stand-in 1.
+    let r = judge(&[("spx2", 15.0), ("f117", 1.0)], None);
+    assert_eq!(on(&r, "spx2").evaluation.verdict, Verdict::Holds);
+    let f117 = &on(&r, "f117").evaluation;
+    assert_eq!(f117.verdict, Verdict::NotDiscriminating, "{}", f117.numbers);
+    assert!(
+        f117.numbers.contains("= 1: the two sides cannot differ")
+            && f117.numbers.contains("it would read \"holds\""),
+        "{}",
+        f117.numbers
+    );
+    // Not a hold, and counted apart in the headline.
+    let tally = claims_report::tally(&r);
+    let count = |v: Verdict| tally.iter().find(|(x, _)| *x == v).unwrap().1;
+    assert_eq!(count(Verdict::NotDiscriminating), 1);
+    assert_eq!(count(Verdict::Holds), 1);
+    assert!(
+        crate::papers::reproduce::tally_text(&r).contains("1 not discriminating"),
+        "{}",
+        crate::papers::reproduce::tally_text(&r)
+    );
+    // The same claim on the same images, f117's analysis now needing 7 entries: judged.
+    let r = judge(&[("spx2", 15.0), ("f117", 7.0)], None);
+    assert_eq!(on(&r, "f117").evaluation.verdict, Verdict::Holds);
+    // Exactly at the hardware's k: still not discriminating.
+    let r = judge(&[("spx2", 15.0), ("f117", 6.0)], None);
+    assert_eq!(
+        on(&r, "f117").evaluation.verdict,
+        Verdict::NotDiscriminating
+    );
+    // Without our analysis of the data set, whether the sides can differ is not known.
+    let r = judge(&[("spx2", 15.0)], None);
+    let e = &on(&r, "f117").evaluation;
+    assert_eq!(e.verdict, Verdict::NotCheckable);
+    assert!(e.numbers.contains("not known"), "{}", e.numbers);
+}
+
+#[test]
+fn a_positive_control_that_passes_the_rule_makes_the_hold_insensitive() {
+    let k = [("spx2", 15.0), ("f117", 1.0)];
+    // k = 1 visibly off (about 27 dB): the rule rejects it, and the hold stands with it.
+    let r = judge(&k, Some(&brighter(0.05)));
+    let spx2 = on(&r, "spx2");
+    assert_eq!(spx2.evaluation.verdict, Verdict::Holds);
+    assert_eq!(spx2.control.as_ref().unwrap().verdict, Verdict::DoesNotHold);
+    assert!(
+        spx2.evaluation
+            .numbers
+            .contains("the rule rejects it, as it must"),
+        "{}",
+        spx2.evaluation.numbers
+    );
+    let md = claims_report::markdown(&r);
+    assert!(
+        md.contains("holds (positive control: does not hold)"),
+        "{md}"
+    );
+    // The control only on the data set it names: f117 has none.
+    assert!(on(&r, "f117").control.is_none());
+    // k = 1 drawing what k = 16 draws: the rule cannot tell a fault, the hold is insensitive.
+    let r = judge(&k, Some(&brighter(0.0)));
+    let spx2 = on(&r, "spx2");
+    assert_eq!(spx2.evaluation.verdict, Verdict::Insensitive);
+    assert_eq!(spx2.control.as_ref().unwrap().verdict, Verdict::Holds);
+    assert!(
+        spx2.evaluation.numbers.contains("the rule is insensitive"),
+        "{}",
+        spx2.evaluation.numbers
+    );
+    // A control that was not run shows nothing either way and says so.
+    let r = judge(&k, None);
+    let spx2 = on(&r, "spx2");
+    assert_eq!(spx2.evaluation.verdict, Verdict::Holds);
+    assert!(
+        spx2.evaluation.numbers.contains("not run"),
+        "{}",
+        spx2.evaluation.numbers
+    );
+}
+
+#[test]
+fn discriminates_parses_and_refuses_with_why() {
+    let d = claims::Discriminates::parse("kbuffer-analysis kbuffer_max_k>6").unwrap();
+    assert!(d.admits(7.0) && !d.admits(6.0));
+    assert_eq!(d.to_string(), "kbuffer-analysis kbuffer_max_k>6");
+    let below = claims::Discriminates::parse("kbuffer-analysis kbuffer_max_k<3").unwrap();
+    assert!(below.admits(2.0) && !below.admits(3.0));
+    for bad in [
+        "kbuffer_max_k>6",
+        "kbuffer-analysis kbuffer_max_k=6",
+        "kbuffer-analysis kbuffer_max_k>six",
+        "kbuffer-analysis nonsense>6",
+    ] {
+        let e = claims::Discriminates::parse(bad).unwrap_err();
+        assert!(
+            e.contains("discriminates") || e.contains("metric"),
+            "{bad}: {e}"
+        );
+    }
+}
