@@ -2,9 +2,9 @@
 //! pre-integration tables built from it (all arithmetic in f64; tables stored as f32).
 //!
 //! Optical model (Williams & Max 1992, emission–absorption): along a segment of length D (in
-//! units of [`Optics::length_unit`]) the normalised scalar goes linearly from `s_front` to
-//! `s_back`; emission is κ(s)·c(s), absorption κ(s). The segment's premultiplied colour and
-//! opacity are
+//! units of [`Optics::length_unit`](crate::transfer::Optics::length_unit)) the normalised
+//! scalar goes linearly from `s_front` to `s_back`; emission is κ(s)·c(s), absorption κ(s). The
+//! segment's premultiplied colour and opacity are
 //!
 //! ```text
 //! C = ∫₀ᴰ κ(s(x))·c(s(x))·T(x) dx,   α = 1 − T(D),   T(x) = exp(−∫₀ˣ κ(s(u)) du).

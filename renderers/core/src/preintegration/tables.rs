@@ -46,7 +46,8 @@ impl Table3d {
     /// HAVS' default resolution, 128³.
     pub const DEFAULT_SIZE: usize = 128;
 
-    /// Builds the table with [`integrate_segment`] at every entry (rayon over length slices).
+    /// Builds the table with [`integrate_segment`](super::integrate_segment) at every
+    /// entry (rayon over length slices).
     pub fn build(optics: &Optics, n_s: usize, n_l: usize, max_length_world: f64) -> Table3d {
         let n_s = n_s.max(2);
         let n_l = n_l.max(2);
