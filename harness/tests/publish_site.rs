@@ -155,6 +155,12 @@ fn the_published_site_passes_a_real_browser_and_a_broken_one_does_not() {
         "no history on the front page"
     );
     assert!(front.contains("charts/across_adapters_"));
+    // The cross-adapter charts name their scale: how many rows each pricing gave.
+    assert!(
+        front.contains("priced by the control their run measured beside them")
+            && front.contains("by their adapter&#x27;s cached calibration"),
+        "the charts do not say which scale they use"
+    );
     // A baseline keeps no images: its report says so and links none.
     let baseline =
         std::fs::read_to_string(site.join("runs/nvidia-h200-2026-12-04/index.html")).unwrap();

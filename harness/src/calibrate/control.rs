@@ -13,7 +13,7 @@
 //! and between variants when [`INTERVAL_S`] has passed). Each sample runs every control
 //! probe's fastest configuration (chosen once per run from the calibration's own set)
 //! [`REPEATS`] times, a share of its pieces sized to about [`TARGET_S`] (the rates are per unit
-//! of work, so a share measures the same figure as the whole), and keeps the fastest. A row's
+//! of work, so a share measures the same figure as the whole), and keeps the median. A row's
 //! round is priced with the best of the two samples around it (the less disturbed, as the
 //! calibration keeps the best repetition), kept in the row as `round_control`.
 
@@ -64,11 +64,11 @@ pub const TARGET_S: f64 = 0.005;
 /// at half the rate, so six splat rows of the default suite beat a bound priced by it.
 pub const MIN_PIECES: u32 = 256;
 
-/// How many times a sample runs each share, keeping the fastest. A row is judged by its fastest
-/// frame, so its bound must come from the machine's least disturbed moment too: one share of
-/// 10 ms caught behind another process (a test running beside, a runner's neighbour) priced the
-/// splat rows of a CI run 1.3–1.6 times too dear, so that their frames beat it.
-pub const REPEATS: u32 = 3;
+/// How many times a sample runs each share, keeping the median: one share caught behind
+/// another process (a test running beside, a runner's neighbour) no longer sets the sample,
+/// and the sample is not the machine's luckiest moment either, which would understate how
+/// much slower a busy machine runs the rows (compare divides the rows' median times by it).
+pub const REPEATS: usize = 3;
 
 /// The control probes prepared for a run: each probe's fastest configuration and the share of
 /// its pieces that runs in about [`TARGET_S`], kept between samples (pipelines and buffers are
@@ -143,8 +143,8 @@ impl<'g> ControlBench<'g> {
             .collect()
     }
 
-    /// One control measurement: each kept configuration's share [`REPEATS`] times, the fastest
-    /// kept (as a row keeps its fastest frame: the figure of the least disturbed moment).
+    /// One control measurement: each kept configuration's share [`REPEATS`] times, the median
+    /// kept.
     pub fn sample(
         &mut self,
         dataset: &str,
@@ -159,9 +159,10 @@ impl<'g> ControlBench<'g> {
                 .workloads
                 .iter_mut()
                 .filter_map(|(w, k)| {
-                    (0..REPEATS)
-                        .filter_map(|_| time_part(w, *k).ok())
-                        .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
+                    let mut repeats: Vec<Timing> =
+                        (0..REPEATS).filter_map(|_| time_part(w, *k).ok()).collect();
+                    repeats.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
+                    (repeats.len() == REPEATS).then(|| repeats[REPEATS / 2])
                 })
                 .collect();
             if timings.len() == c.workloads.len() {

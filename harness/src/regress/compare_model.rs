@@ -117,6 +117,10 @@ pub struct Comparison {
     /// round value of both sides was divided by it before the tests.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<crate::regress::compare_control::MachineDrift>,
+    /// Two machines (adapters, or hosts of one adapter), both with a control: each group's raw
+    /// ratio beside its control-normalised one, as information.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub across: Option<crate::regress::compare_across::AcrossMachines>,
     /// Why the run-wide factor stood in for the control (a side without one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control_missing: Option<String>,
@@ -135,8 +139,15 @@ pub struct Comparison {
 
 impl Comparison {
     /// One word for the whole comparison.
+    /// Two adapters compared without `--normalised`: printed, never a gate.
+    pub fn information_only(&self) -> bool {
+        self.across.as_ref().is_some_and(|a| a.information_only)
+    }
+
     pub fn outcome(&self) -> &'static str {
-        if !self.regressions.is_empty() {
+        if self.information_only() {
+            "information only"
+        } else if !self.regressions.is_empty() {
             "regression"
         } else if !self.improvements.is_empty() || !self.changes.is_empty() {
             "changed"

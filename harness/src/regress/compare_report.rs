@@ -49,6 +49,7 @@ fn header(c: &Comparison) -> Vec<String> {
             (None, _) => drift_line(c),
         },
         c.control_missing.clone().unwrap_or_default(),
+        across_lines(c).first().cloned().unwrap_or_default(),
         format!(
             "outcome: {} — {} regression(s), {} improvement(s), {} other change(s) in {} rows, {} groups",
             c.outcome().to_uppercase(),
@@ -65,6 +66,14 @@ fn header(c: &Comparison) -> Vec<String> {
 }
 
 /// The line on the run-wide factor, for comparisons without a control on both sides.
+/// The across-machines table (compare_across.rs): its summary first, then a line a group.
+fn across_lines(c: &Comparison) -> Vec<String> {
+    c.across
+        .as_ref()
+        .map(crate::regress::compare_across::lines)
+        .unwrap_or_default()
+}
+
 fn drift_line(c: &Comparison) -> String {
     match (c.run_factor, c.drift_corrected, &c.pair_factors) {
         (f, true, Some(per_pair)) => format!(
@@ -123,6 +132,12 @@ pub fn terminal(c: &Comparison) -> String {
         let name = format!("{} {} @ {}", g.algorithm, g.settings, g.dataset);
         let _ = writeln!(s, "  {name:<w$}  {}", time_cell(Some(&g.total)));
     }
+    if let [_, groups @ ..] = across_lines(c).as_slice() {
+        let _ = writeln!(s, "\nacross machines, information only:");
+        for l in groups {
+            let _ = writeln!(s, "  {l}");
+        }
+    }
     let notable: Vec<&RowComparison> = c
         .rows
         .iter()
@@ -165,6 +180,17 @@ fn markdown(c: &Comparison) -> String {
             for l in list.iter() {
                 let _ = writeln!(s, "- {}", l.text);
             }
+        }
+    }
+    if let Some(a) = &c.across {
+        s.push_str("\n## Across machines (information only)\n\n");
+        s.push_str("| algorithm | settings | data set | rows | raw NEW/BASE | control-normalised |\n|---|---|---|---:|---:|---:|\n");
+        for g in &a.groups {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {:.3} | {:.3} |",
+                g.algorithm, g.settings, g.dataset, g.rows, g.raw_ratio, g.control_ratio
+            );
         }
     }
     s.push_str(&format!("\n## Groups ({})\n\n", groups_basis(c)));
@@ -320,6 +346,10 @@ fn html(c: &Comparison) -> anyhow::Result<String> {
                     title: "Other changes",
                     lines: texts(&c.changes),
                 },
+                HtmlSection {
+                    title: "Across machines (information only)",
+                    lines: across_lines(c).into_iter().skip(1).collect(),
+                },
             ],
             rows,
         },
@@ -421,6 +451,9 @@ pub fn run_command(
 /// ([`crate::regress::compare::time_noise`]) are an error (exit 1) under `--fail-on
 /// regression` or `change`: the gate could not do its job, and exit 0 would pretend it had.
 pub fn gate(cmp: &Comparison, fail_on: FailOn) -> anyhow::Result<bool> {
+    if cmp.information_only() {
+        return Ok(false);
+    }
     let met = match fail_on {
         FailOn::Never => return Ok(false),
         FailOn::Regression => !cmp.regressions.is_empty(),

@@ -446,3 +446,50 @@ fn the_control_tells_the_machine_from_a_change_common_to_every_algorithm() {
         .starts_with("NEW has no control"));
     assert!(without.regressions.is_empty(), "{:#?}", without.regressions);
 }
+
+/// Two adapters: with a control on both sides, compare prints raw and control-normalised
+/// ratios as information and never gates, even on rows ×1.4 slower with the machine
+/// unchanged (which on one adapter is a regression); without NEW's control it refuses.
+#[test]
+fn two_adapters_are_compared_as_information_only() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, other) = (tmp.path().join("a"), tmp.path().join("other"));
+    let ones = [1.0; 5];
+    run_dir_controlled(&a, &[1.0; 8], &ones, &ones, 1);
+    run_dir_controlled(&other, &[1.4; 8], &[0.5; 5], &[2.0; 5], 2);
+    let mut file = ResultsFile::read(&other).unwrap();
+    let own_adapter = file.machine.adapter.clone();
+    let another = render_core::AdapterDescription {
+        name: "Some Other GPU".into(),
+        backend: "Vulkan".into(),
+        device_type: "DiscreteGpu".into(),
+        driver: String::new(),
+        driver_info: String::new(),
+    };
+    file.machine.adapter = Some(another.clone());
+    crate::results::write_json(&other, &file).unwrap();
+    let opt = options(&tmp.path().join("out"), true, 1.5);
+    let c = compare(&a, &other, &opt).unwrap();
+    assert!(c.information_only());
+    assert_eq!(c.outcome(), "information only");
+    let across = c.across.as_ref().unwrap();
+    assert!((across.machine_factor - 0.5).abs() < 1e-9);
+    for g in &across.groups {
+        assert!((g.raw_ratio / 0.7 - 1.0).abs() < 0.05, "{g:?}");
+        assert!((g.control_ratio / 1.4 - 1.0).abs() < 0.05, "{g:?}");
+    }
+    let regression = crate::regress::compare_setup::FailOn::Regression;
+    assert!(!crate::regress::compare_report::gate(&c, regression).unwrap());
+    // The same NEW on BASE's adapter gates: the ×1.4 is common to every algorithm.
+    file.machine.adapter = own_adapter;
+    crate::results::write_json(&other, &file).unwrap();
+    let c = compare(&a, &other, &opt).unwrap();
+    assert!(!c.information_only());
+    assert!(crate::regress::compare_report::gate(&c, regression).unwrap());
+    // Another adapter without NEW's control: refused.
+    file.machine.adapter = Some(another);
+    file.control = None;
+    crate::results::write_json(&other, &file).unwrap();
+    let e = compare(&a, &other, &opt).unwrap_err().to_string();
+    assert!(e.contains("--normalised"), "{e}");
+}

@@ -17,6 +17,7 @@ pub mod ab;
 pub mod bisect;
 pub mod build;
 pub mod compare;
+pub mod compare_across;
 pub mod compare_control;
 pub mod compare_findings;
 pub mod compare_image;

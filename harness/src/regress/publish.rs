@@ -33,6 +33,7 @@ use crate::plot::speed_error::SpeedAxis;
 use crate::regress::compare::adapter_of;
 use crate::regress::history_page::StepLine;
 use crate::regress::publish_runs::{copy_file, link_pages_to_front, PageKind, PairRecord, SiteRun};
+use crate::results::control::Pricing;
 use crate::results::names::slug;
 use crate::results::{ResultsFile, JSON_FILE};
 
@@ -346,6 +347,9 @@ fn cross_adapter_charts(site: &Path, latest: &[&SiteRun]) -> anyhow::Result<Site
     let several = latest.len() > 1;
     let mut rows = vec![];
     let mut left_out = 0;
+    // How the charted rows' rooflines were priced: by their own rounds' control, or (results
+    // without one) by their adapter's cached calibration.
+    let (mut by_control, mut by_calibration) = (0, 0);
     let mut tags: Vec<String> = vec![];
     for run in latest {
         let file = ResultsFile::read(&run.dir)?;
@@ -356,7 +360,13 @@ fn cross_adapter_charts(site: &Path, latest: &[&SiteRun]) -> anyhow::Result<Site
             if several {
                 row.settings = row.settings.clone().with("adapter", short.as_str());
                 match row.normalized_time.filter(|n| *n > 0.0) {
-                    Some(n) => row.tets_per_sec = Some(100.0 / n),
+                    Some(n) => {
+                        row.tets_per_sec = Some(100.0 / n);
+                        match row.priced_with {
+                            Pricing::Control { .. } => by_control += 1,
+                            _ => by_calibration += 1,
+                        }
+                    }
                     None => {
                         left_out += 1;
                         continue;
@@ -411,12 +421,15 @@ fn cross_adapter_charts(site: &Path, latest: &[&SiteRun]) -> anyhow::Result<Site
         charts,
         key,
         charts_axis: if several {
-            "Each point is one variant on one adapter (the setting adapter=… names it; the key \
-             below gives every label's settings). Adapters differ, so speed is normalised by \
-             each adapter's calibration: the share of the calibrated roofline (tetbench \
-             calibrate) the row reached, 100 / normalized_time, where 100 % is the adapter's \
-             measured limit for the row's work."
-                .into()
+            format!(
+                "Each point is one variant on one adapter (the setting adapter=… names it; the \
+                 key below gives every label's settings). Adapters differ, so speed is the share \
+                 of the row's roofline it reached, 100 / normalized_time, where 100 % is the \
+                 adapter's measured limit for the row's work. The scale: {by_control} row(s) \
+                 priced by the control their run measured beside them (the machine of the same \
+                 moment), {by_calibration} by their adapter's cached calibration (results \
+                 without a control: the best that adapter ever measured, at another hour)."
+            )
         } else {
             "One adapter: speed in tets per second.".into()
         },
