@@ -248,6 +248,47 @@ pub fn merge_rounds(dirs: &[PathBuf], side_dir: &Path) -> anyhow::Result<Results
         .iter()
         .map(|d| ResultsFile::read(d))
         .collect::<anyhow::Result<_>>()?;
+    rounds_agree(&files, dirs)?;
+    let first = &files[0];
+    let mut keys: Vec<Key> = vec![];
+    for f in &files {
+        for r in &f.rows {
+            if !keys.contains(&key(r)) {
+                keys.push(key(r));
+            }
+        }
+    }
+    let mut errors: Vec<String> = files.iter().flat_map(|f| f.errors.clone()).collect();
+    let mut rows = vec![];
+    for k in &keys {
+        let (row, error) = merge_key(k, &files, dirs, side_dir);
+        errors.extend(error);
+        rows.push(row);
+    }
+    let last = files.last().expect("not empty");
+    let mut machine = first.machine.clone();
+    machine.load_average_end = last.machine.load_average_end;
+    let control = merged_control(&files);
+    if let Some(c) = &control {
+        crate::calibrate::set_control_factors(&mut rows, &c.median());
+    }
+    // Each row priced again with all its rounds' control.
+    if let Some(cal) = &machine.calibration {
+        crate::calibrate::annotate(&mut rows, cal);
+    }
+    Ok(ResultsFile {
+        control,
+        schema_version: crate::results::SCHEMA_VERSION,
+        machine,
+        run: merged_run(&files, dirs),
+        finished_utc: last.finished_utc.clone(),
+        rows,
+        errors,
+    })
+}
+
+/// The rounds of one side must share an adapter and a number of frames a round.
+fn rounds_agree(files: &[ResultsFile], dirs: &[PathBuf]) -> anyhow::Result<()> {
     let first = &files[0];
     for (f, d) in files.iter().zip(dirs).skip(1) {
         anyhow::ensure!(
@@ -267,78 +308,82 @@ pub fn merge_rounds(dirs: &[PathBuf], side_dir: &Path) -> anyhow::Result<Results
             first.run.frames
         );
     }
-    let mut keys: Vec<Key> = vec![];
-    for f in &files {
-        for r in &f.rows {
-            if !keys.contains(&key(r)) {
-                keys.push(key(r));
-            }
-        }
-    }
+    Ok(())
+}
+
+/// The row of key `k` over every round: the samples and round controls of all of them, the
+/// first measured round's other columns (its image paths made relative to `side_dir`), the
+/// failures and missing rounds in its error; and an error of the merged set when its image
+/// differs between rounds.
+fn merge_key(
+    k: &Key,
+    files: &[ResultsFile],
+    dirs: &[PathBuf],
+    side_dir: &Path,
+) -> (Row, Option<String>) {
     let prefix = |d: &Path| -> PathBuf {
         match (d.parent(), d.file_name()) {
             (Some(p), Some(name)) if p == side_dir => PathBuf::from(name),
             _ => std::path::absolute(d).unwrap_or_else(|_| d.to_path_buf()),
         }
     };
-    let mut rows = vec![];
-    let mut errors: Vec<String> = files.iter().flat_map(|f| f.errors.clone()).collect();
-    for k in &keys {
-        let mut merged: Option<Row> = None;
-        let mut failures = vec![];
-        let mut samples = crate::results::FrameSamples::default();
-        let mut round_control = vec![];
-        let mut frames = 0;
-        let mut hashes = vec![];
-        for (i, (f, d)) in files.iter().zip(dirs).enumerate() {
-            let Some(r) = f.rows.iter().find(|r| key(r) == *k) else {
-                failures.push(format!("missing from round {}", i + 1));
-                continue;
-            };
-            if !r.ok() {
-                failures.push(format!("round {}: {}", i + 1, r.error));
-                merged.get_or_insert_with(|| r.clone());
-                continue;
-            }
-            samples.total_ms.extend(&r.samples.total_ms);
-            samples.cpu_ms.extend(&r.samples.cpu_ms);
-            samples.gpu_ms.extend(&r.samples.gpu_ms);
-            round_control.extend(r.round_control.iter().cloned());
-            frames += r.frames;
-            hashes.push(r.image_hash.clone());
-            if merged.as_ref().is_none_or(|m| !m.ok()) {
-                let mut m = r.clone();
-                let base = prefix(d);
-                for p in [
-                    &mut m.image,
-                    &mut m.image_f32,
-                    &mut m.reference_image,
-                    &mut m.heatmap,
-                ] {
-                    if !p.is_empty() {
-                        *p = base.join(&*p).display().to_string();
-                    }
+    let mut merged: Option<Row> = None;
+    let mut failures = vec![];
+    let mut samples = crate::results::FrameSamples::default();
+    let mut round_control = vec![];
+    let mut frames = 0;
+    let mut hashes = vec![];
+    for (i, (f, d)) in files.iter().zip(dirs).enumerate() {
+        let Some(r) = f.rows.iter().find(|r| key(r) == *k) else {
+            failures.push(format!("missing from round {}", i + 1));
+            continue;
+        };
+        if !r.ok() {
+            failures.push(format!("round {}: {}", i + 1, r.error));
+            merged.get_or_insert_with(|| r.clone());
+            continue;
+        }
+        samples.total_ms.extend(&r.samples.total_ms);
+        samples.cpu_ms.extend(&r.samples.cpu_ms);
+        samples.gpu_ms.extend(&r.samples.gpu_ms);
+        round_control.extend(r.round_control.iter().cloned());
+        frames += r.frames;
+        hashes.push(r.image_hash.clone());
+        if merged.as_ref().is_none_or(|m| !m.ok()) {
+            let mut m = r.clone();
+            let base = prefix(d);
+            for p in [
+                &mut m.image,
+                &mut m.image_f32,
+                &mut m.reference_image,
+                &mut m.heatmap,
+            ] {
+                if !p.is_empty() {
+                    *p = base.join(&*p).display().to_string();
                 }
-                merged = Some(m);
             }
+            merged = Some(m);
         }
-        let mut row = merged.expect("every key comes from some round");
-        if hashes.iter().any(|h| *h != hashes[0]) {
-            errors.push(format!(
-                "{} {} {} {}: the image differs between rounds of one build",
-                row.algorithm, row.settings, row.dataset, row.viewpoint
-            ));
-        }
-        // A round's control only where every round has one (the rounds then line up).
-        let complete = failures.is_empty() && round_control.len() == files.len();
-        row.round_control = if complete { round_control } else { vec![] };
-        row.error = failures.join("; ");
-        row.frames = frames;
-        summarise_samples(&mut row, samples);
-        rows.push(row);
     }
-    let last = files.last().expect("not empty");
-    let mut run = first.run.clone();
+    let mut row = merged.expect("every key comes from some round");
+    let error = hashes.iter().any(|h| *h != hashes[0]).then(|| {
+        format!(
+            "{} {} {} {}: the image differs between rounds of one build",
+            row.algorithm, row.settings, row.dataset, row.viewpoint
+        )
+    });
+    // A round's control only where every round has one (the rounds then line up).
+    let complete = failures.is_empty() && round_control.len() == files.len();
+    row.round_control = if complete { round_control } else { vec![] };
+    row.error = failures.join("; ");
+    row.frames = frames;
+    summarise_samples(&mut row, samples);
+    (row, error)
+}
+
+/// The merged set's run description: the first round's, with every round counted and named.
+fn merged_run(files: &[ResultsFile], dirs: &[PathBuf]) -> crate::results::RunDescription {
+    let mut run = files[0].run.clone();
     run.rounds = files.iter().map(|f| f.run.rounds.max(1)).sum();
     run.merged_from = files
         .iter()
@@ -352,25 +397,7 @@ pub fn merge_rounds(dirs: &[PathBuf], side_dir: &Path) -> anyhow::Result<Results
             rows: f.rows.len(),
         })
         .collect();
-    let mut machine = first.machine.clone();
-    machine.load_average_end = last.machine.load_average_end;
-    let control = merged_control(&files);
-    if let Some(c) = &control {
-        crate::calibrate::set_control_factors(&mut rows, &c.median());
-    }
-    // Each row priced again with all its rounds' control.
-    if let Some(cal) = &machine.calibration {
-        crate::calibrate::annotate(&mut rows, cal);
-    }
-    Ok(ResultsFile {
-        control,
-        schema_version: crate::results::SCHEMA_VERSION,
-        machine,
-        run,
-        finished_utc: last.finished_utc.clone(),
-        rows,
-        errors,
-    })
+    run
 }
 
 /// The rounds' controls as one: invocation i's samples become round i's (before it) and

@@ -130,21 +130,12 @@ pub fn compare(
     let mut base = ResultsFile::read(base_dir)?;
     let mut new = ResultsFile::read(new_dir)?;
     let (ba, na) = (adapter_of(&base), adapter_of(&new));
-    // Two adapters without --normalised: where both runs measured a control, compared as one
-    // adapter is (the control divides the machines out) but as information only, never a gate
-    // (compare_across.rs); otherwise refused.
-    let information_only = ba != na && !opt.normalised;
-    let across = crate::regress::compare_across::difference(&base, &new, (&ba, &na))
-        .and_then(|why| crate::regress::compare_across::across(&base, &new, why, information_only));
-    if information_only && across.is_none() {
-        anyhow::bail!(
-            "{} ran on {ba} but {} on {na}: times from two adapters say nothing about a change. \
-             Pass --normalised to compare calibration-normalised figures instead (or compare \
-             two runs that both measured a control, for ratios printed as information)",
-            base_dir.display(),
-            new_dir.display()
-        );
-    }
+    let across = crate::regress::compare_across::across_or_refuse(
+        (&base, &new),
+        (base_dir, new_dir),
+        (&ba, &na),
+        opt.normalised,
+    )?;
     if opt.normalised {
         for (f, d) in [(&base, base_dir), (&new, new_dir)] {
             anyhow::ensure!(

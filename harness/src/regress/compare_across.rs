@@ -11,6 +11,8 @@
 //! (caches, a driver's shader compiler), so a change on one adapter is never judged against
 //! a run on another.
 
+use std::path::Path;
+
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -67,6 +69,31 @@ pub fn difference(base: &ResultsFile, new: &ResultsFile, adapters: (&str, &str))
         }
         _ => None,
     }
+}
+
+/// compare's first step for two machines: two adapters without `--normalised` are compared
+/// as information only where both runs measured a control (the control divides the machines
+/// out as on one adapter, but nothing gates), and refused otherwise; the table, where the
+/// machines differ and both have a control.
+pub fn across_or_refuse(
+    (base, new): (&ResultsFile, &ResultsFile),
+    (base_dir, new_dir): (&Path, &Path),
+    (ba, na): (&str, &str),
+    normalised: bool,
+) -> anyhow::Result<Option<AcrossMachines>> {
+    let information_only = ba != na && !normalised;
+    let table =
+        difference(base, new, (ba, na)).and_then(|why| across(base, new, why, information_only));
+    if information_only && table.is_none() {
+        anyhow::bail!(
+            "{} ran on {ba} but {} on {na}: times from two adapters say nothing about a change. \
+             Pass --normalised to compare calibration-normalised figures instead (or compare \
+             two runs that both measured a control, for ratios printed as information)",
+            base_dir.display(),
+            new_dir.display()
+        );
+    }
+    Ok(table)
 }
 
 /// The across-machines table, where the machines differ and both runs carry a control

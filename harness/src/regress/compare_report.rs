@@ -595,4 +595,27 @@ mod tests {
             assert!(tmp.path().join("ac").join(f).is_file(), "{f}");
         }
     }
+
+    /// The gate never fires on a comparison across adapters given as information: the same
+    /// comparison with its across table taken away gates on its changed pixel.
+    #[test]
+    fn information_only_never_gates() {
+        let tmp = tempfile::tempdir().unwrap();
+        let img = render_core::Image::new(8, 8);
+        let mut changed = img.clone();
+        changed.pixels[3][0] = 1.0;
+        let (a, c) = (tmp.path().join("a"), tmp.path().join("c"));
+        results_dir(&a, &img, 10.0);
+        results_dir(&c, &changed, 10.0);
+        let mut cmp = compare(&a, &c, &gate_on_change(tmp.path().join("out"))).unwrap();
+        assert!(gate(&cmp, FailOn::Change).unwrap());
+        cmp.across = Some(crate::regress::compare_across::AcrossMachines {
+            reason: "two adapters".into(),
+            machine_factor: 1.0,
+            information_only: true,
+            groups: vec![],
+        });
+        assert_eq!(cmp.outcome(), "information only");
+        assert!(!gate(&cmp, FailOn::Change).unwrap());
+    }
 }
