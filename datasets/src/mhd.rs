@@ -61,6 +61,21 @@ fn parse_bool(v: &str) -> Option<bool> {
     }
 }
 
+/// The element type a MetaImage `ElementType` value names, if it is one this reader reads.
+fn element_type(value: &str) -> Option<ElementType> {
+    Some(match value.to_ascii_uppercase().as_str() {
+        "MET_UCHAR" => ElementType::U8,
+        "MET_CHAR" => ElementType::I8,
+        "MET_SHORT" => ElementType::I16,
+        "MET_USHORT" => ElementType::U16,
+        "MET_INT" => ElementType::I32,
+        "MET_UINT" => ElementType::U32,
+        "MET_FLOAT" => ElementType::F32,
+        "MET_DOUBLE" => ElementType::F64,
+        _ => return None,
+    })
+}
+
 fn parse_header(b: &[u8], path: &Path) -> Result<Header, LoadError> {
     let mut ndims = None;
     let mut dims = None;
@@ -142,17 +157,7 @@ fn parse_header(b: &[u8], path: &Path) -> Result<Header, LoadError> {
             "elementsize" => size = Some(reals(3)?),
             "offset" | "origin" | "position" => origin = Some(reals(3)?),
             "elementtype" => {
-                element = Some(match value.to_ascii_uppercase().as_str() {
-                    "MET_UCHAR" => ElementType::U8,
-                    "MET_CHAR" => ElementType::I8,
-                    "MET_SHORT" => ElementType::I16,
-                    "MET_USHORT" => ElementType::U16,
-                    "MET_INT" => ElementType::I32,
-                    "MET_UINT" => ElementType::U32,
-                    "MET_FLOAT" => ElementType::F32,
-                    "MET_DOUBLE" => ElementType::F64,
-                    _ => return Err(err(ErrorKind::Unsupported(format!("ElementType {value} (MET_UCHAR, MET_CHAR, MET_SHORT, MET_USHORT, MET_INT, MET_UINT, MET_FLOAT, MET_DOUBLE are read)")))),
-                })
+                element = Some(element_type(value).ok_or_else(|| err(ErrorKind::Unsupported(format!("ElementType {value} (MET_UCHAR, MET_CHAR, MET_SHORT, MET_USHORT, MET_INT, MET_UINT, MET_FLOAT, MET_DOUBLE are read)"))))?)
             }
             "binarydatabyteordermsb" | "elementbyteordermsb" => {
                 order = if parse_bool(value).ok_or_else(|| syntax("True or False"))? { ByteOrder::Big } else { ByteOrder::Little }

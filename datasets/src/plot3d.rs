@@ -387,6 +387,47 @@ fn check_finite(
     ))
 }
 
+/// The grid's points: the three coordinate blocks of the XYZ file, each checked finite.
+fn grid_points(xyz: &[u8], gl: &Layout, xyz_path: &Path) -> Result<Vec<[f32; 3]>, LoadError> {
+    let n = gl.points();
+    let mut coords = Vec::with_capacity(3);
+    for a in 0..3 {
+        let at = gl.data_at + a * n * gl.prec;
+        let c = block(xyz, gl, at, n);
+        check_finite(
+            xyz,
+            gl,
+            at,
+            &c,
+            &format!("{} coordinate of point", ["x", "y", "z"][a]),
+            xyz_path,
+        )?;
+        coords.push(c);
+    }
+    Ok((0..n)
+        .map(|i| [coords[0][i], coords[1][i], coords[2][i]])
+        .collect())
+}
+
+/// The Q field the options ask for (`--scalar` by name, else the PLOT3D field option).
+fn requested_field(options: &LoadOptions, q_path: &Path) -> Result<Plot3dField, LoadError> {
+    Ok(match &options.scalar {
+        Some(name) => Plot3dField::from_name(name).ok_or_else(|| {
+            LoadError::new(
+                q_path,
+                ErrorKind::MissingArray {
+                    name: name.clone(),
+                    available: Plot3dField::ALL
+                        .iter()
+                        .map(|f| f.name().to_string())
+                        .collect(),
+                },
+            )
+        })?,
+        None => options.plot3d_field.unwrap_or_default(),
+    })
+}
+
 /// Parses an XYZ file and its Q file from memory; the paths only name them in errors. Never
 /// panics on any input (fuzzed: `datasets/fuzz`).
 pub fn from_bytes(
@@ -408,24 +449,7 @@ pub fn from_bytes(
         LoadError::at(xyz_path, Location::Byte(e.at), kind)
     })?;
     let n = gl.points();
-    let mut coords = Vec::with_capacity(3);
-    for a in 0..3 {
-        let at = gl.data_at + a * n * gl.prec;
-        let c = block(xyz, &gl, at, n);
-        check_finite(
-            xyz,
-            &gl,
-            at,
-            &c,
-            &format!("{} coordinate of point", ["x", "y", "z"][a]),
-            xyz_path,
-        )?;
-        coords.push(c);
-    }
-    let points: Vec<[f32; 3]> = (0..n)
-        .map(|i| [coords[0][i], coords[1][i], coords[2][i]])
-        .collect();
-    drop(coords);
+    let points = grid_points(xyz, &gl, xyz_path)?;
     let mut warnings = Vec::new();
     if gl.iblank {
         let at = gl.data_at + 3 * n * gl.prec;
@@ -468,21 +492,7 @@ pub fn from_bytes(
             ql.padding
         ));
     }
-    let field = match &options.scalar {
-        Some(name) => Plot3dField::from_name(name).ok_or_else(|| {
-            LoadError::new(
-                q_path,
-                ErrorKind::MissingArray {
-                    name: name.clone(),
-                    available: Plot3dField::ALL
-                        .iter()
-                        .map(|f| f.name().to_string())
-                        .collect(),
-                },
-            )
-        })?,
-        None => options.plot3d_field.unwrap_or_default(),
-    };
+    let field = requested_field(options, q_path)?;
     // Skip the four reals (mach, alpha, Re, time) and their record.
     let qdata = ql.data_at + 4 * ql.prec + if ql.markers { 8 } else { 0 };
     let names = [

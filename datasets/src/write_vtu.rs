@@ -217,6 +217,67 @@ fn escape(s: &str) -> String {
     quick_xml::escape::escape(s).into_owned()
 }
 
+/// Each array's data as the format places it: inline text (ASCII, inline base64) or a block of
+/// the appended section at an offset.
+struct EncodedArrays {
+    appended: Vec<Vec<u8>>,
+    offsets: Vec<usize>,
+    inline: Vec<Option<String>>,
+}
+
+fn encode_arrays(arrays: &[Array<'_>], o: &VtuOptions) -> EncodedArrays {
+    // Encoded appended blocks and their offsets.
+    let mut appended: Vec<Vec<u8>> = Vec::new();
+    let mut offsets = Vec::new();
+    let mut inline: Vec<Option<String>> = Vec::new();
+    let mut offset = 0usize;
+    for a in arrays {
+        match o.format {
+            VtuFormat::Ascii => {
+                let mut s = String::with_capacity(a.len() * 8);
+                for i in 0..a.len() {
+                    if i > 0 {
+                        s.push(if i % (6 * a.components.max(1)) == 0 {
+                            '\n'
+                        } else {
+                            ' '
+                        });
+                    }
+                    s.push_str(&a.text(i));
+                }
+                inline.push(Some(s));
+                offsets.push(0);
+            }
+            VtuFormat::Binary => {
+                let (h, d) = binary_block(&a.bytes(o.big_endian), o);
+                inline.push(Some(base64_block(&h, &d, o)));
+                offsets.push(0);
+            }
+            VtuFormat::Appended => {
+                let (h, d) = binary_block(&a.bytes(o.big_endian), o);
+                offsets.push(offset);
+                offset += h.len() + d.len();
+                appended.push(h);
+                appended.push(d);
+                inline.push(None);
+            }
+            VtuFormat::AppendedBase64 => {
+                let (h, d) = binary_block(&a.bytes(o.big_endian), o);
+                let s = base64_block(&h, &d, o).into_bytes();
+                offsets.push(offset);
+                offset += s.len();
+                appended.push(s);
+                inline.push(None);
+            }
+        }
+    }
+    EncodedArrays {
+        appended,
+        offsets,
+        inline,
+    }
+}
+
 fn write_to<W: Write>(mesh: &TetMesh, w: &mut W, o: &VtuOptions) -> std::io::Result<()> {
     let np = mesh.num_points();
     let nt = mesh.num_tets();
@@ -273,51 +334,11 @@ fn write_to<W: Write>(mesh: &TetMesh, w: &mut W, o: &VtuOptions) -> std::io::Res
         VtuFormat::Binary => "binary",
         VtuFormat::Appended | VtuFormat::AppendedBase64 => "appended",
     };
-    // Encoded appended blocks and their offsets.
-    let mut appended: Vec<Vec<u8>> = Vec::new();
-    let mut offsets = Vec::new();
-    let mut inline: Vec<Option<String>> = Vec::new();
-    let mut offset = 0usize;
-    for a in &arrays {
-        match o.format {
-            VtuFormat::Ascii => {
-                let mut s = String::with_capacity(a.len() * 8);
-                for i in 0..a.len() {
-                    if i > 0 {
-                        s.push(if i % (6 * a.components.max(1)) == 0 {
-                            '\n'
-                        } else {
-                            ' '
-                        });
-                    }
-                    s.push_str(&a.text(i));
-                }
-                inline.push(Some(s));
-                offsets.push(0);
-            }
-            VtuFormat::Binary => {
-                let (h, d) = binary_block(&a.bytes(o.big_endian), o);
-                inline.push(Some(base64_block(&h, &d, o)));
-                offsets.push(0);
-            }
-            VtuFormat::Appended => {
-                let (h, d) = binary_block(&a.bytes(o.big_endian), o);
-                offsets.push(offset);
-                offset += h.len() + d.len();
-                appended.push(h);
-                appended.push(d);
-                inline.push(None);
-            }
-            VtuFormat::AppendedBase64 => {
-                let (h, d) = binary_block(&a.bytes(o.big_endian), o);
-                let s = base64_block(&h, &d, o).into_bytes();
-                offsets.push(offset);
-                offset += s.len();
-                appended.push(s);
-                inline.push(None);
-            }
-        }
-    }
+    let EncodedArrays {
+        appended,
+        offsets,
+        inline,
+    } = encode_arrays(&arrays, o);
     let array_xml = |w: &mut W, i: usize, indent: &str| -> std::io::Result<()> {
         let a = &arrays[i];
         write!(

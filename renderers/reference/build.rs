@@ -1,6 +1,6 @@
 //! Hashes the reference renderer's own code at build time (blake3 over every `src/**/*.rs` of
-//! this crate in path order, the crate version, and render-core's `preintegration.rs`, whose
-//! segment integrator the reference calls for every step) and exposes it as
+//! this crate in path order, the crate version, and the files of render-core's `preintegration/`
+//! in path order, whose segment integrator the reference calls for every step) and exposes it as
 //! `REFERENCE_CODE_HASH`: the cache key includes it, so cached images never outlive the code
 //! that made them.
 
@@ -25,8 +25,11 @@ fn main() {
     let mut files = Vec::new();
     rs_files(&root.join("src"), &mut files);
     files.sort();
-    let integrator = root.join("../core/src/preintegration.rs");
-    files.push(integrator);
+    let integrator = root.join("../core/src/preintegration");
+    let mut integrator_files = Vec::new();
+    rs_files(&integrator, &mut integrator_files);
+    integrator_files.sort();
+    files.extend(integrator_files);
     let mut h = blake3::Hasher::new();
     h.update(b"version\0");
     h.update(
@@ -47,6 +50,7 @@ fn main() {
     }
     // New files under src/ change the directory, which cargo also watches.
     println!("cargo:rerun-if-changed=src");
+    println!("cargo:rerun-if-changed={}", integrator.display());
     println!("cargo:rerun-if-changed=Cargo.toml");
     println!(
         "cargo:rustc-env=REFERENCE_CODE_HASH={}",

@@ -11,9 +11,9 @@ use render_core::{Camera, Image, Optics};
 use crate::Prepared;
 
 /// blake3 (hex) of the reference renderer's own code, computed by `build.rs` at build time: every
-/// `src/**/*.rs` file of this crate, its version, and render-core's `preintegration.rs` (the
-/// segment integrator each step calls). Part of every cache key, so any change to the code
-/// that makes the images invalidates the images cached before it.
+/// `src/**/*.rs` file of this crate, its version, and every file of render-core's
+/// `preintegration/` (the segment integrator each step calls). Part of every cache key, so any
+/// change to the code that makes the images invalidates the images cached before it.
 pub const CODE_HASH: &str = env!("REFERENCE_CODE_HASH");
 
 const CACHE_MAGIC: &[u8; 8] = b"TBREF\x00\x00\x02";
