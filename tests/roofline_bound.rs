@@ -3,19 +3,18 @@
 //!
 //! The default suite (every algorithm's default variants on box:10k and shell:10k, 3
 //! viewpoints, 128², 3 rounds) runs as two runs, one a data set. Every row is priced by the
-//! control its run measured beside its rounds (the median of three short shares of each
-//! roofline probe, before and after each round; docs/results.md). No row's fastest timed frame
-//! may be faster than its roofline.
+//! control its run measured beside its rounds (one short share of each roofline probe, before
+//! and after each round; docs/results.md). No row's fastest timed frame may be faster than
+//! its roofline.
 //!
 //! What this can honestly assert on a busy machine: other work only ever slows a repetition
 //! down, of the control and of the frames alike. A frame slowed down hides a defect, so a pass
 //! on a busy machine is weak evidence; `tetbench run` lists every beaten bound on any machine,
 //! and an idle run of `scripts/bench.sh` is where a pass counts. A failure needs a frame
-//! faster than the median of three control shares taken seconds before it and of three
-//! after it: either the bound is wrong (a figure that is not the backend's peak for the work
-//! the rows do, a control share that does not spread over the device's threads as the whole
-//! does, or a counter of work not done), or most of those shares were disturbed while that
-//! frame was not. So the
+//! faster than both control shares taken seconds before and after it: either the bound is
+//! wrong (a figure that is not the backend's peak for the work the rows do, a control share
+//! that does not spread over the device's threads as the whole does, or a counter of work not
+//! done), or both shares were disturbed while that frame was not. So the
 //! verdict is only given where the machine was not oversubscribed: the 1-minute load average
 //! at most [`MAX_LOAD_PER_CORE`] a core (this test's own two lavapipe threads included). On a
 //! machine busier than that the test prints the beaten bounds and the load, and passes without
