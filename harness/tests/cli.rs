@@ -318,7 +318,7 @@ fn a_settings_typo_never_drops_an_algorithm() {
             "{args:?}: {err}"
         );
         assert!(
-            err.contains("it offers k=2|3|4|5|6|8|16"),
+            err.contains("it offers k=1|2|3|4|5|6|8|16"),
             "{args:?}: {err}"
         );
         assert!(!err.contains("rows failed"), "{args:?}: {err}");
