@@ -17,8 +17,7 @@ use render_core::Settings;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use crate::calibrate::control::speed_factor;
-use crate::regress::compare_control::has_control;
+use crate::regress::compare_control::{has_control, machine_factor};
 use crate::regress::compare_setup::key;
 use crate::results::aggregate::GroupKey;
 use crate::results::description::as_text;
@@ -111,11 +110,7 @@ pub fn across(
     if !(has_control(base) && has_control(new)) {
         return None;
     }
-    let speed = speed_factor(
-        &new.control.as_ref()?.median(),
-        &base.control.as_ref()?.median(),
-    )?;
-    let machine_factor = 1.0 / speed;
+    let machine_factor = machine_factor(base, new)?;
     let groups = GroupKey::distinct(base.rows.iter())
         .into_iter()
         .filter_map(|g| group(&g, &base.rows, &new.rows, machine_factor))

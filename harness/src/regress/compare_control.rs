@@ -62,6 +62,15 @@ pub fn missing(base: &ResultsFile, new: &ResultsFile) -> Option<String> {
     })
 }
 
+/// The time NEW's machine needed for BASE's work, over BASE's: the two runs' median controls
+/// (`None`: a side without a control, or no figure in common).
+pub fn machine_factor(base: &ResultsFile, new: &ResultsFile) -> Option<f64> {
+    control::speed_factor(
+        &base.control.as_ref()?.median(),
+        &new.control.as_ref()?.median(),
+    )
+}
+
 /// Puts both sides' `total_ms` samples on the scale of BASE's median control; `None` (and
 /// nothing changed) unless both sides carry a control for every measured row.
 pub fn normalise(base: &mut ResultsFile, new: &mut ResultsFile) -> Option<MachineDrift> {
@@ -70,7 +79,7 @@ pub fn normalise(base: &mut ResultsFile, new: &mut ResultsFile) -> Option<Machin
     }
     let reference = base.control.as_ref()?.median();
     let new_median = new.control.as_ref()?.median();
-    let factor = control::speed_factor(&reference, &new_median)?;
+    let factor = machine_factor(base, new)?;
     for f in [&mut *base, &mut *new] {
         let rounds = f.run.rounds.max(1) as usize;
         for row in &mut f.rows {
