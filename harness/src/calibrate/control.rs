@@ -13,9 +13,9 @@
 //! and between variants when [`INTERVAL_S`] has passed). Each sample runs every control
 //! probe's fastest configuration (chosen once per run from the calibration's own set), a
 //! share of its pieces sized to about [`TARGET_S`] (the rates are per unit of work, so a share
-//! measures the same figure as the whole), [`REPEATS`] times, and keeps the median. A row's
-//! round is priced with the best of the two samples around it (the less disturbed, as the
-//! calibration keeps the best repetition), kept in the row as `round_control`.
+//! measures the same figure as the whole), once. A row's round is priced with the best of the
+//! two samples around it (the less disturbed, as the calibration keeps the best repetition),
+//! kept in the row as `round_control`.
 
 use std::time::Instant;
 
@@ -53,9 +53,14 @@ pub fn priced(base: &Calibration, control: &Figures) -> (Calibration, Vec<Figure
     (out, scaled)
 }
 
-/// How long one configuration of a control probe runs in a sample: long enough that a
+/// How long one configuration of a control probe runs in a sample, once: long enough that a
 /// submission's fixed cost (tens of µs on lavapipe) is a small part of it, short enough that a
-/// sample of every probe stays a fraction of a second.
+/// sample of every probe stays a fraction of a second. Shorter or repeated shares did worse:
+/// on the default suite, idle and beside two busy loops (2-core Xeon VM, llvmpipe), the busy
+/// run's median fractions over the idle run's read ×0.80–×1.01 with one 10 ms share,
+/// ×0.53–×0.98 with the median of three 5 ms shares and ×0.65–×1.02 with one 20 ms share:
+/// short shares slip between the busy loops' time slices where the rows' frames do not, so
+/// they understate how much slower a busy machine runs the rows.
 pub const TARGET_S: f64 = 0.01;
 
 /// The fewest pieces a share runs (all of them where there are fewer): a share must still
@@ -63,14 +68,6 @@ pub const TARGET_S: f64 = 0.01;
 /// footprints make 2 workgroups in all, and one of them ran on one of lavapipe's two threads,
 /// at half the rate, so six splat rows of the default suite beat a bound priced by it.
 pub const MIN_PIECES: u32 = 256;
-
-/// How many times a sample runs each share, keeping the median. One: measured on the default
-/// suite, idle and beside two busy loops (2-core Xeon VM, llvmpipe), the busy run's median
-/// fractions over the idle run's read ×0.80–×1.01 with one 10 ms share, ×0.53–×0.98 with the
-/// median of three 5 ms shares and ×0.65–×1.02 with one 20 ms share: short shares slip
-/// between the busy loops' time slices that the rows' frames do not, so they understate how
-/// much slower a busy machine runs the rows.
-pub const REPEATS: usize = 1;
 
 /// The control probes prepared for a run: each probe's fastest configuration and the share of
 /// its pieces that runs in about [`TARGET_S`], kept between samples (pipelines and buffers are
@@ -145,8 +142,7 @@ impl<'g> ControlBench<'g> {
             .collect()
     }
 
-    /// One control measurement: each kept configuration's share [`REPEATS`] times, the median
-    /// kept.
+    /// One control measurement: each kept configuration's share once.
     pub fn sample(
         &mut self,
         dataset: &str,
@@ -160,12 +156,7 @@ impl<'g> ControlBench<'g> {
             let timings: Vec<Timing> = c
                 .workloads
                 .iter_mut()
-                .filter_map(|(w, k)| {
-                    let mut repeats: Vec<Timing> =
-                        (0..REPEATS).filter_map(|_| time_part(w, *k).ok()).collect();
-                    repeats.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
-                    (repeats.len() == REPEATS).then(|| repeats[REPEATS / 2])
-                })
+                .filter_map(|(w, k)| time_part(w, *k).ok())
                 .collect();
             if timings.len() == c.workloads.len() {
                 figures.extend(c.probe.figures_of(&timings));
