@@ -219,7 +219,7 @@ fn summary_of(p: &Paper, session: &Session, report: &Report, seconds: f64) -> Pa
         tables: if tables.is_empty() {
             "–".into()
         } else {
-            tables.join("; ")
+            tables.join(". ")
         },
         cells: Some(cell_counts(&judged)),
         claims: tally_text(&report.claims),

@@ -254,13 +254,13 @@ fn or_skip(versions: Result<Vec<(String, String)>, String>) -> Option<Vec<(Strin
     }
 }
 
+/// The uncovered changes from one version's text to the next's, given which commits lie
+/// between them.
+type Uncovered<'a> = &'a dyn Fn(&str, &str, &mut dyn FnMut(&str) -> bool) -> Vec<String>;
+
 /// Walks the committed versions of `file` and the working tree against the last one, each
 /// step's uncovered changes named with the two versions.
-fn walk(
-    file: &str,
-    versions: &[(String, String)],
-    uncovered: &dyn Fn(&str, &str, &mut dyn FnMut(&str) -> bool) -> Vec<String>,
-) -> (usize, Vec<String>) {
+fn walk(file: &str, versions: &[(String, String)], uncovered: Uncovered) -> (usize, Vec<String>) {
     let working = std::fs::read_to_string(repo().join(file)).unwrap();
     let head = git(&["rev-parse", "HEAD"]).unwrap().trim().to_string();
     let mut missing = vec![];
