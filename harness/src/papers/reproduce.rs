@@ -205,6 +205,22 @@ impl PaperSummary {
             ),
         }
     }
+
+    /// The claims' headline; an older summary (no cells counted) is labelled as such, because
+    /// its verdicts were given in the words of its day: before evidence kinds, "too few
+    /// frames", "not discriminating" and positive controls, a hold there may rest on one frame,
+    /// a layout constant or a pair that cannot differ.
+    pub fn claims_text(&self) -> String {
+        match &self.cells {
+            Some(_) => self.claims.clone(),
+            None => format!(
+                "{} (an older summary, in the verdict words of its day: its holds were not yet \
+                 checked for evidence kind, enough frames, a pair that can differ or a positive \
+                 control)",
+                self.claims
+            ),
+        }
+    }
 }
 
 /// The summary of one paper's report: its tables' cells and its claims, counted.
@@ -275,7 +291,7 @@ pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
                 .position(|x| *x == s.source)
                 .map_or(0, |i| i + 1),
             s.cells_text(),
-            s.claims,
+            s.claims_text(),
             if s.not_measured.is_empty() {
                 "–"
             } else {
@@ -665,6 +681,14 @@ mod tests {
         );
         assert!(
             md.contains("Cells of every paper: not counted by every summary"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| 1 holds |"),
+            "a current summary's claims unlabelled: {md}"
+        );
+        assert!(
+            md.contains("| 2 holds (an older summary, in the verdict words of its day"),
             "{md}"
         );
     }

@@ -671,7 +671,7 @@ fn write_paper(site: &Path, p: &PaperInput) -> anyhow::Result<PaperLine> {
         adapter: p.adapter.clone(),
         mode: p.summary.mode.clone(),
         cells: p.summary.cells_text(),
-        claims: p.summary.claims.clone(),
+        claims: p.summary.claims_text(),
         // The summary's sentence is Markdown (`commit` in backticks): shown as text.
         commit: p.summary.source.replace('`', ""),
         link: format!("{rel}/report.html"),
