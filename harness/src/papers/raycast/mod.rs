@@ -207,7 +207,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         key: "table4".into(),
         title: "Table 4 — number of ray-casting passes (2D table)".into(),
         conditions: format!("A pass (the paper, §2.3 and §3.2): one GPU pass advances every active ray by one tet (one intersection); the count is checked every k passes with an occlusion query. Paper: min/max passes per data set over its camera positions at 512² (GPU and tiling not stated). Ours: the passes one step per pass needs, i.e. the longest walk of any ray in tets (the `steps_max` counter; `mode=passes` runs exactly that many passes, rounded up to the {} after which it counts the active rays), of `{PASSES_SETTINGS}` at 512² over the 14 viewpoints in every mode, min and max over the viewpoints. Ours continues a ray that leaves the mesh at its next peeled entry within the same passes; the paper peels a layer and then runs passes until that layer's rays have left, so its count adds up the layers' longest walks. A count, not a time: it does not depend on the GPU.", raycast::COUNT_EVERY),
-        metrics: vec![Metric::exact("min passes", 0), Metric::exact("max passes", 0)],
+        metrics: vec![Metric::new("min passes", 0), Metric::new("max passes", 0)],
         rows,
         notes,
     });
@@ -283,7 +283,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         key: "memory".into(),
         title: "§3.1 — persistent GPU bytes per tet".into(),
         conditions: "Paper: 9 RGBA32F texels per tet = 144 B (Weiler et al.: 160 B). Ours: the `mesh_bytes_per_tet` counter (the mesh layout; the pre-integration tables are counted apart, as in the paper). Does not depend on the GPU.".into(),
-        metrics: vec![Metric::exact("B/tet", 1)],
+        metrics: vec![Metric::new("B/tet", 1)],
         rows,
         notes: vec![],
     });
