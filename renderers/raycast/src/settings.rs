@@ -25,8 +25,9 @@ impl TableKind {
 /// How ray steps are scheduled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
-    /// Faithful: one GPU pass per ray step and tile, as on 2005 hardware; a tile stops when a
-    /// count of its active rays (every [`crate::COUNT_EVERY`] passes) is zero.
+    /// Faithful: one GPU pass per ray step and tile, as on 2005 hardware; per peeling layer, a
+    /// tile moves on to the next when a count of its active rays (every [`crate::COUNT_EVERY`]
+    /// passes) is zero, and stops when no ray starts again.
     Passes,
     /// Modern: one compute dispatch per tile in which every ray loops until it is done.
     Loop,
