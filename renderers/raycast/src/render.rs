@@ -630,10 +630,10 @@ fn frame(
     let mut tile_passes = vec![0u32; ntiles];
     let mut rounds = passes::Rounds::default();
     // One dispatch per pass covers every listed tile (workgroup z = slot in the list).
-    let groups = [tile_size[0].div_ceil(8), tile_size[1].div_ceil(8)];
+    let grid = passes::Grid::new(tile_size, s.k);
     match s.mode {
         Mode::Passes => {
-            rounds = run_passes(gpu, st, t, groups, counts, &mut tile_passes, &mut clock)?;
+            rounds = run_passes(gpu, st, t, grid, counts, &mut tile_passes, &mut clock)?;
         }
         Mode::Loop => {
             let active = active_tiles(&counts);
@@ -646,7 +646,7 @@ fn frame(
                     pass.set_pipeline(&st.pipes.run_loop);
                     pass.set_bind_group(0, &st.mesh_bind, &[]);
                     pass.set_bind_group(1, &t.cast_binds[0], &[]);
-                    pass.dispatch_workgroups(groups[0], groups[1], active.len() as u32);
+                    pass.dispatch_workgroups(grid.groups[0], grid.groups[1], active.len() as u32);
                 }
                 clock.submit(gpu, [enc.finish()]);
                 for &tile in &active {

@@ -28,6 +28,7 @@ fn exact() -> RaycastSettings {
         mode: Mode::Passes,
         early_termination: false,
         max_layers: 8,
+        k: COUNT_EVERY,
     }
 }
 
@@ -264,6 +265,13 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
     let continued = passmap::passes_per_tile(&joined, d.width, n, d.tile_size, COUNT_EVERY);
     assert!(twin.iter().zip(&continued).all(|(a, b)| a >= b));
     assert!(twin.iter().zip(&continued).any(|(a, b)| a > b));
+    // Another k: the same stretches, rounded to its rounds.
+    for k in [1, 3] {
+        let mut rk = Raycast::new(RaycastSettings { k, ..settings });
+        let (_, dk, ..) = render(&gpu, &mut rk, &mesh, &optics, 6, 72);
+        let twin_k = passmap::passes_per_tile(&segments, d.width, n, d.tile_size, k);
+        assert_eq!(dk.tile_passes, twin_k, "k = {k}");
+    }
     let mut empty = 0;
     for (tile, &passes) in twin.iter().enumerate() {
         if continued[tile] == 0 {

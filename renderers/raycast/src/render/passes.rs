@@ -1,5 +1,5 @@
 //! Phase 3 in mode=passes (§2.3, §3.2 phases 3a–3b), as the paper spends its passes: per tile
-//! and per peeling layer, rounds of [`COUNT_EVERY`] passes of one ray step each; the last pass
+//! and per peeling layer, rounds of k passes ([`crate::RaycastSettings::k`]) of one ray step each; the last pass
 //! of a round counts the tile's rays still inside the mesh (the paper's occlusion query). A
 //! tile at zero has finished its layer: its rays start again from their next layer entries
 //! (`load_layer`), and a tile where none does is done. A tile's passes are thus the sum over
@@ -9,7 +9,31 @@ use render_core::{FrameClock, Gpu};
 
 use super::{active_tiles, read_counts, State};
 use crate::resources::{Target, TilePipelines};
-use crate::COUNT_EVERY;
+
+/// The dispatch of one pass over the listed tiles (workgroups per tile), and k.
+#[derive(Clone, Copy)]
+pub(super) struct Grid {
+    pub groups: [u32; 2],
+    pub k: u32,
+}
+
+impl Grid {
+    /// 8×8 workgroups over a tile of `tile_size` pixels.
+    pub fn new(tile_size: [u32; 2], k: u32) -> Grid {
+        Grid {
+            groups: [tile_size[0].div_ceil(8), tile_size[1].div_ceil(8)],
+            k,
+        }
+    }
+}
+
+/// One round drawn as rectangles: the active tiles, whether it is the frame's first, and k.
+#[derive(Clone, Copy)]
+struct Round {
+    tiles: u32,
+    first: bool,
+    k: u32,
+}
 
 /// What the rounds did: their number, and the tile rectangles drawn (two triangles each) where
 /// the passes are drawn rather than dispatched.
@@ -27,12 +51,13 @@ pub(super) fn run_passes(
     gpu: &Gpu,
     st: &State,
     t: &Target,
-    groups: [u32; 2],
+    grid: Grid,
     mut counts: Vec<u32>,
     tile_passes: &mut [u32],
     clock: &mut FrameClock,
 ) -> anyhow::Result<Rounds> {
     let ntiles = tile_passes.len();
+    let Grid { groups, k } = grid;
     let mut rounds = Rounds::default();
     let tiled = st.pipes.tile_passes.as_ref().zip(t.zcull.as_ref());
     loop {
@@ -47,23 +72,20 @@ pub(super) fn run_passes(
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         match tiled {
             Some((pipes, zcull)) => {
-                encode_tile_round(
-                    &mut enc,
-                    st,
-                    t,
-                    pipes,
-                    zcull,
-                    active.len() as u32,
-                    rounds.rounds == 0,
-                );
-                rounds.rectangles += active.len() as u64 * (COUNT_EVERY as u64 + 1);
+                let round = Round {
+                    tiles: active.len() as u32,
+                    first: rounds.rounds == 0,
+                    k,
+                };
+                encode_tile_round(&mut enc, st, t, pipes, zcull, round);
+                rounds.rectangles += active.len() as u64 * (k as u64 + 1);
             }
             None => {
                 let mut pass = enc.begin_compute_pass(&Default::default());
                 pass.set_pipeline(&st.pipes.step);
                 pass.set_bind_group(0, &st.mesh_bind, &[]);
-                for k in 0..COUNT_EVERY {
-                    let count = (k + 1 == COUNT_EVERY) as usize;
+                for pass_index in 0..k {
+                    let count = (pass_index + 1 == k) as usize;
                     pass.set_bind_group(1, &t.cast_binds[count], &[]);
                     pass.dispatch_workgroups(groups[0], groups[1], active.len() as u32);
                 }
@@ -71,7 +93,7 @@ pub(super) fn run_passes(
         }
         clock.submit(gpu, [enc.finish()]);
         for &tile in &active {
-            tile_passes[tile as usize] += COUNT_EVERY;
+            tile_passes[tile as usize] += k;
         }
         rounds.rounds += 1;
         counts = read_counts(gpu, clock, &t.tile_counts, ntiles)?;
@@ -119,7 +141,7 @@ fn load_layers(
 }
 
 /// One round as the paper draws it: the depth update (rays that have ended or left their layer
-/// to depth 0, the others to 1; the first round clears the depth first), then [`COUNT_EVERY`] passes of a rectangle per active tile, each
+/// to depth 0, the others to 1; the first round clears the depth first), then `k` passes of a rectangle per active tile, each
 /// its own render pass so that a pass sees the rays the one before it stored.
 fn encode_tile_round(
     enc: &mut wgpu::CommandEncoder,
@@ -127,17 +149,17 @@ fn encode_tile_round(
     t: &Target,
     pipes: &TilePipelines,
     zcull: &wgpu::TextureView,
-    tiles: u32,
-    first: bool,
+    round: Round,
 ) {
-    for k in 0..=COUNT_EVERY {
+    let Round { tiles, first, k } = round;
+    for pass_index in 0..=k {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("raycast tile pass"),
             color_attachments: &[],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: zcull,
                 depth_ops: Some(wgpu::Operations {
-                    load: if first && k == 0 {
+                    load: if first && pass_index == 0 {
                         wgpu::LoadOp::Clear(1.0)
                     } else {
                         wgpu::LoadOp::Load
@@ -150,9 +172,13 @@ fn encode_tile_round(
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(if k == 0 { &pipes.cull } else { &pipes.step });
+        pass.set_pipeline(if pass_index == 0 {
+            &pipes.cull
+        } else {
+            &pipes.step
+        });
         pass.set_bind_group(0, &st.mesh_bind, &[]);
-        pass.set_bind_group(1, &t.cast_binds[(k == COUNT_EVERY) as usize], &[]);
+        pass.set_bind_group(1, &t.cast_binds[(pass_index == k) as usize], &[]);
         pass.set_bind_group(2, &st.peel_frame_bind, &[]);
         pass.draw(0..6, 0..tiles);
     }
