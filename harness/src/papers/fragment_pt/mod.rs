@@ -197,8 +197,8 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
             "Paper: 512², model rotating, counts printed rounded (compared after rounding ours the same way). Ours: `{FRAGMENT_SETTINGS}` (the bucket sort the paper uses while the view changes; shading not stated), an orbit of viewpoints, mean over them; fps = 1000 / median total frame ms."
         ),
         metrics: vec![
-            Metric::rounded("vertices"),
-            Metric::rounded("tets"),
+            Metric::new("vertices", 0),
+            Metric::new("tets", 0),
             Metric::new("fps", 2),
             Metric::new("tets/s", 0),
         ],

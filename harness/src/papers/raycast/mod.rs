@@ -255,7 +255,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         key: "memory".into(),
         title: "§3.1 — persistent GPU bytes per tet".into(),
         conditions: "Paper: 9 RGBA32F texels per tet = 144 B (Weiler et al.: 160 B). Ours: the `mesh_bytes_per_tet` counter (the mesh layout; the pre-integration tables are counted apart, as in the paper). Does not depend on the GPU.".into(),
-        metrics: vec![Metric::exact("B/tet", 1)],
+        metrics: vec![Metric::new("B/tet", 1)],
         rows,
         notes: vec![],
     });
