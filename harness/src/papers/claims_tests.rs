@@ -11,9 +11,10 @@ use crate::papers::transcription;
 use crate::papers::verdict::Verdict;
 use crate::results::Row;
 
-const ANALYSES: [&str; 4] = [
+const ANALYSES: [&str; 5] = [
     "sort-analysis",
     "kbuffer-analysis",
+    "classifier-gpu",
     "classifier-twin",
     "dataset",
 ];
@@ -98,9 +99,11 @@ pub(super) fn eval(paper: &str, m: &Measured, x: &Extra) -> Vec<ClaimResult> {
     })
 }
 
+/// The outcomes as both classifiers' (G8 reads the shader's).
 fn truth_table(observed: Vec<gator::ObservedCase>) -> Extra {
     Extra::with_own(gator::GatorAnalyses {
-        truth_table: Some(observed),
+        truth_table: Some(observed.clone()),
+        gpu_truth_table: Some(Ok(observed)),
         geometry: vec![],
     })
 }
@@ -494,36 +497,81 @@ fn quick_plans_run_a_subset_of_the_full_variants_and_every_variant_a_claim_names
     }
 }
 
+/// G1 on "post" (a generated mesh in its place, four diagonal views) from the shader's
+/// readback, tet 0's class changed in the first view's records where `corrupt`, and the twin
+/// `classify`.
+fn g1_extra(
+    gpu: &render_core::Gpu,
+    classifier: &mut gator_pt::GpuClassifier,
+    mesh: &datasets::TetMesh,
+    classify: &(dyn Fn([[f64; 3]; 4]) -> gator_pt::Classification + Sync),
+    corrupt: bool,
+) -> Extra {
+    let views = &render_core::fixed_viewpoints()[6..10];
+    let mut first = corrupt;
+    let mut read = |c: &render_core::Camera| {
+        let mut r = classifier.classify(gpu, c)?;
+        if std::mem::take(&mut first) {
+            r[0].class = 3 - r[0].class;
+        }
+        Ok(r)
+    };
+    let check = gator::geometry::check_mesh("post", mesh, views, 512, classify, Some(&mut read));
+    Extra::with_own(gator::GatorAnalyses {
+        truth_table: None,
+        gpu_truth_table: None,
+        geometry: vec![check],
+    })
+}
+
 #[test]
-fn g1_fails_when_a_geometric_test_of_the_classifier_is_broken_though_its_labels_pass() {
-    use gator::geometry::check_mesh;
+fn g1_judges_the_shaders_classifier_and_one_changed_record_flips_it() {
+    let gpu = render_core::Gpu::new().expect("an adapter (lavapipe)");
     let mesh = datasets::registry::Registry::new(None)
         .resolve("box:2k", &datasets::LoadOptions::default())
         .expect("generated mesh")
         .mesh;
-    let views = render_core::fixed_viewpoints();
+    let mut classifier =
+        gator_pt::GpuClassifier::new(&gpu, &mesh.points, &mesh.scalars, &mesh.tets, None).unwrap();
+    let twin = &gator_pt::classify_cpu;
+    let m = Measured::default();
+    let ok = g1_extra(&gpu, &mut classifier, &mesh, twin, false);
+    assert_eq!(
+        verdict_of(&eval("gator", &m, &ok), "G1", Some("post")),
+        Verdict::Holds
+    );
+    // One tet's class read back changed: the shader's side fails.
+    let bad = g1_extra(&gpu, &mut classifier, &mesh, twin, true);
+    assert_eq!(
+        verdict_of(&eval("gator", &m, &bad), "G1", Some("post")),
+        Verdict::DoesNotHold
+    );
+    // The twin broken in its test 4: G1 judges the shader, which still holds, and its side
+    // names the twin's mismatches beside its own.
     let broken = gator_pt::GeometricTests {
         test4_alpha_limit: 0.5,
     };
-    let broken_classifier = |p| gator_pt::classify_cpu_with(p, &broken);
-    let with = |classify: &(dyn Fn([[f64; 3]; 4]) -> gator_pt::Classification + Sync)| {
-        let geometry = ["bluntfin", "post", "deltawing"]
-            .map(|d| check_mesh(d, &mesh, &views, 512, classify))
-            .to_vec();
-        Extra::with_own(gator::GatorAnalyses {
-            truth_table: Some(gator::observed_truth_table_with(50_000, classify)),
-            geometry,
-        })
-    };
-    let m = Measured::default();
-    let ok = eval("gator", &m, &with(&gator_pt::classify_cpu));
-    assert_eq!(verdict_of(&ok, "G1", Some("post")), Verdict::Holds);
-    assert_eq!(verdict_of(&ok, "G8", None), Verdict::Holds);
-    let bad = eval("gator", &m, &with(&broken_classifier));
-    assert_eq!(verdict_of(&bad, "G1", Some("post")), Verdict::DoesNotHold);
-    // The truth table compares labels only: the broken classifier still passes it.
-    assert_eq!(verdict_of(&bad, "G8", None), Verdict::Holds);
-    // Not run: not checkable.
+    let broken_twin = |p| gator_pt::classify_cpu_with(p, &broken);
+    let x = g1_extra(&gpu, &mut classifier, &mesh, &broken_twin, false);
+    let r = eval("gator", &m, &x);
+    assert_eq!(verdict_of(&r, "G1", Some("post")), Verdict::Holds);
+    let g = &gator::analyses_of(&x).geometry[0];
+    assert!(
+        g.twin.class_mismatches > 0 && g.gpu_twin_disagreements > 0,
+        "{g:?}"
+    );
+    // Not read back: not checkable.
+    let views = render_core::fixed_viewpoints();
+    let twin_only = Extra::with_own(gator::GatorAnalyses {
+        geometry: vec![gator::geometry::check_mesh(
+            "post", &mesh, &views, 512, twin, None,
+        )],
+        ..Default::default()
+    });
+    assert_eq!(
+        verdict_of(&eval("gator", &m, &twin_only), "G1", Some("post")),
+        Verdict::NotCheckable
+    );
     let none = eval("gator", &m, &Extra::default());
     assert_eq!(verdict_of(&none, "G1", Some("post")), Verdict::NotCheckable);
 }

@@ -25,22 +25,30 @@ struct Params {
 };
 
 struct ChunkParams {
-    // Sorted position of this chunk's first entry in `order`.
+    // Sorted position of this chunk's first entry in `order` (in the debug pass: the first
+    // tet of the chunk it classifies).
     base: u32,
     pad0: u32,
     pad1: u32,
     pad2: u32,
 };
 
-// What the debug entry point records per tet (32 bytes; mirrored by `GpuClassification`).
+// What the debug entry point records per tet (80 bytes; mirrored by `GpuClassification`).
 struct DebugRecord {
+    // Screen x and y (NDC) of the four input vertices as this shader projected them.
+    screen_x: vec4<f32>,
+    screen_y: vec4<f32>,
     case_id: u32,
     class_id: u32,
+    // Bit i set: test t(i+1) held (t1..t3 the orientation tests, t4 the class-2 test).
+    tests: u32,
+    pad0: u32,
     thick: vec2<f32>,
     ndc_thickness: f32,
     length: f32,
     s_front: f32,
     s_back: f32,
+    pad1: vec2<u32>,
 };
 
 @group(0) @binding(0) var<uniform> P: Params;
@@ -113,6 +121,8 @@ struct TetProjection {
     ndc_thickness: f32,
     case_id: u32,
     class2: bool,
+    // Bit i: test t(i+1) held (the debug record's `tests`).
+    tests: u32,
     // false when a vertex is behind the eye (w <= 0): the tet is not drawn.
     valid: bool,
 };
@@ -234,6 +244,7 @@ fn project_and_classify(tet_id: u32) -> TetProjection {
         r.s_back = sa;
     }
     r.class2 = t4;
+    r.tests = u32(t1) | (u32(t2) << 1u) | (u32(t3) << 2u) | (u32(t4) << 3u);
     if idx < 6u {
         r.case_id = 2u * idx + 1u + u32(t4);
     } else {
@@ -319,16 +330,20 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     return vec4<f32>(tf.rgb * alpha, alpha);
 }
 
-// Debug: the classification of every tet, written to a buffer (tests compare it with
-// classify.rs).
+// Debug: the classification of tets C.base, C.base + 1, …, written to a buffer from its
+// start (debug.rs reads it back chunk by chunk; the tests and the claims compare it with
+// classify.rs and with the projected hull).
 @compute @workgroup_size(64)
 fn classify_debug(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let id = gid.x;
-    if id >= P.num_tets {
+    let id = C.base + gid.x;
+    if id >= P.num_tets || gid.x >= arrayLength(&debug_out) {
         return;
     }
     let tp = project_and_classify(id);
     var rec: DebugRecord;
+    rec.screen_x = tp.x;
+    rec.screen_y = tp.y;
+    rec.tests = tp.tests;
     rec.case_id = tp.case_id;
     rec.class_id = select(1u, 2u, tp.class2);
     if !tp.valid {
@@ -339,5 +354,5 @@ fn classify_debug(@builtin(global_invocation_id) gid: vec3<u32>) {
     rec.length = tp.length;
     rec.s_front = tp.s_front;
     rec.s_back = tp.s_back;
-    debug_out[id] = rec;
+    debug_out[gid.x] = rec;
 }

@@ -32,8 +32,10 @@
 //! computed exactly in world space (perspective-correct weights), so class boundaries and
 //! degenerate projections stay continuous.
 //!
-//! [`classify_cpu`] is the f64 twin of the shader's classification; [`classify_gpu`] runs the
-//! shader's own function in a compute pass and reads the results back, so tests compare them.
+//! [`classify_cpu`] is the f64 twin of the shader's classification; [`classify_gpu`] (and
+//! [`GpuClassifier`], for many cameras and meshes past one storage binding) runs the shader's
+//! own function in a compute pass and reads the results back, so tests and claims compare
+//! them.
 
 mod classify;
 mod debug;
@@ -42,7 +44,7 @@ mod frame;
 mod mesh_gpu;
 mod ordering;
 
-pub use debug::{classify_gpu, GpuClassification};
+pub use debug::{classify_gpu, GpuClassification, GpuClassifier};
 pub use description::DESCRIPTION;
 
 use anyhow::{anyhow, bail, Context};
@@ -237,7 +239,8 @@ pub fn gpu_layouts() -> render_core::gpu_layout::GpuLayouts {
             tau_max, tf_size, exp_size
         }),
         render_core::rust_layout!(GpuClassification => "gator.wgsl::DebugRecord" {
-            case, class, thick_vertex, ndc_thickness, length, s_front, s_back
+            screen_x, screen_y, case, class, tests, pad0, thick_vertex, ndc_thickness, length,
+            s_front, s_back, pad1
         }),
     ];
     render_core::gpu_layout::GpuLayouts {

@@ -725,3 +725,50 @@ fn settings_and_variants() {
     let e = "gpu".parse::<GatorSort>().unwrap_err().to_string();
     assert!(e.contains("gpu-radix"), "{e}");
 }
+
+/// The debug classification read back in chunks (a binding of a few hundred records, so a
+/// small mesh needs several dispatches) is the one-chunk readback record for record, in mesh
+/// order; its recorded test outcomes spell its case (case = 2·(4·t1 + 2·t2 + t3) + 1 + t4, 13
+/// and 14 where t1 and t2 hold) and its screen points are the projection the twin computes.
+#[test]
+fn the_debug_classification_reads_back_in_chunks_in_mesh_order() {
+    use gator_pt::GpuClassifier;
+    let gpu = gpu();
+    let mesh = datasets::registry::Registry::new(None)
+        .resolve("box:2k", &datasets::LoadOptions::default())
+        .expect("generated mesh")
+        .mesh;
+    let cam = Camera::fit(
+        &mesh.bounds(),
+        &render_core::fixed_viewpoints()[6],
+        Default::default(),
+        512,
+        512,
+    );
+    let scalars = mesh.scalars.clone();
+    let mut one = GpuClassifier::new(&gpu, &mesh.points, &scalars, &mesh.tets, None).unwrap();
+    let mut chunked =
+        GpuClassifier::new(&gpu, &mesh.points, &scalars, &mesh.tets, Some(256 * 80)).unwrap();
+    assert!(chunked.tets_per_chunk() < mesh.tets.len() as u64 / 4);
+    let a = one.classify(&gpu, &cam).unwrap();
+    let b = chunked.classify(&gpu, &cam).unwrap();
+    assert_eq!(a.len(), mesh.tets.len());
+    assert_eq!(a, b);
+    let m = cam.view_proj();
+    for (t, g) in mesh.tets.iter().zip(&a) {
+        let [t1, t2, t3, t4] = g.test_outcomes();
+        let idx = 4 * t1 as u32 + 2 * t2 as u32 + t3 as u32;
+        let case = if idx < 6 {
+            2 * idx + 1 + t4 as u32
+        } else {
+            13 + idx - 6
+        };
+        assert_eq!(g.case, case, "{g:?}");
+        for (k, &v) in t.iter().enumerate() {
+            let p = DVec3::from(mesh.points[v as usize].map(f64::from));
+            let c = m * p.extend(1.0);
+            assert!((g.screen_x[k] as f64 - c.x / c.w).abs() < 1e-5, "{g:?}");
+            assert!((g.screen_y[k] as f64 - c.y / c.w).abs() < 1e-5, "{g:?}");
+        }
+    }
+}

@@ -70,22 +70,63 @@ pub fn observed_truth_table_with(
         x ^= x << 17;
         (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
     };
-    let mut seen: Vec<ObservedCase> = vec![];
-    for _ in 0..samples {
+    distinct((0..samples).map(|_| {
         let p: [[f64; 3]; 4] = std::array::from_fn(|_| [rnd(), rnd(), rnd()]);
         let c = classify(p);
-        let [t1, t2, t3, t4] = c.tests;
-        let o = ObservedCase {
-            case: c.case,
-            class: c.class,
-            tests: [t1, t2, t4, t3],
-        };
+        ObservedCase::of(c.case, c.class, c.tests)
+    }))
+}
+
+/// The distinct outcomes, sorted.
+fn distinct(outcomes: impl Iterator<Item = ObservedCase>) -> Vec<ObservedCase> {
+    let mut seen: Vec<ObservedCase> = vec![];
+    for o in outcomes {
         if !seen.contains(&o) {
             seen.push(o);
         }
     }
     seen.sort();
     seen
+}
+
+impl ObservedCase {
+    /// From a classifier's case, class and tests in our order (t1..t4).
+    fn of(case: u8, class: u8, [t1, t2, t3, t4]: [bool; 4]) -> ObservedCase {
+        ObservedCase {
+            case,
+            class,
+            tests: [t1, t2, t4, t3],
+        }
+    }
+}
+
+/// The shader's own classifier (`gator.wgsl`, read back) on `samples` random tets in the
+/// cube [-1, 1]³ seen from a diagonal: the distinct outcomes, as [`observed_truth_table`].
+pub fn observed_truth_table_gpu(
+    gpu: &render_core::Gpu,
+    samples: usize,
+) -> anyhow::Result<Vec<ObservedCase>> {
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    let mut rnd = || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        ((x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) as f32
+    };
+    let points: Vec<[f32; 3]> = (0..4 * samples).map(|_| [rnd(), rnd(), rnd()]).collect();
+    let tets: Vec<[u32; 4]> = (0..samples as u32)
+        .map(|t| [4 * t, 4 * t + 1, 4 * t + 2, 4 * t + 3])
+        .collect();
+    let bounds = datasets::Aabb {
+        min: [-1.0; 3],
+        max: [1.0; 3],
+    };
+    let view = render_core::Viewpoint::new("+x+y+z", [1.0, 1.0, 1.0]);
+    let camera = render_core::Camera::fit(&bounds, &view, Default::default(), 512, 512);
+    let records = gator_pt::classify_gpu(gpu, &points, &vec![0.0; points.len()], &tets, &camera)?;
+    Ok(distinct(records.iter().filter(|g| g.class != 0).map(|g| {
+        ObservedCase::of(g.case as u8, g.class as u8, g.test_outcomes())
+    })))
 }
 
 /// The paper's Table 1 rows: test outcomes (None = X, either).
@@ -154,12 +195,15 @@ pub fn table1_mismatches(observed: &[ObservedCase], rows: &[[Option<bool>; 4]]) 
     out
 }
 
-/// GATOR's CPU analyses besides the runs, kept in [`Extra::own`].
+/// GATOR's analyses besides the runs, kept in [`Extra::own`].
 #[derive(Debug, Clone, Default)]
 pub struct GatorAnalyses {
-    /// Table 1: the classifier's distinct outcomes on random tets (`None`: not run).
+    /// Table 1: the CPU twin's distinct outcomes on random tets (`None`: not run).
     pub truth_table: Option<Vec<ObservedCase>>,
-    /// G1: the classifier against the projected hull on the paper's meshes and views.
+    /// G8: the shader's classifier's distinct outcomes on random tets, read back (`None`: not
+    /// run; `Err`: no adapter or the readback failed, with why).
+    pub gpu_truth_table: Option<Result<Vec<ObservedCase>, String>>,
+    /// G1: both classifiers against the projected hull on the paper's meshes and views.
     pub geometry: Vec<geometry::GeometryCheck>,
 }
 
@@ -167,6 +211,7 @@ pub struct GatorAnalyses {
 pub fn analyses_of(x: &Extra) -> &GatorAnalyses {
     static NONE: GatorAnalyses = GatorAnalyses {
         truth_table: None,
+        gpu_truth_table: None,
         geometry: Vec::new(),
     };
     x.own::<GatorAnalyses>().unwrap_or(&NONE)
@@ -175,61 +220,147 @@ pub fn analyses_of(x: &Extra) -> &GatorAnalyses {
 /// The viewport of the geometric check (the plan's; only its aspect matters).
 const GEOMETRY_RESOLUTION: u32 = 512;
 
-/// A claim's side from GATOR's CPU analyses (`classifier-twin`); `None`: not one of them.
+/// The classifier a claim's side reads: the shader's (read back) or its CPU twin.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Classifier {
+    Gpu,
+    Twin,
+}
+
+impl Classifier {
+    fn of(side: &str) -> Option<Classifier> {
+        match side {
+            "classifier-gpu" => Some(Classifier::Gpu),
+            "classifier-twin" => Some(Classifier::Twin),
+            _ => None,
+        }
+    }
+}
+
+/// Table 1's mismatches of one classifier's outcomes, in words.
+fn truth_table_words(who: &str, observed: &[ObservedCase]) -> (String, usize) {
+    let mismatches = table1_mismatches(observed, &paper_rows());
+    let words = format!(
+        "{who}, {} distinct outcomes, {} mismatches{}{}",
+        observed.len(),
+        mismatches.len(),
+        if mismatches.is_empty() { "" } else { ": " },
+        mismatches.join("; ")
+    );
+    (words, mismatches.len())
+}
+
+/// One classifier's comparison with the hull, in words.
+fn geometry_words(who: &str, s: &geometry::SideCheck) -> String {
+    format!(
+        "{who}: {} projected tets compared ({} too close to degenerate to call at its precision), {} class and {} thick-vertex mismatches{}{}",
+        s.compared,
+        s.ambiguous,
+        s.class_mismatches,
+        s.thick_vertex_mismatches,
+        if s.examples.is_empty() { "" } else { ", e.g. " },
+        s.examples.join("; ")
+    )
+}
+
+const NOT_RUN: &str = "the classifier was not run (`tetbench reproduce gator` runs it)";
+
+/// A claim's side from GATOR's analyses (`classifier-gpu`, `classifier-twin`); `None`: not
+/// one of them. The shader's side names the twin's figures beside its own.
 pub fn claim_side(
     x: &Extra,
     metric: &spec::Metric,
     spec: &VariantSpec,
     dataset: Option<&str>,
 ) -> Option<Result<Side, String>> {
-    if spec.algorithm != "classifier-twin" {
-        return None;
-    }
+    let who = Classifier::of(&spec.algorithm)?;
     let a = analyses_of(x);
     Some(match metric.analysis_name().unwrap_or_default() {
-        "classifier_mismatches" => match &a.truth_table {
-            None => Err("the classifier was not run (`tetbench reproduce gator` runs it)".into()),
-            Some(observed) => {
-                let mismatches = table1_mismatches(observed, &paper_rows());
-                exact_side(
-                    format!(
-                        "gator-pt classifier (CPU twin), {} distinct outcomes, mismatches{}{}",
-                        observed.len(),
-                        if mismatches.is_empty() { "" } else { ": " },
-                        mismatches.join("; ")
-                    ),
-                    "table1",
-                    mismatches.len() as f64,
-                )
+        "classifier_mismatches" => {
+            let twin = a
+                .truth_table
+                .as_deref()
+                .map(|t| truth_table_words("CPU twin", t));
+            match (who, &a.gpu_truth_table, twin) {
+                (Classifier::Twin, _, None) | (Classifier::Gpu, None, _) => Err(NOT_RUN.into()),
+                (Classifier::Gpu, Some(Err(why)), _) => Err(why.clone()),
+                (Classifier::Twin, _, Some((words, n))) => {
+                    exact_side(format!("gator-pt classifier ({words})"), "table1", n as f64)
+                }
+                (Classifier::Gpu, Some(Ok(observed)), twin) => {
+                    let (words, n) = truth_table_words("shader, read back", observed);
+                    let twin = twin.map_or("CPU twin not run".into(), |(w, _)| w);
+                    exact_side(
+                        format!("gator-pt classifier ({words}; {twin})"),
+                        "table1",
+                        n as f64,
+                    )
+                }
             }
-        },
+        }
         "classifier_geometry_mismatches" => {
             let Some(d) = dataset else {
                 return Some(Err(format!("{metric} needs a data set")));
             };
-            match a.geometry.iter().find(|g| g.dataset == d) {
-                None => Err(format!(
+            match (a.geometry.iter().find(|g| g.dataset == d), who) {
+                (None, _) => Err(format!(
                     "the classifier was not checked against geometry on {d} (`tetbench reproduce gator` does)"
                 )),
-                Some(g) => exact_side(
+                (Some(g), Classifier::Twin) => exact_side(
                     format!(
-                        "gator-pt classifier (CPU twin) against the projected hull on {d}, {} viewpoints: {} projected tets compared ({} too close to degenerate to call, {} behind the eye), {} class and {} thick-vertex mismatches{}{}",
+                        "gator-pt classifier against the projected hull on {d}, {} viewpoints, {} tets behind the eye; {}",
                         g.viewpoints,
-                        g.compared,
-                        g.ambiguous,
                         g.behind_eye,
-                        g.class_mismatches,
-                        g.thick_vertex_mismatches,
-                        if g.examples.is_empty() { "" } else { ", e.g. " },
-                        g.examples.join("; ")
+                        geometry_words("CPU twin", &g.twin)
                     ),
                     d,
-                    g.mismatches() as f64,
+                    g.twin.mismatches() as f64,
                 ),
+                (Some(g), Classifier::Gpu) => match &g.gpu {
+                    Err(why) => Err(why.clone()),
+                    Ok(gpu) => exact_side(
+                        format!(
+                            "gator-pt classifier against the projected hull on {d}, {} viewpoints, {} tets behind the eye; {}; {}; the shader's case differs from the twin's on {} tets both could call",
+                            g.viewpoints,
+                            g.behind_eye,
+                            geometry_words("the shader's, read back", gpu),
+                            geometry_words("its CPU twin", &g.twin),
+                            g.gpu_twin_disagreements
+                        ),
+                        d,
+                        gpu.mismatches() as f64,
+                    ),
+                },
             }
         }
-        _ => Err(format!("classifier-twin has no metric {metric}")),
+        _ => Err(format!("{} has no metric {metric}", spec.algorithm)),
     })
+}
+
+/// G1 on one mesh: the CPU twin, and the shader's classifier where an adapter is there.
+fn check_geometry(
+    d: &str,
+    mesh: &datasets::TetMesh,
+    views: &[render_core::Viewpoint],
+    gpu: &Result<render_core::Gpu, String>,
+) -> geometry::GeometryCheck {
+    let twin = &gator_pt::classify_cpu;
+    let classifier = gpu.as_ref().map_err(Clone::clone).and_then(|g| {
+        gator_pt::GpuClassifier::new(g, &mesh.points, &mesh.scalars, &mesh.tets, None)
+            .map(|c| (g, c))
+            .map_err(|e| format!("the shader's classifier could not be prepared on {d}: {e:#}"))
+    });
+    match classifier {
+        Ok((g, mut c)) => {
+            let mut read = |camera: &render_core::Camera| c.classify(g, camera);
+            geometry::check_mesh(d, mesh, views, GEOMETRY_RESOLUTION, twin, Some(&mut read))
+        }
+        Err(why) => {
+            let mut check = geometry::check_mesh(d, mesh, views, GEOMETRY_RESOLUTION, twin, None);
+            check.gpu = Err(why);
+            check
+        }
+    }
 }
 
 /// The GATOR paper.
@@ -256,12 +387,19 @@ impl PaperModule for Gator {
     }
 
     fn analyses(&self, s: &mut Session, m: &mut Measured) -> anyhow::Result<Extra> {
-        let mut own = GatorAnalyses {
-            truth_table: Some(observed_truth_table(200_000)),
-            geometry: vec![],
-        };
+        // The shader's classifier is read back outside any timed frame, on a device of its own.
+        let gpu = render_core::Gpu::new()
+            .map_err(|e| format!("no adapter for the shader's classifier: {e:#}"));
+        let mut own =
+            GatorAnalyses {
+                truth_table: Some(observed_truth_table(200_000)),
+                gpu_truth_table: Some(gpu.as_ref().map_err(Clone::clone).and_then(|g| {
+                    observed_truth_table_gpu(g, 200_000).map_err(|e| format!("{e:#}"))
+                })),
+                geometry: vec![],
+            };
         s.log.push(
-            "Table 1: 200,000 random projected tets through the classifier's CPU twin".into(),
+            "Table 1: 200,000 random projected tets through the classifier's CPU twin and through the shader's, read back".into(),
         );
         let views = render_core::fixed_viewpoints();
         let mut x = Extra::default();
@@ -279,17 +417,11 @@ impl PaperModule for Gator {
                     // G1: every tet from the paper's views (the 14; it averages "many"), at
                     // full size in every mode: no GPU, a few seconds.
                     let t0 = std::time::Instant::now();
-                    let g = geometry::check_mesh(
-                        d,
-                        &ds.mesh,
-                        &views,
-                        GEOMETRY_RESOLUTION,
-                        &gator_pt::classify_cpu,
-                    );
+                    let g = check_geometry(d, &ds.mesh, &views, &gpu);
                     s.log.push(format!(
-                        "G1: the classifier against the projected hull on {d}, {} viewpoints, {} tets compared, {:.0} s",
+                        "G1: the shader's classifier (read back) and its CPU twin against the projected hull on {d}, {} viewpoints, {} tets compared (twin), {:.0} s",
                         views.len(),
-                        g.compared,
+                        g.twin.compared,
                         t0.elapsed().as_secs_f64()
                     ));
                     own.geometry.push(g);
