@@ -144,7 +144,8 @@ pub fn compare(
     // The machine divided out by the control measured beside the rows, where both runs have
     // one (compare_control.rs); otherwise the run-wide factor, as before.
     let control_missing = crate::regress::compare_control::missing(&base, &new);
-    let machine = (opt.drift_correction && !opt.normalised)
+    let by_drift = opt.drift_correction && !opt.normalised;
+    let machine = by_drift
         .then(|| crate::regress::compare_control::normalise(&mut base, &mut new))
         .flatten();
     let by_rows = opt.drift_correction && machine.is_none();
@@ -170,17 +171,7 @@ pub fn compare(
         _ => (None, None),
     };
     let time_judged = rounds.enough() && noise.is_none();
-    let mut groups = group_tests(&base.rows, &new.rows, opt, &scale, rounds)?;
-    adjust_family(
-        groups.iter_mut().map(|g| &mut g.total),
-        opt.threshold,
-        opt.alpha,
-    );
-    if noise.is_some() {
-        for g in &mut groups {
-            g.total.verdict = Verdict::TooNoisy;
-        }
-    }
+    let groups = judged_groups((&base, &new), opt, &scale, rounds, noise.is_some())?;
     let rows = compare_all_rows(
         (&base, &new),
         (base_dir, new_dir),
@@ -199,20 +190,17 @@ pub fn compare(
         threshold: opt.threshold,
         alpha: opt.alpha,
         rounds,
-        warnings: [("BASE", &base), ("NEW", &new)]
-            .iter()
-            .flat_map(|(side, f)| provenance_warnings(side, f))
-            .collect(),
+        warnings: [
+            provenance_warnings("BASE", &base),
+            provenance_warnings("NEW", &new),
+        ]
+        .concat(),
         time_refused: rounds.refusal().or(noise.clone()),
         group_spread,
         too_noisy: noise.is_some(),
         run_factor,
         drift_corrected: by_rows && scale != [1.0],
-        control_missing: if machine.is_none() && opt.drift_correction && !opt.normalised {
-            control_missing
-        } else {
-            None
-        },
+        control_missing: control_missing.filter(|_| machine.is_none() && by_drift),
         machine,
         across,
         pair_factors,
@@ -225,6 +213,29 @@ pub fn compare(
     };
     crate::regress::compare_findings::collect(&mut cmp, opt.drift_limit);
     Ok(cmp)
+}
+
+/// The groups' tests on NEW divided by `scale`, Holm-adjusted over the groups; all too noisy
+/// when the run's groups scatter beyond the threshold (`too_noisy`).
+fn judged_groups(
+    (base, new): (&ResultsFile, &ResultsFile),
+    opt: &CompareOptions,
+    scale: &[f64],
+    rounds: Rounds,
+    too_noisy: bool,
+) -> anyhow::Result<Vec<GroupComparison>> {
+    let mut groups = group_tests(&base.rows, &new.rows, opt, scale, rounds)?;
+    adjust_family(
+        groups.iter_mut().map(|g| &mut g.total),
+        opt.threshold,
+        opt.alpha,
+    );
+    if too_noisy {
+        for g in &mut groups {
+            g.total.verdict = Verdict::TooNoisy;
+        }
+    }
+    Ok(groups)
 }
 
 /// What NEW's times are divided by: each pair's drift (`per_pair`), else the run-wide factor
