@@ -6,7 +6,9 @@ introduction (at most MAX_README_LINES lines; the reference belongs in docs/).
 
 The manual states how things are now; the lab book (docs/notes/) keeps dated investigations.
 So README.md, ARCHITECTURE.md and docs/*.md may hold no dated heading (an ISO date, a day and
-month with a year, or an "Again after/at ..." section) and no issue reference ("issue 43",
+month with a year, or an "Again after/at ..." section), no dated paragraph lead (a bold lead
+with an ISO date in it or in a parenthesis right after it), no "since/until/before YYYY-MM-DD"
+outside table rows (a rule-history table dates its rows), and no issue reference ("issue 43",
 "issues 25 and 43", "#43", "issue-43", in text, code blocks or file names they link); every
 note in docs/notes/ (README.md there is its index) names its date (YYYY-MM-DD) and its commit
 (a hash in backticks after the word "commit") in its first NOTE_HEADER_LINES lines. Links in
@@ -34,6 +36,13 @@ DATED_HEADING = re.compile(
 # "issue 43", "Issue 43's", "issues 25 and 43", "issue-43", "issue #43", and a bare "#43" (one
 # to four digits, not part of a word, a link anchor or a hex colour such as #1f77b4).
 ISSUE_REF = re.compile(r"\bissues?[ -]#?\d+\b|(?<![\w#/&])#\d{1,4}\b(?![\w-])", re.IGNORECASE)
+# A paragraph (or list item) that opens with a bold lead carrying a date, in the lead or in a
+# parenthesis right after it: "**A ring of sheets** (2026-12-03, evening).", "**Measured
+# 2026-12-03, 14:14 UTC**". Such a paragraph is a journal entry.
+DATED_LEAD = re.compile(r"^\s*(?:[-*+]\s+|\d+\.\s+)?\*\*([^*]+)\*\*\s*(?:\(([^)]*)\))?")
+ISO_DATE = re.compile(r"\b\d{4}-\d{2}-\d{2}\b")
+# "since 2026-12-03", "until 2026-12-05", "before 2026-12-04": narration of when things changed.
+DATED_CHANGE = re.compile(r"\b(since|until|before)\s+\d{4}-\d{2}-\d{2}\b", re.IGNORECASE)
 NOTE_DATE = re.compile(r"\b\d{4}-\d{2}-\d{2}\b")
 NOTE_COMMIT = re.compile(r"\bcommit\b[^`]*`[0-9a-f]{7,40}`", re.IGNORECASE)
 
@@ -75,7 +84,8 @@ def anchors(path):
 
 
 def manual_problems(page, rel):
-    """Dated headings and issue references in a page of the manual (not a note)."""
+    """Dated headings, dated paragraph leads, "since/until/before DATE" outside tables and issue
+    references in a page of the manual (not a note)."""
     problems = []
     inside = False
     with open(page, encoding="utf-8") as f:
@@ -87,6 +97,16 @@ def manual_problems(page, rel):
                 problems.append(f"{rel}:{number}: dated heading \"{heading.group(2)}\": "
                                 "the manual says how things are now; a dated investigation "
                                 "belongs in docs/notes/")
+            lead = None if inside else DATED_LEAD.match(line)
+            if lead and any(g and ISO_DATE.search(g) for g in lead.groups()):
+                problems.append(f"{rel}:{number}: dated paragraph lead \"{lead.group(0).strip()}\": "
+                                "state the current figure; the story of how it came to be "
+                                "belongs in a note in docs/notes/")
+            # Table rows (a rule-history table, say) may date their entries.
+            if not inside and not line.lstrip().startswith("|"):
+                for m in DATED_CHANGE.finditer(line):
+                    problems.append(f"{rel}:{number}: dated narration (\"{m.group(0)}\"): "
+                                    "say how it is now; when it changed belongs in a note")
             for m in ISSUE_REF.finditer(line):
                 problems.append(f"{rel}:{number}: names an issue (\"{m.group(0)}\"): a reader "
                                 "has no issue tracker; say what it is")
@@ -162,10 +182,16 @@ def self_test():
         "README.md": "# t\n\n./scripts/bench.sh ./scripts/test.sh [m](docs/page.md#now)\n",
         "ARCHITECTURE.md": "# a\n",
         "docs/page.md": "# Page\n\n## Now\n\nColour #1f77b4, [here](#now), measured on "
-                        "2026-12-05 ([note](notes/2026-12-05-x.md)).\n",
+                        "2026-12-05 ([note](notes/2026-12-05-x.md)).\n\n"
+                        "**A ring of sheets** (the splatter). Each bucket once.\n\n"
+                        "| rule | commit | changed |\n|---|---|---|\n"
+                        "| H5 | fc24378 (2026-12-03) | tolerance, since 2026-12-03 |\n\n"
+                        "The fill is a compute pass.\n",
         "docs/notes/README.md": "# Notes\n\n[x](2026-12-05-x.md)\n",
         "docs/notes/2026-12-05-x.md": "# X\n\nDate: 2026-12-05. Commit: `abc1234`.\n\n"
-                                      "Text.\n\n## Again after issue 43 (2026-12-05)\n",
+                                      "Text.\n\n## Again after issue 43 (2026-12-05)\n\n"
+                                      "**At abc1234** (2026-12-05, evening). Since 2026-12-03 "
+                                      "a compute pass.\n",
         "scripts/bench.sh": "", "scripts/test.sh": "",
     }
     flips = [
@@ -179,6 +205,12 @@ def self_test():
         ("docs/notes/2026-12-05-x.md", "Date: 2026-12-05. ", "", "no date"),
         ("docs/notes/2026-12-05-x.md", "Commit: `abc1234`.", "", "no commit"),
         ("docs/page.md", "(#now)", "(#later)", "no heading with that anchor"),
+        ("docs/page.md", "(the splatter)", "(2026-12-03, evening)", "dated paragraph lead"),
+        ("docs/page.md", "**A ring of sheets**", "- **Measured 2026-12-03, 14:14 UTC**",
+         "dated paragraph lead"),
+        ("docs/page.md", "The fill is", "Since 2026-12-03 the fill is", "dated narration"),
+        ("docs/page.md", "The fill is", "Until 2026-12-05 the fill was", "dated narration"),
+        ("docs/page.md", "The fill is", "Before 2026-12-04 the fill was", "dated narration"),
     ]
 
     def problems_of(files):

@@ -14,6 +14,7 @@ use clap::Subcommand;
 use crate::papers::fragment_pt::fig8;
 use crate::papers::havs::analysis;
 
+pub mod medians;
 pub mod peers;
 pub mod summary;
 
@@ -40,6 +41,9 @@ pub enum AnalyzeCommand {
     /// directories or results CSVs), and targets on those ratios judged by a rule file
     /// (`--targets docs/targets/lavapipe-vs-vtk.json`), each beside the ratio its roofline allows.
     Peers(peers::Args),
+    /// Each algorithm's median of one row field (limit fraction by default) in each of
+    /// several runs, side by side, and each run's over the first's.
+    Medians(medians::Args),
 }
 
 pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
@@ -49,5 +53,6 @@ pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
         AnalyzeCommand::Sort(args) => analysis::run_sort(args),
         AnalyzeCommand::Kbuffer(args) => analysis::run_kbuffer(args, ctx.data_dir.clone()),
         AnalyzeCommand::Peers(args) => peers::run(args),
+        AnalyzeCommand::Medians(args) => medians::run(args),
     }
 }

@@ -33,6 +33,9 @@ pub struct Args {
     /// Also write the Markdown to this file.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Print only the judged targets (with `--targets`), not each input's table of ratios.
+    #[arg(long, requires = "targets")]
+    pub targets_only: bool,
 }
 
 /// A rule file: targets on the ratio of one variant's speed to one peer's.
@@ -432,14 +435,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             v.dedup();
             v
         };
-        let _ = write!(
-            md,
-            "\n### {} ({} rows, adapter {})\n{}",
-            path.display(),
-            rows.len(),
-            adapters.join(", "),
-            ratio_table(&aggs)
-        );
+        if !args.targets_only {
+            let _ = write!(
+                md,
+                "\n### {} ({} rows, adapter {})\n{}",
+                path.display(),
+                rows.len(),
+                adapters.join(", "),
+                ratio_table(&aggs)
+            );
+        }
         inputs.push((path.display().to_string(), aggs));
     }
     if let Some(t) = &args.targets {
