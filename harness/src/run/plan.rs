@@ -75,11 +75,7 @@ impl RunPlan {
                 .map(|s| s.to_string())
                 .collect()
         } else {
-            m.datasets
-                .iter()
-                .map(|s| s.trim().to_string())
-                .filter(|s| !s.is_empty())
-                .collect()
+            named(&m.datasets)
         };
         if datasets.is_empty() {
             anyhow::bail!("--datasets is empty");
@@ -170,11 +166,7 @@ fn algorithm_list(m: &MatrixArgs, externals: &[ExternalSpec]) -> anyhow::Result<
             .map(|s| s.to_string())
             .collect()
     } else {
-        m.algorithms
-            .iter()
-            .map(|s| s.trim().to_string())
-            .filter(|s| !s.is_empty())
-            .collect()
+        named(&m.algorithms)
     };
     for a in &algorithms {
         if !known.contains(&a.as_str()) && !externals.iter().any(|s| s.name == *a) {
@@ -200,6 +192,14 @@ fn algorithm_list(m: &MatrixArgs, externals: &[ExternalSpec]) -> anyhow::Result<
         anyhow::bail!("--algorithms is empty; known: {}", known.join(", "));
     }
     Ok(algorithms)
+}
+
+/// The names a list flag gave, trimmed, the empty ones left out.
+fn named(list: &[String]) -> Vec<String> {
+    list.iter()
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .collect()
 }
 
 /// A flag's text (`given`, else `default`) parsed into its type; a failure names the flag
