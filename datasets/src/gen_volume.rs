@@ -26,6 +26,7 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use crate::error::{ErrorKind, LoadError};
+use crate::grid::grid_ijk;
 use crate::volume::{CellSplit, VoxelGrid};
 use crate::voxel_volume::{CellCover, VoxelVolume};
 use crate::TetMesh;
@@ -178,11 +179,7 @@ pub fn volume_grid(spec: &VolumeSpec) -> Result<VoxelGrid, ErrorKind> {
         let mut values: Vec<f32> = (0..n)
             .into_par_iter()
             .map(|g| {
-                let p = [
-                    g % dims[0],
-                    (g / dims[0]) % dims[1],
-                    g / (dims[0] * dims[1]),
-                ];
+                let p = grid_ijk(g, dims);
                 field(&bs, p.map(|c| c as f64)) as f32
             })
             .collect();

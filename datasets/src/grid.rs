@@ -80,6 +80,15 @@ pub struct VoxelGrid {
     pub scalar_name: String,
 }
 
+/// The `[i, j, k]` of flat index `g` in a grid of `dims` points or cells, x fastest.
+pub fn grid_ijk(g: usize, dims: [usize; 3]) -> [usize; 3] {
+    [
+        g % dims[0],
+        (g / dims[0]) % dims[1],
+        g / (dims[0] * dims[1]),
+    ]
+}
+
 impl VoxelGrid {
     pub fn index(&self, i: usize, j: usize, k: usize) -> usize {
         i + self.dims[0] * (j + self.dims[1] * k)

@@ -6,6 +6,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use rayon::prelude::*;
 
 use crate::error::ErrorKind;
+use crate::grid::grid_ijk;
 use crate::mesh::{cross, dot, sub, TetMesh};
 
 pub use crate::grid::VoxelGrid;
@@ -127,11 +128,7 @@ impl VoxelGrid {
                 if t == u32::MAX {
                     return outside;
                 }
-                let q = [
-                    g % dims[0],
-                    (g / dims[0]) % dims[1],
-                    g / (dims[0] * dims[1]),
-                ];
+                let q = grid_ijk(g, dims);
                 let q = [0, 1, 2].map(|a| origin[a] + q[a] as f64 * spacing[a]);
                 let w = Barycentric::new(mesh.tet_points(t as usize)).weights(q);
                 let s = mesh.tets[t as usize].map(|v| mesh.scalars[v as usize] as f64);

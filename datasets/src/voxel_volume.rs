@@ -14,7 +14,7 @@ use std::sync::{Arc, OnceLock};
 use rayon::prelude::*;
 
 use crate::error::ErrorKind;
-use crate::grid::VoxelGrid;
+use crate::grid::{grid_ijk, VoxelGrid};
 use crate::mesh::{Aabb, TetMesh};
 use crate::volume::{split_cells, CellSplit};
 
@@ -198,7 +198,7 @@ impl VoxelVolume {
                     return true;
                 }
                 let d = g.dims;
-                let ijk = [index % d[0], (index / d[0]) % d[1], index / (d[0] * d[1])];
+                let ijk = grid_ijk(index, d);
                 let lo = ijk.map(|c| c.saturating_sub(1));
                 let hi = [0, 1, 2].map(|a| (ijk[a] + 1).min(d[a] - 1));
                 (lo[2]..=hi[2]).any(|k| {
@@ -384,13 +384,7 @@ mod tests {
         let n: usize = dims.iter().product();
         let spots: Vec<[usize; 3]> = (0..n)
             .filter(|&p| (p as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 61 == 0)
-            .map(|p| {
-                [
-                    p % dims[0],
-                    (p / dims[0]) % dims[1],
-                    p / (dims[0] * dims[1]),
-                ]
-            })
+            .map(|p| grid_ijk(p, dims))
             .collect();
         sparse_grid(dims, &spots)
     }

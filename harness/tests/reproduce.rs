@@ -1,6 +1,7 @@
 //! `tetbench reproduce` end to end: GATOR's quick plan on small generated meshes (substituted
 //! for the paper's data sets) writes a report with the paper's values beside ours, the exact
-//! truth-table verdict, the claims with their verdicts, the charts and the index; a paper whose
+//! truth-table verdict, the claims with their verdicts, every table's cells counted, the charts
+//! and the index; a paper whose
 //! algorithm is not built in fails clearly.
 
 use std::process::Command;
@@ -63,8 +64,26 @@ fn quick_gator_reproduction_end_to_end() {
     );
     assert!(report.contains("Linear cells are slower"), "{report}");
     assert!(report.contains("commit `"), "{report}");
+    // ... every table's cells are counted beside the claims, in the report, its typed summary
+    // and the index ...
+    assert!(
+        report.contains("Cells of the paper's tables: ")
+            && report.contains("## Cells outside their rule"),
+        "{report}"
+    );
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("gator/summary.json")).unwrap(),
+    )
+    .unwrap();
+    let cells = &summary["cells"];
+    assert!(
+        cells["within"].as_u64().unwrap() + cells["outside"].as_u64().unwrap() > 0
+            && cells["on_this_adapter"].as_u64().unwrap() > 0,
+        "{summary}"
+    );
     let index = std::fs::read_to_string(dir.path().join("README.md")).unwrap();
     assert!(index.contains("| gator | quick |"), "{index}");
+    assert!(index.contains("cells within the rule"), "{index}");
     assert!(dir.path().join("index.html").is_file());
     let html = std::fs::read_to_string(dir.path().join("gator/report.html")).unwrap();
     assert!(html.contains("<table>"));

@@ -5,6 +5,7 @@ use rayon::prelude::*;
 use super::field::rand01;
 use super::{finish, FieldEval};
 use crate::error::ErrorKind;
+use crate::grid::grid_ijk;
 use crate::volume::structured_tets;
 use crate::TetMesh;
 
@@ -38,7 +39,7 @@ fn grid_points(cells: [usize; 3], z_levels: Option<&[f64]>) -> Vec<[f64; 3]> {
     (0..n)
         .into_par_iter()
         .map(|g| {
-            let ijk = [g % d[0], (g / d[0]) % d[1], g / (d[0] * d[1])];
+            let ijk = grid_ijk(g, d);
             let mut p = [0, 1, 2].map(|a| -1.0 + 2.0 * ijk[a] as f64 / cells[a] as f64);
             if let Some(z) = z_levels {
                 p[2] = z[ijk[2]];

@@ -5,6 +5,7 @@ use rayon::prelude::*;
 
 use crate::error::ErrorKind;
 use crate::generate::{Field, FieldEval};
+use crate::grid::grid_ijk;
 use crate::volume::hex_cell_tets;
 use crate::TetMesh;
 
@@ -129,7 +130,7 @@ pub fn domain_mesh(shape: Shape, target: usize, seed: u64) -> Result<TetMesh, Er
             let g = *v as usize;
             if remap[g] == u32::MAX {
                 remap[g] = points.len() as u32;
-                let ijk = [g % d[0], (g / d[0]) % d[1], g / (d[0] * d[1])];
+                let ijk = grid_ijk(g, d);
                 points.push(std::array::from_fn(|a| {
                     (-ext[a] + 2.0 * ext[a] * ijk[a] as f64 / cells[a] as f64) as f32
                 }));

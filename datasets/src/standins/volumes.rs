@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use crate::error::ErrorKind;
 use crate::generate::{Field, FieldEval};
-use crate::grid::GridValues;
+use crate::grid::{grid_ijk, GridValues};
 use crate::volume::{split_cells, CellSplit, VoxelGrid};
 use crate::voxel_volume::{CellCover, VoxelVolume};
 use crate::TetMesh;
@@ -147,11 +147,7 @@ pub fn resample_trilinear(grid: &VoxelGrid, dims: [usize; 3]) -> VoxelGrid {
     let values: Vec<f32> = (0..n)
         .into_par_iter()
         .map(|g| {
-            let ijk = [
-                g % dims[0],
-                (g / dims[0]) % dims[1],
-                g / (dims[0] * dims[1]),
-            ];
+            let ijk = grid_ijk(g, dims);
             sample(std::array::from_fn(|a| {
                 grid.origin[a] + ijk[a] as f64 * spacing[a]
             }))
@@ -184,11 +180,7 @@ pub fn splat_volume(dims: [usize; 3], effective: usize, seed: u64) -> VoxelGrid 
     let mut levels: Vec<u16> = (0..n)
         .into_par_iter()
         .map(|g| {
-            let ijk = [
-                g % dims[0],
-                (g / dims[0]) % dims[1],
-                g / (dims[0] * dims[1]),
-            ];
+            let ijk = grid_ijk(g, dims);
             (lattice.at(ijk) / step).round().clamp(1.0, u16::MAX as f64) as u16
         })
         .collect();

@@ -16,8 +16,9 @@
 //! point data (with a warning in the repair report).
 //!
 //! Layout: `xml` (the element tree, cutting off the appended block), `arrays` (DataArray
-//! decoding: ascii, inline base64, zlib blocks, appended raw/base64), `pieces` (assembling a
-//! piece into a mesh: scalar choice, unstructured cells, structured grids and images).
+//! decoding: ascii, inline base64, zlib blocks, appended raw/base64), `pieces` (what every
+//! dataset type shares: pieces, points, scalar choice, extents, the final mesh),
+//! `unstructured` (cells split into tets) and `structured` (structured grids and images).
 
 use std::path::Path;
 
@@ -26,8 +27,10 @@ use crate::error::{ErrorKind, LoadError, Location};
 
 mod arrays;
 mod pieces;
+mod structured;
 #[cfg(test)]
 mod tests;
+mod unstructured;
 mod xml;
 
 use arrays::Appended;

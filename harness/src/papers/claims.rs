@@ -265,7 +265,10 @@ pub fn attach_history(
     history: Vec<RuleChange>,
     file: &str,
 ) -> anyhow::Result<()> {
-    for h in history.into_iter().filter(|h| !h.is_verdict_rule()) {
+    for h in history
+        .into_iter()
+        .filter(|h| !h.is_verdict_rule() && !h.is_cell_rule())
+    {
         let Some(c) = claims
             .iter_mut()
             .find(|c| c.paper == h.paper && c.id == h.id)
@@ -667,7 +670,7 @@ mod tests {
         assert!(e.contains("derived from H9"), "{e}");
         let h = parse_history(
             &format!(
-                "{}\nhavs,H2,2026-12-04,abc,why,,total_ms,,havs,,a>2,0,measured,none,,\n",
+                "{}\nhavs,H2,2026-12-04,abc,why,,total_ms,,havs,,a>2,0,measured,none,,,,\n",
                 crate::papers::rules::HISTORY_HEADER.join(",")
             ),
             "h.csv",

@@ -138,9 +138,9 @@ fn gator_table1_fails_when_two_cases_are_swapped() {
     assert!(!gator::table1_mismatches(&tri, &gator::paper_rows()).is_empty());
     // And the table shows ours beside the paper's in every non-X cell.
     let report = gator::tables(&m, &x);
-    assert_eq!(report.comparisons[0].verdict(), Some(true));
+    assert_eq!(all_within("gator", &report.comparisons[0]), Some(true));
     let report = gator::tables(&m, &x2);
-    assert_eq!(report.comparisons[0].verdict(), Some(false));
+    assert_eq!(all_within("gator", &report.comparisons[0]), Some(false));
     // Not run: not checkable, with why.
     let none = eval("gator", &m, &Extra::default());
     assert_eq!(verdict_of(&none, "G8", None), Verdict::NotCheckable);
@@ -186,16 +186,16 @@ fn gator_table2_counts_the_split_and_says_what_the_loader_dropped() {
     };
     // Blunt Fin as measured: 187,318 loaded + 77 of zero volume = the paper's 187,395.
     let ok = table2(&x(187_318, 77));
-    assert_eq!(ok.verdict(), Some(true));
+    assert_eq!(all_within("gator", &ok), Some(true));
     assert!(
         ok.notes.iter().any(|n| n.contains("187395 tets; 77")),
         "{:?}",
         ok.notes
     );
     // One tet lost by the split (not by the drop) flips the table.
-    assert_eq!(table2(&x(187_317, 77)).verdict(), Some(false));
+    assert_eq!(all_within("gator", &table2(&x(187_317, 77))), Some(false));
     // Without the dropped ones counted back, the cell would not match either.
-    assert_eq!(table2(&x(187_318, 0)).verdict(), Some(false));
+    assert_eq!(all_within("gator", &table2(&x(187_318, 0))), Some(false));
 }
 
 #[test]
@@ -282,23 +282,23 @@ fn memory_claims_fail_with_four_more_bytes_per_tet() {
     assert_eq!(verdict_of(&ok, "R5", Some("spx1")), Verdict::Holds);
     let fat = eval("raycast", &ray(148.0), &x);
     assert_eq!(verdict_of(&fat, "R4", Some("spx1")), Verdict::DoesNotHold);
-    // The memory table compares with the paper's own 144, exactly.
-    assert_eq!(
-        raycast::tables(&ray(144.0), &x)
+    // The memory table shows the paper's own 144 beside ours, but a layout's bytes are not
+    // compared: every cell of it is counted by construction, whatever ours is.
+    for b in [144.0, 148.0] {
+        let n = raycast::tables(&ray(b), &x)
             .comparisons
             .last()
             .unwrap()
-            .verdict(),
-        Some(true)
-    );
-    assert_eq!(
-        raycast::tables(&ray(148.0), &x)
-            .comparisons
-            .last()
-            .unwrap()
-            .verdict(),
-        Some(false)
-    );
+            .judge("raycast")
+            .counts();
+        assert_eq!((n.by_construction, n.within + n.outside), (3, 0));
+    }
+}
+
+/// Whether every cell the table's rules compare is within them (`None`: none compared).
+fn all_within(paper: &str, c: &crate::papers::table::Comparison) -> Option<bool> {
+    let n = c.judge(paper).counts();
+    (n.within + n.outside > 0).then_some(n.outside == 0)
 }
 
 #[test]
@@ -679,20 +679,21 @@ fn havs_memory_claim_flips_when_havs_holds_more_bytes_per_tet() {
     );
 }
 
-/// R6 and R7 (Table 4's most and fewest passes) read the longest ray walk of each viewpoint:
-/// walks within 10 % of the paper's 601 and 571 on spx1 hold, our measured 218 does not.
+/// R6 and R7 (Table 4's most and fewest passes) read the passes the passes mode issues per
+/// frame, spent per peeling layer as the paper does: counts within 10 % of the paper's 601 and
+/// 571 on spx1 hold; one count lowered beyond the tolerance flips its claim alone.
 #[test]
-fn raycast_pass_claims_flip_with_the_longest_walk() {
-    let m = |longest: f64, shortest: f64| Measured {
-        rows: [("+x", longest), ("+y", shortest)]
+fn raycast_pass_claims_flip_with_the_passes_issued() {
+    let m = |most: f64, fewest: f64| Measured {
+        rows: [("+x", most), ("+y", fewest)]
             .into_iter()
-            .map(|(vp, steps)| Row {
+            .map(|(vp, passes)| Row {
                 viewpoint: vp.into(),
                 ..counter_row(
                     "raycast",
-                    "tiles=1x1;table=2d;mode=loop;et=on;layers=32",
+                    "tiles=1x1;table=2d;mode=passes;et=on;layers=32;k=8",
                     "spx1",
-                    &format!("steps_max={steps}"),
+                    &format!("passes_max={passes}"),
                 )
             })
             .collect(),
@@ -700,10 +701,30 @@ fn raycast_pass_claims_flip_with_the_longest_walk() {
         calibration: None,
         row_dirs: vec![],
     };
-    let like_paper = eval("raycast", &m(590.0, 575.0), &Extra::default());
+    let like_paper = eval("raycast", &m(600.0, 576.0), &Extra::default());
     assert_eq!(verdict_of(&like_paper, "R6", Some("spx1")), Verdict::Holds);
     assert_eq!(verdict_of(&like_paper, "R7", Some("spx1")), Verdict::Holds);
-    let ours = eval("raycast", &m(218.0, 150.0), &Extra::default());
-    assert_eq!(verdict_of(&ours, "R6", Some("spx1")), Verdict::DoesNotHold);
+    // The most passes 71 short of the paper's 601 (−11.8 %): R6 flips; the fewest, 520, still
+    // lie within 10 % of 571, and R7 holds.
+    let fewer = eval("raycast", &m(530.0, 520.0), &Extra::default());
+    assert_eq!(verdict_of(&fewer, "R6", Some("spx1")), Verdict::DoesNotHold);
+    assert_eq!(verdict_of(&fewer, "R7", Some("spx1")), Verdict::Holds);
+    // The fewest passes far below the paper's minimum: R7 flips.
+    let ours = eval("raycast", &m(600.0, 200.0), &Extra::default());
+    assert_eq!(verdict_of(&ours, "R6", Some("spx1")), Verdict::Holds);
     assert_eq!(verdict_of(&ours, "R7", Some("spx1")), Verdict::DoesNotHold);
+    // The loop mode's rows (the longest walk) no longer decide it.
+    let walks = Measured {
+        rows: vec![counter_row(
+            "raycast",
+            "tiles=1x1;table=2d;mode=loop;et=on;layers=32",
+            "spx1",
+            "steps_max=590",
+        )],
+        errors: vec![],
+        calibration: None,
+        row_dirs: vec![],
+    };
+    let e = eval("raycast", &walks, &Extra::default());
+    assert_ne!(verdict_of(&e, "R6", Some("spx1")), Verdict::Holds);
 }

@@ -6,13 +6,15 @@
 //! ([`from_run`]) runs the same tables over finished runs, so every table has one writer.
 //!
 //! Beside them: [`transcription`] (the one reader of the papers' tables as CSV), [`claims`]
-//! (the papers' claims as data) and [`verdict`] (the one rule that decides them), [`table`]
-//! (paper | ours | ours/paper as Markdown, HTML and charts), [`session`] (what a reproduction
+//! (the papers' claims as data) and [`verdict`] (the one rule that decides them), [`cells`]
+//! (each table cell's rule and verdict), [`table`] (paper | ours | verdict or ours/paper as
+//! Markdown, HTML and charts), [`session`] (what a reproduction
 //! works with) and [`evidence`] (the numbers behind the claims).
 //!
 //! To add a paper: its transcription in `reports/papers/`, its folder here with a type
 //! implementing [`PaperModule`], and one line in [`PAPERS`].
 
+pub mod cells;
 pub mod claims;
 pub mod claims_report;
 pub mod evidence;

@@ -17,6 +17,7 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 
+use super::cells::CellCounts;
 use super::claims::ClaimResult;
 use super::claims_report;
 pub use super::session::SourceState;
@@ -128,24 +129,7 @@ pub fn run(args: Args, data_dir: Option<PathBuf>) -> anyhow::Result<()> {
         let report = measure_and_tabulate(module, &mut session, &mut progress)?;
         let seconds = t0.elapsed().as_secs_f64();
         write_report(p, &session, &report, seconds)?;
-        let exact: Vec<String> = report
-            .comparisons
-            .iter()
-            .filter_map(|c| c.summary())
-            .collect();
-        let summary = PaperSummary {
-            paper: p.id.to_string(),
-            mode: if args.quick { "quick" } else { "full" }.into(),
-            seconds,
-            source: session.source.describe(),
-            exact_tables: if exact.is_empty() {
-                "–".into()
-            } else {
-                exact.join("; ")
-            },
-            claims: tally_text(&report.claims),
-            not_measured: tally_apart_text(&report.claims),
-        };
+        let summary = summary_of(p, &session, &report, seconds);
         write_file(
             &dir.join(SUMMARY_FILE),
             &serde_json::to_string_pretty(&summary)?,
@@ -193,7 +177,14 @@ pub struct PaperSummary {
     pub seconds: f64,
     /// The commit sentence of [`SourceState::describe`].
     pub source: String,
-    pub exact_tables: String,
+    /// Each table's count of cells within its rule (an older summary: the exact tables'
+    /// verdicts, which counted no cell).
+    #[serde(alias = "exact_tables")]
+    pub tables: String,
+    /// Every table's cells by verdict, the headline beside the claims (`None`: a summary
+    /// written before cells were counted).
+    #[serde(default)]
+    pub cells: Option<CellCounts>,
     /// The measured claims' verdicts (the headline).
     pub claims: String,
     /// The claims by construction and the derived ones, with their own words.
@@ -203,10 +194,74 @@ pub struct PaperSummary {
 
 pub const SUMMARY_FILE: &str = "summary.json";
 
+impl PaperSummary {
+    /// The cells' headline, or what an older summary says instead.
+    pub fn cells_text(&self) -> String {
+        match &self.cells {
+            Some(n) => n.headline(),
+            None => format!(
+                "not counted (an older summary; exact tables: {})",
+                self.tables
+            ),
+        }
+    }
+
+    /// The claims' headline; an older summary (no cells counted) is labelled as such, because
+    /// its verdicts were given in the words of its day: before evidence kinds, "too few
+    /// frames", "not discriminating" and positive controls, a hold there may rest on one frame,
+    /// a layout constant or a pair that cannot differ.
+    pub fn claims_text(&self) -> String {
+        match &self.cells {
+            Some(_) => self.claims.clone(),
+            None => format!(
+                "{} (an older summary, in the verdict words of its day: its holds were not yet \
+                 checked for evidence kind, enough frames, a pair that can differ or a positive \
+                 control)",
+                self.claims
+            ),
+        }
+    }
+}
+
+/// The summary of one paper's report: its tables' cells and its claims, counted.
+fn summary_of(p: &Paper, session: &Session, report: &Report, seconds: f64) -> PaperSummary {
+    let judged = judged(p, report);
+    let tables: Vec<String> = judged.iter().map(|j| j.summary()).collect();
+    PaperSummary {
+        paper: p.id.to_string(),
+        mode: if session.quick { "quick" } else { "full" }.into(),
+        seconds,
+        source: session.source.describe(),
+        tables: if tables.is_empty() {
+            "–".into()
+        } else {
+            tables.join(". ")
+        },
+        cells: Some(cell_counts(&judged)),
+        claims: tally_text(&report.claims),
+        not_measured: tally_apart_text(&report.claims),
+    }
+}
+
+/// Every table of a report judged by its cell rules.
+fn judged<'a>(p: &Paper, report: &'a Report) -> Vec<table::Judged<'a, 'static>> {
+    report.comparisons.iter().map(|c| c.judge(p.id)).collect()
+}
+
+/// The cells of every table of a report, by verdict.
+fn cell_counts(judged: &[table::Judged]) -> CellCounts {
+    let mut n = CellCounts::default();
+    for j in judged {
+        n.merge(&j.counts());
+    }
+    n
+}
+
 /// The index of every paper reproduced under `out`, from their summaries.
 pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
-    let mut md = String::from("# Papers reproduced\n\nWritten by `tetbench reproduce` from each paper's `summary.json`; nothing here is edited by hand.\n\n| paper | mode | seconds | commit | exact tables (columns compared) | measured claims (verdicts per data set) | by construction, derived | report |\n|---|---|---:|---|---|---|---|---|\n");
+    let mut md = String::from("# Papers reproduced\n\nWritten by `tetbench reproduce` from each paper's `summary.json`; nothing here is edited by hand.\n\n| paper | mode | seconds | commit | cells (every table's, by its rule in `reports/papers/cell_rules.csv`) | measured claims (verdicts per data set) | by construction, derived | report |\n|---|---|---:|---|---|---|---|---|\n");
     let mut total = 0.0;
+    let mut cells = Some(CellCounts::default());
     let mut sources = vec![];
     for p in PAPERS.iter().map(|p| p.paper()) {
         let path = out.join(p.id).join(SUMMARY_FILE);
@@ -218,6 +273,10 @@ pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
         let s: PaperSummary = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a paper summary", path.display()))?;
         total += s.seconds;
+        cells = cells.zip(s.cells).map(|(mut all, one)| {
+            all.merge(&one);
+            all
+        });
         if !sources.contains(&s.source) {
             sources.push(s.source.clone());
         }
@@ -231,8 +290,8 @@ pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
                 .iter()
                 .position(|x| *x == s.source)
                 .map_or(0, |i| i + 1),
-            s.exact_tables,
-            s.claims,
+            s.cells_text(),
+            s.claims_text(),
             if s.not_measured.is_empty() {
                 "–"
             } else {
@@ -240,7 +299,11 @@ pub fn index_markdown(out: &Path) -> anyhow::Result<String> {
             }
         );
     }
-    let _ = writeln!(md, "\nTotal: {total:.0} s.\n");
+    let _ = writeln!(
+        md,
+        "\nTotal: {total:.0} s. Cells of every paper: {}.\n",
+        cells.map_or("not counted by every summary".into(), |n| n.headline())
+    );
     for (i, s) in sources.iter().enumerate() {
         let _ = writeln!(md, "Commit {}: {s}\n", i + 1);
     }
@@ -340,6 +403,13 @@ pub(crate) fn write_report(
         let _ = writeln!(md, "{mode} Took {seconds:.0} s.\n");
     }
     let _ = writeln!(md, "{}\n", session.source.describe());
+    let judged = judged(paper, report);
+    let _ = writeln!(
+        md,
+        "**Headline.** Measured claims: {}. Cells of the paper's tables: {}.\n",
+        tally_text(&report.claims),
+        cell_counts(&judged).headline()
+    );
     if let Some(r) = session.resolution {
         let _ = writeln!(md, "Viewport overridden: {r}×{r} (`--resolution`).\n");
     }
@@ -371,13 +441,14 @@ pub(crate) fn write_report(
         md.push_str(&claims_report::markdown(&report.claims));
         md.push('\n');
     }
+    md.push_str(&findings_markdown(paper, &judged));
     let _ = writeln!(md, "## Tables\n");
     let charts = dir.join("charts");
-    for c in &report.comparisons {
-        md.push_str(&table::markdown(c));
+    for j in &judged {
+        md.push_str(&table::markdown(j));
         md.push('\n');
-        for f in table::write_charts(&charts, c)? {
-            let _ = writeln!(md, "![{} {f}](charts/{f})\n", c.key);
+        for f in table::write_charts(&charts, j)? {
+            let _ = writeln!(md, "![{} {f}](charts/{f})\n", j.comparison.key);
         }
     }
     if !report.notes.is_empty() {
@@ -399,6 +470,36 @@ pub(crate) fn write_report(
         &dir.join("report.html"),
         &table::markdown_to_html(&md, paper.title)?,
     )
+}
+
+/// The cells outside their rule, each a finding with its explanation or "unexplained", and
+/// the cell rules' history for this paper.
+fn findings_markdown(paper: &Paper, judged: &[table::Judged]) -> String {
+    let mut md = String::from("## Cells outside their rule\n\n");
+    let findings: Vec<String> = judged.iter().flat_map(|j| j.findings()).collect();
+    if findings.is_empty() {
+        md.push_str("None: every cell the rules compare is within its rule.\n");
+    }
+    for f in &findings {
+        let _ = writeln!(md, "- {f}");
+    }
+    md.push_str("\nEach table's rule (`reports/papers/cell_rules.csv`, written before the run) says which columns are compared, how (exact, rounded as the paper prints it, or within a relative tolerance) and in which direction; times and rates of the paper's hardware are not compared on this adapter, and columns that follow from a layout are not compared either. Rows on stand-ins are not compared. Each is counted apart.\n");
+    for h in super::rules::cell_rule_changes(paper.id) {
+        if let Some(old) = &h.old_cell {
+            let _ = writeln!(
+                md,
+                "\n- {} {}: until {} (commit {}) the rule was {}. Why it changed: {}",
+                h.paper,
+                h.id,
+                h.date,
+                h.commit,
+                old.describe(),
+                h.reason
+            );
+        }
+    }
+    md.push('\n');
+    md
 }
 
 fn write_file(path: &Path, text: &str) -> anyhow::Result<()> {
@@ -447,9 +548,149 @@ mod tests {
             }
             // Every table's markdown renders.
             for c in &report.comparisons {
-                assert!(table::markdown(c).contains("paper"));
+                assert!(table::markdown(&c.judge(prefix)).contains("paper"));
             }
         }
+    }
+
+    /// Every column of every paper's tables has its rule in `reports/papers/cell_rules.csv`,
+    /// and every line of the file names a table and a column (or `*`) that exist.
+    #[test]
+    fn every_column_has_a_cell_rule_and_every_rule_a_column() {
+        use crate::papers::cells::{self, EVERY_OTHER_COLUMN};
+        use crate::papers::session::Extra;
+        let mut columns: Vec<(&str, String, String)> = vec![];
+        for paper in PAPERS {
+            let id = paper.paper().id;
+            for c in paper
+                .tables(&Measured::default(), &Extra::default())
+                .comparisons
+            {
+                let judged = c.judge(id);
+                for (m, r) in c.metrics.iter().zip(&judged.rules) {
+                    assert!(r.is_some(), "{id} {} {:?} has no cell rule", c.key, m.name);
+                    columns.push((id, c.key.clone(), m.name.clone()));
+                }
+            }
+        }
+        for r in cells::rules() {
+            assert!(
+                columns.iter().any(|(p, t, c)| *p == r.paper
+                    && *t == r.table
+                    && (r.column == EVERY_OTHER_COLUMN || *c == r.column)),
+                "{}: {} {} {:?} names no column of the paper's tables",
+                cells::CELL_RULES_FILE,
+                r.paper,
+                r.table,
+                r.column
+            );
+        }
+    }
+
+    /// HAVS Table 2 on spx2 at the paper's own values, then with 314 pixels needing k > 6 (as
+    /// measured): the cell flips to outside its rule, the report's headline and the summary's
+    /// typed count flip with it, and the report lists the cell as a finding.
+    #[test]
+    fn one_changed_cell_flips_the_reports_headline_and_is_a_finding() {
+        use crate::papers::havs::{self, analysis};
+        use crate::papers::session::Extra;
+        let t = crate::papers::transcription::table("havs_table2").unwrap();
+        let paper = |c: &str| t.value("spx2", c).unwrap();
+        let report = |k_gt6: u64| {
+            let x = Extra::with_own(analysis::HavsAnalyses {
+                kbuffer: vec![analysis::KbufferRow {
+                    dataset: "spx2".into(),
+                    fragments: paper("fragments_count") as u64,
+                    max_list: paper("max_abuffer_list_length") as u32,
+                    max_k: paper("max_k") as u32,
+                    pixels_k_gt2: paper("pixels_needing_k_gt_2") as u64,
+                    pixels_k_gt6: k_gt6,
+                    ..Default::default()
+                }],
+                kbuffer_views: 14,
+                kbuffer_resolution: 512,
+                ..Default::default()
+            });
+            havs::tables(&Measured::default(), &x)
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let session = Session {
+            dir: dir.path().to_path_buf(),
+            quick: true,
+            data_dir: None,
+            cache_dir: None,
+            substitutes: vec![],
+            resolution: None,
+            rounds: None,
+            machine: None,
+            log: vec![],
+            external: Default::default(),
+            source: SourceState::default(),
+            from_run: None,
+        };
+        let p = havs::PAPER;
+        for (k_gt6, within, finding) in [(512, 5, false), (314, 4, true)] {
+            let r = report(k_gt6);
+            let s = summary_of(&p, &session, &r, 1.0);
+            let n = s.cells.unwrap();
+            assert_eq!((n.within, n.outside), (within, 5 - within), "{s:?}");
+            write_report(&p, &session, &r, 1.0).unwrap();
+            let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+            let head = format!("Cells of the paper's tables: {within} of 5 cells within the rule;");
+            assert!(md.contains(&head), "{md}");
+            let line = "- table2 spx2, pixels k>6: ours 314, paper 512 (-38.7 %); rule exact, two-sided: unexplained";
+            assert_eq!(md.contains(line), finding, "{md}");
+        }
+    }
+
+    /// The index counts every paper's cells from its typed summary; a summary written before
+    /// cells were counted still loads and says so.
+    #[test]
+    fn the_index_counts_cells_and_reads_older_summaries() {
+        let dir = tempfile::tempdir().unwrap();
+        let write = |paper: &str, json: serde_json::Value| {
+            std::fs::create_dir_all(dir.path().join(paper)).unwrap();
+            std::fs::write(dir.path().join(paper).join(SUMMARY_FILE), json.to_string()).unwrap();
+        };
+        let cells = CellCounts {
+            within: 3,
+            outside: 2,
+            on_this_adapter: 7,
+            ..Default::default()
+        };
+        write(
+            "havs",
+            serde_json::json!({"paper": "havs", "mode": "quick", "seconds": 1.0, "source": "s",
+                "tables": "table2: …", "cells": cells, "claims": "1 holds"}),
+        );
+        let md = index_markdown(dir.path()).unwrap();
+        assert!(md.contains("| 3 of 5 cells within the rule; not compared: 7 on this adapter (timings) | 1 holds |"), "{md}");
+        assert!(
+            md.contains("Cells of every paper: 3 of 5 cells within the rule"),
+            "{md}"
+        );
+        write(
+            "gator",
+            serde_json::json!({"paper": "gator", "mode": "quick", "seconds": 1.0, "source": "s",
+                "exact_tables": "table1: test1 match", "claims": "2 holds"}),
+        );
+        let md = index_markdown(dir.path()).unwrap();
+        assert!(
+            md.contains("not counted (an older summary; exact tables: table1: test1 match)"),
+            "{md}"
+        );
+        assert!(
+            md.contains("Cells of every paper: not counted by every summary"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| 1 holds |"),
+            "a current summary's claims unlabelled: {md}"
+        );
+        assert!(
+            md.contains("| 2 holds (an older summary, in the verdict words of its day"),
+            "{md}"
+        );
     }
 
     #[test]

@@ -2,13 +2,16 @@
 //! the working tree against the last one, is diffed on the rule fields (metric, data sets,
 //! sides, expectation, tolerance, evidence, normalisation, and ids that move), and each change
 //! must have its row in `reports/papers/rule_history.csv` naming the claim, the old value and a
-//! commit between the two versions. A clone without the history (shallow, or no git) cannot be
+//! commit between the two versions. The table cells' rules (`reports/papers/cell_rules.csv`)
+//! are walked the same way: a changed or removed rule of a column needs its row (id
+//! `TABLE:COLUMN`, the old compare, tolerance and direction). A clone without the history (shallow, or no git) cannot be
 //! checked: the test says so, and fails under `TETBENCH_REQUIRE_DATA=1` (CI's full clone).
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use crate::papers::cells::{How, CELL_RULES_FILE};
 use crate::papers::claims::{Discriminates, Metric, VariantSpec};
 use crate::papers::rules::{self, Evidence, Normalise, RuleChange};
 
@@ -219,31 +222,25 @@ fn is_ancestor(a: &str, b: &str) -> bool {
     git(&["merge-base", "--is-ancestor", a, b]).is_ok()
 }
 
-/// The committed versions of the claims file, oldest first, or why git cannot give them.
-fn committed_versions() -> Result<Vec<(String, String)>, String> {
+/// The committed versions of a rule file, oldest first, or why git cannot give them.
+fn committed_versions(file: &str) -> Result<Vec<(String, String)>, String> {
     if git(&["rev-parse", "--is-shallow-repository"])?.trim() == "true" {
-        return Err("the clone is shallow: the claims file's history is not here".into());
+        return Err(format!(
+            "the clone is shallow: {file}'s history is not here"
+        ));
     }
-    let log = git(&["log", "--format=%H", "--", "reports/papers/claims.csv"])?;
-    let commits: Vec<&str> = log.lines().rev().collect();
-    if commits.is_empty() {
-        return Err("git log finds no commit of reports/papers/claims.csv".into());
-    }
-    commits
-        .into_iter()
-        .map(|c| {
-            Ok((
-                c.to_string(),
-                git(&["show", &format!("{c}:reports/papers/claims.csv")])?,
-            ))
-        })
+    let log = git(&["log", "--format=%H", "--", file])?;
+    log.lines()
+        .rev()
+        .map(|c| Ok((c.to_string(), git(&["show", &format!("{c}:{file}")])?)))
         .collect()
 }
 
-#[test]
-fn every_rule_change_since_the_claims_file_began_has_its_history_row() {
-    let versions = match committed_versions() {
-        Ok(v) => v,
+/// `versions`, or skips the test where git cannot give them (fails under
+/// `TETBENCH_REQUIRE_DATA=1`).
+fn or_skip(versions: Result<Vec<(String, String)>, String>) -> Option<Vec<(String, String)>> {
+    match versions {
+        Ok(v) => Some(v),
         Err(why) => {
             let msg = format!(
                 "the rule history cannot be checked against git: {why} (a full clone checks it)"
@@ -252,24 +249,29 @@ fn every_rule_change_since_the_claims_file_began_has_its_history_row() {
                 panic!("TETBENCH_REQUIRE_DATA=1 but {msg}");
             }
             eprintln!("SKIPPED: {msg}");
-            return;
+            None
         }
-    };
-    let history = rules::history().unwrap();
-    let working = std::fs::read_to_string(repo().join("reports/papers/claims.csv")).unwrap();
+    }
+}
+
+/// The uncovered changes from one version's text to the next's, given which commits lie
+/// between them.
+type Uncovered<'a> = &'a dyn Fn(&str, &str, &mut dyn FnMut(&str) -> bool) -> Vec<String>;
+
+/// Walks the committed versions of `file` and the working tree against the last one, each
+/// step's uncovered changes named with the two versions.
+fn walk(file: &str, versions: &[(String, String)], uncovered: Uncovered) -> (usize, Vec<String>) {
+    let working = std::fs::read_to_string(repo().join(file)).unwrap();
     let head = git(&["rev-parse", "HEAD"]).unwrap().trim().to_string();
     let mut missing = vec![];
-    let mut steps = 0;
     for i in 0..versions.len() {
         let (p_commit, p_text) = &versions[i];
         let (c_commit, c_text) = match versions.get(i + 1) {
             Some((c, t)) => (c.clone(), t.clone()),
             None => (head.clone(), working.clone()),
         };
-        let prev = read_version(p_text).unwrap();
-        let cur = read_version(&c_text).unwrap();
         let mut in_range = |h: &str| is_ancestor(p_commit, h) && is_ancestor(h, &c_commit);
-        for m in uncovered(&prev, &cur, &history, &mut in_range) {
+        for m in uncovered(p_text, &c_text, &mut in_range) {
             let to = if i + 1 < versions.len() {
                 c_commit[..7].to_string()
             } else {
@@ -277,10 +279,177 @@ fn every_rule_change_since_the_claims_file_began_has_its_history_row() {
             };
             missing.push(format!("{} → {to}: {m}", &p_commit[..7]));
         }
-        steps += 1;
     }
+    (versions.len(), missing)
+}
+
+#[test]
+fn every_rule_change_since_the_claims_file_began_has_its_history_row() {
+    let Some(versions) = or_skip(committed_versions("reports/papers/claims.csv")) else {
+        return;
+    };
+    let history = rules::history().unwrap();
+    let (steps, missing) = walk("reports/papers/claims.csv", &versions, &|p, c, in_range| {
+        uncovered(
+            &read_version(p).unwrap(),
+            &read_version(c).unwrap(),
+            &history,
+            in_range,
+        )
+    });
     assert!(steps >= 8, "only {steps} versions of the claims file");
     assert!(missing.is_empty(), "{}", missing.join("\n"));
+}
+
+/// One version of the cell rule file: each column's rule, canonical (`exact, two-sided`).
+fn read_cell_version(text: &str) -> Result<Vec<(Key, String)>, String> {
+    let mut r = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = r
+        .headers()
+        .map_err(|e| e.to_string())?
+        .iter()
+        .map(String::from)
+        .collect();
+    let mut out = vec![];
+    for rec in r.records() {
+        let rec = rec.map_err(|e| e.to_string())?;
+        let col = |name: &str| {
+            let i = header.iter().position(|h| h == name);
+            i.and_then(|i| rec.get(i)).unwrap_or("").to_string()
+        };
+        let tolerance = col("tolerance");
+        let how = How::from_fields(&col("compare"), tolerance.parse().ok(), &col("direction"))
+            .map_or(
+                format!("{} {tolerance} {}", col("compare"), col("direction")),
+                |h| h.describe(),
+            );
+        out.push((
+            (col("paper"), format!("{}:{}", col("table"), col("column"))),
+            how,
+        ));
+    }
+    Ok(out)
+}
+
+/// The cell rule changes from `prev` to `cur` (a rule changed or removed) that no history row
+/// covers: a row of the paper, with id `TABLE:COLUMN`, the old rule, at a commit in range.
+fn uncovered_cells(
+    prev: &[(Key, String)],
+    cur: &[(Key, String)],
+    history: &[RuleChange],
+    in_range: &mut dyn FnMut(&str) -> bool,
+) -> Vec<String> {
+    let mut missing = vec![];
+    for ((paper, id), before) in prev {
+        let now = cur.iter().find(|(k, _)| k.0 == *paper && k.1 == *id);
+        if now.is_some_and(|(_, now)| now == before) {
+            continue;
+        }
+        let covered = history
+            .iter()
+            .filter(|h| h.paper == *paper && h.id == *id)
+            .filter(|h| h.old_cell.is_some_and(|o| o.describe() == *before))
+            .any(|h| in_range(&h.commit));
+        if !covered {
+            let what = now.map_or("removed".to_string(), |(_, n)| format!("changed to {n:?}"));
+            missing.push(format!(
+                "{paper} {id}: the cell rule {before:?} {what} with no history row naming it"
+            ));
+        }
+    }
+    missing
+}
+
+#[test]
+fn every_cell_rule_change_has_its_history_row() {
+    let Some(versions) = or_skip(committed_versions(CELL_RULES_FILE)) else {
+        return;
+    };
+    let history = rules::history().unwrap();
+    let (_, missing) = walk(CELL_RULES_FILE, &versions, &|p, c, in_range| {
+        uncovered_cells(
+            &read_cell_version(p).unwrap(),
+            &read_cell_version(c).unwrap(),
+            &history,
+            in_range,
+        )
+    });
+    assert!(missing.is_empty(), "{}", missing.join("\n"));
+}
+
+/// The cell rules' check must be able to fail: a changed tolerance or a removed rule without
+/// its row is found, with its row (right old rule, commit in range) it is not; a cell row that
+/// also fills a claim's fields fails the history's load.
+#[test]
+fn a_cell_rule_change_without_its_row_is_found() {
+    let head = "paper,table,column,compare,tolerance,direction,why\n";
+    let v = |rest: &str| read_cell_version(&format!("{head}{rest}")).unwrap();
+    let two = v("havs,table2,*,relative,0.02,two-sided,x\n");
+    let five = v("havs,table2,*,relative,0.05,two-sided,x\n");
+    let none = v("");
+    // A history row with these fields set (by column name), the others empty.
+    let row_with = |set: &[(&str, &str)]| {
+        let fields: Vec<&str> = rules::HISTORY_HEADER
+            .iter()
+            .map(|h| set.iter().find(|(k, _)| k == h).map_or("", |(_, v)| *v))
+            .collect();
+        rules::parse_history(
+            &format!(
+                "{}\n{}\n",
+                rules::HISTORY_HEADER.join(","),
+                fields.join(",")
+            ),
+            "h.csv",
+        )
+    };
+    let row = |tol: &str, compare: &str| {
+        row_with(&[
+            ("paper", "havs"),
+            ("id", "table2:*"),
+            ("date", "2026-12-07"),
+            ("commit", "c"),
+            ("reason", "why"),
+            ("old_tolerance", tol),
+            ("old_compare", compare),
+            ("old_direction", "two-sided"),
+        ])
+    };
+    let two_row = row("0.02", "relative").unwrap();
+    let exact_row = row("", "exact").unwrap();
+    let (mut yes, mut never) = (|_: &str| true, |_: &str| false);
+    assert_eq!(uncovered_cells(&two, &five, &[], &mut yes).len(), 1);
+    assert!(uncovered_cells(&two, &five, &two_row, &mut yes).is_empty());
+    assert_eq!(uncovered_cells(&two, &five, &exact_row, &mut yes).len(), 1);
+    assert_eq!(uncovered_cells(&two, &five, &two_row, &mut never).len(), 1);
+    assert_eq!(uncovered_cells(&two, &none, &[], &mut yes).len(), 1);
+    assert!(uncovered_cells(&two, &none, &two_row, &mut yes).is_empty());
+    assert!(uncovered_cells(&none, &two, &[], &mut yes).is_empty());
+    assert!(uncovered_cells(&two, &two, &[], &mut yes).is_empty());
+    // A cell row is not a claim's: it names TABLE:COLUMN and fills no claim field.
+    let e = row_with(&[
+        ("paper", "havs"),
+        ("id", "table2:*"),
+        ("date", "2026-12-07"),
+        ("commit", "c"),
+        ("reason", "why"),
+        ("old_metric", "total_ms"),
+        ("old_compare", "exact"),
+        ("old_direction", "two-sided"),
+    ])
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("h.csv: line 2:") && e.contains("TABLE:COLUMN"),
+        "{e}"
+    );
+    let e = row("0.5", "exact").unwrap_err().to_string();
+    assert!(
+        e.contains("line 2:") && e.contains("only a relative rule"),
+        "{e}"
+    );
 }
 
 /// The check must be able to fail: one changed rule field without a row, a moved id without
@@ -297,7 +466,7 @@ fn a_rule_change_without_its_row_is_found() {
     let row = |id: &str, old_id: &str, tol: &str, commit: &str| {
         rules::parse_history(
             &format!(
-                "{}\nhavs,{id},2026-12-03,{commit},why,{old_id},kbuffer_pixels_k_gt2,spx2,kbuffer-analysis,,a=havs_table2.pixels_needing_k_gt_2,{tol},measured,none,,\n",
+                "{}\nhavs,{id},2026-12-03,{commit},why,{old_id},kbuffer_pixels_k_gt2,spx2,kbuffer-analysis,,a=havs_table2.pixels_needing_k_gt_2,{tol},measured,none,,,,\n",
                 rules::HISTORY_HEADER.join(",")
             ),
             "h.csv",

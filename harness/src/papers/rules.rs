@@ -1,8 +1,11 @@
 //! A claim's rule and its history: what it compares and how it decides (metric, data sets,
 //! sides, expectation, tolerance, evidence kind, normalisation), and every earlier rule with
 //! the date, the commit and the reason it changed (`reports/papers/rule_history.csv`,
-//! docs/reproduction.md, "Rules and their history").
+//! docs/reproduction.md, "Rules and their history"). The same history holds the changes of
+//! the table cells' rules (`reports/papers/cell_rules.csv`, [`super::cells`]): such a row's id
+//! is `TABLE:COLUMN` and it fills `old_compare`, `old_tolerance` and `old_direction` only.
 
+use super::cells::How;
 use super::spec::{Discriminates, ExpectSpec, Metric, VariantSpec};
 use super::transcription::deserialize_rows;
 use super::verdict;
@@ -29,6 +32,8 @@ pub const HISTORY_HEADER: &[&str] = &[
     "old_normalise",
     "old_discriminates",
     "old_control",
+    "old_compare",
+    "old_direction",
 ];
 
 /// The `paper` and `id` of a history row that changes the verdict rule itself, for every
@@ -244,11 +249,18 @@ pub struct RuleChange {
     /// The id the claim had before (`None`: the same).
     pub old_id: Option<String>,
     pub old: Option<Rule>,
+    /// A cell rule's earlier rule (its id is `TABLE:COLUMN`); `None` for a claim's row.
+    pub old_cell: Option<How>,
 }
 
 impl RuleChange {
     pub fn is_verdict_rule(&self) -> bool {
         self.paper == EVERY_CLAIM
+    }
+
+    /// Whether it changed a table cell rule, not a claim's.
+    pub fn is_cell_rule(&self) -> bool {
+        self.old_cell.is_some()
     }
 }
 
@@ -270,6 +282,8 @@ struct HistoryRecord {
     old_normalise: Normalise,
     old_discriminates: Option<Discriminates>,
     old_control: Option<VariantSpec>,
+    old_compare: String,
+    old_direction: String,
 }
 
 /// Parses a rule history; errors name the file, the line and what is wrong.
@@ -288,15 +302,30 @@ pub fn parse_history(text: &str, file: &str) -> anyhow::Result<Vec<RuleChange>> 
                 return Err(err(format!("{name} is empty")));
             }
         }
-        let old = if r.paper == EVERY_CLAIM {
-            let any = r.old_metric.is_some()
-                || r.old_a.is_some()
-                || !r.old_expect.is_empty()
-                || r.old_tolerance.is_some()
-                || r.old_evidence.is_some()
-                || r.old_discriminates.is_some()
-                || r.old_control.is_some();
-            if any || r.id != EVERY_CLAIM {
+        let claim_fields = r.old_metric.is_some()
+            || r.old_a.is_some()
+            || !r.old_expect.is_empty()
+            || r.old_evidence.is_some()
+            || r.old_discriminates.is_some()
+            || r.old_control.is_some();
+        let old_cell = if r.old_compare.is_empty() {
+            if !r.old_direction.is_empty() {
+                return Err(err("old_direction without old_compare".into()));
+            }
+            None
+        } else {
+            if claim_fields || !r.id.contains(':') {
+                return Err(err(format!(
+                    "a cell rule's change (old_compare {:?}) names its TABLE:COLUMN as id and fills only old_compare, old_tolerance and old_direction",
+                    r.old_compare
+                )));
+            }
+            Some(How::from_fields(&r.old_compare, r.old_tolerance, &r.old_direction).map_err(err)?)
+        };
+        let old = if old_cell.is_some() {
+            None
+        } else if r.paper == EVERY_CLAIM {
+            if claim_fields || r.old_tolerance.is_some() || r.id != EVERY_CLAIM {
                 return Err(err(format!(
                     "a change of the verdict rule ({EVERY_CLAIM},{EVERY_CLAIM}) has no old rule of one claim"
                 )));
@@ -326,6 +355,7 @@ pub fn parse_history(text: &str, file: &str) -> anyhow::Result<Vec<RuleChange>> 
             reason: r.reason,
             old_id: r.old_id.filter(|s| !s.is_empty()),
             old,
+            old_cell,
         });
     }
     Ok(out)
@@ -342,5 +372,14 @@ pub fn verdict_rule_changes() -> Vec<RuleChange> {
         .expect("reports/papers/rule_history.csv parses (tested)")
         .into_iter()
         .filter(RuleChange::is_verdict_rule)
+        .collect()
+}
+
+/// The changes of `paper`'s table cell rules, oldest first.
+pub fn cell_rule_changes(paper: &str) -> Vec<RuleChange> {
+    history()
+        .expect("reports/papers/rule_history.csv parses (tested)")
+        .into_iter()
+        .filter(|h| h.is_cell_rule() && h.paper == paper)
         .collect()
 }

@@ -1,31 +1,22 @@
-//! What every paper's report is made of: comparison tables (paper | ours | ours/paper, or an
-//! exact verdict for tables that do not depend on the GPU), their Markdown, HTML and bar
-//! charts. The paper's claims and their verdicts are [`crate::papers::claims`].
+//! What every paper's report is made of: comparison tables (paper | ours | each cell's verdict
+//! under its column's rule, or ours/paper where the rule does not compare), their Markdown, HTML
+//! and bar charts. The paper's claims and their verdicts are [`crate::papers::claims`].
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Context;
 
-/// How a metric is compared with the paper's.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MetricKind {
-    /// Depends on the hardware: shown as ours/paper.
-    Measured,
-    /// Does not depend on the GPU: ours must equal the paper's.
-    Exact,
-    /// A count the paper prints rounded ("2.9 K"): ours rounded to the paper's significant
-    /// digits must equal it.
-    RoundedAsPrinted,
-}
+use super::cells::{self, CellCounts, CellRule, CellVerdict, NotCompared};
 
-/// One metric (column group) of a comparison table.
+/// One metric (column group) of a comparison table. How its cells are judged is its rule in
+/// `reports/papers/cell_rules.csv` ([`super::cells`]), found by the paper, the table's key and
+/// this name.
 #[derive(Debug, Clone)]
 pub struct Metric {
     pub name: String,
     /// Digits after the decimal point when printed.
     pub digits: usize,
-    pub kind: MetricKind,
 }
 
 impl Metric {
@@ -33,57 +24,7 @@ impl Metric {
         Metric {
             name: name.into(),
             digits,
-            kind: MetricKind::Measured,
         }
-    }
-    pub fn exact(name: impl Into<String>, digits: usize) -> Metric {
-        Metric {
-            kind: MetricKind::Exact,
-            ..Metric::new(name, digits)
-        }
-    }
-    pub fn rounded(name: impl Into<String>) -> Metric {
-        Metric {
-            kind: MetricKind::RoundedAsPrinted,
-            ..Metric::new(name, 0)
-        }
-    }
-    fn compared_exactly(&self) -> bool {
-        self.kind != MetricKind::Measured
-    }
-    /// Whether ours equals the paper's under this metric's rule.
-    pub fn agrees(&self, paper: f64, ours: f64) -> bool {
-        match self.kind {
-            MetricKind::RoundedAsPrinted => round_sig(ours, significant_digits(paper)) == paper,
-            _ => paper == ours,
-        }
-    }
-}
-
-/// Significant digits of a value printed rounded (trailing zeros of an integer do not count).
-fn significant_digits(v: f64) -> i32 {
-    let mut x = v.abs().round() as u64;
-    if x == 0 {
-        return 1;
-    }
-    while x.is_multiple_of(10) {
-        x /= 10;
-    }
-    x.to_string().len() as i32
-}
-
-fn round_sig(v: f64, digits: i32) -> f64 {
-    if v == 0.0 {
-        return 0.0;
-    }
-    // Divide or multiply by an exact power of ten so 1,500,282 → 1,500,000 exactly.
-    let e = v.abs().log10().floor() as i32 - (digits - 1);
-    if e >= 0 {
-        let p = 10f64.powi(e);
-        (v / p).round() * p
-    } else {
-        let p = 10f64.powi(-e);
-        (v * p).round() / p
     }
 }
 
@@ -148,75 +89,124 @@ pub struct Comparison {
     pub notes: Vec<String>,
 }
 
-impl Comparison {
-    /// The metrics compared exactly, over every non-stand-in cell where both have a value:
-    /// `Some(true)` if all agree, `None` when no such cell exists.
-    pub fn verdict(&self) -> Option<bool> {
-        let mut any = false;
-        for r in self.rows.iter().filter(|r| !r.standin) {
-            for (m, c) in self.metrics.iter().zip(&r.cells) {
-                if !m.compared_exactly() {
-                    continue;
-                }
-                if let (Some(p), Some(o)) = (c.paper, c.ours) {
-                    any = true;
-                    if !m.agrees(p, o) {
-                        return Some(false);
-                    }
-                }
-            }
-        }
-        any.then_some(true)
-    }
+/// A table's cells judged by their rules (`reports/papers/cell_rules.csv`, [`cells`]): the
+/// one judging of every paper's tables, which the table's verdict columns, its counts and the
+/// report's findings read.
+pub struct Judged<'a, 'r> {
+    pub comparison: &'a Comparison,
+    /// Per metric, its rule (`None`: no line of the file covers it).
+    pub rules: Vec<Option<&'r CellRule>>,
+    /// Per row, per metric: the verdict (`None`: the paper prints no value there).
+    pub verdicts: Vec<Vec<Option<CellVerdict>>>,
 }
 
 impl Comparison {
-    /// The columns the exact verdict compares (exact metrics).
-    pub fn compared_columns(&self) -> Vec<&str> {
-        self.metrics
+    /// Its cells judged by the compiled-in rules of `paper`.
+    pub fn judge(&self, paper: &str) -> Judged<'_, 'static> {
+        self.judge_with(cells::rules(), paper)
+    }
+
+    /// Its cells judged by `rules`.
+    pub fn judge_with<'r>(&self, rules: &'r [CellRule], paper: &str) -> Judged<'_, 'r> {
+        let rules: Vec<Option<&CellRule>> = self
+            .metrics
             .iter()
-            .filter(|m| m.compared_exactly())
-            .map(|m| m.name.as_str())
-            .collect()
-    }
-
-    /// The columns that depend on the hardware: shown as ours/paper, never part of a match.
-    pub fn not_compared_columns(&self) -> Vec<&str> {
-        self.metrics
+            .map(|m| cells::rule_for(rules, paper, &self.key, &m.name))
+            .collect();
+        let verdicts = self
+            .rows
             .iter()
-            .filter(|m| !m.compared_exactly())
-            .map(|m| m.name.as_str())
-            .collect()
+            .map(|r| {
+                rules
+                    .iter()
+                    .zip(&r.cells)
+                    .map(|(rule, c)| {
+                        let how = rule.map(|r| &r.how);
+                        cells::judge(how, r.standin, c.paper, c.ours, c.why_no_ours.as_deref())
+                    })
+                    .collect()
+            })
+            .collect();
+        Judged {
+            comparison: self,
+            rules,
+            verdicts,
+        }
+    }
+}
+
+impl Judged<'_, '_> {
+    /// How many of its cells took each verdict.
+    pub fn counts(&self) -> CellCounts {
+        let mut n = CellCounts::default();
+        for v in self.verdicts.iter().flatten().flatten() {
+            n.add(v);
+        }
+        n
     }
 
-    /// "Compared: tets. Not compared (they depend on the hardware): fps, tets/s."
-    pub fn columns_sentence(&self) -> String {
-        let mut s = format!("Compared: {}.", self.compared_columns().join(", "));
-        let not = self.not_compared_columns();
-        if !not.is_empty() {
-            s.push_str(&format!(
-                " Not compared (they depend on the hardware; ours/paper shown): {}.",
-                not.join(", ")
-            ));
-        }
-        s
+    /// The table's line for the index: `table2: 1 of 5 cells within the rule; …`.
+    pub fn summary(&self) -> String {
+        format!("{}: {}", self.comparison.key, self.counts().headline())
     }
 
-    /// The table's one-line verdict for the index, naming the columns it compared and those
-    /// it did not: `table1: tets match (fps, tets/s not compared)` (`None`: no exact column).
-    pub fn summary(&self) -> Option<String> {
-        let v = self.verdict()?;
-        let mut s = format!(
-            "{}: {} {}",
-            self.key,
-            self.compared_columns().join(", "),
-            if v { "match" } else { "differ" }
-        );
-        let not = self.not_compared_columns();
-        if !not.is_empty() {
-            s.push_str(&format!(" ({} not compared)", not.join(", ")));
+    /// Each cell outside its rule, as one line: where, both values, the difference, the rule,
+    /// and its explanation (none is measured in the code yet: "unexplained").
+    pub fn findings(&self) -> Vec<String> {
+        let c = self.comparison;
+        let mut out = vec![];
+        for (row, verdicts) in c.rows.iter().zip(&self.verdicts) {
+            for (i, v) in verdicts.iter().enumerate() {
+                if *v != Some(CellVerdict::Outside) {
+                    continue;
+                }
+                let (m, cell) = (&c.metrics[i], &row.cells[i]);
+                let (paper, ours) = (cell.paper.unwrap_or(0.0), cell.ours.unwrap_or(0.0));
+                let rule = self.rules[i].map_or(String::new(), |r| r.how.describe());
+                out.push(format!(
+                    "{} {}, {}: ours {}, paper {} ({}); rule {rule}: unexplained",
+                    c.key,
+                    row.label,
+                    m.name,
+                    num(Some(ours), m.digits),
+                    num(Some(paper), m.digits),
+                    difference(paper, ours)
+                ));
+            }
         }
-        Some(s)
+        out
+    }
+
+    /// Whether column `i`'s rule compares (a timing or a layout column does not, and shows
+    /// ours/paper instead; a column without a rule shows that it has none).
+    fn compares(&self, i: usize) -> bool {
+        self.rules[i].is_none_or(|r| r.how.compare.compares())
+    }
+
+    /// `fragments, max A: exact, two-sided (why); …` for the columns under each rule.
+    fn rules_sentence(&self) -> String {
+        let mut groups: Vec<(&CellRule, Vec<&str>)> = vec![];
+        for (m, r) in self.comparison.metrics.iter().zip(&self.rules) {
+            let Some(r) = r else { continue };
+            match groups.iter_mut().find(|(g, _)| std::ptr::eq(*g, *r)) {
+                Some((_, cols)) => cols.push(&m.name),
+                None => groups.push((r, vec![&m.name])),
+            }
+        }
+        groups
+            .iter()
+            .map(|(r, cols)| format!("{}: {} ({})", cols.join(", "), r.how.describe(), r.why))
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
+}
+
+/// `−38.7 %` (or the absolute difference where the paper's value is 0).
+fn difference(paper: f64, ours: f64) -> String {
+    if paper != 0.0 {
+        format!("{:+.1} %", cells::relative(paper, ours) * 100.0)
+    } else {
+        format!("{:+}", ours - paper)
     }
 }
 
@@ -238,22 +228,30 @@ fn ratio_text(c: &Cell) -> String {
     c.ratio().map(|r| format!("{r:.3}")).unwrap_or("–".into())
 }
 
-fn exact_text(m: &Metric, c: &Cell) -> &'static str {
-    match (c.paper, c.ours) {
-        (Some(p), Some(o)) if m.agrees(p, o) => "matches",
-        (Some(_), Some(_)) => "does not match",
-        _ => "–",
+/// A compared cell's verdict as the table prints it.
+fn verdict_text(v: Option<&CellVerdict>, c: &Cell) -> String {
+    match v {
+        Some(CellVerdict::Within) => "within".into(),
+        Some(CellVerdict::Outside) => match (c.paper, c.ours) {
+            (Some(p), Some(o)) => format!("outside ({})", difference(p, o)),
+            _ => "outside".into(),
+        },
+        Some(CellVerdict::NotCompared(NotCompared::StandIn)) => "stand-in".into(),
+        Some(CellVerdict::NotCompared(NotCompared::NoRule)) => "no rule".into(),
+        _ => "–".into(),
     }
 }
 
-/// The table as Markdown: per metric the paper's value, ours, and ours/paper (or the exact
-/// verdict), then the footnotes (stand-ins, uncertain cells, missing values).
-pub fn markdown(c: &Comparison) -> String {
+/// The table as Markdown: per metric the paper's value, ours, and the cell's verdict under
+/// its rule (or ours/paper for a column the rule does not compare), then the counts, the
+/// rules, and the footnotes (stand-ins, uncertain cells, missing values).
+pub fn markdown(j: &Judged) -> String {
+    let c = j.comparison;
     let mut md = format!("### {}\n\n{}\n\n", c.title, c.conditions);
     let mut head = String::from("| row |");
     let mut rule = String::from("|---|");
-    for m in &c.metrics {
-        let third = if m.compared_exactly() {
+    for (i, m) in c.metrics.iter().enumerate() {
+        let third = if j.compares(i) {
             "verdict"
         } else {
             "ours/paper"
@@ -273,14 +271,14 @@ pub fn markdown(c: &Comparison) -> String {
         };
         format!("[{}]", i + 1)
     };
-    for r in &c.rows {
+    for (r, verdicts) in c.rows.iter().zip(&j.verdicts) {
         let label = if r.standin {
             format!("{} (stand-in)", r.label)
         } else {
             r.label.clone()
         };
         let _ = write!(md, "| {label} |");
-        for (m, cell) in c.metrics.iter().zip(&r.cells) {
+        for (i, (m, cell)) in c.metrics.iter().zip(&r.cells).enumerate() {
             let mut p = num(cell.paper, m.digits);
             if let Some(u) = &cell.uncertain {
                 p.push_str(&format!(" ?{}", mark(format!("uncertain: {u}"))));
@@ -289,13 +287,8 @@ pub fn markdown(c: &Comparison) -> String {
             if let Some(w) = &cell.why_no_ours {
                 o.push_str(&format!(" {}", mark(w.clone())));
             }
-            let t = if m.compared_exactly() {
-                let v = exact_text(m, cell);
-                if r.standin && v != "–" {
-                    format!("{v} (stand-in)")
-                } else {
-                    v.to_string()
-                }
+            let t = if j.compares(i) {
+                verdict_text(verdicts[i].as_ref(), cell)
             } else {
                 ratio_text(cell)
             };
@@ -303,18 +296,13 @@ pub fn markdown(c: &Comparison) -> String {
         }
         md.push('\n');
     }
-    if c.metrics.iter().any(|m| m.compared_exactly()) {
-        let v = match c.verdict() {
-            Some(true) => {
-                "**ours matches the paper** in every cell of the compared columns both have (stand-in rows excluded)"
-            }
-            Some(false) => {
-                "**ours does not match the paper** in at least one cell of the compared columns (stand-in rows excluded)"
-            }
-            None => "no cell could be compared",
-        };
-        let _ = writeln!(md, "\nVerdict: {v}. {}", c.columns_sentence());
-    }
+    let _ = writeln!(
+        md,
+        "\nCells: {}. Rules (`{}`): {}.",
+        j.counts().headline(),
+        cells::CELL_RULES_FILE,
+        j.rules_sentence()
+    );
     if !footnotes.is_empty() {
         md.push('\n');
         for (i, f) in footnotes.iter().enumerate() {
@@ -357,12 +345,13 @@ pub fn markdown_to_html(md: &str, title: &str) -> anyhow::Result<String> {
 /// Bar charts paper vs ours, one PNG per metric of `c` that has values on both sides, on a
 /// log scale (papers' GPUs and ours differ by orders of magnitude). Returns the file names
 /// written (relative to `dir`).
-pub fn write_charts(dir: &Path, c: &Comparison) -> anyhow::Result<Vec<String>> {
+pub fn write_charts(dir: &Path, j: &Judged) -> anyhow::Result<Vec<String>> {
+    let c = j.comparison;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut written = vec![];
     for (mi, m) in c.metrics.iter().enumerate() {
-        // Exact metrics (counts, truth values) are compared in the table, not charted.
-        if m.compared_exactly() {
+        // Columns the rule compares (counts, truth values) are judged in the table, not charted.
+        if j.compares(mi) {
             continue;
         }
         let bars: Vec<(String, Option<f64>, Option<f64>)> = c
@@ -400,16 +389,26 @@ pub fn write_charts(dir: &Path, c: &Comparison) -> anyhow::Result<Vec<String>> {
 mod tests {
     use super::*;
 
-    fn comparison(exact: bool, ours: f64) -> Comparison {
+    /// One rule for column `ms` of table `t` of paper `p`.
+    fn rules(compare: &str) -> Vec<CellRule> {
+        let how = match compare {
+            "exact" => "exact,,two-sided",
+            "relative" => "relative,0.1,two-sided",
+            _ => "timing,,",
+        };
+        cells::parse_rules(
+            &format!("paper,table,column,compare,tolerance,direction,why\np,t,ms,{how},why not\n"),
+            "r.csv",
+        )
+        .unwrap()
+    }
+
+    fn comparison(ours: f64) -> Comparison {
         Comparison {
             key: "t".into(),
             title: "T".into(),
             conditions: "c".into(),
-            metrics: vec![if exact {
-                Metric::exact("ms", 1)
-            } else {
-                Metric::new("ms", 1)
-            }],
+            metrics: vec![Metric::new("ms", 1)],
             rows: vec![
                 CompRow {
                     label: "a".into(),
@@ -428,24 +427,64 @@ mod tests {
 
     #[test]
     fn tables_ratios_and_verdicts() {
-        let md = markdown(&comparison(false, 4.0));
+        let timing = rules("timing");
+        let md = markdown(&comparison(4.0).judge_with(&timing, "p"));
         assert!(md.contains("| a | 2.0 | 4.0 | 2.000 |"), "{md}");
         assert!(
             md.contains("| b (stand-in) | 3.0 ?[1] | – [2] | – |"),
             "{md}"
         );
         assert!(md.contains("[2] not built"), "{md}");
-        assert_eq!(comparison(true, 2.0).verdict(), Some(true));
-        assert_eq!(comparison(true, 2.5).verdict(), Some(false));
-        let r = Metric::rounded("tets");
-        assert!(r.agrees(2900.0, 2896.0) && r.agrees(187000.0, 187318.0));
-        assert!(r.agrees(1_500_000.0, 1_500_282.0) && !r.agrees(950_000.0, 941_192.0));
-        assert!(markdown(&comparison(true, 2.0)).contains("| a | 2.0 | 2.0 | matches |"));
-        let html = markdown_to_html(&markdown(&comparison(false, 4.0)), "t").unwrap();
+        assert!(
+            md.contains("Cells: 0 of 0 cells within the rule; not compared: 2 on this adapter (timings). Rules (`reports/papers/cell_rules.csv`): ms: timing (why not)."),
+            "{md}"
+        );
+        let exact = rules("exact");
+        assert!(markdown(&comparison(2.0).judge_with(&exact, "p"))
+            .contains("| a | 2.0 | 2.0 | within |"));
+        // A table of another paper or key has no rule here: its cells say so.
+        let none = comparison(2.0);
+        let j = none.judge_with(&exact, "q");
+        assert_eq!(j.counts().no_rule, 2);
+        assert!(markdown(&j).contains("| a | 2.0 | 2.0 | no rule |"));
+        let html = markdown_to_html(&md, "t").unwrap();
         assert!(
             html.contains("<table>") && html.contains("2.000</td>"),
             "{html}"
         );
+    }
+
+    /// One measured value changed: the cell's verdict, the table's count and its finding flip.
+    #[test]
+    fn a_changed_value_flips_the_cell_and_the_count() {
+        let exact = rules("exact");
+        let (same, off) = (comparison(2.0), comparison(2.5));
+        let (same, off) = (same.judge_with(&exact, "p"), off.judge_with(&exact, "p"));
+        assert_eq!(same.verdicts[0][0], Some(CellVerdict::Within));
+        assert_eq!(off.verdicts[0][0], Some(CellVerdict::Outside));
+        // The stand-in row is not compared, with its reason, in both.
+        assert_eq!(
+            off.verdicts[1][0],
+            Some(CellVerdict::NotCompared(NotCompared::StandIn))
+        );
+        assert_eq!(
+            same.summary(),
+            "t: 1 of 1 cells within the rule; not compared: 1 on stand-ins"
+        );
+        assert_eq!(
+            off.summary(),
+            "t: 0 of 1 cells within the rule; not compared: 1 on stand-ins"
+        );
+        assert!(same.findings().is_empty());
+        assert_eq!(
+            off.findings(),
+            ["t a, ms: ours 2.5, paper 2.0 (+25.0 %); rule exact, two-sided: unexplained"]
+        );
+        assert!(markdown(&off).contains("| a | 2.0 | 2.5 | outside (+25.0 %) |"));
+        // Within a relative tolerance of 10 %, 2.1 holds and 2.5 does not.
+        let rel = rules("relative");
+        assert_eq!(comparison(2.1).judge_with(&rel, "p").counts().within, 1);
+        assert_eq!(comparison(2.5).judge_with(&rel, "p").counts().outside, 1);
     }
 
     /// Markup in a data set's name, in an image's alt text or path, lands as text.
@@ -468,9 +507,10 @@ mod tests {
     #[test]
     fn charts_are_written() {
         let dir = tempfile::tempdir().unwrap();
-        let files = write_charts(dir.path(), &comparison(false, 4.0)).unwrap();
+        let (timing, exact, c) = (rules("timing"), rules("exact"), comparison(4.0));
+        let files = write_charts(dir.path(), &c.judge_with(&timing, "p")).unwrap();
         assert_eq!(files, vec!["t_ms.png"]);
-        assert!(write_charts(dir.path(), &comparison(true, 4.0))
+        assert!(write_charts(dir.path(), &c.judge_with(&exact, "p"))
             .unwrap()
             .is_empty());
         assert!(

@@ -248,7 +248,8 @@ struct PaperLine {
     source: String,
     adapter: String,
     mode: String,
-    exact_tables: String,
+    /// The cells of its tables within their rules (or what an older summary says instead).
+    cells: String,
     claims: String,
     commit: String,
     link: String,
@@ -669,8 +670,8 @@ fn write_paper(site: &Path, p: &PaperInput) -> anyhow::Result<PaperLine> {
         source: p.source.clone(),
         adapter: p.adapter.clone(),
         mode: p.summary.mode.clone(),
-        exact_tables: p.summary.exact_tables.clone(),
-        claims: p.summary.claims.clone(),
+        cells: p.summary.cells_text(),
+        claims: p.summary.claims_text(),
         // The summary's sentence is Markdown (`commit` in backticks): shown as text.
         commit: p.summary.source.replace('`', ""),
         link: format!("{rel}/report.html"),

@@ -117,6 +117,24 @@ pub fn whole(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     }
 }
 
+/// A bind-group entry binding `size` bytes of a buffer from `offset` (a chunk of an array, or
+/// one entry of a block read at dynamic offsets).
+pub fn buffer_range(
+    binding: u32,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    size: u64,
+) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer,
+            offset,
+            size: wgpu::BufferSize::new(size),
+        }),
+    }
+}
+
 /// Bind-group entries `first, first + 1, …` binding whole buffers.
 pub fn whole_from<'a>(first: u32, buffers: &[&'a wgpu::Buffer]) -> Vec<wgpu::BindGroupEntry<'a>> {
     buffers
@@ -382,14 +400,7 @@ pub fn range_entries(
             } else {
                 (0, 1)
             };
-            wgpu::BindGroupEntry {
-                binding: first + c,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer,
-                    offset,
-                    size: wgpu::BufferSize::new(elements * elem_bytes),
-                }),
-            }
+            buffer_range(first + c, buffer, offset, elements * elem_bytes)
         })
         .collect()
 }

@@ -23,7 +23,8 @@
 
 use anyhow::ensure;
 
-use crate::gpu::{Gpu, Lifetime, MemoryLedger};
+use crate::bind::{buffer_range, whole};
+use crate::gpu::{Gpu, LayoutEntries, Lifetime, MemoryLedger};
 
 /// Keys per workgroup tile (256 threads × 16 sub-blocks); must match `TILE` in the shader.
 pub const TILE: u32 = 4096;
@@ -115,15 +116,6 @@ pub struct GpuRadixSort {
     digit_total: wgpu::Buffer,
 }
 
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    crate::bind::storage_entry(binding, wgpu::ShaderStages::COMPUTE, read_only)
-}
-
-/// The parameter block of a pass ([`crate::bind::params_entry`]).
-fn params_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    crate::bind::params_entry(binding, wgpu::ShaderStages::COMPUTE)
-}
-
 impl GpuRadixSort {
     /// Compiles the pipelines and allocates the scratch (recorded in `ledger` as per-frame sort
     /// buffers: 8 bytes per key of ping-pong copies plus 1 KiB of histogram per tile).
@@ -137,33 +129,21 @@ impl GpuRadixSort {
             tiles <= gpu.limits.max_compute_workgroups_per_dimension,
             "too many tiles for one dispatch"
         );
-        let device = &gpu.device;
         let module = gpu.shader("gpu_sort.wgsl", &sort_source(chunks, per_chunk));
-        let mut entries = vec![
-            params_entry(0),
-            storage_entry(5, false),
-            storage_entry(6, false),
-        ];
-        for a in 0..4 {
-            for c in 0..chunks {
-                entries.push(storage_entry(ARRAYS_BINDING + a * chunks + c, a < 2));
-            }
-        }
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("radix sort"),
-            entries: &entries,
-        });
-        let pipeline_layout = crate::bind::pipeline_layout(gpu, "radix sort", &[Some(&layout)]);
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        // The four arrays in chunks: keys and values in (read), keys and values out.
+        let arrays = ARRAYS_BINDING;
+        let layout = LayoutEntries::new(wgpu::ShaderStages::COMPUTE)
+            .params(0)
+            .read_write(5..=6)
+            .read(arrays..arrays + 2 * chunks)
+            .read_write(arrays + 2 * chunks..arrays + 4 * chunks)
+            .build(gpu, "radix sort");
+        let [histogram, scan_tiles, scan_digits, scatter] = gpu.compute_pipelines(
+            "radix sort",
+            &[&layout],
+            &module,
+            ["histogram", "scan_tiles", "scan_digits", "scatter"],
+        );
         let storage = wgpu::BufferUsages::STORAGE;
         Ok(GpuRadixSort {
             device: gpu.device.clone(),
@@ -171,10 +151,10 @@ impl GpuRadixSort {
             max_len,
             per_chunk,
             chunks,
-            histogram: pipeline("histogram"),
-            scan_tiles: pipeline("scan_tiles"),
-            scan_digits: pipeline("scan_digits"),
-            scatter: pipeline("scatter"),
+            histogram,
+            scan_tiles,
+            scan_digits,
+            scatter,
             tile_scan: TileScan::for_adapter(gpu),
             layout,
             params: ledger.buffer(
@@ -289,22 +269,9 @@ impl GpuRadixSort {
                 (&self.tmp_keys, &self.tmp_vals, keys, values)
             };
             let mut entries = vec![
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &self.params,
-                        offset: p as u64 * PARAM_STRIDE,
-                        size: wgpu::BufferSize::new(16),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: self.tile_hist.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: self.digit_total.as_entire_binding(),
-                },
+                buffer_range(0, &self.params, p as u64 * PARAM_STRIDE, 16),
+                whole(5, &self.tile_hist),
+                whole(6, &self.digit_total),
             ];
             for (a, buffer) in [ki, vi, ko, vo].into_iter().enumerate() {
                 entries.extend(crate::bind::range_entries(
@@ -463,32 +430,24 @@ impl GpuCentroidKeys {
         ledger: &mut MemoryLedger,
     ) -> anyhow::Result<GpuCentroidKeys> {
         let max_calls = max_calls.max(1);
-        let device = &gpu.device;
         // The module's sort entry points need their arrays declared; one binding each.
         let module = gpu.shader(
             "gpu_sort.wgsl",
             &sort_source(1, gpu.max_storage_binding() / 4),
         );
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("centroid keys"),
-            entries: &[
-                params_entry(0),
-                storage_entry(1, true),
-                storage_entry(2, true),
-                storage_entry(3, false),
-                storage_entry(4, false),
-            ],
-        });
+        let layout = LayoutEntries::new(wgpu::ShaderStages::COMPUTE)
+            .params(0)
+            .read(1..=2)
+            .read_write(3..=4)
+            .build(gpu, "centroid keys");
         let pipeline_layout =
             crate::bind::pipeline_layout(gpu, "centroid keys", &[None, Some(&layout)]);
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("centroid_keys"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("centroid_keys"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = gpu.compute_pipeline(
+            "centroid_keys",
+            Some(&pipeline_layout),
+            &module,
+            "centroid_keys",
+        );
         let params = ledger.buffer(
             gpu,
             "centroid key params",
@@ -653,30 +612,16 @@ impl GpuCentroidKeys {
                 label: Some("centroid keys"),
                 layout: &self.layout,
                 entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &self.params,
-                            offset: i as u64 * PARAM_STRIDE,
-                            size: wgpu::BufferSize::new(std::mem::size_of::<KeyParams>() as u64),
-                        }),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: points.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: c.prims.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: keys.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: values.as_entire_binding(),
-                    },
+                    buffer_range(
+                        0,
+                        &self.params,
+                        i as u64 * PARAM_STRIDE,
+                        std::mem::size_of::<KeyParams>() as u64,
+                    ),
+                    whole(1, points),
+                    whole(2, c.prims),
+                    whole(3, keys),
+                    whole(4, values),
                 ],
             });
             let groups = c.count.div_ceil(256);

@@ -3,11 +3,8 @@
 
 use anyhow::bail;
 use datasets::TetMesh;
-use render_core::bind::{
-    buffer_entry, check_storage_bindings, texture_entry, view_entry, whole as storage,
-    ChunkedBuffer,
-};
-use render_core::gpu::{Lifetime, MemoryLedger};
+use render_core::bind::{check_storage_bindings, view_entry, whole as storage, ChunkedBuffer};
+use render_core::gpu::{LayoutEntries, Lifetime, MemoryLedger};
 use render_core::{Gpu, Optics};
 
 use crate::classify::packed_table;
@@ -337,10 +334,10 @@ fn pass1_pipeline(
         &(arrays.wgsl(false) + include_str!("pass1.wgsl")),
     );
     let pass1 = gpu.compute_pipeline("fragment-pt pass 1", None, &module, "classify");
-    let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("fragment-pt pass 1"),
-        layout: &pass1.get_bind_group_layout(0),
-        entries: &[
+    let bind = gpu.bind_group(
+        "fragment-pt pass 1",
+        &pass1.get_bind_group_layout(0),
+        &[
             vec![
                 storage(0, params),
                 storage(3, &tables.truth),
@@ -350,7 +347,7 @@ fn pass1_pipeline(
             arrays.bind_entries(),
         ]
         .concat(),
-    });
+    );
     (pass1, bind)
 }
 
@@ -373,24 +370,14 @@ fn pass2_pipeline(
     };
     // An explicit layout: each shading mode leaves some tables unused, and an automatic
     // layout would drop their bindings.
-    let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
-    let ro = wgpu::BufferBindingType::Storage { read_only: true };
-    let mut layout_entries = vec![buffer_entry(0, vf, wgpu::BufferBindingType::Uniform)];
-    layout_entries.push(buffer_entry(4, vf, ro));
-    layout_entries.extend([
-        texture_entry(5, vf, false, wgpu::TextureViewDimension::D1),
-        texture_entry(6, vf, false, wgpu::TextureViewDimension::D1),
-        texture_entry(7, vf, false, wgpu::TextureViewDimension::D2),
-    ]);
-    layout_entries.extend((0..arrays.bindings()).map(|i| buffer_entry(MESH_BINDING + i, vf, ro)));
-    let layout = gpu
-        .device
-        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("fragment-pt pass 2"),
-            entries: &layout_entries,
-        });
-    let pipeline_layout =
-        render_core::bind::pipeline_layout(gpu, "fragment-pt pass 2", &[Some(&layout)]);
+    let layout = LayoutEntries::new(wgpu::ShaderStages::VERTEX_FRAGMENT)
+        .uniform(0)
+        .read(4)
+        .texture(5..=6, wgpu::TextureViewDimension::D1)
+        .texture(7, wgpu::TextureViewDimension::D2)
+        .read(MESH_BINDING..MESH_BINDING + arrays.bindings())
+        .build(gpu, "fragment-pt pass 2");
+    let pipeline_layout = gpu.pipeline_layout("fragment-pt pass 2", &[&layout]);
     // Back to front, premultiplied: dst = src + (1 − src.a) · dst.
     let pass2 = gpu.triangle_pipeline(
         "fragment-pt pass 2",
@@ -402,10 +389,10 @@ fn pass2_pipeline(
         Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
         wgpu::ColorWrites::ALL,
     );
-    let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("fragment-pt pass 2"),
-        layout: &layout,
-        entries: &[
+    let bind = gpu.bind_group(
+        "fragment-pt pass 2",
+        &layout,
+        &[
             vec![
                 storage(0, params),
                 storage(4, order),
@@ -416,7 +403,7 @@ fn pass2_pipeline(
             arrays.bind_entries(),
         ]
         .concat(),
-    });
+    );
     (pass2, bind)
 }
 

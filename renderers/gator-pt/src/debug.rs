@@ -2,7 +2,8 @@
 //! the tests that hold it against the CPU twin ([`crate::classify_cpu`]).
 
 use anyhow::bail;
-use render_core::bind::storage_entry;
+use render_core::bind::whole;
+use render_core::gpu::LayoutEntries;
 use render_core::{Camera, Gpu, Lifetime, MemoryLedger};
 
 use crate::mesh_gpu::MeshGpu;
@@ -77,22 +78,14 @@ pub fn classify_gpu(
     )?;
     mesh.write_params(gpu, camera, CellModel::Linear);
     let shader = gpu.shader("gator.wgsl", SHADER);
-    let g1_layout = gpu
-        .device
-        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gator debug out"),
-            entries: &[storage_entry(2, wgpu::ShaderStages::COMPUTE, false)],
-        });
-    let layout = render_core::bind::pipeline_layout(
-        gpu,
+    let g1_layout = LayoutEntries::new(wgpu::ShaderStages::COMPUTE)
+        .read_write(2)
+        .build(gpu, "gator debug out");
+    let [pipeline] = gpu.compute_pipelines(
         "gator debug",
-        &[Some(&mesh.g0_layout), Some(&g1_layout)],
-    );
-    let pipeline = gpu.compute_pipeline(
-        "gator classify debug",
-        Some(&layout),
+        &[&mesh.g0_layout, &g1_layout],
         &shader,
-        "classify_debug",
+        ["classify_debug"],
     );
     let size = (tets.len().max(1) * std::mem::size_of::<GpuClassification>()) as u64;
     let out = ledger.buffer(
@@ -102,14 +95,7 @@ pub fn classify_gpu(
         size,
         wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
     )?;
-    let g1 = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("gator debug out"),
-        layout: &g1_layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 2,
-            resource: out.as_entire_binding(),
-        }],
-    });
+    let g1 = gpu.bind_group("gator debug out", &g1_layout, &[whole(2, &out)]);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     {
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {

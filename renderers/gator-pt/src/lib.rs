@@ -47,8 +47,8 @@ pub use description::DESCRIPTION;
 
 use anyhow::{anyhow, bail, Context};
 use datasets::TetMesh;
-use render_core::bind::{storage_entry, uniform_entry};
-use render_core::gpu::chunk_ranges;
+use render_core::bind::{buffer_range, whole};
+use render_core::gpu::{chunk_ranges, LayoutEntries};
 pub use render_core::visibility::VisibilityOrder;
 use render_core::visibility::VisibilitySorter;
 use render_core::{
@@ -404,17 +404,11 @@ fn pipeline(
     g0_layout: &wgpu::BindGroupLayout,
 ) -> (wgpu::RenderPipeline, wgpu::BindGroupLayout) {
     let shader = gpu.shader("gator.wgsl", SHADER);
-    let g1_layout = gpu
-        .device
-        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gator order"),
-            entries: &[
-                storage_entry(0, wgpu::ShaderStages::VERTEX, true),
-                uniform_entry(1, wgpu::ShaderStages::VERTEX),
-            ],
-        });
-    let layout =
-        render_core::bind::pipeline_layout(gpu, "gator", &[Some(g0_layout), Some(&g1_layout)]);
+    let g1_layout = LayoutEntries::new(wgpu::ShaderStages::VERTEX)
+        .read(0)
+        .uniform(1)
+        .build(gpu, "gator order");
+    let layout = gpu.pipeline_layout("gator", &[g0_layout, &g1_layout]);
     // Premultiplied "over", back to front: dst = src + (1 − src_α)·dst.
     let pipeline = gpu.triangle_pipeline(
         "gator",
@@ -448,25 +442,15 @@ fn order_chunks(
             bytemuck::cast_slice(&cp),
             wgpu::BufferUsages::UNIFORM,
         )?;
-        let size = std::num::NonZeroU64::new(((range.end - range.start) * 4).max(4));
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gator order chunk"),
-            layout: g1_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: order_buf,
-                        offset: range.start * 4,
-                        size,
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: cbuf.as_entire_binding(),
-                },
+        let size = ((range.end - range.start) * 4).max(4);
+        let bind_group = gpu.bind_group(
+            "gator order chunk",
+            g1_layout,
+            &[
+                buffer_range(0, order_buf, range.start * 4, size),
+                whole(1, &cbuf),
             ],
-        });
+        );
         chunks.push(DrawChunk { range, bind_group });
     }
     Ok(chunks)

@@ -3,8 +3,8 @@
 //! shared by the draw and the debug classification).
 
 use anyhow::{anyhow, bail};
-use render_core::bind::{lookup_texture, storage_entry, texture_entry, uniform_entry};
-use render_core::gpu::chunk_ranges;
+use render_core::bind::{lookup_texture, view_entry, whole, whole_from};
+use render_core::gpu::{chunk_ranges, LayoutEntries};
 use render_core::{Camera, Gpu, Lifetime, MemoryLedger, Optics};
 
 use crate::{
@@ -37,15 +37,6 @@ pub(crate) struct MeshGpu {
     pub(crate) tet_ranges: Vec<std::ops::Range<u64>>,
     /// The point chunks (then placeholders up to [`MAX_POINT_CHUNKS`]).
     pub(crate) point_bufs: Vec<wgpu::Buffer>,
-}
-
-fn lut_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    texture_entry(
-        binding,
-        wgpu::ShaderStages::FRAGMENT,
-        false,
-        wgpu::TextureViewDimension::D1,
-    )
 }
 
 /// Opacity table: α(τ) = 1 − exp(−τ) for τ = i/(n−1)·TAU_MAX.
@@ -230,44 +221,20 @@ fn bind_group(
     tf_view: &wgpu::TextureView,
     exp_view: &wgpu::TextureView,
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
-    let vc = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE;
-    let mut entries = vec![uniform_entry(
-        0,
-        wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
-    )];
-    for b in 1..=(MAX_TET_CHUNKS + MAX_POINT_CHUNKS) as u32 {
-        entries.push(storage_entry(b, vc, true));
-    }
-    entries.push(lut_entry(8));
-    entries.push(lut_entry(9));
-    let g0_layout = gpu
-        .device
-        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gator g0"),
-            entries: &entries,
-        });
-    let mut bind = vec![wgpu::BindGroupEntry {
-        binding: 0,
-        resource: params.as_entire_binding(),
-    }];
-    for (i, b) in tet_bufs.iter().chain(point_bufs.iter()).enumerate() {
-        bind.push(wgpu::BindGroupEntry {
-            binding: 1 + i as u32,
-            resource: b.as_entire_binding(),
-        });
-    }
-    bind.push(wgpu::BindGroupEntry {
-        binding: 8,
-        resource: wgpu::BindingResource::TextureView(tf_view),
-    });
-    bind.push(wgpu::BindGroupEntry {
-        binding: 9,
-        resource: wgpu::BindingResource::TextureView(exp_view),
-    });
-    let g0 = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("gator g0"),
-        layout: &g0_layout,
-        entries: &bind,
-    });
+    let g0_layout =
+        LayoutEntries::new(wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE)
+            .uniform(0)
+            .visible(wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE)
+            .read(1..=(MAX_TET_CHUNKS + MAX_POINT_CHUNKS) as u32)
+            .visible(wgpu::ShaderStages::FRAGMENT)
+            .texture(8..=9, wgpu::TextureViewDimension::D1)
+            .build(gpu, "gator g0");
+    let chunks: Vec<&wgpu::Buffer> = tet_bufs.iter().chain(point_bufs).collect();
+    let entries = [
+        vec![whole(0, params)],
+        whole_from(1, &chunks),
+        vec![view_entry(8, tf_view), view_entry(9, exp_view)],
+    ];
+    let g0 = gpu.bind_group("gator g0", &g0_layout, &entries.concat());
     (g0_layout, g0)
 }

@@ -128,22 +128,56 @@ pub fn for_each_band<R: Send>(
     f: impl Fn(&Band) -> R + Sync,
 ) -> Vec<R> {
     let (w, h) = (camera.width, camera.height);
-    let screen: Vec<[f64; 3]> = {
-        let vp = camera.view_proj();
-        geom.verts
-            .par_iter()
-            .map(|p| {
-                let c = vp * glam::DVec4::new(p[0] as f64, p[1] as f64, p[2] as f64, 1.0);
-                let ndc = c.truncate() / c.w;
-                [
-                    (ndc.x + 1.0) * 0.5 * w as f64,
-                    (1.0 - ndc.y) * 0.5 * h as f64,
-                    c.w,
-                ]
+    let faces = project_faces(geom, order, camera);
+    let view = View {
+        width: w,
+        rays: (0..w * h)
+            .into_par_iter()
+            .map(|i| {
+                let r = camera.pixel_ray(i % w, i / w);
+                (r.origin, r.dir)
             })
-            .collect()
+            .collect(),
+        eye: camera.eye,
+        forward: camera.forward(),
+        perspective: camera.is_perspective(),
     };
-    let faces: Vec<ProjectedFace> = order
+    let bands: Vec<u32> = (0..h.div_ceil(band_rows)).collect();
+    bands
+        .par_iter()
+        .map(|&b| {
+            let y0 = b * band_rows;
+            let y1 = (y0 + band_rows).min(h);
+            let mut raw: Vec<(u32, AFrag)> = Vec::new();
+            for face in &faces {
+                rasterise(face, &view, y0..y1, &mut raw);
+            }
+            let (offsets, frags) = by_pixel(raw, ((y1 - y0) * w) as usize);
+            f(&Band {
+                y0,
+                rows: y1 - y0,
+                width: w,
+                offsets,
+                frags,
+            })
+        })
+        .collect()
+}
+
+/// The faces in `order`, projected to the screen with their planes and scalars.
+fn project_faces(geom: &Geometry, order: &[u32], camera: &Camera) -> Vec<ProjectedFace> {
+    let (w, h) = (camera.width as f64, camera.height as f64);
+    let vp = camera.view_proj();
+    let screen: Vec<[f64; 2]> = geom
+        .verts
+        .par_iter()
+        .map(|p| {
+            let c = vp * glam::DVec4::new(p[0] as f64, p[1] as f64, p[2] as f64, 1.0);
+            let ndc = c.truncate() / c.w;
+            [(ndc.x + 1.0) * 0.5 * w, (1.0 - ndc.y) * 0.5 * h]
+        })
+        .collect();
+    order
         .par_iter()
         .map(|&fi| {
             let f = geom.faces[fi as usize];
@@ -155,7 +189,7 @@ pub fn for_each_band<R: Send>(
             let l = dot(n, n).sqrt().max(f64::MIN_POSITIVE);
             let v = f.map(|v| geom.verts[v as usize][3]);
             ProjectedFace {
-                s: f.map(|v| [screen[v as usize][0], screen[v as usize][1]]),
+                s: f.map(|v| screen[v as usize]),
                 n: n.map(|x| x / l),
                 a: p[0],
                 p,
@@ -163,132 +197,136 @@ pub fn for_each_band<R: Send>(
                 boundary: v[0] >= 1.5,
             }
         })
-        .collect();
-    let rays: Vec<([f64; 3], [f64; 3])> = (0..w * h)
-        .into_par_iter()
-        .map(|i| {
-            let r = camera.pixel_ray(i % w, i / w);
-            (r.origin, r.dir)
-        })
-        .collect();
-    let eye = camera.eye;
-    let fwd = camera.forward();
-    let persp = camera.is_perspective();
-    let bands: Vec<u32> = (0..h.div_ceil(band_rows)).collect();
-    bands
-        .par_iter()
-        .map(|&b| {
-            let y0 = b * band_rows;
-            let y1 = (y0 + band_rows).min(h);
-            let mut raw: Vec<(u32, AFrag)> = Vec::new();
-            for face in &faces {
-                let [a, bb, c] = face.s;
-                let area = (bb[0] - a[0]) * (c[1] - a[1]) - (bb[1] - a[1]) * (c[0] - a[0]);
-                if area == 0.0 || !area.is_finite() {
-                    continue;
-                }
-                // Order the corners so the interior is on the positive side of each edge.
-                let (a, bb, c) = if area > 0.0 { (a, bb, c) } else { (a, c, bb) };
-                let ymin = a[1].min(bb[1]).min(c[1]);
-                let ymax = a[1].max(bb[1]).max(c[1]);
-                let py0 = ((ymin - 0.5).ceil().max(y0 as f64)) as i64;
-                let py1 = ((ymax - 0.5).floor().min(y1 as f64 - 1.0)) as i64;
-                if py0 > py1 {
-                    continue;
-                }
-                let xmin = a[0].min(bb[0]).min(c[0]);
-                let xmax = a[0].max(bb[0]).max(c[0]);
-                let px0 = ((xmin - 0.5).ceil().max(0.0)) as i64;
-                let px1 = ((xmax - 0.5).floor().min(w as f64 - 1.0)) as i64;
-                if px0 > px1 {
-                    continue;
-                }
-                let edges = [(a, bb), (bb, c), (c, a)];
-                for py in py0..=py1 {
-                    let y = py as f64 + 0.5;
-                    for px in px0..=px1 {
-                        let x = px as f64 + 0.5;
-                        let inside = edges.iter().all(|&(p, q)| {
-                            let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
-                            let e = dx * (y - p[1]) - dy * (x - p[0]);
-                            e > 0.0 || (e == 0.0 && owns_edge(dx, dy))
-                        });
-                        if !inside {
-                            continue;
-                        }
-                        let (o, d) = rays[(py as u32 * w + px as u32) as usize];
-                        let nd = dot(face.n, d);
-                        if nd == 0.0 {
-                            continue;
-                        }
-                        let t = dot(face.n, sub(face.a, o)) / nd;
-                        let hit = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
-                        let depth = if persp { t } else { dot(sub(hit, eye), fwd) };
-                        // Barycentric weights of the hit point in the face's plane.
-                        let [p0, p1, p2] = face.p;
-                        let w0 = dot(cross(sub(p1, hit), sub(p2, hit)), face.n);
-                        let w1 = dot(cross(sub(p2, hit), sub(p0, hit)), face.n);
-                        let w2 = dot(cross(sub(p0, hit), sub(p1, hit)), face.n);
-                        let sum = w0 + w1 + w2;
-                        let raw_v = if sum != 0.0 {
-                            (w0 * face.v[0] as f64 + w1 * face.v[1] as f64 + w2 * face.v[2] as f64)
-                                / sum
-                        } else {
-                            face.v[0] as f64
-                        };
-                        let (scalar, tag) = if face.boundary {
-                            // Boundary faces are wound outward: seen from outside the ray enters.
-                            (
-                                (raw_v - 2.0).clamp(0.0, 1.0),
-                                if nd < 0.0 { Tag::Entry } else { Tag::Exit },
-                            )
-                        } else {
-                            (raw_v.clamp(0.0, 1.0), Tag::Interior)
-                        };
-                        let local = (py as u32 - y0) * w + px as u32;
-                        raw.push((
-                            local,
-                            AFrag {
-                                depth: depth as f32,
-                                scalar: scalar as f32,
-                                tag,
-                            },
-                        ));
-                    }
-                }
-            }
-            // Counting sort by pixel keeps each pixel's fragments in arrival order.
-            let npx = ((y1 - y0) * w) as usize;
-            let mut offsets = vec![0u32; npx + 1];
-            for (p, _) in &raw {
-                offsets[*p as usize + 1] += 1;
-            }
-            for i in 0..npx {
-                offsets[i + 1] += offsets[i];
-            }
-            let mut fill = offsets.clone();
-            let mut frags = vec![
-                AFrag {
-                    depth: 0.0,
-                    scalar: 0.0,
-                    tag: Tag::Interior
-                };
-                raw.len()
-            ];
-            for (p, fr) in raw {
-                let slot = &mut fill[p as usize];
-                frags[*slot as usize] = fr;
-                *slot += 1;
-            }
-            f(&Band {
-                y0,
-                rows: y1 - y0,
-                width: w,
-                offsets,
-                frags,
-            })
-        })
         .collect()
+}
+
+/// What rasterising needs of the camera: every pixel's ray, the eye and the view direction.
+struct View {
+    width: u32,
+    rays: Vec<([f64; 3], [f64; 3])>,
+    eye: [f64; 3],
+    forward: [f64; 3],
+    perspective: bool,
+}
+
+/// Appends the fragments of `face` in rows `rows` to `out`, as (pixel within the rows,
+/// fragment), pixel centres sampled with the top-left rule.
+fn rasterise(
+    face: &ProjectedFace,
+    view: &View,
+    rows: std::ops::Range<u32>,
+    out: &mut Vec<(u32, AFrag)>,
+) {
+    let w = view.width;
+    let [a, bb, c] = face.s;
+    let area = (bb[0] - a[0]) * (c[1] - a[1]) - (bb[1] - a[1]) * (c[0] - a[0]);
+    if area == 0.0 || !area.is_finite() {
+        return;
+    }
+    // Order the corners so the interior is on the positive side of each edge.
+    let (a, bb, c) = if area > 0.0 { (a, bb, c) } else { (a, c, bb) };
+    let ymin = a[1].min(bb[1]).min(c[1]);
+    let ymax = a[1].max(bb[1]).max(c[1]);
+    let py0 = ((ymin - 0.5).ceil().max(rows.start as f64)) as i64;
+    let py1 = ((ymax - 0.5).floor().min(rows.end as f64 - 1.0)) as i64;
+    if py0 > py1 {
+        return;
+    }
+    let xmin = a[0].min(bb[0]).min(c[0]);
+    let xmax = a[0].max(bb[0]).max(c[0]);
+    let px0 = ((xmin - 0.5).ceil().max(0.0)) as i64;
+    let px1 = ((xmax - 0.5).floor().min(w as f64 - 1.0)) as i64;
+    if px0 > px1 {
+        return;
+    }
+    let edges = [(a, bb), (bb, c), (c, a)];
+    for py in py0..=py1 {
+        let y = py as f64 + 0.5;
+        for px in px0..=px1 {
+            let x = px as f64 + 0.5;
+            let inside = edges.iter().all(|&(p, q)| {
+                let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+                let e = dx * (y - p[1]) - dy * (x - p[0]);
+                e > 0.0 || (e == 0.0 && owns_edge(dx, dy))
+            });
+            if !inside {
+                continue;
+            }
+            let ray = view.rays[(py as u32 * w + px as u32) as usize];
+            if let Some(frag) = fragment(face, view, ray) {
+                out.push(((py as u32 - rows.start) * w + px as u32, frag));
+            }
+        }
+    }
+}
+
+/// The fragment where `ray` (origin, direction) meets `face`'s plane: its depth, its scalar
+/// interpolated with barycentric weights, and its tag (boundary faces are wound outward, so a
+/// ray seen from outside enters); none for a ray parallel to the plane.
+fn fragment(face: &ProjectedFace, view: &View, (o, d): ([f64; 3], [f64; 3])) -> Option<AFrag> {
+    let nd = dot(face.n, d);
+    if nd == 0.0 {
+        return None;
+    }
+    let t = dot(face.n, sub(face.a, o)) / nd;
+    let hit = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+    let depth = if view.perspective {
+        t
+    } else {
+        dot(sub(hit, view.eye), view.forward)
+    };
+    // Barycentric weights of the hit point in the face's plane.
+    let [p0, p1, p2] = face.p;
+    let w0 = dot(cross(sub(p1, hit), sub(p2, hit)), face.n);
+    let w1 = dot(cross(sub(p2, hit), sub(p0, hit)), face.n);
+    let w2 = dot(cross(sub(p0, hit), sub(p1, hit)), face.n);
+    let sum = w0 + w1 + w2;
+    let raw_v = if sum != 0.0 {
+        (w0 * face.v[0] as f64 + w1 * face.v[1] as f64 + w2 * face.v[2] as f64) / sum
+    } else {
+        face.v[0] as f64
+    };
+    let (scalar, tag) = if face.boundary {
+        (
+            (raw_v - 2.0).clamp(0.0, 1.0),
+            if nd < 0.0 { Tag::Entry } else { Tag::Exit },
+        )
+    } else {
+        (raw_v.clamp(0.0, 1.0), Tag::Interior)
+    };
+    Some(AFrag {
+        depth: depth as f32,
+        scalar: scalar as f32,
+        tag,
+    })
+}
+
+/// `raw` (pixel, fragment) pairs as per-pixel lists over `npx` pixels: a counting sort by
+/// pixel, which keeps each pixel's fragments in arrival order. Returns the lists' offsets and
+/// the fragments.
+fn by_pixel(raw: Vec<(u32, AFrag)>, npx: usize) -> (Vec<u32>, Vec<AFrag>) {
+    let mut offsets = vec![0u32; npx + 1];
+    for (p, _) in &raw {
+        offsets[*p as usize + 1] += 1;
+    }
+    for i in 0..npx {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut fill = offsets.clone();
+    let mut frags = vec![
+        AFrag {
+            depth: 0.0,
+            scalar: 0.0,
+            tag: Tag::Interior
+        };
+        raw.len()
+    ];
+    for (p, fr) in raw {
+        let slot = &mut fill[p as usize];
+        frags[*slot as usize] = fr;
+        *slot += 1;
+    }
+    (offsets, frags)
 }
 
 /// Table 2's figures for one view, and Fig. 6's map of where small k-buffers fail.

@@ -1,19 +1,19 @@
-//! HAVS per frame: the GPU key pass of the `gpu-radix` sort, the per-viewport targets, and
-//! one frame (object-space sort, face raster into the k-buffers, drain), timed with
-//! [`FrameClock`] (one definition of `cpu_ms` for every renderer).
+//! HAVS per frame: the per-viewport targets, and one frame in stages (object-space sort on
+//! the host or the device, uniforms, clears, face raster into the k-buffers, drain, counters),
+//! timed with [`FrameClock`] (one definition of `cpu_ms` for every renderer).
 
 use std::time::Instant;
 
 use anyhow::bail;
 use rayon::prelude::*;
-use render_core::bind::{chunked_wgsl, range_entries, whole};
-use render_core::gpu::{Lifetime, MemoryLedger};
+use render_core::bind::{buffer_range, whole, whole_from};
+use render_core::gpu::Lifetime;
 use render_core::sort::radix_sort_indices;
-use render_core::{Camera, ChunkedBuffer, FrameClock, FrameStats, Gpu};
+use render_core::{Camera, FrameClock, FrameStats, Gpu};
 
 use super::{
-    kbuffer, mesh_decls, sort_key, GpuSortState, HavsSettings, KeyUniforms, Mode, SortMode, State,
-    TagScheme, Target, Uniforms, KEY_MESH_BINDING, MESH_BINDING,
+    kbuffer, sort_key, HavsSettings, KeyUniforms, Mode, SortMode, State, TagScheme, Target,
+    Uniforms, MESH_BINDING,
 };
 
 /// Which fragment program a frame draws with (`mode=fragment-race`; the race-free mode has one).
@@ -52,77 +52,14 @@ pub(super) fn gpu_counters(mode: Mode, c: &[u32; 8]) -> Vec<(String, f64)> {
     counters
 }
 
-impl GpuSortState {
-    pub(super) fn new(
-        gpu: &Gpu,
-        ledger: &mut MemoryLedger,
-        verts: &ChunkedBuffer,
-        faces: &ChunkedBuffer,
-        num_faces: u64,
-    ) -> anyhow::Result<GpuSortState> {
-        // Keys and ids larger than one storage binding are written and sorted as chunks of
-        // one buffer each (render_core::bind::range_entries; the sort does the same).
-        let per_chunk = gpu.max_storage_binding() / 4;
-        let chunks = num_faces.max(1).div_ceil(per_chunk) as u32;
-        let usage = wgpu::BufferUsages::STORAGE
-            | wgpu::BufferUsages::COPY_SRC
-            | wgpu::BufferUsages::COPY_DST;
-        let keys = ledger.buffer(
-            gpu,
-            "havs sort keys",
-            Lifetime::PerFrame,
-            num_faces * 4,
-            usage,
-        )?;
-        let ids = ledger.buffer(
-            gpu,
-            "havs sort ids",
-            Lifetime::PerFrame,
-            num_faces * 4,
-            usage,
-        )?;
-        let key_uniforms = ledger.buffer(
-            gpu,
-            "havs key uniforms",
-            Lifetime::PerFrame,
-            std::mem::size_of::<KeyUniforms>() as u64,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        )?;
-        let keys_binding = KEY_MESH_BINDING + verts.bindings() + faces.bindings();
-        let ids_binding = keys_binding + chunks;
-        let source = mesh_decls(verts, faces, KEY_MESH_BINDING)
-            + &chunked_wgsl("keys", "f32", 0, keys_binding, chunks, per_chunk, false)
-            + &chunked_wgsl("ids", "u32", 0, ids_binding, chunks, per_chunk, false)
-            + include_str!("keys.wgsl");
-        render_core::bind::check_storage_bindings(
-            gpu,
-            "HAVS face keys",
-            verts.bindings() + faces.bindings() + 2 * chunks,
-        )?;
-        let module = gpu.shader("havs keys", &source);
-        let key_pipeline = gpu.compute_pipeline("havs face keys", None, &module, "face_keys");
-        let key_bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("havs keys"),
-            layout: &key_pipeline.get_bind_group_layout(0),
-            entries: &[
-                vec![whole(0, &key_uniforms)],
-                verts.bind_entries(KEY_MESH_BINDING),
-                faces.bind_entries(KEY_MESH_BINDING + verts.bindings()),
-                range_entries(keys_binding, &keys, 4, per_chunk, chunks, num_faces),
-                range_entries(ids_binding, &ids, 4, per_chunk, chunks, num_faces),
-            ]
-            .concat(),
-        });
-        let sorter = render_core::gpu_sort::GpuRadixSort::new(gpu, num_faces as u32, ledger)?;
-        Ok(GpuSortState {
-            sorter,
-            keys,
-            ids,
-            key_uniforms,
-            key_pipeline,
-            key_bind_group,
-        })
-    }
+/// A target's per-pixel buffers beside the image: the k-buffer and the count of fragments
+/// shaded (`mode=fragment-race`), or the list heads and the node pool (`mode=race-free`); the
+/// other mode's buffers are 16-byte placeholders for the bindings.
+struct PixelBuffers {
+    kentries: wgpu::Buffer,
+    heads: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    node_capacity: u64,
 }
 
 impl State {
@@ -150,48 +87,69 @@ impl State {
             keep
         });
         let npx = w as u64 * h as u64;
-        let max_binding = gpu.max_storage_binding();
-        let usage = wgpu::BufferUsages::STORAGE
-            | wgpu::BufferUsages::COPY_SRC
-            | wgpu::BufferUsages::COPY_DST;
         let pixels = self.ledger.buffer(
             gpu,
             "havs target pixels",
             Lifetime::PerFrame,
             npx * 32,
-            usage,
+            TARGET_USAGE,
         )?;
-        let (kentries, heads, nodes_buf, node_capacity) = match s.mode {
+        let px = self.pixel_buffers(gpu, s, (w, h), nodes)?;
+        let (_, dummy_view) = render_core::bind::render_target(
+            gpu,
+            &mut self.ledger,
+            "havs target attachment",
+            (w, h),
+            wgpu::TextureFormat::R8Unorm,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )?;
+        let bind_groups = self.bind_groups(
+            gpu,
+            &[&pixels, &px.kentries, &self.counters, &px.heads, &px.nodes],
+        );
+        self.target = Some(Target {
+            width: w,
+            height: h,
+            pixels,
+            kentries: px.kentries,
+            heads: px.heads,
+            _nodes: px.nodes,
+            node_capacity: px.node_capacity,
+            dummy_view,
+            bind_groups,
+        });
+        Ok(())
+    }
+
+    /// The per-pixel buffers of the settings' mode for a `w`×`h` target.
+    fn pixel_buffers(
+        &mut self,
+        gpu: &Gpu,
+        s: HavsSettings,
+        (w, h): (u32, u32),
+        nodes: Option<u64>,
+    ) -> anyhow::Result<PixelBuffers> {
+        let npx = w as u64 * h as u64;
+        let max_binding = gpu.max_storage_binding();
+        let mut buffer = |label: &str, bytes: u64| {
+            self.ledger
+                .buffer(gpu, label, Lifetime::PerFrame, bytes, TARGET_USAGE)
+        };
+        Ok(match s.mode {
             Mode::FragmentRace => {
                 let bytes = npx * s.k as u64 * 8;
                 if bytes > max_binding {
                     bail!("HAVS: a {w}x{h} k-buffer with k = {} needs {bytes} bytes, over one storage binding", s.k);
                 }
-                let kb = self.ledger.buffer(
-                    gpu,
-                    "havs target k-buffer",
-                    Lifetime::PerFrame,
-                    bytes,
-                    usage,
-                )?;
-                // Every fragment shaded, counted per pixel with an atomic: the racy per-pixel
-                // counts (`Pixel.info`) lose updates on a GPU, and the difference is the
-                // frame's `race_lost_updates`.
-                let shaded = self.ledger.buffer(
-                    gpu,
-                    "havs target fragments shaded per pixel",
-                    Lifetime::PerFrame,
-                    npx * 4,
-                    usage,
-                )?;
-                let nodes = self.ledger.buffer(
-                    gpu,
-                    "havs target unused nodes",
-                    Lifetime::PerFrame,
-                    16,
-                    usage,
-                )?;
-                (kb, shaded, nodes, 0)
+                PixelBuffers {
+                    kentries: buffer("havs target k-buffer", bytes)?,
+                    // Every fragment shaded, counted per pixel with an atomic: the racy
+                    // per-pixel counts (`Pixel.info`) lose updates on a GPU, and the
+                    // difference is the frame's `race_lost_updates`.
+                    heads: buffer("havs target fragments shaded per pixel", npx * 4)?,
+                    nodes: buffer("havs target unused nodes", 16)?,
+                    node_capacity: 0,
+                }
             }
             Mode::RaceFree => {
                 // Start from a pool of 8 fragments per pixel; `render` grows it when a view needs more.
@@ -203,87 +161,44 @@ impl State {
                         cap * 16
                     );
                 }
-                let kb = self.ledger.buffer(
-                    gpu,
-                    "havs target unused k-buffer",
-                    Lifetime::PerFrame,
-                    16,
-                    usage,
-                )?;
-                let heads = self.ledger.buffer(
-                    gpu,
-                    "havs target list heads",
-                    Lifetime::PerFrame,
-                    npx * 4,
-                    usage,
-                )?;
-                let nodes = self.ledger.buffer(
-                    gpu,
-                    "havs target fragment lists",
-                    Lifetime::PerFrame,
-                    cap * 16,
-                    usage,
-                )?;
-                (kb, heads, nodes, cap)
+                PixelBuffers {
+                    kentries: buffer("havs target unused k-buffer", 16)?,
+                    heads: buffer("havs target list heads", npx * 4)?,
+                    nodes: buffer("havs target fragment lists", cap * 16)?,
+                    node_capacity: cap,
+                }
             }
-        };
-        let (_, dummy_view) = render_core::bind::render_target(
-            gpu,
-            &mut self.ledger,
-            "havs target attachment",
-            (w, h),
-            wgpu::TextureFormat::R8Unorm,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-        )?;
-        let bind_groups = self
-            .chunks
+        })
+    }
+
+    /// One bind group per chunk of the order: its uniforms and its slice of the order, the
+    /// table, the target's `buffers` (bindings 6…10) and the mesh.
+    fn bind_groups(&self, gpu: &Gpu, buffers: &[&wgpu::Buffer; 5]) -> Vec<wgpu::BindGroup> {
+        let mesh = [
+            self.verts.bind_entries(MESH_BINDING),
+            self.faces
+                .bind_entries(MESH_BINDING + self.verts.bindings()),
+        ]
+        .concat();
+        self.chunks
             .iter()
             .zip(&self.uniforms)
             .map(|(range, ub)| {
-                let mesh = [
-                    self.verts.bind_entries(MESH_BINDING),
-                    self.faces
-                        .bind_entries(MESH_BINDING + self.verts.bindings()),
-                ]
-                .concat();
-                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("havs bind group"),
-                    layout: &self.layout,
-                    entries: &[
-                        vec![whole(0, ub)],
-                        vec![wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                                buffer: &self.order,
-                                offset: range.start * 4,
-                                size: std::num::NonZeroU64::new(
-                                    (range.end - range.start).max(1) * 4,
-                                ),
-                            }),
-                        }],
-                        self.table.bind_entries(4, 5).to_vec(),
-                        render_core::bind::whole_from(
-                            6,
-                            &[&pixels, &kentries, &self.counters, &heads, &nodes_buf],
-                        ),
-                        mesh,
-                    ]
-                    .concat(),
-                })
+                let order = buffer_range(
+                    3,
+                    &self.order,
+                    range.start * 4,
+                    (range.end - range.start).max(1) * 4,
+                );
+                let entries = [
+                    vec![whole(0, ub), order],
+                    self.table.bind_entries(4, 5).to_vec(),
+                    whole_from(6, buffers),
+                    mesh.clone(),
+                ];
+                gpu.bind_group("havs bind group", &self.pipes.layout, &entries.concat())
             })
-            .collect();
-        self.target = Some(Target {
-            width: w,
-            height: h,
-            pixels,
-            kentries,
-            heads,
-            _nodes: nodes_buf,
-            node_capacity,
-            dummy_view,
-            bind_groups,
-        });
-        Ok(())
+            .collect()
     }
 
     /// One frame of `camera`, drawn with the timed program or the counting one; its stats
@@ -296,48 +211,80 @@ impl State {
         camera: &Camera,
         draw: Draw,
     ) -> anyhow::Result<(FrameStats, [u32; 8])> {
-        let pipeline = match (draw, &self.counting_pipeline) {
-            (Draw::Counting, Some(counting)) => counting,
-            _ => &self.draw_pipeline,
-        };
-        let eye = camera.eye.map(|c| c as f32);
-        let fwd = camera.forward().map(|c| c as f32);
-        let persp = camera.is_perspective();
         let mut clock = FrameClock::start();
-
-        // Object space: sort the faces front to back by centroid distance (§5.1).
         if s.sort == SortMode::CpuRadix {
-            let t = Instant::now();
-            let cents = &self.centroids;
-            self.keys.clear();
-            self.keys
-                .par_extend(cents.par_iter().map(|&c| sort_key(eye, fwd, persp, c)));
-            clock.stage("keys", t);
-            let t = Instant::now();
-            radix_sort_indices(&self.keys, &mut self.sorted, &mut self.scratch);
-            clock.stage("sort", t);
-            let t = Instant::now();
-            gpu.queue
-                .write_buffer(&self.order, 0, bytemuck::cast_slice(&self.sorted));
-            clock.stage("upload", t);
+            self.sort_on_cpu(gpu, &mut clock, camera);
         }
-        let t = self.target.as_ref().expect("target ensured");
-        let flags = (s.tags == TagScheme::Two) as u32 | ((s.early_termination as u32) << 1);
         // The per-pixel passes (k-buffer clear, drain) cover the rows and columns the mesh can
         // reach, rounded up to whole 8×8 workgroups; no fragment lands outside, and `pixels`
         // (the image) is still cleared whole. Rows left out keep stale k-buffer entries, which
         // no pass of this frame reads, and a later frame clears the rows it uses.
-        let [x0, y0, x1, y1] = camera.covered_rect(&self.bounds);
+        let rect = camera.covered_rect(&self.bounds);
         let groups = (
-            x1.saturating_sub(x0).div_ceil(8),
-            y1.saturating_sub(y0).div_ceil(8),
+            rect[2].saturating_sub(rect[0]).div_ceil(8),
+            rect[3].saturating_sub(rect[1]).div_ceil(8),
         );
-        let rows = y0..(y0 + 8 * groups.1).min(t.height);
+        self.write_uniforms(gpu, s, camera, rect);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        self.timer.begin(&mut enc);
+        self.encode_gpu_sort(gpu, &mut enc, camera)?;
+        self.encode_clears(&mut enc, s, rect[1]..rect[1] + 8 * groups.1);
+        self.encode_faces(gpu, &mut enc, draw);
+        self.encode_drain(&mut enc, groups);
+        self.timer.end(&mut enc);
+        clock.submit(gpu, [enc.finish()]);
+        clock.wait(gpu)?;
+        let times = clock.finish();
+        let gpu_ms = self.timer.gpu_ms(gpu)?;
+        // A timed frame's counters hold nothing: it is not read back.
+        let c: [u32; 8] = match draw {
+            Draw::Counting => {
+                bytemuck::pod_read_unaligned(&gpu.read_buffer(&self.counters, 0, 32)?)
+            }
+            Draw::Timed => [0; 8],
+        };
+        self.last_frame_counted = draw == Draw::Counting;
+        let counters = self.counters_of(camera);
+        Ok((times.stats(gpu_ms, self.ledger.per_frame, counters), c))
+    }
+
+    /// Object space: sorts the faces front to back by centroid distance (§5.1) on the host
+    /// and uploads the order.
+    fn sort_on_cpu(&mut self, gpu: &Gpu, clock: &mut FrameClock, camera: &Camera) {
+        let t = Instant::now();
+        let eye = camera.eye.map(|c| c as f32);
+        let fwd = camera.forward().map(|c| c as f32);
+        let persp = camera.is_perspective();
+        let cents = &self.centroids;
+        self.keys.clear();
+        self.keys
+            .par_extend(cents.par_iter().map(|&c| sort_key(eye, fwd, persp, c)));
+        clock.stage("keys", t);
+        let t = Instant::now();
+        radix_sort_indices(&self.keys, &mut self.sorted, &mut self.scratch);
+        clock.stage("sort", t);
+        let t = Instant::now();
+        gpu.queue
+            .write_buffer(&self.order, 0, bytemuck::cast_slice(&self.sorted));
+        clock.stage("upload", t);
+    }
+
+    /// Every order chunk's uniforms for this view.
+    fn write_uniforms(
+        &self,
+        gpu: &Gpu,
+        s: HavsSettings,
+        camera: &Camera,
+        [x0, y0, _, _]: [u32; 4],
+    ) {
+        let (eye, forward) = shader_view(camera);
+        let t = self.target.as_ref().expect("target ensured");
+        let flags = (s.tags == TagScheme::Two) as u32 | ((s.early_termination as u32) << 1);
         for (range, ub) in self.chunks.iter().zip(&self.uniforms) {
             let u = Uniforms {
                 view_proj: camera.view_proj_f32(),
-                eye: [eye[0], eye[1], eye[2], persp as u32 as f32],
-                forward: [fwd[0], fwd[1], fwd[2], 0.0],
+                eye,
+                forward,
                 width: t.width,
                 height: t.height,
                 flags,
@@ -353,63 +300,95 @@ impl State {
             };
             gpu.queue.write_buffer(ub, 0, bytemuck::bytes_of(&u));
         }
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        self.timer.begin(&mut enc);
-        if let Some(gs) = &self.gpu_sort {
-            let ku = KeyUniforms {
-                eye: [eye[0], eye[1], eye[2], persp as u32 as f32],
-                forward: [fwd[0], fwd[1], fwd[2], 0.0],
-                faces: self.num_faces as u32,
-                _pad: [0; 3],
+    }
+
+    /// `sort=gpu-radix`: the face keys computed and radix-sorted on the device, the ids copied
+    /// into the order. Nothing where the host sorted.
+    fn encode_gpu_sort(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        camera: &Camera,
+    ) -> anyhow::Result<()> {
+        let Some(gs) = &self.gpu_sort else {
+            return Ok(());
+        };
+        let (eye, forward) = shader_view(camera);
+        let ku = KeyUniforms {
+            eye,
+            forward,
+            faces: self.num_faces as u32,
+            _pad: [0; 3],
+        };
+        gpu.queue
+            .write_buffer(&gs.key_uniforms, 0, bytemuck::bytes_of(&ku));
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("havs keys"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&gs.key_pipeline);
+            pass.set_bind_group(0, &gs.key_bind_group, &[]);
+            let groups = self.num_faces.div_ceil(256) as u32;
+            let max = gpu.limits.max_compute_workgroups_per_dimension;
+            let (gx, gy) = if groups <= max {
+                (groups, 1)
+            } else {
+                (max, groups.div_ceil(max))
             };
-            gpu.queue
-                .write_buffer(&gs.key_uniforms, 0, bytemuck::bytes_of(&ku));
-            {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("havs keys"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&gs.key_pipeline);
-                pass.set_bind_group(0, &gs.key_bind_group, &[]);
-                let groups = self.num_faces.div_ceil(256) as u32;
-                let max = gpu.limits.max_compute_workgroups_per_dimension;
-                let (gx, gy) = if groups <= max {
-                    (groups, 1)
-                } else {
-                    (max, groups.div_ceil(max))
-                };
-                pass.dispatch_workgroups(gx, gy, 1);
-            }
-            gs.sorter
-                .encode(&mut enc, &gs.keys, &gs.ids, self.num_faces as u32, false)?;
-            enc.copy_buffer_to_buffer(&gs.ids, 0, &self.order, 0, self.num_faces * 4);
+            pass.dispatch_workgroups(gx, gy, 1);
         }
+        gs.sorter
+            .encode(enc, &gs.keys, &gs.ids, self.num_faces as u32, false)?;
+        enc.copy_buffer_to_buffer(&gs.ids, 0, &self.order, 0, self.num_faces * 4);
+        Ok(())
+    }
+
+    /// Clears the image and the counters whole, and the per-pixel state of `rows`.
+    fn encode_clears(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        s: HavsSettings,
+        rows: std::ops::Range<u32>,
+    ) {
+        let t = self.target.as_ref().expect("target ensured");
+        let rows = rows.start..rows.end.min(t.height);
         enc.clear_buffer(&t.pixels, 0, None);
         enc.clear_buffer(&self.counters, 0, None);
+        if rows.is_empty() {
+            return;
+        }
         // Per pixel: k entries of 8 bytes (fragment race) and, in both modes, a u32 in `heads`
         // (the race-free list head, or the fragment race's count of fragments shaded).
         let mut row_buffers = vec![(4, &t.heads)];
         if s.mode == Mode::FragmentRace {
             row_buffers.push((s.k as u64 * 8, &t.kentries));
         }
-        if !rows.is_empty() {
-            for (per_pixel, buffer) in row_buffers {
-                let row_bytes = t.width as u64 * per_pixel;
-                enc.clear_buffer(
-                    buffer,
-                    rows.start as u64 * row_bytes,
-                    Some(rows.len() as u64 * row_bytes),
-                );
-            }
+        for (per_pixel, buffer) in row_buffers {
+            let row_bytes = t.width as u64 * per_pixel;
+            enc.clear_buffer(
+                buffer,
+                rows.start as u64 * row_bytes,
+                Some(rows.len() as u64 * row_bytes),
+            );
         }
-        // Chunks in order, each in passes of bounded size (render_core::bind::pass_slices): the
-        // faces stay in sorted order across chunk and pass boundaries, and the k-buffer lives
-        // in storage buffers, so a new pass (its dummy attachment cleared) continues it.
+    }
+
+    /// The faces in sorted order into the k-buffers: chunks in order, each in passes of
+    /// bounded size (render_core::bind::pass_slices). The faces stay in sorted order across
+    /// chunk and pass boundaries, and the k-buffer lives in storage buffers, so a new pass
+    /// (its dummy attachment cleared) continues it.
+    fn encode_faces(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, draw: Draw) {
+        let t = self.target.as_ref().expect("target ensured");
+        let pipeline = match (draw, &self.pipes.counting) {
+            (Draw::Counting, Some(counting)) => counting,
+            _ => &self.pipes.draw,
+        };
         for (range, bg) in self.chunks.iter().zip(&t.bind_groups) {
             let vertices = 0..((range.end - range.start) * 3) as u32;
             for slice in render_core::bind::pass_slices(vertices, gpu.triangles_per_pass) {
                 let mut pass = render_core::bind::color_pass(
-                    &mut enc,
+                    enc,
                     "havs faces",
                     &t.dummy_view,
                     true,
@@ -421,30 +400,25 @@ impl State {
                 render_core::bind::draw_in_slices(&mut pass, slice);
             }
         }
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("havs drain"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.drain_pipeline);
-            pass.set_bind_group(0, &t.bind_groups[0], &[]);
-            if groups.0 > 0 && groups.1 > 0 {
-                pass.dispatch_workgroups(groups.0, groups.1, 1);
-            }
+    }
+
+    /// The screen pass over `groups` 8×8 workgroups: drains what the k-buffers hold (or
+    /// resolves the fragment lists) into the image.
+    fn encode_drain(&self, enc: &mut wgpu::CommandEncoder, groups: (u32, u32)) {
+        let t = self.target.as_ref().expect("target ensured");
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("havs drain"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipes.drain);
+        pass.set_bind_group(0, &t.bind_groups[0], &[]);
+        if groups.0 > 0 && groups.1 > 0 {
+            pass.dispatch_workgroups(groups.0, groups.1, 1);
         }
-        self.timer.end(&mut enc);
-        clock.submit(gpu, [enc.finish()]);
-        clock.wait(gpu)?;
-        let times = clock.finish();
-        let gpu_ms = self.timer.gpu_ms(gpu)?;
-        // A timed frame's counters hold nothing: it is not read back.
-        let c: [u32; 8] = match draw {
-            Draw::Counting => {
-                bytemuck::pod_read_unaligned(&gpu.read_buffer(&self.counters, 0, 32)?)
-            }
-            Draw::Timed => [0; 8],
-        };
-        self.last_frame_counted = draw == Draw::Counting;
+    }
+
+    /// The row's counters known without the GPU's counts.
+    fn counters_of(&mut self, camera: &Camera) -> Vec<(String, f64)> {
         let mut counters = vec![("faces".to_string(), self.num_faces as f64)];
         // The roofline's work: every unique face is one triangle, and the sort orders them all.
         counters.push(("triangles".to_string(), self.num_faces as f64));
@@ -470,9 +444,23 @@ impl State {
             "mesh_bindings".to_string(),
             (self.verts.bindings() + self.faces.bindings()) as f64,
         ));
-        Ok((times.stats(gpu_ms, self.ledger.per_frame, counters), c))
+        counters
     }
 }
+
+/// The eye with the projection in `w` (1: perspective) and the view direction, in f32 as the
+/// shaders read them.
+fn shader_view(camera: &Camera) -> ([f32; 4], [f32; 4]) {
+    let [x, y, z] = camera.eye.map(|c| c as f32);
+    let [fx, fy, fz] = camera.forward().map(|c| c as f32);
+    let persp = camera.is_perspective() as u32 as f32;
+    ([x, y, z, persp], [fx, fy, fz, 0.0])
+}
+
+/// Usage of a target's storage buffers.
+const TARGET_USAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
+    .union(wgpu::BufferUsages::COPY_SRC)
+    .union(wgpu::BufferUsages::COPY_DST);
 
 #[cfg(test)]
 mod tests {

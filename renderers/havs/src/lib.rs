@@ -19,13 +19,12 @@ mod description;
 mod frame;
 use frame::Draw;
 pub mod kbuffer;
+mod prepare;
 
 use anyhow::{bail, Context};
 use datasets::TetMesh;
-use rayon::prelude::*;
-use render_core::bind::{check_storage_bindings, storage_entry, uniform_entry};
-use render_core::gpu::{Lifetime, MemoryLedger};
-use render_core::preintegration::Table3d;
+use render_core::bind::check_storage_bindings;
+use render_core::gpu::MemoryLedger;
 use render_core::sort::RadixScratch;
 use render_core::table_texture::TableTexture;
 use render_core::{
@@ -306,17 +305,14 @@ struct State {
     uniforms: Vec<wgpu::Buffer>,
     counters: wgpu::Buffer,
     table: TableTexture,
-    layout: wgpu::BindGroupLayout,
-    draw_pipeline: wgpu::RenderPipeline,
-    /// `mode=fragment-race`: the draw with the row's per-pixel counts (`fs_kbuffer_counting`),
-    /// run in one untimed frame per view; the timed frames draw with `fs_kbuffer`, the
-    /// paper's program, which counts nothing.
-    counting_pipeline: Option<wgpu::RenderPipeline>,
+    /// The draw and drain pipelines. In `mode=fragment-race` the counting draw
+    /// (`fs_kbuffer_counting`) runs in one untimed frame per view; the timed frames draw with
+    /// `fs_kbuffer`, the paper's program, which counts nothing.
+    pipes: prepare::Pipelines,
     /// The counts of the last view's counting frame (`counters` of havs.wgsl).
     counts: render_core::silhouette::PerView<[u32; 8]>,
     /// Whether the last frame drawn was a counting frame (its per-pixel counts are readable).
     last_frame_counted: bool,
-    drain_pipeline: wgpu::ComputePipeline,
     max_len: f32,
     n_s: u32,
     n_l: u32,
@@ -416,173 +412,47 @@ impl Renderer for Havs {
             bail!("HAVS: the pre-integrated table needs at least 2 entries per axis");
         }
         let mut ledger = MemoryLedger::default();
-        let abuffer::Geometry { verts, faces } = tagged_geometry(mesh, optics);
+        let geometry = tagged_geometry(mesh, optics);
         let max_binding = match self.max_binding {
             Some(b) => b.min(gpu.max_storage_binding()) & !255,
             None => gpu.max_storage_binding(),
         }
         .max(256);
-        // Vertex and face arrays split over as many storage bindings as they need;
-        // the shaders read them through the generated `verts_at` / `faces_at`.
-        let storage = wgpu::BufferUsages::STORAGE;
-        let verts_buf = ChunkedBuffer::with_data(
-            gpu,
-            &mut ledger,
-            "havs vertices",
-            Lifetime::Persistent,
-            bytemuck::cast_slice(&verts),
-            16,
-            max_binding,
-            storage,
-        )?;
-        let faces_buf = ChunkedBuffer::with_data(
-            gpu,
-            &mut ledger,
-            "havs faces",
-            Lifetime::Persistent,
-            bytemuck::cast_slice(&faces),
-            4,
-            max_binding,
-            storage,
-        )?;
-        check_storage_bindings(gpu, "HAVS", 6 + verts_buf.bindings() + faces_buf.bindings())?;
-        let num_faces = faces.len() as u64;
-        // Only the CPU sort reads face centroids (12 B a face); the GPU sort's key pass
-        // computes them from the uploaded faces.
-        let centroids: Vec<[f32; 3]> = match s.sort {
-            SortMode::CpuRadix => faces
-                .par_iter()
-                .map(|f| {
-                    let p = f.map(|v| verts[v as usize]);
-                    [0, 1, 2].map(|a| (p[0][a] + p[1][a] + p[2][a]) / 3.0)
-                })
-                .collect(),
+        let (verts, faces) = prepare::upload_mesh(gpu, &mut ledger, &geometry, max_binding)?;
+        check_storage_bindings(gpu, "HAVS", 6 + verts.bindings() + faces.bindings())?;
+        let num_faces = geometry.faces.len() as u64;
+        let centroids = match s.sort {
+            SortMode::CpuRadix => prepare::face_centroids(&geometry),
             SortMode::GpuRadix => Vec::new(),
         };
-
-        // The 3D pre-integrated table (s_front, s_back, length), lengths up to the longest
-        // edge: no segment inside a tet is longer.
+        drop(geometry);
         let max_len = mesh.quality().max_edge.max(f64::MIN_POSITIVE);
-        let table = Table3d::build(
-            optics,
-            s.table_scalar as usize,
-            s.table_length as usize,
-            max_len,
-        );
-        let (n_s, n_l) = (s.table_scalar, s.table_length);
-        let table = TableTexture::new(
-            gpu,
-            &mut ledger,
-            "havs preintegration table",
-            [n_s, n_s, n_l],
-            &table.data,
-        )?;
-        let filterable = table.filterable;
-
-        // The order buffer (face indices front to back) is bound in chunks that each fit one
-        // storage binding, with offsets aligned as the device requires.
-        let align_elems = (gpu.limits.min_storage_buffer_offset_alignment as u64 / 4).max(1);
-        let per_chunk = ((max_binding / 4) / align_elems * align_elems).max(align_elems);
-        let chunks: Vec<_> = (0..num_faces.div_ceil(per_chunk))
-            .map(|i| i * per_chunk..((i + 1) * per_chunk).min(num_faces))
-            .collect();
-        let order = ledger.buffer(
-            gpu,
-            "havs face order",
-            Lifetime::PerFrame,
-            num_faces * 4,
-            storage | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        )?;
-        let uniforms: Vec<wgpu::Buffer> = chunks
-            .iter()
-            .map(|_| {
-                ledger.buffer(
-                    gpu,
-                    "havs uniforms",
-                    Lifetime::PerFrame,
-                    std::mem::size_of::<Uniforms>() as u64,
-                    wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                )
-            })
-            .collect::<anyhow::Result<_>>()?;
-        let counters = ledger.buffer(
-            gpu,
-            "havs counters",
-            Lifetime::PerFrame,
-            32,
-            storage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-        )?;
-
-        let all =
-            wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let fc = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let mut entries = vec![uniform_entry(0, all), storage_entry(3, all, true)];
-        entries.extend(TableTexture::layout_entries(filterable, 4, 5, fc));
-        entries.extend((6..=10).map(|b| storage_entry(b, fc, false)));
-        entries.extend(verts_buf.layout_entries(MESH_BINDING, all, true));
-        entries.extend(faces_buf.layout_entries(MESH_BINDING + verts_buf.bindings(), all, true));
-        let layout = gpu
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("havs layout"),
-                entries: &entries,
-            });
-        let pipeline_layout =
-            render_core::bind::pipeline_layout(gpu, "havs pipeline layout", &[Some(&layout)]);
-        let module = gpu.shader(
-            "havs",
-            &shader_source(s.k, &mesh_decls(&verts_buf, &faces_buf, MESH_BINDING)),
-        );
-        let fs_entry = match s.mode {
-            Mode::FragmentRace => "fs_kbuffer",
-            Mode::RaceFree => "fs_append",
-        };
-        // Every face is needed from both sides (entry and exit of a ray). wgpu needs an attachment;
-        // the k-buffer lives in storage, so nothing is written to it.
-        let draw = |label: &str, entry: &str| {
-            gpu.triangle_pipeline(
-                label,
-                &pipeline_layout,
-                &module,
-                "vs",
-                entry,
-                wgpu::TextureFormat::R8Unorm,
-                None,
-                wgpu::ColorWrites::empty(),
-            )
-        };
-        let draw_pipeline = draw("havs draw", fs_entry);
-        let counting_pipeline = (s.mode == Mode::FragmentRace)
-            .then(|| draw("havs draw, counting", "fs_kbuffer_counting"));
-        let drain_pipeline = gpu.compute_pipeline(
-            "havs drain",
-            Some(&pipeline_layout),
-            &module,
-            match s.mode {
-                Mode::FragmentRace => "drain",
-                Mode::RaceFree => "resolve_lists",
-            },
-        );
-
+        let table = prepare::table(gpu, &mut ledger, optics, s, max_len)?;
+        let prepare::OrderBuffers {
+            order,
+            chunks,
+            uniforms,
+            counters,
+        } = prepare::OrderBuffers::new(gpu, &mut ledger, num_faces, max_binding)?;
+        let pipes = prepare::Pipelines::new(gpu, s, &verts, &faces, table.filterable);
         let gpu_sort = match s.sort {
             SortMode::CpuRadix => None,
             SortMode::GpuRadix => Some(GpuSortState::new(
                 gpu,
                 &mut ledger,
-                &verts_buf,
-                &faces_buf,
+                &verts,
+                &faces,
                 num_faces,
             )?),
         };
-
         let prepared = Prepared {
             persistent_bytes: ledger.persistent,
             tets: mesh.num_tets() as u64,
         };
         self.state = Some(State {
             ledger,
-            verts: verts_buf,
-            faces: faces_buf,
+            verts,
+            faces,
             num_faces,
             centroids,
             bounds: mesh.bounds(),
@@ -592,17 +462,14 @@ impl Renderer for Havs {
             chunks,
             uniforms,
             counters,
+            table_nearest: !table.filterable,
             table,
-            layout,
-            draw_pipeline,
-            counting_pipeline,
+            pipes,
             counts: Default::default(),
             last_frame_counted: false,
-            drain_pipeline,
             max_len: max_len as f32,
-            n_s,
-            n_l,
-            table_nearest: !filterable,
+            n_s: s.table_scalar,
+            n_l: s.table_length,
             target: None,
             timer: FrameTimer::new(gpu),
             scratch: RadixScratch::default(),

@@ -3,7 +3,9 @@
 // a positive denominator (§2.2) — and composites that segment front to back (Eq. 3) with the
 // 3D pre-integrated table (s_front, s_back, length / longest edge) or the 2D one (fixed length,
 // scaled by length as the paper's code does). A ray that leaves the mesh continues from its
-// next peeling layer. `step` is one pass (mode=passes), `run_loop` loops to the end (mode=loop).
+// next peeling layer: in mode=passes once its tile's rays have all left their layer
+// (`load_layer`, §3.2 phase 3a), in mode=loop at once. `step` is one pass (mode=passes),
+// `run_loop` loops to the end (mode=loop).
 
 // Statistics slots (atomics).
 const STAT_ENTERED: u32 = 0u;
@@ -29,7 +31,7 @@ struct PassParams {
 
 @group(1) @binding(0) var<storage, read_write> rays: array<vec4<u32>>;
 @group(1) @binding(1) var<storage, read_write> colours: array<vec4<f32>>;
-// (peel layer the ray is in, steps taken)
+// (peel layer the ray is in, or ENDED once it has ended; steps taken)
 @group(1) @binding(2) var<storage, read_write> aux: array<vec2<u32>>;
 @group(1) @binding(3) var layers: texture_2d_array<u32>;
 @group(1) @binding(4) var table: texture_3d<f32>;
@@ -120,6 +122,10 @@ fn store(i: u32, st: State) {
     colours[i] = st.colour;
 }
 
+// The layer of a ray that has ended (`aux.x`): a ray at tet NONE with any other layer has left
+// its layer and waits for `load_layer`.
+const ENDED: u32 = 0xffffffffu;
+
 // Why `advance` ended a ray; ACTIVE: it did not.
 const ACTIVE: u32 = 0u;
 const END_LEFT: u32 = 1u;
@@ -138,6 +144,7 @@ fn count_end(st: ptr<function, State>, end: u32) {
         return;
     }
     (*st).tet = vec2<u32>(NONE, NONE);
+    (*st).layer = ENDED;
     if end == END_TERMINATED {
         atomicAdd(&stats[STAT_TERMINATED], 1u);
     } else if end == END_STALLED {
@@ -207,12 +214,14 @@ fn init(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let i = p.y * frame.size.x + p.x;
     colours[i] = vec4<f32>(0.0);
-    aux[i] = vec2<u32>(0u, 0u);
     var e = vec4<u32>(NONE);
     if frame.counts.y > 0u {
         e = textureLoad(layers, vec2<i32>(p), 0, 0);
     }
     rays[i] = e;
+    // A pixel no ray enters has ended (no later layer holds it either: peeling goes front to
+    // back per pixel).
+    aux[i] = vec2<u32>(select(0u, ENDED, e.x == NONE), 0u);
     if e.x != NONE {
         atomicAdd(&tile_counts[tile_of(p)], 1u);
         atomicAdd(&stats[STAT_ENTERED], 1u);
@@ -245,9 +254,10 @@ fn tile_pixel(wg: vec3<u32>, lid: vec3<u32>, p: ptr<function, vec2<u32>>) -> u32
     return t;
 }
 
-// One pass of mode=passes for the ray of pixel `p` in tile `t`: one step (§2.3), and a ray that
-// left the mesh finds its next entry in the same pass; on the pass that ends a round the rays
-// still active are counted per tile (the paper's occlusion query, here an atomic count).
+// One pass of mode=passes for the ray of pixel `p` in tile `t`: one step (§2.3). A ray that
+// leaves the mesh waits at tet NONE for its tile's next layer (`load_layer`). On the pass that
+// ends a round the rays still active are counted per tile (the paper's occlusion query, here an
+// atomic count).
 fn pass_step(p: vec2<u32>, t: u32, width: u32, sp: StepParams, rf: RayFrame) {
     let i = p.y * width + p.x;
     if rays[i].x == NONE {
@@ -255,7 +265,32 @@ fn pass_step(p: vec2<u32>, t: u32, width: u32, sp: StepParams, rf: RayFrame) {
     }
     var st = load(i);
     let ray = ray_through(rf, vec2<f32>(p) + 0.5);
-    var end = advance(&st, ray, sp);
+    let end = advance(&st, ray, sp);
+    count_end(&st, end);
+    store(i, st);
+    if end == ACTIVE && st.tet.x != NONE && pass_params.count != 0u {
+        atomicAdd(&tile_counts[t], 1u);
+    }
+}
+
+// mode=passes, once every ray of a tile has left its layer (§3.2 phase 3a: the next peeling
+// layer is recovered and the passes restart from it): every waiting ray of the listed tiles
+// moves to its next entry ahead of it, or ends where none is left; the rays that start again
+// are counted per tile (a tile at zero is done).
+@compute @workgroup_size(8, 8)
+fn load_layer(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    let sp = step_params();
+    var p: vec2<u32>;
+    let t = tile_pixel(wg, lid, &p);
+    if t == NONE {
+        return;
+    }
+    let i = p.y * frame.size.x + p.x;
+    if rays[i].x != NONE || aux[i].x == ENDED {
+        return;
+    }
+    var st = load(i);
+    var end = ACTIVE;
     loop {
         if end != ACTIVE || st.tet.x != NONE {
             break;
@@ -264,7 +299,7 @@ fn pass_step(p: vec2<u32>, t: u32, width: u32, sp: StepParams, rf: RayFrame) {
     }
     count_end(&st, end);
     store(i, st);
-    if end == ACTIVE && pass_params.count != 0u {
+    if end == ACTIVE {
         atomicAdd(&tile_counts[t], 1u);
     }
 }

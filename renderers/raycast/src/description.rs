@@ -43,6 +43,12 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
             meaning: "most depth-peeling layers for non-convex meshes",
             section: "§2.4",
         },
+        Param {
+            key: "k",
+            kind: ValueKind::Int,
+            meaning: "mode=passes: passes between counts of a tile's active rays (the occlusion query)",
+            section: "§3.2 (phase 3b); the paper does not give k",
+        },
     ],
     default_grid: || default_settings().iter().map(RaycastSettings::to_settings).collect(),
     full_grid: || all_settings().iter().map(RaycastSettings::to_settings).collect(),

@@ -15,8 +15,11 @@
 //!   from its next layer; early ray termination at opacity [`ET_OPACITY`] (the paper's code).
 //! * Phase 3b / tiles (§2.3): the screen is cut into N×N tiles; each runs its own number of
 //!   passes. The paper's occlusion query every k passes is here an atomic count of the tile's
-//!   active rays in every [`COUNT_EVERY`]-th pass, read back by the CPU; a tile whose count is
-//!   zero gets no more passes, and a tile no ray enters gets none at all. Its z-update is drawn
+//!   active rays in every k-th pass ([`RaycastSettings::k`]), read back by the CPU. As in the paper, a tile
+//!   spends its passes layer by layer: once its count is zero its rays start again from their
+//!   next peeling layer (`load_layer`), and a tile where none does gets no more passes; a tile
+//!   no ray enters gets none at all. Its passes are the sum over its layers of the longest
+//!   stretch in each, rounded up to whole rounds ([`passmap::passes_per_tile`] is the twin). Its z-update is drawn
 //!   where the device forces early depth tests (`tile_pass.wgsl`): each pass a rectangle per
 //!   active tile, the step in the fragment shader, rays that have ended given depth 0 at the
 //!   start of each round so that the early depth test rejects them (§3.2); elsewhere the passes
@@ -40,8 +43,9 @@ pub use settings::{Mode, RaycastSettings, TableKind};
 
 /// Opacity at which a ray stops when early termination is on (the paper's shader uses 0.95).
 pub const ET_OPACITY: f32 = 0.95;
-/// The termination test (an atomic count of active rays per tile) runs in every k-th pass; the
-/// paper amortises its occlusion query the same way without giving k.
+/// The default k ([`RaycastSettings::k`]): the termination test (an atomic count of active rays
+/// per tile) runs in every k-th pass; the paper amortises its occlusion query the same way
+/// without giving k.
 pub const COUNT_EVERY: u32 = 8;
 /// Entries per scalar axis of both tables, and per length axis of the 3D one (HAVS' 128³).
 pub const TABLE_SCALAR: usize = 128;

@@ -1,5 +1,6 @@
 //! The pass-count map (the paper's Fig. 5): every tile filled with a colour for the number of
-//! ray-casting passes it ran, brighter where a ray entered the mesh, with dark tile borders.
+//! ray-casting passes it ran, brighter where a ray entered the mesh, with dark tile borders;
+//! and the CPU twin of that count ([`passes_per_tile`]).
 
 use render_core::Image;
 
@@ -64,4 +65,79 @@ pub fn pass_map(
         }
     }
     img
+}
+
+/// The passes each tile of a `width`×`height` view cut into `tiles`×`tiles` tiles of
+/// `tile_size` pixels needs when it spends them as the paper does (§2.3, §3.2 phases 3a–3b):
+/// per peeling layer, rounds of `k` passes until a count after a round finds none of the
+/// tile's rays still inside the mesh, then the next layer. `segments[pixel]` holds the steps
+/// of each stretch of that pixel's ray, one per layer it walked from, in order
+/// ([`crate::step::walk_segments`]). A tile's count is thus, summed over the stretches, the
+/// longest stretch of that rank among its pixels rounded up to a multiple of `k`; a tile no
+/// ray enters needs none. Row-major, like the renderer's per-tile counts.
+pub fn passes_per_tile(
+    segments: &[Vec<u32>],
+    width: u32,
+    tiles: u32,
+    tile_size: [u32; 2],
+    k: u32,
+) -> Vec<u32> {
+    // The longest stretch of each rank, per tile.
+    let mut longest: Vec<Vec<u32>> = vec![Vec::new(); (tiles * tiles) as usize];
+    for (i, segs) in segments.iter().enumerate() {
+        let (x, y) = (i as u32 % width, i as u32 / width);
+        let tile = &mut longest[((y / tile_size[1]) * tiles + x / tile_size[0]) as usize];
+        if tile.len() < segs.len() {
+            tile.resize(segs.len(), 0);
+        }
+        for (l, &s) in tile.iter_mut().zip(segs) {
+            *l = (*l).max(s);
+        }
+    }
+    longest
+        .iter()
+        .map(|l| l.iter().map(|&s| s.div_ceil(k) * k).sum())
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::passes_per_tile;
+
+    #[test]
+    fn each_layer_of_a_tile_is_rounded_up_to_whole_rounds_of_its_longest_stretch() {
+        // The top half of a 4×4 view in 2×2 tiles of 2×2 pixels (row-major pixels); the bottom
+        // tiles hold no pixel listed.
+        let segments = vec![
+            vec![3, 9],
+            vec![5],
+            vec![],
+            vec![],
+            vec![1, 1, 1],
+            vec![],
+            vec![],
+            vec![],
+        ];
+        // Left tile: layer 0 longest 5 → 8, layer 1 longest 9 → 16, layer 2 longest 1 → 8;
+        // the other tiles have no ray.
+        assert_eq!(
+            passes_per_tile(&segments, 4, 2, [2, 2], 8),
+            vec![32, 0, 0, 0]
+        );
+        // k = 1 counts the longest stretches exactly.
+        assert_eq!(
+            passes_per_tile(&segments, 4, 2, [2, 2], 1),
+            vec![5 + 9 + 1, 0, 0, 0]
+        );
+        // One stretch longer in the second layer adds a round.
+        let mut more = segments.clone();
+        more[0][1] = 17;
+        assert_eq!(passes_per_tile(&more, 4, 2, [2, 2], 8), vec![40, 0, 0, 0]);
+        // The same walks continued across layers (no restart): the longest whole walk.
+        let joined: Vec<Vec<u32>> = segments
+            .iter()
+            .map(|s| vec![s.iter().sum::<u32>()])
+            .collect();
+        assert_eq!(passes_per_tile(&joined, 4, 2, [2, 2], 8), vec![16, 0, 0, 0]);
+    }
 }

@@ -628,15 +628,12 @@ fn frame(
     clock.submit(gpu, [enc.finish()]);
     let counts = read_counts(gpu, &mut clock, &t.tile_counts, ntiles)?;
     let mut tile_passes = vec![0u32; ntiles];
-    let mut rounds = 0u32;
-    let mut tile_rectangles = 0u64;
+    let mut rounds = passes::Rounds::default();
     // One dispatch per pass covers every listed tile (workgroup z = slot in the list).
-    let groups = [tile_size[0].div_ceil(8), tile_size[1].div_ceil(8)];
+    let grid = passes::Grid::new(tile_size, s.k);
     match s.mode {
         Mode::Passes => {
-            let r = run_passes(gpu, st, t, groups, counts, &mut tile_passes, &mut clock)?;
-            rounds = r.rounds;
-            tile_rectangles = r.rectangles;
+            rounds = run_passes(gpu, st, t, grid, counts, &mut tile_passes, &mut clock)?;
         }
         Mode::Loop => {
             let active = active_tiles(&counts);
@@ -649,7 +646,7 @@ fn frame(
                     pass.set_pipeline(&st.pipes.run_loop);
                     pass.set_bind_group(0, &st.mesh_bind, &[]);
                     pass.set_bind_group(1, &t.cast_binds[0], &[]);
-                    pass.dispatch_workgroups(groups[0], groups[1], active.len() as u32);
+                    pass.dispatch_workgroups(grid.groups[0], grid.groups[1], active.len() as u32);
                 }
                 clock.submit(gpu, [enc.finish()]);
                 for &tile in &active {
@@ -679,7 +676,7 @@ fn frame(
             "tiles_empty".to_string(),
             tile_passes.iter().filter(|&&p| p == 0).count() as f64,
         ),
-        ("count_rounds".to_string(), rounds as f64),
+        ("count_rounds".to_string(), rounds.rounds as f64),
         ("peel_layers".to_string(), layers_used as f64),
         ("rays".to_string(), entered),
         (
@@ -697,7 +694,7 @@ fn frame(
         // add two triangles a rectangle.
         (
             "triangles".to_string(),
-            (st.face_vertices / 3) as f64 * peel_draws as f64 + 2.0 * tile_rectangles as f64,
+            (st.face_vertices / 3) as f64 * peel_draws as f64 + 2.0 * rounds.rectangles as f64,
         ),
         (
             "early_terminated_rays".to_string(),
@@ -724,7 +721,9 @@ fn frame(
     ];
     if s.mode == Mode::Passes {
         // The passes' and depth updates' rectangles (0 where the passes are compute dispatches).
-        counters.push(("tile_rectangles".to_string(), tile_rectangles as f64));
+        counters.push(("tile_rectangles".to_string(), rounds.rectangles as f64));
+        // Times a tile restarted its passes from its next peeling layer (§3.2 phase 3a).
+        counters.push(("layer_loads".to_string(), rounds.layer_loads as f64));
     }
     st.last = Some(LastFrame {
         camera: camera.clone(),

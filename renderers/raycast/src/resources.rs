@@ -161,6 +161,8 @@ pub struct Pipelines {
     pub more: Option<wgpu::RenderPipeline>,
     pub init: wgpu::ComputePipeline,
     pub step: wgpu::ComputePipeline,
+    /// mode=passes: a tile's rays that left their layer start again from the next.
+    pub load_layer: wgpu::ComputePipeline,
     /// mode=passes as rectangles per tile (`tile_pass.wgsl`), where the device can force early
     /// depth tests; `None`: the compute pass `step`.
     pub tile_passes: Option<TilePipelines>,
@@ -354,25 +356,21 @@ impl Pipelines {
                 cache: None,
             })
         });
-        let init = gpu.compute_pipeline("raycast init", Some(&cast_pl), &cast_module, "init");
-        let step = gpu.compute_pipeline("raycast step", Some(&cast_pl), &cast_module, "step");
-        let run_loop =
-            gpu.compute_pipeline("raycast loop", Some(&cast_pl), &cast_module, "run_loop");
+        let cast = |label, entry| gpu.compute_pipeline(label, Some(&cast_pl), &cast_module, entry);
+        let (init, step) = (cast("raycast init", "init"), cast("raycast step", "step"));
+        let run_loop = cast("raycast loop", "run_loop");
+        let load_layer = cast("raycast load layer", "load_layer");
         let probe = gpu.compute_pipeline("raycast probe", Some(&probe_pl), &probe_module, "probe");
         let early_depth = gpu
             .features
             .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
         let tile_passes = (tile_passes && early_depth).then(|| {
-            let tile_pl = layout(
-                "raycast tile passes",
-                &[
-                    Some(&mesh_layout),
-                    Some(&cast_layout),
-                    Some(&peel_frame_layout),
-                ],
-            );
-            let src = format!("{cast_src}\n{}", include_str!("tile_pass.wgsl"));
-            TilePipelines::new(gpu, &tile_pl, &gpu.shader("raycast tile passes", &src))
+            let groups = [&mesh_layout, &cast_layout, &peel_frame_layout];
+            TilePipelines::build(
+                gpu,
+                &layout("raycast tile passes", &groups.map(Some)),
+                &cast_src,
+            )
         });
         Pipelines {
             mesh_layout,
@@ -385,6 +383,7 @@ impl Pipelines {
             more,
             init,
             step,
+            load_layer,
             tile_passes,
             run_loop,
             probe,
@@ -393,6 +392,12 @@ impl Pipelines {
 }
 
 impl TilePipelines {
+    /// The pipelines from `cast_src` (cast.wgsl with its prelude) and `tile_pass.wgsl`.
+    fn build(gpu: &Gpu, layout: &wgpu::PipelineLayout, cast_src: &str) -> Self {
+        let src = format!("{cast_src}\n{}", include_str!("tile_pass.wgsl"));
+        TilePipelines::new(gpu, layout, &gpu.shader("raycast tile passes", &src))
+    }
+
     fn new(gpu: &Gpu, layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule) -> Self {
         let pipeline = |label: &str, fs: &str, compare, write| {
             gpu.device

@@ -25,8 +25,9 @@ impl TableKind {
 /// How ray steps are scheduled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
-    /// Faithful: one GPU pass per ray step and tile, as on 2005 hardware; a tile stops when a
-    /// count of its active rays (every [`crate::COUNT_EVERY`] passes) is zero.
+    /// Faithful: one GPU pass per ray step and tile, as on 2005 hardware; per peeling layer, a
+    /// tile moves on to the next when a count of its active rays (every [`crate::COUNT_EVERY`]
+    /// passes) is zero, and stops when no ray starts again.
     Passes,
     /// Modern: one compute dispatch per tile in which every ray loops until it is done.
     Loop,
@@ -52,6 +53,9 @@ pub struct RaycastSettings {
     pub early_termination: bool,
     /// Most peeling layers (§2.4); re-entries beyond are counted as dropped.
     pub max_layers: u32,
+    /// mode=passes: a tile's active rays are counted after every `k` passes (§3.2 phase 3b,
+    /// the paper's occlusion query; it does not give k). Default [`crate::COUNT_EVERY`].
+    pub k: u32,
 }
 
 impl Default for RaycastSettings {
@@ -62,6 +66,7 @@ impl Default for RaycastSettings {
             mode: Mode::Passes,
             early_termination: true,
             max_layers: 8,
+            k: crate::COUNT_EVERY,
         }
     }
 }
@@ -74,6 +79,7 @@ impl RaycastSettings {
             .with("mode", self.mode.name())
             .with("et", self.early_termination)
             .with("layers", self.max_layers)
+            .with("k", self.k)
     }
 
     /// The typed settings of a variant, checked by [`RaycastSettings::validate`].
@@ -95,6 +101,8 @@ impl RaycastSettings {
             v => return Err(anyhow!("raycast: mode={v} is neither passes nor loop")),
         };
         let layers = s.require_int("layers")?;
+        // Rows written before k was a setting ran it at the default.
+        let k = s.int("k").unwrap_or(crate::COUNT_EVERY as i64);
         let settings = RaycastSettings {
             tiles,
             table,
@@ -102,12 +110,13 @@ impl RaycastSettings {
             early_termination: s.require_switch("et")?,
             max_layers: u32::try_from(layers)
                 .map_err(|_| anyhow!("raycast: layers={layers} is negative"))?,
+            k: u32::try_from(k).map_err(|_| anyhow!("raycast: k={k} is negative"))?,
         };
         settings.validate()?;
         Ok(settings)
     }
 
-    /// Checks the ranges (tiles 1…6, at least one layer).
+    /// Checks the ranges (tiles 1…6, 1 … 64 layers, k 1 … 64).
     pub fn validate(&self) -> anyhow::Result<()> {
         if !(1..=6).contains(&self.tiles) {
             return Err(anyhow!(
@@ -120,6 +129,9 @@ impl RaycastSettings {
                 "raycast: layers must be 1 … 64, got {}",
                 self.max_layers
             ));
+        }
+        if !(1..=64).contains(&self.k) {
+            return Err(anyhow!("raycast: k must be 1 … 64, got {}", self.k));
         }
         Ok(())
     }
@@ -146,21 +158,33 @@ pub fn default_settings() -> Vec<RaycastSettings> {
     ]
 }
 
-/// Every combination: tiles 1…6 × table × mode × et × layers.
+/// Values of k the full grid offers in mode=passes: the default, and a count after every pass
+/// (the rounding k adds, measured against it).
+pub const K_CHOICES: [u32; 2] = [crate::COUNT_EVERY, 1];
+
+/// Every combination: tiles 1…6 × table × mode × et × layers, and in mode=passes × k
+/// ([`K_CHOICES`]; mode=loop issues no counts and keeps the default).
 pub fn all_settings() -> Vec<RaycastSettings> {
     let mut v = Vec::new();
     for tiles in 1..=6 {
         for table in [TableKind::TwoD, TableKind::ThreeD] {
             for mode in [Mode::Passes, Mode::Loop] {
+                let ks: &[u32] = match mode {
+                    Mode::Passes => &K_CHOICES,
+                    Mode::Loop => &K_CHOICES[..1],
+                };
                 for early_termination in [true, false] {
                     for max_layers in LAYER_CHOICES {
-                        v.push(RaycastSettings {
-                            tiles,
-                            table,
-                            mode,
-                            early_termination,
-                            max_layers,
-                        });
+                        for &k in ks {
+                            v.push(RaycastSettings {
+                                tiles,
+                                table,
+                                mode,
+                                early_termination,
+                                max_layers,
+                                k,
+                            });
+                        }
                     }
                 }
             }

@@ -214,26 +214,44 @@ pub fn walk(
     bias: f32,
     max_steps: u32,
 ) -> Walk {
+    walk_segments(layout, layers, o, d, bias, max_steps).0
+}
+
+/// [`walk`], and the steps of each stretch between an entry and the ray's exit from the mesh
+/// (one per layer the ray walked from, in order): what mode=passes spends per layer.
+pub fn walk_segments(
+    layout: &MeshLayout,
+    layers: &[Option<LayerEntry>],
+    o: [f32; 3],
+    d: [f32; 3],
+    bias: f32,
+    max_steps: u32,
+) -> (Walk, Vec<u32>) {
     let mut w = Walk::default();
+    let mut segments = Vec::new();
     let Some(Some(first)) = layers.first() else {
-        return w;
+        return (w, segments);
     };
     let (mut tet, mut lambda) = (first.tet, first.lambda);
     let mut layer = 0usize;
+    let mut segment = 0u32;
     loop {
         let ex = exit_of(layout, tet, o, d, lambda);
         w.steps += 1;
+        segment += 1;
         tet = ex.next;
         lambda = ex.lambda;
         if w.steps >= max_steps {
             w.stalled = true;
-            return w;
+            segments.push(segment);
+            return (w, segments);
         }
         if tet.is_none() {
+            segments.push(std::mem::take(&mut segment));
             loop {
                 layer += 1;
                 match layers.get(layer).copied().flatten() {
-                    None => return w,
+                    None => return (w, segments),
                     Some(e) if e.lambda >= lambda - bias => {
                         tet = e.tet;
                         lambda = e.lambda;

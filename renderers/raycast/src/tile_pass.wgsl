@@ -43,12 +43,11 @@ fn fs_step(@builtin(position) pos: vec4<f32>) {
     pass_step(p, t, f.size.x, step_params_of(f), ray_frame_of(f));
 }
 
-// The depth update: a pixel whose ray has ended gets depth 0, in front of the rectangles.
+// The depth update: a pixel whose ray has ended or left its layer gets depth 0, in front of
+// the rectangles; an active one 1, behind them (a ray that starts again from the next layer
+// is stepped again).
 @fragment
 fn fs_cull(@builtin(position) pos: vec4<f32>) -> @builtin(frag_depth) f32 {
     let p = vec2<u32>(pos.xy);
-    if rays[p.y * tile_frame.size.x + p.x].x != NONE {
-        discard;
-    }
-    return 0.0;
+    return select(1.0, 0.0, rays[p.y * tile_frame.size.x + p.x].x == NONE);
 }

@@ -2,15 +2,15 @@
 //!
 //! * one ray step (exit face, next tet, exit λ and scalar) on random rays, shader vs twin;
 //! * every pixel's step count equals the twin's walk from the same peeling layers, every tile's
-//!   pass count is the number of k-pass rounds its slowest ray needs, and an empty tile runs
-//!   no pass;
+//!   pass count is the twin's count of the paper's scheme (per layer, the k-pass rounds its
+//!   longest stretch needs), and an empty tile runs no pass;
 //! * the image against the reference on a non-convex mesh (rays leave and re-enter) and on SPX;
 //! * a mesh split over several bindings renders the same image as in one binding, and both
 //!   modes agree.
 
 use datasets::TetMesh;
 use raycast::layout::{MeshLayout, TetRef, BYTES_PER_TET};
-use raycast::step;
+use raycast::{passmap, step};
 use raycast::{Mode, Raycast, RaycastSettings, TableKind, COUNT_EVERY};
 use render_core::image_error::psnr;
 use render_core::{
@@ -28,6 +28,7 @@ fn exact() -> RaycastSettings {
         mode: Mode::Passes,
         early_termination: false,
         max_layers: 8,
+        k: COUNT_EVERY,
     }
 }
 
@@ -199,13 +200,16 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
     let layout = r.layout(&mesh, &optics).unwrap();
     let mut reentering = 0;
     let mut twin_steps = 0u64;
+    let mut segments = Vec::new();
     for y in 0..d.height {
         for x in 0..d.width {
             let i = (y * d.width + x) as usize;
             let entries: Vec<_> = d.layers.iter().map(|l| l[i]).collect();
             let (o, dir) = d.ray_frame.ray(x as f32 + 0.5, y as f32 + 0.5);
-            let w = step::walk(&layout, &entries, o, dir, d.bias, d.max_steps);
+            let (w, segs) = step::walk_segments(&layout, &entries, o, dir, d.bias, d.max_steps);
             assert_eq!(w.steps, d.steps[i], "pixel ({x}, {y})");
+            assert_eq!(segs.iter().sum::<u32>(), w.steps);
+            segments.push(segs);
             assert!(!w.stalled);
             twin_steps += w.steps as u64;
             if entries.iter().filter(|e| e.is_some()).count() > 1 {
@@ -248,25 +252,31 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
             as f64
     );
     let n = settings.tiles;
+    // The paper's scheme (per layer, rounds of k passes until the tile's rays have all left).
+    let twin = passmap::passes_per_tile(&segments, d.width, n, d.tile_size, COUNT_EVERY);
+    assert_eq!(d.tile_passes, twin);
+    assert_eq!(
+        counter(&stats, "passes_max"),
+        *twin.iter().max().unwrap() as f64
+    );
+    // Restarting per layer costs more than walks continued across layers would: the shell's
+    // re-entering rays make some tile spend more than its longest whole walk rounded up.
+    let joined: Vec<Vec<u32>> = segments.iter().map(|s| vec![s.iter().sum()]).collect();
+    let continued = passmap::passes_per_tile(&joined, d.width, n, d.tile_size, COUNT_EVERY);
+    assert!(twin.iter().zip(&continued).all(|(a, b)| a >= b));
+    assert!(twin.iter().zip(&continued).any(|(a, b)| a > b));
+    // Another k: the same stretches, rounded to its rounds.
+    for k in [1, 3] {
+        let mut rk = Raycast::new(RaycastSettings { k, ..settings });
+        let (_, dk, ..) = render(&gpu, &mut rk, &mesh, &optics, 6, 72);
+        let twin_k = passmap::passes_per_tile(&segments, d.width, n, d.tile_size, k);
+        assert_eq!(dk.tile_passes, twin_k, "k = {k}");
+    }
     let mut empty = 0;
-    for ty in 0..n {
-        for tx in 0..n {
-            let mut max_steps = 0;
-            for y in ty * d.tile_size[1]..((ty + 1) * d.tile_size[1]).min(d.height) {
-                for x in tx * d.tile_size[0]..((tx + 1) * d.tile_size[0]).min(d.width) {
-                    max_steps = max_steps.max(d.steps[(y * d.width + x) as usize]);
-                }
-            }
-            let passes = d.tile_passes[(ty * n + tx) as usize];
-            assert_eq!(
-                passes,
-                max_steps.div_ceil(COUNT_EVERY) * COUNT_EVERY,
-                "tile ({tx}, {ty})"
-            );
-            if max_steps == 0 {
-                empty += 1;
-                assert_eq!(passes, 0);
-            }
+    for (tile, &passes) in twin.iter().enumerate() {
+        if continued[tile] == 0 {
+            empty += 1;
+            assert_eq!(passes, 0, "tile {tile}");
         }
     }
     assert!(empty > 0, "expected empty corner tiles");

@@ -6,7 +6,10 @@ use std::time::Instant;
 
 use anyhow::{bail, Context};
 use render_core::bind::UNIFORM_STRIDE;
-use render_core::bind::{color_pass, render_target, strided_uniforms, whole as entry};
+use render_core::bind::{
+    buffer_range, color_pass, render_target, strided_uniforms, view_entry, whole as entry,
+    whole_from,
+};
 use render_core::{Camera, FrameClock, Gpu, Lifetime, MemoryLedger};
 
 use crate::buckets::{depth, SlabGeometry};
@@ -79,18 +82,21 @@ impl Splat {
                     GpuSort::Bitonic => n.next_power_of_two().max(256),
                     GpuSort::Radix => n,
                 };
-                let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("splat buckets"),
-                    layout: &st.pipes.compute_layout,
-                    entries: &[
-                        entry(0, &st.frame_buf),
-                        entry(1, &st.bricks[b]),
-                        entry(2, &st.keys),
-                        entry(3, &st.vals),
-                        entry(4, &st.sorted),
-                        entry(5, &st.ends),
-                    ],
-                });
+                let bind = gpu.bind_group(
+                    "splat buckets",
+                    &st.pipes.compute_layout,
+                    &whole_from(
+                        0,
+                        &[
+                            &st.frame_buf,
+                            &st.bricks[b],
+                            &st.keys,
+                            &st.vals,
+                            &st.sorted,
+                            &st.ends,
+                        ],
+                    ),
+                );
                 let mut enc = gpu.device.create_command_encoder(&Default::default());
                 dispatch(&mut enc, &st.pipes.transform, &bind, padded);
                 match self.settings.sort {
@@ -105,22 +111,15 @@ impl Splat {
                             steps.iter().map(|step| step.params(padded)).collect();
                         gpu.queue
                             .write_buffer(&st.bitonic_buf, 0, &strided_uniforms(&params));
-                        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                            label: Some("splat bitonic"),
-                            layout: &st.pipes.bitonic_layout,
-                            entries: &[
-                                wgpu::BindGroupEntry {
-                                    binding: 0,
-                                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                                        buffer: &st.bitonic_buf,
-                                        offset: 0,
-                                        size: wgpu::BufferSize::new(16),
-                                    }),
-                                },
+                        let bind = gpu.bind_group(
+                            "splat bitonic",
+                            &st.pipes.bitonic_layout,
+                            &[
+                                buffer_range(0, &st.bitonic_buf, 0, 16),
                                 entry(1, &st.keys),
                                 entry(2, &st.vals),
                             ],
-                        });
+                        );
                         let mut pass = enc.begin_compute_pass(&Default::default());
                         for (s, &step) in steps.iter().enumerate() {
                             pass.set_pipeline(match step {
@@ -415,49 +414,33 @@ impl Splat {
             gpu.queue
                 .write_buffer(&st.slab_buf, 0, &strided_uniforms(&params));
         }
-        let splat_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("splat sheet"),
-            layout: &st.pipes.splat_layout,
-            entries: &[
+        let splat_bind = gpu.bind_group(
+            "splat sheet",
+            &st.pipes.splat_layout,
+            &[
                 entry(0, &st.frame_buf),
                 entry(1, &st.sorted),
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&st.table_view),
-                },
+                view_entry(2, &st.table_view),
                 wgpu::BindGroupEntry {
                     binding: 6,
                     resource: wgpu::BindingResource::Sampler(&st.table_sampler),
                 },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&t.image_view),
-                },
+                view_entry(3, &t.image_view),
                 entry(4, &st.ese_dropped),
                 entry(5, &t.sheet),
             ],
-        });
-        let slab_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("splat slab"),
-            layout: &st.pipes.slab_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &st.slab_buf,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<SlabParams>() as u64),
-                }),
-            }],
-        });
-        let comp_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("splat composite"),
-            layout: &st.pipes.composite_layout,
-            entries: &[
-                entry(0, &st.frame_buf),
-                entry(1, &t.sheet),
-                entry(2, &st.tf_buf),
-            ],
-        });
+        );
+        let slab_size = std::mem::size_of::<SlabParams>() as u64;
+        let slab_bind = gpu.bind_group(
+            "splat slab",
+            &st.pipes.slab_layout,
+            &[buffer_range(0, &st.slab_buf, 0, slab_size)],
+        );
+        let comp_bind = gpu.bind_group(
+            "splat composite",
+            &st.pipes.composite_layout,
+            &whole_from(0, &[&st.frame_buf, &t.sheet, &st.tf_buf]),
+        );
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         for (index, (step, composite)) in steps.iter().enumerate() {
             let offset = (index as u64 * UNIFORM_STRIDE) as u32;

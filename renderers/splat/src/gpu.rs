@@ -1,6 +1,7 @@
 //! Pipelines, bind group layouts and the per-frame parameters of the splatter.
 
-use render_core::bind::{self, storage_entry as storage};
+use render_core::bind;
+use render_core::gpu::LayoutEntries;
 use render_core::table_texture::TableTexture;
 use render_core::Gpu;
 
@@ -92,10 +93,6 @@ pub struct Pipelines {
     pub composite: wgpu::RenderPipeline,
 }
 
-fn float_texture(binding: u32, stage: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    bind::texture_entry(binding, stage, false, wgpu::TextureViewDimension::D2)
-}
-
 fn with_frame(body: &str) -> String {
     format!("{}\n{}", include_str!("frame.wgsl"), body)
 }
@@ -107,148 +104,66 @@ impl Pipelines {
     /// `filtered`: the footprint table is sampled with trilinear filtering (`splat.wgsl`,
     /// TABLE_FILTERED) rather than loaded and interpolated by hand.
     pub fn new(gpu: &Gpu, filtered: bool) -> Pipelines {
-        let d = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries,
-            })
-        };
-        let pipeline_layout = |label: &str, groups: &[&wgpu::BindGroupLayout]| {
-            let groups: Vec<Option<&wgpu::BindGroupLayout>> =
-                groups.iter().map(|g| Some(*g)).collect();
-            render_core::bind::pipeline_layout(gpu, label, &groups)
-        };
-
-        let compute_layout = layout(
-            "splat buckets",
-            &[
-                bind::params_entry(0, c),
-                storage(1, c, true),
-                storage(2, c, false),
-                storage(3, c, false),
-                storage(4, c, false),
-                storage(5, c, false),
-            ],
-        );
+        let compute_layout = LayoutEntries::new(c)
+            .params(0)
+            .read(1)
+            .read_write(2..=5)
+            .build(gpu, "splat buckets");
         let compute_module = gpu.shader(
             "splat compute.wgsl",
             &with_frame(include_str!("compute.wgsl")),
         );
-        let cpl = pipeline_layout("splat buckets", &[&compute_layout]);
-        let transform =
-            gpu.compute_pipeline("splat transform", Some(&cpl), &compute_module, "transform");
-        let gather = gpu.compute_pipeline("splat gather", Some(&cpl), &compute_module, "gather");
-        let boundaries = gpu.compute_pipeline(
-            "splat boundaries",
-            Some(&cpl),
+        let [transform, gather, boundaries] = gpu.compute_pipelines(
+            "splat",
+            &[&compute_layout],
             &compute_module,
-            "boundaries",
+            ["transform", "gather", "boundaries"],
         );
 
-        let bitonic_layout = layout(
-            "splat bitonic",
-            &[
-                bind::with_dynamic_offset(bind::params_entry(0, c)),
-                storage(1, c, false),
-                storage(2, c, false),
-            ],
-        );
+        let bitonic_layout = LayoutEntries::new(c)
+            .params_at_offset(0)
+            .read_write(1..=2)
+            .build(gpu, "splat bitonic");
         let bitonic_module = gpu.shader("splat bitonic.wgsl", include_str!("bitonic.wgsl"));
-        let bpl = pipeline_layout("splat bitonic", &[&bitonic_layout]);
-        let bitonic_double = gpu.compute_pipeline(
-            "splat bitonic double",
-            Some(&bpl),
+        let [bitonic_double, bitonic_wide, bitonic_narrow] = gpu.compute_pipelines(
+            "splat",
+            &[&bitonic_layout],
             &bitonic_module,
-            "bitonic_double",
-        );
-        let bitonic_wide = gpu.compute_pipeline(
-            "splat bitonic wide",
-            Some(&bpl),
-            &bitonic_module,
-            "bitonic_wide",
-        );
-        let bitonic_narrow = gpu.compute_pipeline(
-            "splat bitonic narrow",
-            Some(&bpl),
-            &bitonic_module,
-            "bitonic_narrow",
+            ["bitonic_double", "bitonic_wide", "bitonic_narrow"],
         );
 
-        // The footprint slices (binding 2) and their sampler (6), a 3D table texture's entries.
-        let table = TableTexture::layout_entries(filtered, 2, 6, c);
-        let splat_layout = layout(
-            "splat sheet",
-            &[
-                bind::params_entry(0, c),
-                storage(1, c, true),
-                table[0],
-                table[1],
-                float_texture(3, c),
-                // Fragments dropped by early splat elimination (counted, not timed).
-                storage(4, c, false),
-                storage(5, c, false),
-            ],
-        );
+        let splat_layout = LayoutEntries::new(c)
+            .params(0)
+            .read(1)
+            // The footprint slices (binding 2) and their sampler (6), a 3D table texture's entries.
+            .with(TableTexture::layout_entries(filtered, 2, 6, c))
+            .texture(3, wgpu::TextureViewDimension::D2)
+            // Fragments dropped by early splat elimination (counted, not timed).
+            .read_write(4..=5)
+            .build(gpu, "splat sheet");
         // The step: the splat pass reads its bucket, the composite its ring slot.
-        let slab_layout = layout(
-            "splat slab",
-            &[bind::with_dynamic_offset(bind::params_entry(
-                0,
-                c | wgpu::ShaderStages::FRAGMENT,
-            ))],
-        );
+        let slab_layout = LayoutEntries::new(c | wgpu::ShaderStages::FRAGMENT)
+            .params_at_offset(0)
+            .build(gpu, "splat slab");
         let splat_source = format!(
             "const SPLAT_WORKGROUP: u32 = {SPLAT_WORKGROUP}u;\nconst TABLE_FILTERED: bool = {filtered};\n{}",
             with_frame(include_str!("splat.wgsl"))
         );
         let splat_module = gpu.shader("splat splat.wgsl", &splat_source);
-        let splat = gpu.compute_pipeline(
+        let [splat] = gpu.compute_pipelines(
             "splat sheet",
-            Some(&pipeline_layout(
-                "splat sheet",
-                &[&splat_layout, &slab_layout],
-            )),
+            &[&splat_layout, &slab_layout],
             &splat_module,
-            "splat_cs",
+            ["splat_cs"],
         );
 
-        let composite_layout = layout(
-            "splat composite",
-            &[
-                bind::params_entry(0, wgpu::ShaderStages::FRAGMENT),
-                storage(1, wgpu::ShaderStages::FRAGMENT, false),
-                storage(2, wgpu::ShaderStages::FRAGMENT, true),
-            ],
-        );
-        let composite_module = gpu.shader(
-            "splat composite.wgsl",
-            &format!(
-                "{}\n{}",
-                with_frame(include_str!("composite.wgsl")),
-                render_core::bind::FULLSCREEN_WGSL
-            ),
-        );
-        // Front-to-back "under": C += (1 − A_dst) · C_src, premultiplied.
-        let under = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::OneMinusDstAlpha,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let composite = gpu.triangle_pipeline(
-            "splat composite",
-            &pipeline_layout("splat composite", &[&composite_layout, &slab_layout]),
-            &composite_module,
-            "fullscreen_vs",
-            "composite_fs",
-            IMAGE_FORMAT,
-            Some(wgpu::BlendState {
-                color: under,
-                alpha: under,
-            }),
-            wgpu::ColorWrites::ALL,
-        );
+        let composite_layout = LayoutEntries::new(wgpu::ShaderStages::FRAGMENT)
+            .params(0)
+            .read_write(1)
+            .read(2)
+            .build(gpu, "splat composite");
+        let composite = composite_pipeline(gpu, &composite_layout, &slab_layout);
         Pipelines {
             compute_layout,
             transform,
@@ -265,6 +180,41 @@ impl Pipelines {
             composite,
         }
     }
+}
+
+/// The composite pass: a full-screen triangle blending a slab's sheet "under" the image.
+fn composite_pipeline(
+    gpu: &Gpu,
+    composite_layout: &wgpu::BindGroupLayout,
+    slab_layout: &wgpu::BindGroupLayout,
+) -> wgpu::RenderPipeline {
+    let composite_module = gpu.shader(
+        "splat composite.wgsl",
+        &format!(
+            "{}\n{}",
+            with_frame(include_str!("composite.wgsl")),
+            bind::FULLSCREEN_WGSL
+        ),
+    );
+    // Front-to-back "under": C += (1 − A_dst) · C_src, premultiplied.
+    let under = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::OneMinusDstAlpha,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    gpu.triangle_pipeline(
+        "splat composite",
+        &gpu.pipeline_layout("splat composite", &[composite_layout, slab_layout]),
+        &composite_module,
+        "fullscreen_vs",
+        "composite_fs",
+        IMAGE_FORMAT,
+        Some(wgpu::BlendState {
+            color: under,
+            alpha: under,
+        }),
+        wgpu::ColorWrites::ALL,
+    )
 }
 
 /// Workgroups (x, y) for `threads` threads of 256, split over two dimensions past the

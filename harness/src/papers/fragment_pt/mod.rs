@@ -197,8 +197,8 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
             "Paper: 512², model rotating, counts printed rounded (compared after rounding ours the same way). Ours: `{FRAGMENT_SETTINGS}` (the bucket sort the paper uses while the view changes; shading not stated), an orbit of viewpoints, mean over them; fps = 1000 / median total frame ms."
         ),
         metrics: vec![
-            Metric::rounded("vertices"),
-            Metric::rounded("tets"),
+            Metric::new("vertices", 0),
+            Metric::new("tets", 0),
             Metric::new("fps", 2),
             Metric::new("tets/s", 0),
         ],
@@ -261,6 +261,33 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     report
 }
 
+/// The bytes of a 256 MB board (claim F7).
+const BOARD_BYTES: f64 = 268_435_456.0;
+
+/// Claim F7's 256 MiB line against two readings of the paper's layout for `tets` tets: the model
+/// alone resident (§4: 20 B/tet), and the model with pass 1's output for every tet at once
+/// (§3.1: two RGBA32F render targets, one texel per tet, 32 B/tet more). Says which side of
+/// the line each falls on, and so which readings the line can tell apart.
+fn layout_readings(tets: f64) -> String {
+    const MIB: f64 = 1048576.0;
+    let model = 20.0 * tets;
+    let described = 52.0 * tets;
+    let side = |b: f64| if b <= BOARD_BYTES { "under" } else { "over" };
+    let verdict = if (model <= BOARD_BYTES) != (described <= BOARD_BYTES) {
+        "The 256 MiB line tells these two readings apart; it cannot tell the second from an allocation larger still, such as ours."
+    } else {
+        "The 256 MiB line cannot tell these two readings apart on this mesh."
+    };
+    format!(
+        "Two readings of the paper's layout for this mesh: the model alone (§4, 20 B/tet) {:.1} MiB, {} 256 MiB; the model with pass 1's two RGBA32F records of every tet at once, as §3.1 describes pass 1 (52 B/tet) {:.1} MiB, {} it. {verdict} The paper describes the second and mentions no batching of pass 1, so by its own layout this mesh is {} its 256 MB board.",
+        model / MIB,
+        side(model),
+        described / MIB,
+        side(described),
+        side(described),
+    )
+}
+
 /// §5's 5.5 M tets on a 256 MB board (claim F7): where the Brain row's device bytes go, from
 /// the renderer's ledger counters, beside what the paper's own textures would take.
 fn brain_bytes_note(m: &Measured) -> Option<String> {
@@ -271,10 +298,7 @@ fn brain_bytes_note(m: &Measured) -> Option<String> {
     let total = r.gpu_bytes? as f64;
     let tets = r.tets as f64;
     const MIB: f64 = 1048576.0;
-    let paper = format!(
-        "The paper keeps pass 1's output in two RGBA32F render targets, one texel per tet (§3.1): 32 B/tet beside the 20 of §4, which for this mesh alone is {:.1} MiB.",
-        52.0 * tets / MIB
-    );
+    let paper = layout_readings(tets);
     let head = format!(
         "Brain (claim F7, §5's 5.5 M tets on a 256 MB board), as allocated at {}²: {:.1} MiB in all for {} tets, {:.1} B/tet",
         r.width,
@@ -299,4 +323,29 @@ fn brain_bytes_note(m: &Measured) -> Option<String> {
             r.gpu_bytes_frame.unwrap_or(0) as f64 / tets
         ),
     })
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::layout_readings;
+
+    /// On Brain's 5,476,038 tets the model alone fits 256 MiB and the layout §3.1 describes
+    /// does not, so the line tells them apart; on 4 M tets both fit and it cannot.
+    #[test]
+    fn the_256_mib_line_tells_the_readings_apart_only_where_it_falls_between_them() {
+        let brain = layout_readings(5_476_038.0);
+        assert!(brain.contains("104.4 MiB, under"), "{brain}");
+        assert!(brain.contains("271.6 MiB, over"), "{brain}");
+        assert!(brain.contains("tells these two readings apart"), "{brain}");
+        assert!(
+            brain.contains("this mesh is over its 256 MB board"),
+            "{brain}"
+        );
+        let smaller = layout_readings(4_000_000.0);
+        assert!(
+            smaller.contains("cannot tell these two readings apart"),
+            "{smaller}"
+        );
+        assert!(smaller.contains("this mesh is under"), "{smaller}");
+    }
 }

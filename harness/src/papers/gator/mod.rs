@@ -383,9 +383,9 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     }
     let mut metrics: Vec<Metric> = cols
         .iter()
-        .map(|c| Metric::exact(c.replace("_bool", ""), 0))
+        .map(|c| Metric::new(c.replace("_bool", ""), 0))
         .collect();
-    metrics.push(Metric::exact("triangles", 0));
+    metrics.push(Metric::new("triangles", 0));
     report.comparisons.push(Comparison {
         key: "table1".into(),
         title: "Table 1 — truth table of the 14 projection cases".into(),
@@ -429,7 +429,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         key: "table2".into(),
         title: "Table 2 — data sets".into(),
         conditions: "Vertices as tetbench loads the meshes; tets as the five-tet split of each PLOT3D hexahedron produces them, which is what the paper counts (our loader afterwards drops the tets of zero volume; the notes give how many).".into(),
-        metrics: vec![Metric::exact("vertices", 0), Metric::exact("tets (split)", 0)],
+        metrics: vec![Metric::new("vertices", 0), Metric::new("tets (split)", 0)],
         rows,
         notes: {
             let mut notes: Vec<String> = DATASETS

@@ -180,7 +180,7 @@ pub fn run_sort(args: SortArgs) -> anyhow::Result<()> {
         sorts: rows,
         ..HavsAnalyses::default()
     });
-    md.push_str(&markdown(&super::table1(&extra)));
+    md.push_str(&markdown(&super::table1(&extra).judge(super::PAPER.id)));
     let md_path = args.out.join("havs_table1.md");
     std::fs::write(&md_path, &md).with_context(|| format!("cannot write {}", md_path.display()))?;
     println!("{md}");
@@ -410,7 +410,7 @@ pub fn table2_markdown(rows: &[KbufferRow], resolution: u32, viewpoints: usize) 
         .iter()
         .any(|r| papers_own.contains(&r.dataset.as_str()))
     {
-        md.push_str(&markdown(&table));
+        md.push_str(&markdown(&table.judge(super::PAPER.id)));
     } else {
         let _ = writeln!(
             md,

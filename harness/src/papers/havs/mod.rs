@@ -235,7 +235,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         title: "Table 3 — GPU-only rate, k = 2 and k = 6".into(),
         conditions: "Paper: GPU time with glFinish, CPU sort excluded, early termination off, mean of 14 viewpoints. Ours: GPU time from timestamp queries of the draw and drain passes (faces sorted on the CPU, excluded), early termination off; fps = 1000 / GPU ms.".into(),
         metrics: vec![
-            Metric::exact("tets", 0),
+            Metric::new("tets", 0),
             Metric::new("k=2 fps", 2),
             Metric::new("k=2 tets/s", 0),
             Metric::new("k=6 fps", 2),
@@ -460,7 +460,7 @@ pub fn table2(m: &Measured, x: &Extra) -> Comparison {
             "Paper: software A-buffer, 512², maximum over 14 viewpoints; k is the deepest insertion of a fragment into its pixel's ordered A-buffer, plus one for compositing (§5.2). Ours: the CPU model of `tetbench analyze kbuffer`, {}², over {} viewpoint(s), k measured the same way. Counts are geometric (no GPU); they can equal the paper's only on the same mesh, camera, viewport, rasterisation rule and face order, so the cells are compared exactly here and claims H3–H5 compare spx2 (the paper's own mesh) within a stated tolerance.",
             analysis::of(x).kbuffer_resolution, analysis::of(x).kbuffer_views
         ),
-        metrics: cols.iter().map(|(_, n)| Metric::exact(*n, 0)).collect(),
+        metrics: cols.iter().map(|(_, n)| Metric::new(*n, 0)).collect(),
         rows,
         notes: rows_differ_why(&t, x)
             .into_iter()

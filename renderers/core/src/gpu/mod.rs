@@ -5,9 +5,11 @@
 //! machines), Vulkan/Metal/DX12 on real hardware. Every result row records which.
 //!
 //! `request.rs` what to ask of the adapter, `pipelines.rs` the shader and pipeline builders,
+//! `layouts.rs` bind-group layouts from typed bindings, bind groups and pipeline layouts,
 //! `readback.rs` copies to the host through kept mappable buffers, `memory.rs` the ledger and
 //! chunking, `timer.rs` the timestamp queries.
 
+mod layouts;
 mod memory;
 mod pipelines;
 mod readback;
@@ -17,6 +19,7 @@ mod timer;
 use anyhow::{anyhow, Context};
 use serde::{Deserialize, Serialize};
 
+pub use layouts::{BindingNumbers, LayoutEntries};
 pub use memory::{chunk_ranges, Lifetime, MemoryLedger, UPLOAD_CHUNK};
 pub use request::{
     DeviceRequest, ENV_MAX_STORAGE_BINDING, ENV_MAX_TRIANGLES_PER_PASS, ENV_TIMESTAMPS,
