@@ -104,11 +104,12 @@ fn failing_rows_are_recorded_and_the_run_goes_on() {
         assert!(r.settings.is("variant", "constant"), "{}", r.settings);
         match r.viewpoint.as_str() {
             "-x" => assert!(
-                r.error.contains("simulated out of memory") && r.total_ms.is_none(),
+                r.error_text().contains("simulated out of memory") && r.total_ms.is_none(),
                 "{r:?}"
             ),
             "+y" => assert!(
-                r.error.contains("panicked") && r.error.contains("simulated device loss"),
+                r.error_text().contains("panicked")
+                    && r.error_text().contains("simulated device loss"),
                 "{r:?}"
             ),
             _ => {

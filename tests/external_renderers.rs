@@ -177,11 +177,11 @@ fn examples_render_the_default_suite_meshes_in_a_run() {
     );
     for row in &file.rows {
         assert!(
-            row.error.is_empty(),
+            row.ok(),
             "{} {}: {}",
             row.algorithm,
             row.dataset,
-            row.error
+            row.error_text()
         );
         assert!(
             row.settings.keys().next() == Some("peer") && row.settings.is("peer", "external"),
@@ -271,29 +271,30 @@ fn a_crash_and_a_hang_fail_their_rows_and_the_run_goes_on() {
         match row.algorithm.as_str() {
             "crash" => {
                 assert!(
-                    row.error.contains("exited (exit status: 3)"),
+                    row.error_text().contains("exited (exit status: 3)"),
                     "{}",
-                    row.error
+                    row.error_text()
                 );
                 assert!(
-                    row.error.contains("boom: a simulated crash"),
+                    row.error_text().contains("boom: a simulated crash"),
                     "{}",
-                    row.error
+                    row.error_text()
                 );
             }
             "hang" => {
                 assert!(
-                    row.error.contains("did not answer `render` within 8 s"),
+                    row.error_text()
+                        .contains("did not answer `render` within 8 s"),
                     "{}",
-                    row.error
+                    row.error_text()
                 );
-                assert!(row.error.contains("about to hang"), "{}", row.error);
+                assert!(
+                    row.error_text().contains("about to hang"),
+                    "{}",
+                    row.error_text()
+                );
             }
-            _ => assert!(
-                row.error.is_empty() && row.psnr_db.is_some(),
-                "{}",
-                row.error
-            ),
+            _ => assert!(row.ok() && row.psnr_db.is_some(), "{}", row.error_text()),
         }
     }
 }

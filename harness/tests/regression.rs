@@ -47,7 +47,7 @@ fn untimed(r: &Row) -> String {
         r.gpu_bytes_persistent,
         r.gpu_bytes_frame,
         r.counters,
-        r.error
+        r.error_text()
     )
 }
 

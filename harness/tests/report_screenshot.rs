@@ -66,12 +66,12 @@ fn row(algorithm: &str, settings: &str, dataset: &str, viewpoint: &str, i: usize
         image_hash: String::new(),
         roofline_ms: None,
         limit_fraction: None,
-        bound_by: String::new(),
+        bound_by: None,
         normalized_time: None,
         host_peak_bytes: None,
         harness_ms: None,
-        suspect: String::new(),
-        error: String::new(),
+        suspect: None,
+        error: None,
         samples: Default::default(),
     }
 }

@@ -147,7 +147,7 @@ fn check_run(dir: &Path) {
         dir.display()
     );
     for row in &results.rows {
-        assert!(row.error.is_empty(), "{}: {}", row.algorithm, row.error);
+        assert!(row.ok(), "{}: {}", row.algorithm, row.error_text());
         assert!(
             row.tets_per_sec.is_some_and(|v| v > 0.0),
             "{}: no speed",

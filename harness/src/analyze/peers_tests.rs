@@ -81,7 +81,10 @@ fn a_verdict_flips_with_one_row() {
 #[test]
 fn no_verdict_on_incomplete_evidence() {
     let mut rows = run_rows();
-    rows[1].error = "renderer crashed".into();
+    rows[1].error = Some(crate::results::Failure::new(
+        crate::results::Stage::Render,
+        "renderer crashed",
+    ));
     rows[1].tets_per_sec = None;
     let c = cell(&rows, 1.0);
     assert!(

@@ -86,9 +86,8 @@ fn step(
 /// Commands a step records into its command buffer.
 type Encode<'a> = &'a dyn Fn(&mut wgpu::CommandEncoder);
 
-/// Measures every step at a `width`² viewport, `reps` times each.
-pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
-    anyhow::ensure!(reps >= 1, "the floor needs at least one repetition");
+/// Submitting an empty command buffer, without and with waiting for it.
+fn submit_steps(gpu: &Gpu, reps: usize) -> anyhow::Result<Vec<FloorStep>> {
     let empty = || {
         gpu.device
             .create_command_encoder(&Default::default())
@@ -104,6 +103,12 @@ pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
         gpu.queue.submit([empty()]);
         gpu.wait()
     })?);
+    Ok(steps)
+}
+
+/// Clearing a `width`² target, and [`PASSES`] empty render and compute passes.
+fn pass_steps(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Vec<FloorStep>> {
+    let mut steps = vec![];
     let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("floor target"),
         size: wgpu::Extent3d {
@@ -154,6 +159,13 @@ pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
             })
         })?);
     }
+    Ok(steps)
+}
+
+/// Reading a few bytes back (into a new and into a reused buffer) and, where the adapter has
+/// them, a pair of timestamps.
+fn readback_steps(gpu: &Gpu, reps: usize) -> anyhow::Result<Vec<FloorStep>> {
+    let mut steps = vec![];
     let counters = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("floor counters"),
         size: 32,
@@ -187,6 +199,15 @@ pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
             timer.gpu_ms(gpu).map(|_| ())
         })?);
     }
+    Ok(steps)
+}
+
+/// Measures every step at a `width`² viewport, `reps` times each.
+pub fn measure(gpu: &Gpu, width: u32, reps: usize) -> anyhow::Result<Floor> {
+    anyhow::ensure!(reps >= 1, "the floor needs at least one repetition");
+    let mut steps = submit_steps(gpu, reps)?;
+    steps.extend(pass_steps(gpu, width, reps)?);
+    steps.extend(readback_steps(gpu, reps)?);
     let mut floor = Floor {
         adapter: gpu.adapter.name.clone(),
         width,

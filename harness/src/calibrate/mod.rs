@@ -41,7 +41,7 @@ use render_core::Gpu;
 use crate::calibrate::probes::{ProbeContext, PROBES};
 use crate::report::progress::Progress;
 use crate::results::machine::MachineInfo;
-use crate::results::Row;
+use crate::results::{Bound, Row};
 
 pub mod control;
 pub mod floor;
@@ -169,7 +169,7 @@ pub type CounterCost = (&'static str, fn(&Calibration) -> f64);
 
 /// One resource of the roofline: the work counters a row reports on it, each at its own cost.
 pub struct Resource {
-    pub name: &'static str,
+    pub bound: Bound,
     pub costs: &'static [CounterCost],
 }
 
@@ -192,11 +192,11 @@ fn covering_triangle_cost(c: &Calibration) -> f64 {
 /// knows which renderer reports what.
 pub const RESOURCES: [Resource; 8] = [
     Resource {
-        name: "triangle setup",
+        bound: Bound::TriangleSetup,
         costs: &[("triangles", |c| per(c.triangles_per_sec))],
     },
     Resource {
-        name: "fill",
+        bound: Bound::Fill,
         costs: &[("fragments", |c| per(c.fill_fragments_per_sec))],
     },
     // Every triangle costs at least its setup (the sub-pixel figure); one that yields fragments
@@ -206,7 +206,7 @@ pub const RESOURCES: [Resource; 8] = [
     // (faces drawn as one triangle each whose projection holds a pixel centre) counts them.
     // Rows without either (and calibrations without the fit) price no triangle above its setup.
     Resource {
-        name: "rasterisation",
+        bound: Bound::Rasterisation,
         costs: &[
             ("triangles", |c| {
                 if c.raster_seconds_per_fragment > 0.0 || c.raster_seconds_per_triangle > 0.0 {
@@ -224,29 +224,29 @@ pub const RESOURCES: [Resource; 8] = [
     // lookups and atomics of those behind an opaque pixel (`ese_dropped_fragments`, the GPU's
     // exact count), so they are taken back: a bound must not price work the frame skipped.
     Resource {
-        name: "splat fill",
+        bound: Bound::SplatFill,
         costs: &[
             ("splat_fragments", |c| per(c.splat_fragments_per_sec)),
             ("ese_dropped_fragments", |c| -per(c.splat_fragments_per_sec)),
         ],
     },
     Resource {
-        name: "ray steps",
+        bound: Bound::RaySteps,
         costs: &[("ray_steps", |c| per(c.ray_steps_per_sec))],
     },
     Resource {
-        name: "cpu sort",
+        bound: Bound::CpuSort,
         costs: &[("cpu_sort_keys", |c| per(c.sort_keys_per_sec))],
     },
     Resource {
-        name: "gpu sort",
+        bound: Bound::GpuSort,
         costs: &[("gpu_sort_keys", |c| per(c.gpu_sort_keys_per_sec))],
     },
     // A resource of its own, not a term of `rasterisation`: a vertex stage's classification
     // may overlap the rasterisation of earlier triangles (llvmpipe bins and rasterises in
     // different threads), so only the larger of the two is a bound.
     Resource {
-        name: "classification",
+        bound: Bound::Classification,
         costs: &[(
             "tet_classifications",
             |c| per(c.tet_classifications_per_sec),
@@ -257,7 +257,7 @@ pub const RESOURCES: [Resource; 8] = [
 /// The time (ms) each modelled resource alone needs for the row's work: each resource whose
 /// counters the row reports (and whose rate the calibration has), and the per-frame GPU bytes
 /// (scratch, targets: each written at least once a frame) at the copy bandwidth.
-pub fn resource_times(row: &Row, cal: &Calibration) -> Vec<(&'static str, f64)> {
+pub fn resource_times(row: &Row, cal: &Calibration) -> Vec<(Bound, f64)> {
     let mut t = vec![];
     for r in &RESOURCES {
         let priced: Vec<(f64, f64)> = r
@@ -270,12 +270,12 @@ pub fn resource_times(row: &Row, cal: &Calibration) -> Vec<(&'static str, f64)> 
         // resource is priced only where some work is counted, and never below 0.
         if priced.iter().any(|&(_, cost)| cost > 0.0) {
             let seconds: f64 = priced.iter().map(|(work, cost)| work * cost).sum();
-            t.push((r.name, seconds.max(0.0) * 1e3));
+            t.push((r.bound, seconds.max(0.0) * 1e3));
         }
     }
     if let Some(b) = row.gpu_bytes_frame {
         if cal.copy_bytes_per_sec > 0.0 {
-            t.push(("memory", b as f64 / cal.copy_bytes_per_sec * 1e3));
+            t.push((Bound::Memory, b as f64 / cal.copy_bytes_per_sec * 1e3));
         }
     }
     t
@@ -298,9 +298,9 @@ pub fn annotate(rows: &mut [Row], cal: &Calibration) {
         let bound = resource_times(row, &priced)
             .into_iter()
             .max_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some((name, ms)) = bound.filter(|b| b.1 > 0.0) {
+        if let Some((resource, ms)) = bound.filter(|b| b.1 > 0.0) {
             row.roofline_ms = Some(ms);
-            row.bound_by = name.to_string();
+            row.bound_by = Some(resource);
             row.priced_with = pricing;
             set_fraction(row);
         }

@@ -100,11 +100,6 @@ pub fn best_seconds_of(
     Ok(best.max(1e-9))
 }
 
-/// Best seconds of [`REPS`] runs of `f` after one warm-up.
-pub fn best_seconds(f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Result<f64> {
-    best_seconds_of(REPS, f)
-}
-
 /// The straight line `t = a + f·b` through two (fragments per triangle, seconds per triangle)
 /// points: `(a, b)`, the cost of a triangle and of each of its fragments. Each is at least 0,
 /// since timing noise can tilt a two-point fit.
@@ -202,11 +197,3 @@ pub const PROBES: [Probe; 10] = [
         in_control: true,
     },
 ];
-
-/// The probe that measures `figure`.
-pub fn probe_of(figure: Figure) -> &'static Probe {
-    PROBES
-        .iter()
-        .find(|p| p.figures.contains(&figure))
-        .expect("every figure has a probe")
-}

@@ -52,31 +52,11 @@ pub fn ray_steps<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>
     // Whole rows of the texture walk's 8192 texels (9 a cell, TEXEL_ROW): a multiple of 8192
     // cells.
     let cells = (WALK_CELLS.min(gpu.max_storage_binding() / 128) / 8192 * 8192).max(8192);
-    let mut fill = Filler(0x2545_F491_4F6C_DD1D);
-    // Four planes whose normals point to a tetrahedron's corners (some face is always an
-    // exit), a scalar gradient, three filler texels.
-    let normals = [
-        [1.0, 1.0, 1.0],
-        [1.0, -1.0, -1.0],
-        [-1.0, 1.0, -1.0],
-        [-1.0, -1.0, 1.0],
-    ];
-    let mut geometry: Vec<[f32; 4]> = Vec::with_capacity(cells as usize * 8);
-    for _ in 0..cells {
-        for n in normals {
-            geometry.push([n[0], n[1], n[2], 0.1 + fill.unit()]);
-        }
-        for _ in 0..4 {
-            geometry.push([fill.unit(), fill.unit(), fill.unit(), fill.unit()]);
-        }
-    }
-    // Neighbours a few cells to a few thousand cells ahead, as a mesh's tets are numbered.
-    let next: Vec<[u32; 4]> = (0..cells)
-        .map(|c| [1u64, 97, 1031, 32771].map(|o| ((c + o) % cells) as u32))
-        .collect();
-    let table: Vec<[f32; 4]> = (0..WALK_TABLE)
-        .map(|_| [fill.unit(), fill.unit(), fill.unit(), fill.unit() * 0.01])
-        .collect();
+    let WalkMesh {
+        geometry,
+        next,
+        table,
+    } = walk_mesh(cells);
     let mut ledger = MemoryLedger::default();
     let cells_buf = storage(
         gpu,
@@ -122,8 +102,77 @@ pub fn ray_steps<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>
     };
     let storage_walk = walk(pipeline, bind);
 
-    // The texture walk: the same cells, each its 8 geometry texels then its neighbours.
-    let mut texels: Vec<[u32; 4]> = Vec::with_capacity(cells as usize * 9);
+    let (tex_pipeline, tex_bind) = texture_walk(
+        gpu,
+        &mut ledger,
+        module,
+        &out,
+        WalkMesh {
+            geometry,
+            next,
+            table,
+        },
+    )?;
+    // The buffers and textures live as long as the bind groups that hold them.
+    Ok(vec![storage_walk, walk(tex_pipeline, tex_bind)])
+}
+
+/// The walk's synthetic mesh: per cell four planes and a scalar gradient (8 texels), its
+/// four neighbours, and the table it samples.
+struct WalkMesh {
+    geometry: Vec<[f32; 4]>,
+    next: Vec<[u32; 4]>,
+    table: Vec<[f32; 4]>,
+}
+
+/// `cells` cells of seeded values: four planes whose normals point to a tetrahedron's corners
+/// (some face is always an exit), a scalar gradient, three filler texels; neighbours a few
+/// cells to a few thousand cells ahead, as a mesh's tets are numbered.
+fn walk_mesh(cells: u64) -> WalkMesh {
+    let mut fill = Filler(0x2545_F491_4F6C_DD1D);
+    let normals = [
+        [1.0, 1.0, 1.0],
+        [1.0, -1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+    ];
+    let mut geometry: Vec<[f32; 4]> = Vec::with_capacity(cells as usize * 8);
+    for _ in 0..cells {
+        for n in normals {
+            geometry.push([n[0], n[1], n[2], 0.1 + fill.unit()]);
+        }
+        for _ in 0..4 {
+            geometry.push([fill.unit(), fill.unit(), fill.unit(), fill.unit()]);
+        }
+    }
+    let next: Vec<[u32; 4]> = (0..cells)
+        .map(|c| [1u64, 97, 1031, 32771].map(|o| ((c + o) % cells) as u32))
+        .collect();
+    let table: Vec<[f32; 4]> = (0..WALK_TABLE)
+        .map(|_| [fill.unit(), fill.unit(), fill.unit(), fill.unit() * 0.01])
+        .collect();
+    WalkMesh {
+        geometry,
+        next,
+        table,
+    }
+}
+
+/// The texture walk's pipeline and bind group: the same cells as texels (each its 8 geometry
+/// texels, then its neighbours) and the table as a 3D texture, writing to `out`.
+fn texture_walk(
+    gpu: &Gpu,
+    ledger: &mut MemoryLedger,
+    module: &wgpu::ShaderModule,
+    out: &wgpu::Buffer,
+    mesh: WalkMesh,
+) -> anyhow::Result<(wgpu::ComputePipeline, wgpu::BindGroup)> {
+    let WalkMesh {
+        geometry,
+        next,
+        table,
+    } = mesh;
+    let mut texels: Vec<[u32; 4]> = Vec::with_capacity(next.len() * 9);
     for (c, n) in next.iter().enumerate() {
         texels.extend(
             geometry[c * 8..c * 8 + 8]
@@ -135,7 +184,7 @@ pub fn ray_steps<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>
     drop(geometry);
     let cells_tex = TexelTexture::new(
         gpu,
-        &mut ledger,
+        ledger,
         "calibrate walk cells texture",
         Lifetime::PerFrame,
         TexelTexture::rows_for(texels.len()),
@@ -146,7 +195,7 @@ pub fn ray_steps<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>
     let side = (WALK_TABLE as f64).cbrt().round() as u32;
     let table_tex = TableTexture::new(
         gpu,
-        &mut ledger,
+        ledger,
         "calibrate walk table texture",
         [side; 3],
         &table,
@@ -184,7 +233,7 @@ pub fn ray_steps<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>
         "walk_tex_main",
     );
     let mut bind_entries = vec![
-        render_core::bind::whole(6, &out),
+        render_core::bind::whole(6, out),
         wgpu::BindGroupEntry {
             binding: 14,
             resource: wgpu::BindingResource::TextureView(&cells_tex.view),
@@ -196,8 +245,7 @@ pub fn ray_steps<'g>(ctx: &ProbeContext<'g>) -> anyhow::Result<Vec<Workload<'g>>
         layout: &tex_layout,
         entries: &bind_entries,
     });
-    // The buffers and textures live as long as the bind groups that hold them.
-    Ok(vec![storage_walk, walk(tex_pipeline, tex_bind)])
+    Ok((tex_pipeline, tex_bind))
 }
 
 /// The two tables of the splat benchmark: 8 slices of 32² texels, one with no zero (every

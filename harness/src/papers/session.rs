@@ -134,9 +134,9 @@ impl Measured {
         if let Some(r) = self
             .rows
             .iter()
-            .find(|r| r.algorithm == algorithm && r.dataset == dataset && !r.error.is_empty())
+            .find(|r| r.algorithm == algorithm && r.dataset == dataset && !r.ok())
         {
-            return format!("failed: {}", r.error);
+            return format!("failed: {}", r.error_text());
         }
         if let Some(e) = self
             .errors

@@ -9,9 +9,9 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use serde::Serialize;
 
 use super::data::{distinct, write_csv, Point};
-use super::draw::{self, err, Chart, LegendEntry, FONT, MAX_LEGEND_ROWS, PLOT_WIDTH};
+use super::draw::{self, err, Chart, LegendEntry, FONT, PLOT_WIDTH};
 use super::speed_error::sort_by_style;
-use super::style::StyleBook;
+use super::style::{Style, StyleBook};
 use super::{ChartFile, Kind};
 use crate::results::stats::Spread;
 
@@ -122,57 +122,17 @@ impl Chart for Bars<'_> {
                 else {
                     continue;
                 };
-                let Some(mean) = r.mean else { continue };
-                // The bar at the mean, the whisker over the viewpoints' range.
-                let (height, low, high) = (
-                    mean * self.scale,
-                    r.min.unwrap_or(mean) * self.scale,
-                    r.max.unwrap_or(mean) * self.scale,
-                );
                 let x0 = gi as f64 + 0.1 + si as f64 * bar;
-                let x1 = x0 + bar * 0.9;
-                let xc = 0.5 * (x0 + x1);
-                let fill = if style.hollow {
-                    style.color.stroke_width(2)
-                } else {
-                    style.color.filled()
-                };
-                chart
-                    .draw_series(std::iter::once(Rectangle::new(
-                        [(x0, 0.0), (x1, height)],
-                        fill,
-                    )))
-                    .map_err(err)?;
-                if high > low {
-                    let cap = bar * 0.2;
-                    let k = BLACK.stroke_width(1);
-                    chart
-                        .draw_series([
-                            PathElement::new(vec![(xc, low), (xc, high)], k),
-                            PathElement::new(vec![(xc - cap, low), (xc + cap, low)], k),
-                            PathElement::new(vec![(xc - cap, high), (xc + cap, high)], k),
-                        ])
-                        .map_err(err)?;
-                }
-                // Shades repeat within a family; the marker on the bar tells variants apart.
-                let top = chart.backend_coord(&(xc, height));
-                let r = ((chart.backend_coord(&(x1, 0.0)).0 - chart.backend_coord(&(x0, 0.0)).0)
-                    / 3)
-                .clamp(3, 7);
-                plot.draw(&Circle::new(top, r + 3, WHITE.filled()))
-                    .map_err(err)?;
-                draw::marker(&plot, top, r, &style)?;
-                if label_bars {
-                    let ts = TextStyle::from((FONT, 12).into_font())
-                        .pos(Pos::new(HPos::Center, VPos::Bottom));
-                    chart
-                        .draw_series(std::iter::once(Text::new(
-                            short_number(height),
-                            (xc, high.max(height) + ymax * 0.01),
-                            ts,
-                        )))
-                        .map_err(err)?;
-                }
+                let label_at = label_bars.then_some(ymax * 0.01);
+                draw_bar(
+                    &mut chart,
+                    &plot,
+                    (x0, x0 + bar * 0.9),
+                    r,
+                    self.scale,
+                    &style,
+                    label_at,
+                )?;
             }
         }
         let name_style =
@@ -186,6 +146,69 @@ impl Chart for Bars<'_> {
         root.present().map_err(err)?;
         Ok(())
     }
+}
+
+/// One bar of `r` over `x0..x1`: at its mean (filled, or outlined for a hollow style), a
+/// whisker over the viewpoints' range, the variant's marker on top (shades repeat within a
+/// family; the marker tells variants apart) and, with `label_gap`, its value that far above.
+fn draw_bar<DB: DrawingBackend>(
+    chart: &mut draw::Chart2d<DB>,
+    plot: &DrawingArea<DB, Shift>,
+    (x0, x1): (f64, f64),
+    r: &Record,
+    scale: f64,
+    style: &Style,
+    label_gap: Option<f64>,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let Some(mean) = r.mean else { return Ok(()) };
+    let (height, low, high) = (
+        mean * scale,
+        r.min.unwrap_or(mean) * scale,
+        r.max.unwrap_or(mean) * scale,
+    );
+    let xc = 0.5 * (x0 + x1);
+    let fill = if style.hollow {
+        style.color.stroke_width(2)
+    } else {
+        style.color.filled()
+    };
+    chart
+        .draw_series(std::iter::once(Rectangle::new(
+            [(x0, 0.0), (x1, height)],
+            fill,
+        )))
+        .map_err(err)?;
+    if high > low {
+        let cap = (x1 - x0) / 0.9 * 0.2;
+        let k = BLACK.stroke_width(1);
+        chart
+            .draw_series([
+                PathElement::new(vec![(xc, low), (xc, high)], k),
+                PathElement::new(vec![(xc - cap, low), (xc + cap, low)], k),
+                PathElement::new(vec![(xc - cap, high), (xc + cap, high)], k),
+            ])
+            .map_err(err)?;
+    }
+    let top = chart.backend_coord(&(xc, height));
+    let radius =
+        ((chart.backend_coord(&(x1, 0.0)).0 - chart.backend_coord(&(x0, 0.0)).0) / 3).clamp(3, 7);
+    plot.draw(&Circle::new(top, radius + 3, WHITE.filled()))
+        .map_err(err)?;
+    draw::marker(plot, top, radius, style)?;
+    if let Some(gap) = label_gap {
+        let ts = TextStyle::from((FONT, 12).into_font()).pos(Pos::new(HPos::Center, VPos::Bottom));
+        chart
+            .draw_series(std::iter::once(Text::new(
+                short_number(height),
+                (xc, high.max(height) + gap),
+                ts,
+            )))
+            .map_err(err)?;
+    }
+    Ok(())
 }
 
 /// Writes `stem.{png,svg,csv}` for one metric (split per algorithm when the legend would not
@@ -234,17 +257,7 @@ fn write_metric(
             }
         })
         .collect();
-    let parts: Vec<(String, Vec<(String, String)>)> = if series.len() > MAX_LEGEND_ROWS {
-        distinct(series.iter().map(|(a, _)| a.clone()))
-            .into_iter()
-            .map(|a| {
-                let v = series.iter().filter(|(x, _)| *x == a).cloned().collect();
-                (a, v)
-            })
-            .collect()
-    } else {
-        vec![(String::new(), series)]
-    };
+    let parts = draw::legend_parts(series, |(a, _)| a);
     let mut files = vec![];
     for (alg, part) in parts {
         let stem = if alg.is_empty() {

@@ -296,7 +296,10 @@ pub(crate) mod tests {
         failed.dataset = "box:100k".into();
         failed.tets = 100_000;
         failed.tets_per_sec = None;
-        failed.error = "out of memory".into();
+        failed.error = Some(crate::results::Failure::new(
+            crate::results::Stage::Render,
+            "out of memory",
+        ));
         rows.push(failed);
         rows
     }

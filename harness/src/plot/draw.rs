@@ -231,6 +231,21 @@ where
     Ok(())
 }
 
+/// `items` on one chart, or, when its legend would not fit, one chart per algorithm (in order
+/// of first appearance): each part with its algorithm, empty for the one chart.
+pub fn legend_parts<T: Clone>(items: Vec<T>, algorithm: fn(&T) -> &str) -> Vec<(String, Vec<T>)> {
+    if items.len() <= MAX_LEGEND_ROWS {
+        return vec![(String::new(), items)];
+    }
+    super::data::distinct(items.iter().map(algorithm))
+        .into_iter()
+        .map(|a| {
+            let part = items.iter().filter(|i| algorithm(i) == a).cloned();
+            (a.to_string(), part.collect())
+        })
+        .collect()
+}
+
 /// Height that fits `rows` legend rows below a heading of `heading` lines.
 pub fn height_for_legend(rows: usize, heading: usize, min: u32) -> u32 {
     (70 + 17 * heading as u32 + LEGEND_ROW as u32 * rows as u32).max(min)
@@ -366,9 +381,59 @@ impl Axis {
     }
 }
 
+/// The plot panel of a chart on two [`Axis`]: its title, the axes described, our grid and
+/// tick labels in place of plotters' mesh.
+pub struct Axes<'t> {
+    pub title: &'t str,
+    pub x: Axis,
+    pub y: Axis,
+    pub x_desc: &'t str,
+    pub y_desc: &'t str,
+    pub x_fmt: fn(f64) -> String,
+    pub y_fmt: fn(f64) -> String,
+    /// Room left of the plot for the widest y label.
+    pub y_label_area: u32,
+}
+
+/// A chart on linear coordinates ([`Axis::at`] maps data values onto them).
+pub type Chart2d<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+impl Axes<'_> {
+    /// Draws the panel on `area` and returns the chart to draw the data on.
+    pub fn draw<'a, DB: DrawingBackend>(
+        &self,
+        area: &'a DrawingArea<DB, Shift>,
+    ) -> anyhow::Result<Chart2d<'a, DB>>
+    where
+        DB::ErrorType: 'static,
+    {
+        let mut chart = ChartBuilder::on(area)
+            .caption(self.title, (FONT, 21).into_font())
+            .margin(14)
+            .x_label_area_size(52)
+            .y_label_area_size(self.y_label_area)
+            .build_cartesian_2d(self.x.range(), self.y.range())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(WHITE.mix(0.0))
+            .x_labels(0)
+            .y_labels(0)
+            .x_desc(self.x_desc)
+            .y_desc(self.y_desc)
+            .axis_desc_style((FONT, 15))
+            .draw()
+            .map_err(err)?;
+        grid(&chart, area, self.x, self.y, self.x_fmt, self.y_fmt)?;
+        Ok(chart)
+    }
+}
+
 /// Grid lines and tick labels of both axes (the mesh of plotters is switched off).
-pub fn grid<DB: DrawingBackend>(
-    chart: &ChartContext<DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+fn grid<DB: DrawingBackend>(
+    chart: &Chart2d<DB>,
     area: &DrawingArea<DB, Shift>,
     x: Axis,
     y: Axis,

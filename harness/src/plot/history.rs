@@ -191,68 +191,19 @@ pub fn svg_chart(title: &str, runs: &[RunTick], lines: &[Line]) -> SvgChart {
         .filter(|v| v.is_finite())
         .fold(0.0, f64::max);
     let step = nice_step(top * 1.05 / 5.0);
-    let ymax = ((top * 1.05 / step).ceil() * step).max(step);
-    let x = |run: usize| LEFT + (run as f64 + 0.5) * col;
-    let y = |v: f64| TOP + PLOT_H - (v.clamp(0.0, ymax) / ymax) * PLOT_H;
-    let y_ticks = (0..)
-        .map(|k| k as f64 * step)
-        .take_while(|v| *v <= ymax * (1.0 + 1e-9))
-        .map(|v| Tick {
-            at: px(y(v)),
-            label_at: px(y(v) + 4.0),
-            label: tick_label(v, step),
-            anchor: "end",
-        })
-        .collect();
-    let shown = n.min(8);
-    let mut x_ticks: Vec<Tick> = vec![];
-    for k in 0..shown {
-        let i = if shown == 1 {
-            0
-        } else {
-            (k as f64 * (n - 1) as f64 / (shown - 1) as f64).round() as usize
-        };
-        if let Some(r) = runs.get(i) {
-            x_ticks.push(Tick {
-                at: px(x(i)),
-                label_at: px(TOP + PLOT_H + 16.0),
-                label: r.date.clone(),
-                anchor: if k + 1 == shown && shown > 1 {
-                    "end"
-                } else {
-                    "middle"
-                },
-            });
-        }
-    }
+    let place = Place {
+        col,
+        ymax: ((top * 1.05 / step).ceil() * step).max(step),
+    };
+    let y_ticks = place.y_ticks(step);
+    let x_ticks = place.x_ticks(runs);
     let legend_top = TOP + PLOT_H + 48.0;
     let mut svg_lines = vec![];
     let mut steps = vec![];
     let mut markers = vec![];
     for (k, l) in lines.iter().enumerate() {
         let color = hex(categorical(k));
-        let mut segments = vec![];
-        let mut start = 0;
-        for i in 1..=l.points.len() {
-            if i == l.points.len() || l.points[i].run != l.points[i - 1].run + 1 {
-                let pts = &l.points[start..i];
-                let line: Vec<String> = pts
-                    .iter()
-                    .map(|p| format!("{},{}", px(x(p.run)), px(y(p.total_ms))))
-                    .collect();
-                let band: Vec<String> = pts
-                    .iter()
-                    .map(|p| (p.run, p.band_hi))
-                    .chain(pts.iter().rev().map(|p| (p.run, p.band_lo)))
-                    .map(|(r, v)| format!("{},{}", px(x(r)), px(y(v))))
-                    .collect();
-                segments.push(Segment {
-                    line: line.join(" "),
-                    band: band.join(" "),
-                });
-                start = i;
-            }
-        }
+        let segments = place.segments(&l.points);
         for p in &l.points {
             if let Some(r) = p.step {
                 let at = LEFT + p.run as f64 * col;
@@ -265,35 +216,7 @@ pub fn svg_chart(title: &str, runs: &[RunTick], lines: &[Line]) -> SvgChart {
                 });
             }
             if let Some(c) = p.change {
-                let (mx, my) = (x(p.run), y(p.total_ms));
-                let (kind, path, stroke, color) = match c {
-                    Change::Slower => (
-                        "slower",
-                        format!("M{},{}l4.5,8h-9z", px(mx), px(my - 5.0)),
-                        "0",
-                        hex(SLOWER),
-                    ),
-                    Change::Faster => (
-                        "faster",
-                        format!("M{},{}l8,8m0,-8l-8,8", px(mx - 4.0), px(my - 4.0)),
-                        "2",
-                        hex(FASTER),
-                    ),
-                    Change::Other => (
-                        "other",
-                        String::new(),
-                        "0",
-                        hex(plotters::style::colors::BLACK),
-                    ),
-                };
-                markers.push(Marker {
-                    kind,
-                    x: px(mx),
-                    y: px(my),
-                    path,
-                    stroke,
-                    color,
-                });
+                markers.push(change_marker(c, place.x(p.run), place.y(p.total_ms)));
             }
         }
         svg_lines.push(SvgLine {
@@ -334,6 +257,124 @@ pub fn svg_chart(title: &str, runs: &[RunTick], lines: &[Line]) -> SvgChart {
         steps,
         markers,
         columns,
+    }
+}
+
+/// Where a run's column and a time sit on the chart.
+#[derive(Clone, Copy)]
+struct Place {
+    /// A run's column width.
+    col: f64,
+    /// The time at the top of the plot.
+    ymax: f64,
+}
+
+impl Place {
+    fn x(&self, run: usize) -> f64 {
+        LEFT + (run as f64 + 0.5) * self.col
+    }
+
+    fn y(&self, v: f64) -> f64 {
+        TOP + PLOT_H - (v.clamp(0.0, self.ymax) / self.ymax) * PLOT_H
+    }
+
+    /// A tick every `step` ms from 0 to the top.
+    fn y_ticks(&self, step: f64) -> Vec<Tick> {
+        (0..)
+            .map(|k| k as f64 * step)
+            .take_while(|v| *v <= self.ymax * (1.0 + 1e-9))
+            .map(|v| Tick {
+                at: px(self.y(v)),
+                label_at: px(self.y(v) + 4.0),
+                label: tick_label(v, step),
+                anchor: "end",
+            })
+            .collect()
+    }
+
+    /// The dates of up to eight runs spread evenly, the last one's label ending at its tick.
+    fn x_ticks(&self, runs: &[RunTick]) -> Vec<Tick> {
+        let n = runs.len().max(1);
+        let shown = n.min(8);
+        let mut ticks = vec![];
+        for k in 0..shown {
+            let i = if shown == 1 {
+                0
+            } else {
+                (k as f64 * (n - 1) as f64 / (shown - 1) as f64).round() as usize
+            };
+            if let Some(r) = runs.get(i) {
+                ticks.push(Tick {
+                    at: px(self.x(i)),
+                    label_at: px(TOP + PLOT_H + 16.0),
+                    label: r.date.clone(),
+                    anchor: if k + 1 == shown && shown > 1 {
+                        "end"
+                    } else {
+                        "middle"
+                    },
+                });
+            }
+        }
+        ticks
+    }
+
+    /// A line's runs of consecutive points, each as its polyline and its band's polygon.
+    fn segments(&self, points: &[LinePoint]) -> Vec<Segment> {
+        let mut segments = vec![];
+        let mut start = 0;
+        for i in 1..=points.len() {
+            if i == points.len() || points[i].run != points[i - 1].run + 1 {
+                let pts = &points[start..i];
+                let at = |(r, v): (usize, f64)| format!("{},{}", px(self.x(r)), px(self.y(v)));
+                let line: Vec<String> = pts.iter().map(|p| at((p.run, p.total_ms))).collect();
+                let band: Vec<String> = pts
+                    .iter()
+                    .map(|p| (p.run, p.band_hi))
+                    .chain(pts.iter().rev().map(|p| (p.run, p.band_lo)))
+                    .map(at)
+                    .collect();
+                segments.push(Segment {
+                    line: line.join(" "),
+                    band: band.join(" "),
+                });
+                start = i;
+            }
+        }
+        segments
+    }
+}
+
+/// The marker of compare's finding at a point (`mx`, `my`): a triangle for slower, a cross
+/// for faster.
+fn change_marker(c: Change, mx: f64, my: f64) -> Marker {
+    let (kind, path, stroke, color) = match c {
+        Change::Slower => (
+            "slower",
+            format!("M{},{}l4.5,8h-9z", px(mx), px(my - 5.0)),
+            "0",
+            hex(SLOWER),
+        ),
+        Change::Faster => (
+            "faster",
+            format!("M{},{}l8,8m0,-8l-8,8", px(mx - 4.0), px(my - 4.0)),
+            "2",
+            hex(FASTER),
+        ),
+        Change::Other => (
+            "other",
+            String::new(),
+            "0",
+            hex(plotters::style::colors::BLACK),
+        ),
+    };
+    Marker {
+        kind,
+        x: px(mx),
+        y: px(my),
+        path,
+        stroke,
+        color,
     }
 }
 

@@ -2,12 +2,16 @@
 //! measured points (whiskers min–max over viewpoints), failed points marked on the bottom edge
 //! rather than dropped, optional backend bounds as dashed horizontal lines.
 
+use std::path::Path;
+
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use serde::Serialize;
 
-use super::data::Bound;
+use super::data::{distinct, write_csv, Bound, Point};
 use super::draw::{self, err, Chart, LegendEntry, FONT, PLOT_WIDTH};
 use super::style::{Marker, Style, StyleBook};
+use super::{ChartFile, Kind};
 use crate::results::stats::Spread;
 
 /// One measured (or failed) point of a line.
@@ -132,30 +136,20 @@ impl Chart for LineChart<'_> {
             lo: ylo,
             hi: yhi,
         };
-        let mut chart = ChartBuilder::on(&plot)
-            .caption(&self.title, (FONT, 21).into_font())
-            .margin(14)
-            .x_label_area_size(52)
-            .y_label_area_size(72)
-            .build_cartesian_2d(xa.range(), ya.range())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .light_line_style(WHITE.mix(0.0))
-            .bold_line_style(WHITE.mix(0.0))
-            .x_labels(0)
-            .y_labels(0)
-            .x_desc(&self.x_desc)
-            .y_desc(&self.y_desc)
-            .axis_desc_style((FONT, 15))
-            .draw()
-            .map_err(err)?;
-        draw::grid(&chart, &plot, xa, ya, self.x_fmt, self.y_fmt)?;
+        let chart = draw::Axes {
+            title: &self.title,
+            x: xa,
+            y: ya,
+            x_desc: &self.x_desc,
+            y_desc: &self.y_desc,
+            x_fmt: self.x_fmt,
+            y_fmt: self.y_fmt,
+            y_label_area: 72,
+        }
+        .draw(&plot)?;
         let px = |x: f64, y: f64| chart.backend_coord(&(xa.at(x), ya.at(y)));
         // Per line, per point: (whisker bottom, centre, whisker top) in pixels; a failed
         // point has no whisker and sits on the bottom edge.
-        type Px = (Option<(i32, i32)>, (i32, i32), Option<(i32, i32)>);
         let points_px: Vec<(usize, Vec<Px>)> = self
             .lines
             .iter()
@@ -191,70 +185,144 @@ impl Chart for LineChart<'_> {
                 )
             })
             .collect();
-        for (x0, x1, y, text) in &bound_px {
-            plot.draw(&plotters::element::DashedPathElement::new(
-                vec![(*x0, *y), (*x1, *y)],
-                8,
-                5,
-                RED.mix(0.7).stroke_width(2),
-            ))
-            .map_err(err)?;
-            plot.draw(&Text::new(
-                text.clone(),
-                (x0 + 6, y - 18),
-                (FONT, 13).into_font(),
-            ))
-            .map_err(err)?;
-        }
+        draw_bounds(&plot, &bound_px)?;
         // Failed points sit on the bottom edge, stacked upwards where several share an x.
         let mut failed_at: Vec<(i32, i32)> = vec![];
         for (li, pts) in &points_px {
-            let st = self
-                .book
-                .get(&self.lines[*li].algorithm, &self.lines[*li].settings);
-            let line_style = st.color.stroke_width(2);
-            // Lines join consecutive measured points only; a failure breaks the line.
-            let mut run: Vec<(i32, i32)> = vec![];
-            let mut runs: Vec<Vec<(i32, i32)>> = vec![];
-            for (lo, mid, _) in pts {
-                if lo.is_some() {
-                    run.push(*mid);
-                } else if !run.is_empty() {
-                    runs.push(std::mem::take(&mut run));
-                }
-            }
-            runs.push(run);
-            for r in runs.into_iter().filter(|r| r.len() > 1) {
-                plot.draw(&PathElement::new(r, line_style)).map_err(err)?;
-            }
-            for (lo, mid, hi) in pts {
-                match (lo, hi) {
-                    (Some(lo), Some(hi)) => {
-                        if lo != hi {
-                            plot.draw(&PathElement::new(vec![*lo, *hi], st.color.stroke_width(1)))
-                                .map_err(err)?;
-                        }
-                        draw::marker(&plot, *mid, 6, &st)?;
-                    }
-                    _ => {
-                        let below = failed_at.iter().filter(|(x, _)| *x == mid.0).count() as i32;
-                        failed_at.push(*mid);
-                        let c = (mid.0, mid.1 - 10 - 18 * below);
-                        draw::marker(&plot, c, 6, &st)?;
-                        let cross = Style {
-                            marker: Marker::Cross,
-                            color: BLACK,
-                            hollow: true,
-                            ..st.clone()
-                        };
-                        draw::marker(&plot, c, 5, &cross)?;
-                    }
-                }
-            }
+            let line = &self.lines[*li];
+            let st = self.book.get(&line.algorithm, &line.settings);
+            draw_line(&plot, pts, &st, &mut failed_at)?;
         }
         let entries = self.entries();
         draw::legend(&legend, &self.heading(), &entries)?;
         root.present().map_err(err)?;
         Ok(())
     }
+}
+
+/// The variants of `points` in legend order.
+pub fn variants(points: &[&Point], book: &StyleBook) -> Vec<(String, String)> {
+    let mut v = distinct(
+        points
+            .iter()
+            .map(|p| (p.algorithm.clone(), p.settings.clone())),
+    );
+    v.sort_by_key(|(a, s)| super::style::order_key(book, a, s));
+    v
+}
+
+/// Saves `lines` as `stem` (or, when the legend would not fit, as `stem_ALG` per algorithm)
+/// with `records` as each chart's CSV. `chart(suffix, lines)` makes a chart, `suffix` being
+/// `, ALG` for a per-algorithm part (for its title) and empty for the one chart.
+pub fn save_parts<'b, R: Serialize>(
+    dir: &Path,
+    (stem, kind): (&str, Kind),
+    lines: Vec<Line>,
+    records: &[R],
+    chart: impl Fn(&str, Vec<Line>) -> LineChart<'b>,
+) -> anyhow::Result<Vec<ChartFile>> {
+    let mut files = vec![];
+    for (alg, part) in draw::legend_parts(lines, |l| &l.algorithm) {
+        let (stem, suffix) = if alg.is_empty() {
+            (stem.to_string(), String::new())
+        } else {
+            (
+                format!("{stem}_{}", crate::results::names::slug(&alg)),
+                format!(", {alg}"),
+            )
+        };
+        let chart = chart(&suffix, part);
+        draw::save(&chart, dir, &stem)?;
+        write_csv(dir, &stem, records)?;
+        files.push(ChartFile {
+            kind,
+            title: chart.title,
+            stem,
+            note: String::new(),
+        });
+    }
+    Ok(files)
+}
+
+/// A point of a line in pixels: (whisker bottom, centre, whisker top); a failed point has no
+/// whisker and sits on the bottom edge.
+type Px = (Option<(i32, i32)>, (i32, i32), Option<(i32, i32)>);
+
+/// The backend bounds: dashed horizontal lines, each labelled (`(x0, x1, y, label)`).
+fn draw_bounds<DB: DrawingBackend>(
+    plot: &DrawingArea<DB, Shift>,
+    bounds: &[(i32, i32, i32, String)],
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    for (x0, x1, y, text) in bounds {
+        plot.draw(&plotters::element::DashedPathElement::new(
+            vec![(*x0, *y), (*x1, *y)],
+            8,
+            5,
+            RED.mix(0.7).stroke_width(2),
+        ))
+        .map_err(err)?;
+        plot.draw(&Text::new(
+            text.clone(),
+            (x0 + 6, y - 18),
+            (FONT, 13).into_font(),
+        ))
+        .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// One line: segments through consecutive measured points (a failure breaks the line), the
+/// whiskers and markers, and each failed point crossed on the bottom edge, stacked above the
+/// failed points already drawn at its x (`failed_at`).
+fn draw_line<DB: DrawingBackend>(
+    plot: &DrawingArea<DB, Shift>,
+    pts: &[Px],
+    st: &Style,
+    failed_at: &mut Vec<(i32, i32)>,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let mut run: Vec<(i32, i32)> = vec![];
+    let mut runs: Vec<Vec<(i32, i32)>> = vec![];
+    for (lo, mid, _) in pts {
+        if lo.is_some() {
+            run.push(*mid);
+        } else if !run.is_empty() {
+            runs.push(std::mem::take(&mut run));
+        }
+    }
+    runs.push(run);
+    for r in runs.into_iter().filter(|r| r.len() > 1) {
+        plot.draw(&PathElement::new(r, st.color.stroke_width(2)))
+            .map_err(err)?;
+    }
+    for (lo, mid, hi) in pts {
+        match (lo, hi) {
+            (Some(lo), Some(hi)) => {
+                if lo != hi {
+                    plot.draw(&PathElement::new(vec![*lo, *hi], st.color.stroke_width(1)))
+                        .map_err(err)?;
+                }
+                draw::marker(plot, *mid, 6, st)?;
+            }
+            _ => {
+                let below = failed_at.iter().filter(|(x, _)| *x == mid.0).count() as i32;
+                failed_at.push(*mid);
+                let c = (mid.0, mid.1 - 10 - 18 * below);
+                draw::marker(plot, c, 6, st)?;
+                let cross = Style {
+                    marker: Marker::Cross,
+                    color: BLACK,
+                    hollow: true,
+                    ..st.clone()
+                };
+                draw::marker(plot, c, 5, &cross)?;
+            }
+        }
+    }
+    Ok(())
 }

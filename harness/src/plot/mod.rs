@@ -7,7 +7,7 @@
 //! `tetbench plot KIND RESULTS… --out DIR` draws them from any results (one run, shards,
 //! several runs, a sweep); the HTML report of a run embeds them, speed vs error first.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::Context;
 use serde::Serialize;
@@ -215,11 +215,6 @@ pub fn raw_results(dir: &Path) -> Option<serde_json::Value> {
     serde_json::from_str(&text).ok()
 }
 
-/// Where `tetbench plot` writes when `--out` is not given.
-pub fn default_out() -> PathBuf {
-    PathBuf::from("plots")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -403,7 +398,10 @@ mod tests {
             if r.algorithm == "havs" {
                 r.tets_per_sec = None;
                 r.psnr_db = None;
-                r.error = "device lost".into();
+                r.error = Some(crate::results::Failure::new(
+                    crate::results::Stage::Render,
+                    "device lost",
+                ));
             }
         }
         rows.extend(big);

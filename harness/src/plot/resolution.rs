@@ -6,9 +6,9 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::data::{distinct, write_csv, Inputs, Point};
-use super::draw::{self, MAX_LEGEND_ROWS};
-use super::lines::{Line, LineChart, LinePoint};
+use super::data::{distinct, Inputs, Point};
+use super::draw;
+use super::lines::{save_parts, variants, Line, LineChart, LinePoint};
 use super::speed_error::sort_by_style;
 use super::style::StyleBook;
 use super::{ChartFile, Kind};
@@ -68,19 +68,12 @@ pub fn write(
                 error: p.error.clone(),
             })
             .collect();
-        let mut variants = distinct(
-            pts.iter()
-                .map(|p| (p.algorithm.clone(), p.settings.clone())),
-        );
-        variants.sort_by_key(|(a, s)| super::style::order_key(book, a, s));
-        let lines: Vec<Line> = variants
-            .iter()
+        let lines: Vec<Line> = variants(&pts, book)
+            .into_iter()
             .map(|(a, s)| Line {
-                algorithm: a.clone(),
-                settings: s.clone(),
                 points: pts
                     .iter()
-                    .filter(|p| &p.algorithm == a && &p.settings == s)
+                    .filter(|p| p.algorithm == a && p.settings == s)
                     .map(|p| LinePoint {
                         // Square viewports by the side (as Fig. 8); others by √pixels.
                         x: if square {
@@ -91,6 +84,8 @@ pub fn write(
                         y: p.tets_per_sec,
                     })
                     .collect(),
+                algorithm: a,
+                settings: s,
                 extra: String::new(),
             })
             .collect();
@@ -98,32 +93,14 @@ pub fn write(
         if inputs.without_reference {
             notes.push("timing only (--no-reference)".into());
         }
-        let parts: Vec<(String, Vec<Line>)> = if lines.len() > MAX_LEGEND_ROWS {
-            distinct(lines.iter().map(|l| l.algorithm.clone()))
-                .into_iter()
-                .map(|a| {
-                    let v = lines.iter().filter(|l| l.algorithm == a).cloned().collect();
-                    (a, v)
-                })
-                .collect()
-        } else {
-            vec![(String::new(), lines)]
-        };
-        for (alg, part) in parts {
-            let mut stem = format!("resolution_{}", crate::results::names::slug(&dataset));
-            if !alg.is_empty() {
-                stem.push_str(&format!("_{}", crate::results::names::slug(&alg)));
-            }
-            let title = format!(
-                "Throughput vs viewport size — {dataset}{}",
-                if alg.is_empty() {
-                    String::new()
-                } else {
-                    format!(", {alg}")
-                }
-            );
-            let chart = LineChart {
-                title: title.clone(),
+        let stem = format!("resolution_{}", crate::results::names::slug(&dataset));
+        let made = save_parts(
+            dir,
+            (&stem, Kind::Resolution),
+            lines,
+            &records,
+            |alg, part| LineChart {
+                title: format!("Throughput vs viewport size — {dataset}{alg}"),
                 x_desc: if square {
                     "viewport side (pixels, square)".into()
                 } else {
@@ -137,16 +114,9 @@ pub fn write(
                 bounds: vec![],
                 notes: notes.clone(),
                 book,
-            };
-            draw::save(&chart, dir, &stem)?;
-            write_csv(dir, &stem, &records)?;
-            files.push(ChartFile {
-                kind: Kind::Resolution,
-                title,
-                stem,
-                note: String::new(),
-            });
-        }
+            },
+        )?;
+        files.extend(made);
     }
     Ok(files)
 }

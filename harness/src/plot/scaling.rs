@@ -7,9 +7,9 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::data::{distinct, write_csv, Bound, Inputs, Point};
-use super::draw::{self, MAX_LEGEND_ROWS};
-use super::lines::{Line, LineChart, LinePoint};
+use super::data::{distinct, write_csv, Inputs, Point};
+use super::draw;
+use super::lines::{save_parts, variants, Line, LineChart, LinePoint};
 use super::speed_error::sort_by_style;
 use super::style::StyleBook;
 use super::{ChartFile, Kind};
@@ -139,121 +139,34 @@ pub fn write(
         if many_sizes {
             stem.push_str(&format!("_{width}x{height}"));
         }
-        let mut variants: Vec<(String, String)> = distinct(
-            pts.iter()
-                .map(|p| (p.algorithm.clone(), p.settings.clone())),
-        );
-        variants.sort_by_key(|(a, s)| super::style::order_key(book, a, s));
-        let records: Vec<Record> = pts
-            .iter()
-            .map(|p| Record {
-                family: fam.clone(),
-                dataset: p.dataset.clone(),
-                tets: p.tets,
-                width,
-                height,
-                label: book.get(&p.algorithm, &p.settings).label,
-                algorithm: p.algorithm.clone(),
-                settings: p.settings.clone(),
-                rows: p.rows,
-                failed: p.failed,
-                tets_per_sec_mean: p.tets_per_sec.map(|s| s.mean),
-                tets_per_sec_min: p.tets_per_sec.map(|s| s.min),
-                tets_per_sec_max: p.tets_per_sec.map(|s| s.max),
-                gpu_bytes: p.gpu_bytes,
-                bytes_per_tet: p.bytes_per_tet,
-                error: p.error.clone(),
-            })
-            .collect();
-        let mut speed_lines = vec![];
-        let mut byte_lines = vec![];
-        for (a, s) in &variants {
-            let mine: Vec<&&Point> = pts
+        let records = records(&fam, &pts, book);
+        let (mut speed_lines, mut byte_lines, mut fits) = (vec![], vec![], vec![]);
+        for (a, s) in variants(&pts, book) {
+            let mine: Vec<&Point> = pts
                 .iter()
-                .filter(|p| &p.algorithm == a && &p.settings == s)
+                .copied()
+                .filter(|p| p.algorithm == a && p.settings == s)
                 .collect();
-            let tps: Vec<(f64, f64)> = mine
-                .iter()
-                .filter_map(|p| Some((p.tets as f64, p.tets_per_sec?.mean)))
-                .collect();
-            let gb: Vec<(f64, f64)> = mine
-                .iter()
-                .filter_map(|p| Some((p.tets as f64, p.gpu_bytes? as f64)))
-                .collect();
-            let fit = Fit {
-                family: fam.clone(),
-                width,
-                height,
-                label: book.get(a, s).label,
-                algorithm: a.clone(),
-                settings: s.clone(),
-                sizes_measured: tps.len(),
-                sizes_failed: mine.iter().filter(|p| p.tets_per_sec.is_none()).count(),
-                tets_per_sec_exponent: power_law_exponent(&tps),
-                gpu_bytes_exponent: power_law_exponent(&gb),
-                gpu_bytes_per_tet_marginal: linear_slope(&gb),
-            };
-            let failed_sizes: Vec<String> = mine
-                .iter()
-                .filter(|p| p.tets_per_sec.is_none())
-                .map(|p| draw::si(p.tets as f64))
-                .collect();
-            let failed_note = if failed_sizes.is_empty() {
-                String::new()
-            } else {
-                format!(", failed at {}", failed_sizes.join(", "))
-            };
-            speed_lines.push(Line {
-                algorithm: a.clone(),
-                settings: s.clone(),
-                points: mine
-                    .iter()
-                    .map(|p| LinePoint {
-                        x: p.tets as f64,
-                        y: p.tets_per_sec,
-                    })
-                    .collect(),
-                extra: exponent_text(fit.tets_per_sec_exponent) + &failed_note,
-            });
-            byte_lines.push(Line {
-                algorithm: a.clone(),
-                settings: s.clone(),
-                points: mine
-                    .iter()
-                    .map(|p| LinePoint {
-                        x: p.tets as f64,
-                        y: p.gpu_bytes.map(|b| Spread::single(b as f64)),
-                    })
-                    .collect(),
-                extra: exponent_text(fit.gpu_bytes_exponent) + &failed_note,
-            });
-            out.fits.push(fit);
+            let fit = fit(&fam, (width, height), &mine, book);
+            let (speed, bytes) = variant_lines(&mine, &fit);
+            speed_lines.push(speed);
+            byte_lines.push(bytes);
+            fits.push(fit);
         }
-        let mut notes = vec![format!("viewport {width}×{height}")];
-        if inputs.without_reference {
-            notes.push("timing only (--no-reference):".into());
-            notes.push("image error not checked".into());
-        }
-        let missing: Vec<&(String, String)> = inputs
-            .missing_datasets
-            .iter()
-            .filter(|(d, _)| family(d) == fam)
-            .collect();
-        for (d, _) in &missing {
-            notes.push(format!("{d}: not loaded, no rows"));
-        }
-        let bounds: Vec<Bound> = inputs.bounds.clone();
+        let notes = notes(&fam, (width, height), inputs);
         let charts = [
             (
                 "tets_per_sec",
+                "throughput",
                 "tets per second (log)",
                 speed_lines,
-                bounds,
+                inputs.bounds.clone(),
                 "b: fitted exponent, tets/s ∝ tets^b",
                 draw::si as fn(f64) -> String,
             ),
             (
                 "gpu_bytes",
+                "GPU memory",
                 "GPU bytes (log)",
                 byte_lines,
                 vec![],
@@ -261,42 +174,11 @@ pub fn write(
                 draw::bytes as fn(f64) -> String,
             ),
         ];
-        for (what, y_desc, lines, bounds, fit_note, y_fmt) in charts {
-            let mut n = notes.clone();
-            n.insert(0, fit_note.into());
-            // Split per algorithm when the legend would not fit.
-            let parts: Vec<(String, Vec<Line>)> = if lines.len() > MAX_LEGEND_ROWS {
-                distinct(lines.iter().map(|l| l.algorithm.clone()))
-                    .into_iter()
-                    .map(|a| {
-                        let v = lines.iter().filter(|l| l.algorithm == a).cloned().collect();
-                        (a, v)
-                    })
-                    .collect()
-            } else {
-                vec![(String::new(), lines)]
-            };
-            for (alg, part) in parts {
-                let stem = if alg.is_empty() {
-                    format!("{stem}_{what}")
-                } else {
-                    format!("{stem}_{what}_{}", crate::results::names::slug(&alg))
-                };
-                let title = format!(
-                    "Scaling with mesh size — {fam}{}: {}",
-                    if alg.is_empty() {
-                        String::new()
-                    } else {
-                        format!(", {alg}")
-                    },
-                    if what == "gpu_bytes" {
-                        "GPU memory"
-                    } else {
-                        "throughput"
-                    }
-                );
-                let chart = LineChart {
-                    title: title.clone(),
+        for (what, shows, y_desc, lines, bounds, fit_note, y_fmt) in charts {
+            let stem = format!("{stem}_{what}");
+            let made = save_parts(dir, (&stem, Kind::Scaling), lines, &records, |alg, part| {
+                LineChart {
+                    title: format!("Scaling with mesh size — {fam}{alg}: {shows}"),
                     x_desc: "tets in the mesh (log)".into(),
                     y_desc: y_desc.into(),
                     x_log: true,
@@ -304,28 +186,120 @@ pub fn write(
                     y_fmt,
                     lines: part,
                     bounds: bounds.clone(),
-                    notes: n.clone(),
+                    notes: std::iter::once(fit_note.to_string())
+                        .chain(notes.iter().cloned())
+                        .collect(),
                     book,
-                };
-                draw::save(&chart, dir, &stem)?;
-                write_csv(dir, &stem, &records)?;
-                out.files.push(ChartFile {
-                    kind: Kind::Scaling,
-                    title,
-                    stem,
-                    note: String::new(),
-                });
-            }
+                }
+            })?;
+            out.files.extend(made);
         }
-        let fits: Vec<Fit> = out
-            .fits
-            .iter()
-            .filter(|f| f.family == fam && f.width == width && f.height == height)
-            .cloned()
-            .collect();
         write_csv(dir, &format!("{stem}_fit"), &fits)?;
+        out.fits.extend(fits);
     }
     Ok(out)
+}
+
+/// The CSV lines of one family's points.
+fn records(fam: &str, pts: &[&Point], book: &StyleBook) -> Vec<Record> {
+    pts.iter()
+        .map(|p| Record {
+            family: fam.to_string(),
+            dataset: p.dataset.clone(),
+            tets: p.tets,
+            width: p.width,
+            height: p.height,
+            label: book.get(&p.algorithm, &p.settings).label,
+            algorithm: p.algorithm.clone(),
+            settings: p.settings.clone(),
+            rows: p.rows,
+            failed: p.failed,
+            tets_per_sec_mean: p.tets_per_sec.map(|s| s.mean),
+            tets_per_sec_min: p.tets_per_sec.map(|s| s.min),
+            tets_per_sec_max: p.tets_per_sec.map(|s| s.max),
+            gpu_bytes: p.gpu_bytes,
+            bytes_per_tet: p.bytes_per_tet,
+            error: p.error.clone(),
+        })
+        .collect()
+}
+
+/// One variant's exponents over the sizes of `mine` (its points, smallest mesh first).
+fn fit(fam: &str, (width, height): (u32, u32), mine: &[&Point], book: &StyleBook) -> Fit {
+    let tps: Vec<(f64, f64)> = mine
+        .iter()
+        .filter_map(|p| Some((p.tets as f64, p.tets_per_sec?.mean)))
+        .collect();
+    let gb: Vec<(f64, f64)> = mine
+        .iter()
+        .filter_map(|p| Some((p.tets as f64, p.gpu_bytes? as f64)))
+        .collect();
+    let (a, s) = (&mine[0].algorithm, &mine[0].settings);
+    Fit {
+        family: fam.to_string(),
+        width,
+        height,
+        label: book.get(a, s).label,
+        algorithm: a.clone(),
+        settings: s.clone(),
+        sizes_measured: tps.len(),
+        sizes_failed: mine.iter().filter(|p| p.tets_per_sec.is_none()).count(),
+        tets_per_sec_exponent: power_law_exponent(&tps),
+        gpu_bytes_exponent: power_law_exponent(&gb),
+        gpu_bytes_per_tet_marginal: linear_slope(&gb),
+    }
+}
+
+/// A variant's throughput line and its GPU bytes line, each labelled with its exponent and
+/// the sizes it failed at.
+fn variant_lines(mine: &[&Point], fit: &Fit) -> (Line, Line) {
+    let failed_sizes: Vec<String> = mine
+        .iter()
+        .filter(|p| p.tets_per_sec.is_none())
+        .map(|p| draw::si(p.tets as f64))
+        .collect();
+    let failed_note = if failed_sizes.is_empty() {
+        String::new()
+    } else {
+        format!(", failed at {}", failed_sizes.join(", "))
+    };
+    let line = |y: fn(&Point) -> Option<Spread>, exponent: Option<f64>| Line {
+        algorithm: fit.algorithm.clone(),
+        settings: fit.settings.clone(),
+        points: mine
+            .iter()
+            .map(|p| LinePoint {
+                x: p.tets as f64,
+                y: y(p),
+            })
+            .collect(),
+        extra: exponent_text(exponent) + &failed_note,
+    };
+    (
+        line(|p| p.tets_per_sec, fit.tets_per_sec_exponent),
+        line(
+            |p| p.gpu_bytes.map(|b| Spread::single(b as f64)),
+            fit.gpu_bytes_exponent,
+        ),
+    )
+}
+
+/// The lines of text above a family's legend: its viewport, a run without reference, and the
+/// family's data sets that did not load.
+fn notes(fam: &str, (width, height): (u32, u32), inputs: &Inputs) -> Vec<String> {
+    let mut notes = vec![format!("viewport {width}×{height}")];
+    if inputs.without_reference {
+        notes.push("timing only (--no-reference):".into());
+        notes.push("image error not checked".into());
+    }
+    for (d, _) in inputs
+        .missing_datasets
+        .iter()
+        .filter(|(d, _)| family(d) == fam)
+    {
+        notes.push(format!("{d}: not loaded, no rows"));
+    }
+    notes
 }
 
 /// The fits as a Markdown table.

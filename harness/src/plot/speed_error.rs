@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use serde::Serialize;
 
 use super::data::{distinct, write_csv, Point};
-use super::draw::{self, err, Chart, LegendEntry, FONT, MAX_LEGEND_ROWS, PLOT_WIDTH};
+use super::draw::{self, err, Chart, LegendEntry, FONT, PLOT_WIDTH};
 use super::style::{Marker, Style, StyleBook};
 use super::ChartFile;
 use crate::results::metrics::PSNR_CAP_DB;
@@ -212,55 +212,19 @@ impl Chart for SpeedError<'_> {
             .iter()
             .filter(|r| r.tets_per_sec_mean.is_some() && r.psnr_db_mean.is_some())
             .collect();
-        let xs = plotted
-            .iter()
-            .flat_map(|r| [r.tets_per_sec_min, r.tets_per_sec_max])
-            .flatten();
-        let (xlo, xhi) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
-        let (xlo, xhi) = draw::log_range(xlo, xhi);
-        let ys = plotted
-            .iter()
-            .flat_map(|r| [r.psnr_db_min, r.psnr_db_max])
-            .flatten();
-        let (ylo, yhi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
-            (a.min(y), b.max(y))
-        });
-        let (ylo, yhi) = if ylo.is_finite() {
-            let pad = ((yhi - ylo) * 0.08).max(2.0);
-            ((ylo - pad).max(0.0), yhi + pad)
-        } else {
-            (0.0, PSNR_CAP_DB + 1.0)
-        };
-        let xa = draw::Axis {
-            log: true,
-            lo: xlo,
-            hi: xhi,
-        };
-        let ya = draw::Axis {
-            log: false,
-            lo: ylo,
-            hi: yhi,
-        };
-        let mut chart = ChartBuilder::on(&plot)
-            .caption(&self.title, (FONT, 21).into_font())
-            .margin(14)
-            .x_label_area_size(52)
-            .y_label_area_size(64)
-            .build_cartesian_2d(xa.range(), ya.range())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .light_line_style(WHITE.mix(0.0))
-            .bold_line_style(WHITE.mix(0.0))
-            .x_labels(0)
-            .y_labels(0)
-            .x_desc(self.x_desc)
-            .y_desc("PSNR against the exact reference (dB)")
-            .axis_desc_style((FONT, 15))
-            .draw()
-            .map_err(err)?;
-        draw::grid(&chart, &plot, xa, ya, draw::si, |v| format!("{v:.0}"))?;
+        let (xa, ya) = speed_psnr_axes(&plotted);
+        let ((xlo, _), (ylo, yhi)) = ((xa.lo, xa.hi), (ya.lo, ya.hi));
+        let mut chart = draw::Axes {
+            title: &self.title,
+            x: xa,
+            y: ya,
+            x_desc: self.x_desc,
+            y_desc: "PSNR against the exact reference (dB)",
+            x_fmt: draw::si,
+            y_fmt: |v| format!("{v:.0}"),
+            y_label_area: 64,
+        }
+        .draw(&plot)?;
         let at = |x: f64, y: f64| (xa.at(x), ya.at(y));
         if plotted.is_empty() {
             let (px, py) = chart.backend_coord(&at(xlo * 1.2, 0.5 * (ylo + yhi)));
@@ -330,6 +294,41 @@ impl Chart for SpeedError<'_> {
     }
 }
 
+/// The speed axis (log) and the PSNR axis (padded, 0 at least) over the plotted records'
+/// whiskers; without records, a PSNR axis up to the cap.
+fn speed_psnr_axes(plotted: &[&Record]) -> (draw::Axis, draw::Axis) {
+    let xs = plotted
+        .iter()
+        .flat_map(|r| [r.tets_per_sec_min, r.tets_per_sec_max])
+        .flatten();
+    let (xlo, xhi) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+    let (xlo, xhi) = draw::log_range(xlo, xhi);
+    let ys = plotted
+        .iter()
+        .flat_map(|r| [r.psnr_db_min, r.psnr_db_max])
+        .flatten();
+    let (ylo, yhi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
+        (a.min(y), b.max(y))
+    });
+    let (ylo, yhi) = if ylo.is_finite() {
+        let pad = ((yhi - ylo) * 0.08).max(2.0);
+        ((ylo - pad).max(0.0), yhi + pad)
+    } else {
+        (0.0, PSNR_CAP_DB + 1.0)
+    };
+    let xa = draw::Axis {
+        log: true,
+        lo: xlo,
+        hi: xhi,
+    };
+    let ya = draw::Axis {
+        log: false,
+        lo: ylo,
+        hi: yhi,
+    };
+    (xa, ya)
+}
+
 /// Orders a chart's points by algorithm, then style slot (the legend's order, the same in
 /// every chart).
 pub fn sort_by_style(points: &mut [&Point], book: &StyleBook) {
@@ -385,17 +384,7 @@ pub fn write_with(
             .filter(|p| p.dataset == dataset && p.width == width && p.height == height)
             .collect();
         sort_by_style(&mut pts, book);
-        let parts: Vec<(String, Vec<&Point>)> = if pts.len() > MAX_LEGEND_ROWS {
-            distinct(pts.iter().map(|p| p.algorithm.clone()))
-                .into_iter()
-                .map(|a| {
-                    let v = pts.iter().filter(|p| p.algorithm == a).copied().collect();
-                    (a, v)
-                })
-                .collect()
-        } else {
-            vec![(String::new(), pts.clone())]
-        };
+        let parts = draw::legend_parts(pts.clone(), |p| &p.algorithm);
         let mut stem_base = format!("{}_{}", axis.stem, crate::results::names::slug(&dataset));
         if many_sizes {
             stem_base.push_str(&format!("_{width}x{height}"));

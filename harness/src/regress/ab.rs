@@ -335,11 +335,11 @@ fn merge_key(
     let mut hashes = vec![];
     for (i, (f, d)) in files.iter().zip(dirs).enumerate() {
         let Some(r) = f.rows.iter().find(|r| key(r) == *k) else {
-            failures.push(format!("missing from round {}", i + 1));
+            failures.push(format!("round {}: missing", i + 1));
             continue;
         };
         if !r.ok() {
-            failures.push(format!("round {}: {}", i + 1, r.error));
+            failures.push(format!("round {}: {}", i + 1, r.error_text()));
             merged.get_or_insert_with(|| r.clone());
             continue;
         }
@@ -375,7 +375,8 @@ fn merge_key(
     // A round's control only where every round has one (the rounds then line up).
     let complete = failures.is_empty() && round_control.len() == files.len();
     row.round_control = if complete { round_control } else { vec![] };
-    row.error = failures.join("; ");
+    row.error = (!failures.is_empty())
+        .then(|| crate::results::Failure::new(crate::results::Stage::Rounds, failures.join("; ")));
     row.frames = frames;
     summarise_samples(&mut row, samples);
     (row, error)

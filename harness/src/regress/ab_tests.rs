@@ -95,7 +95,10 @@ fn a_failed_round_is_named_and_a_changed_image_noted() {
     let side = tmp.path().join("new");
     let dirs: Vec<PathBuf> = (1..=3).map(|i| side.join(format!("round-0{i}"))).collect();
     let mut failed = row("havs", "+x", &[1.0, 1.0]);
-    failed.error = "out of memory".into();
+    failed.error = Some(crate::results::Failure::new(
+        crate::results::Stage::Render,
+        "out of memory",
+    ));
     failed.samples = FrameSamples::default();
     let mut other_image = row("havs", "+x", &[3.0, 3.0]);
     other_image.image_hash = "other".into();
@@ -104,7 +107,7 @@ fn a_failed_round_is_named_and_a_changed_image_noted() {
     round(&dirs[2], vec![other_image]);
     let merged = merge_rounds(&dirs, &side).unwrap();
     let r = &merged.rows[0];
-    assert_eq!(r.error, "round 1: out of memory");
+    assert_eq!(r.error_text(), "round 1: out of memory");
     assert_eq!(r.samples.total_ms, [2.0, 2.0, 3.0, 3.0]);
     assert_eq!(r.image_f32, "round-02/images/havs+x.f32.zz");
     assert_eq!(merged.errors.len(), 1, "{:?}", merged.errors);

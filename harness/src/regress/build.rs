@@ -123,6 +123,41 @@ pub fn resolve(spec: &str, args: &BuildArgs) -> anyhow::Result<Binary> {
     })
 }
 
+/// The cache's worktree of the repository at `commit` (added on first use, else checked out
+/// and cleaned): one per repository, whichever checkout of it asks.
+fn checkout(cache: &Path, commit: &str, repo: &Path) -> anyhow::Result<PathBuf> {
+    let repo = std::path::absolute(repo)?;
+    let common = git(
+        &repo,
+        &["rev-parse", "--path-format=absolute", "--git-common-dir"],
+    )?;
+    let tree = cache.join(format!(
+        "src-{:016x}",
+        crate::results::names::stable_hash(&common)
+    ));
+    if tree.join(".git").exists() {
+        git(
+            &tree,
+            &["checkout", "--quiet", "--force", "--detach", commit],
+        )?;
+        git(&tree, &["clean", "--quiet", "-fd"])?;
+    } else {
+        git(&repo, &["worktree", "prune"])?;
+        git(
+            &repo,
+            &[
+                "worktree",
+                "add",
+                "--quiet",
+                "--detach",
+                &tree.display().to_string(),
+                commit,
+            ],
+        )?;
+    }
+    Ok(tree)
+}
+
 /// Builds `commit` (or finds it built before) and returns the binary's path in the cache.
 pub fn build_commit(commit: &str, args: &BuildArgs) -> anyhow::Result<PathBuf> {
     let cache = std::path::absolute(args.cache()).context("cannot resolve the build cache")?;
@@ -158,35 +193,7 @@ pub fn build_commit(commit: &str, args: &BuildArgs) -> anyhow::Result<PathBuf> {
     if built() {
         return Ok(bin);
     }
-    let repo = std::path::absolute(&args.repo)?;
-    let common = git(
-        &repo,
-        &["rev-parse", "--path-format=absolute", "--git-common-dir"],
-    )?;
-    let tree = cache.join(format!(
-        "src-{:016x}",
-        crate::results::names::stable_hash(&common)
-    ));
-    if tree.join(".git").exists() {
-        git(
-            &tree,
-            &["checkout", "--quiet", "--force", "--detach", commit],
-        )?;
-        git(&tree, &["clean", "--quiet", "-fd"])?;
-    } else {
-        git(&repo, &["worktree", "prune"])?;
-        git(
-            &repo,
-            &[
-                "worktree",
-                "add",
-                "--quiet",
-                "--detach",
-                &tree.display().to_string(),
-                commit,
-            ],
-        )?;
-    }
+    let tree = checkout(&cache, commit, &args.repo)?;
     let target = cache.join("target");
     eprintln!(
         "tetbench: building {} in {} ({})",

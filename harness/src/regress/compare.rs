@@ -137,20 +137,15 @@ pub fn compare(
         opt.normalised,
     )?;
     if opt.normalised {
-        for (f, d) in [(&base, base_dir), (&new, new_dir)] {
-            anyhow::ensure!(
-                f.machine.calibration.is_some(),
-                "--normalised: {} has no calibration in its machine record (run it without \
-                 --no-calibrate)",
-                d.display()
-            );
-        }
+        require_calibration(&base, base_dir)?;
+        require_calibration(&new, new_dir)?;
     }
     let rounds = Rounds::of(&base, &new);
     // The machine divided out by the control measured beside the rows, where both runs have
     // one (compare_control.rs); otherwise the run-wide factor, as before.
     let control_missing = crate::regress::compare_control::missing(&base, &new);
-    let machine = (opt.drift_correction && !opt.normalised)
+    let by_drift = opt.drift_correction && !opt.normalised;
+    let machine = by_drift
         .then(|| crate::regress::compare_control::normalise(&mut base, &mut new))
         .flatten();
     let by_rows = opt.drift_correction && machine.is_none();
@@ -160,14 +155,12 @@ pub fn compare(
     let pair_factors = (paired && by_rows)
         .then(|| pair_factors(&group_pair_ratios(&base.rows, &new.rows, rounds, opt).ok()?))
         .flatten();
-    let scale: Vec<f64> = match (&pair_factors, run_factor) {
-        (Some(per_pair), _) => per_pair.clone(),
-        (None, Some(f)) if by_rows => vec![f],
-        // Paired rounds on absolute or control-divided times (`ab --no-drift-correction`, or
-        // both sides with a control): a factor of 1 per pair keeps the paired test.
-        (None, _) if paired => vec![1.0; rounds.base as usize],
-        _ => vec![1.0],
-    };
+    let scale = time_scale(
+        pair_factors.as_deref(),
+        run_factor.filter(|_| by_rows),
+        paired,
+        rounds,
+    );
     let paired_test = scale.len() > 1;
     let drift_per_pair = pair_factors.is_some();
     // The groups' scatter around the run-wide factor measures the noise of separate runs
@@ -178,17 +171,7 @@ pub fn compare(
         _ => (None, None),
     };
     let time_judged = rounds.enough() && noise.is_none();
-    let mut groups = group_tests(&base.rows, &new.rows, opt, &scale, rounds)?;
-    adjust_family(
-        groups.iter_mut().map(|g| &mut g.total),
-        opt.threshold,
-        opt.alpha,
-    );
-    if noise.is_some() {
-        for g in &mut groups {
-            g.total.verdict = Verdict::TooNoisy;
-        }
-    }
+    let groups = judged_groups((&base, &new), opt, &scale, rounds, noise.is_some())?;
     let rows = compare_all_rows(
         (&base, &new),
         (base_dir, new_dir),
@@ -207,43 +190,21 @@ pub fn compare(
         threshold: opt.threshold,
         alpha: opt.alpha,
         rounds,
-        warnings: [("BASE", &base), ("NEW", &new)]
-            .iter()
-            .flat_map(|(side, f)| provenance_warnings(side, f))
-            .collect(),
+        warnings: [
+            provenance_warnings("BASE", &base),
+            provenance_warnings("NEW", &new),
+        ]
+        .concat(),
         time_refused: rounds.refusal().or(noise.clone()),
         group_spread,
         too_noisy: noise.is_some(),
         run_factor,
         drift_corrected: by_rows && scale != [1.0],
-        control_missing: if machine.is_none() && opt.drift_correction && !opt.normalised {
-            control_missing
-        } else {
-            None
-        },
+        control_missing: control_missing.filter(|_| machine.is_none() && by_drift),
         machine,
         across,
         pair_factors,
-        test: format!(
-            "work counters and GPU bytes exact; time: Mann–Whitney U (two-sided, α = {}, \
-             Holm-adjusted over the groups and over the rows) and ratio of medians ≥ {} (asv's \
-             rule){}",
-            opt.alpha,
-            opt.threshold,
-            match (paired_test, drift_per_pair) {
-                (true, true) => {
-                    "; groups and rows (paired rounds): a t-test of each one's per-pair \
-                     ln(NEW/BASE), each pair's drift divided out, variance pooled over the \
-                     groups (rows: over their group's rows); ratio = exp(mean)"
-                }
-                (true, false) => {
-                    "; groups and rows (paired rounds): a t-test of each one's per-pair \
-                     ln(NEW/BASE) on absolute times (no drift divided out), variance pooled \
-                     over the groups (rows: over their group's rows); ratio = exp(mean)"
-                }
-                _ => "",
-            }
-        ),
+        test: test_description(opt, paired_test, drift_per_pair),
         groups,
         rows,
         regressions: vec![],
@@ -252,6 +213,83 @@ pub fn compare(
     };
     crate::regress::compare_findings::collect(&mut cmp, opt.drift_limit);
     Ok(cmp)
+}
+
+/// The groups' tests on NEW divided by `scale`, Holm-adjusted over the groups; all too noisy
+/// when the run's groups scatter beyond the threshold (`too_noisy`).
+fn judged_groups(
+    (base, new): (&ResultsFile, &ResultsFile),
+    opt: &CompareOptions,
+    scale: &[f64],
+    rounds: Rounds,
+    too_noisy: bool,
+) -> anyhow::Result<Vec<GroupComparison>> {
+    let mut groups = group_tests(&base.rows, &new.rows, opt, scale, rounds)?;
+    adjust_family(
+        groups.iter_mut().map(|g| &mut g.total),
+        opt.threshold,
+        opt.alpha,
+    );
+    if too_noisy {
+        for g in &mut groups {
+            g.total.verdict = Verdict::TooNoisy;
+        }
+    }
+    Ok(groups)
+}
+
+/// What NEW's times are divided by: each pair's drift (`per_pair`), else the run-wide factor
+/// (`run_factor`, where drift is divided out by the rows), else 1 — once per pair in paired
+/// rounds, which keeps the paired test.
+fn time_scale(
+    per_pair: Option<&[f64]>,
+    run_factor: Option<f64>,
+    paired: bool,
+    rounds: Rounds,
+) -> Vec<f64> {
+    match (per_pair, run_factor) {
+        (Some(per_pair), _) => per_pair.to_vec(),
+        (None, Some(f)) => vec![f],
+        // Paired rounds on absolute or control-divided times (`ab --no-drift-correction`, or
+        // both sides with a control): a factor of 1 per pair keeps the paired test.
+        (None, None) if paired => vec![1.0; rounds.base as usize],
+        _ => vec![1.0],
+    }
+}
+
+/// `--normalised` needs each side's calibration.
+fn require_calibration(f: &ResultsFile, dir: &Path) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        f.machine.calibration.is_some(),
+        "--normalised: {} has no calibration in its machine record (run it without \
+         --no-calibrate)",
+        dir.display()
+    );
+    Ok(())
+}
+
+/// The tests a comparison ran, in words (its `test` field).
+fn test_description(opt: &CompareOptions, paired_test: bool, drift_per_pair: bool) -> String {
+    format!(
+        "work counters and GPU bytes exact; time: Mann–Whitney U (two-sided, α = {}, \
+         Holm-adjusted over the groups and over the rows) and ratio of medians ≥ {} (asv's \
+         rule){}",
+        opt.alpha,
+        opt.threshold,
+        match (paired_test, drift_per_pair) {
+            (true, true) => {
+                "; groups and rows (paired rounds): a t-test of each one's per-pair \
+                 ln(NEW/BASE), each pair's drift divided out, variance pooled over the \
+                 groups (rows: over their group's rows); ratio = exp(mean)"
+            }
+            (true, false) => {
+                "; groups and rows (paired rounds): a t-test of each one's per-pair \
+                 ln(NEW/BASE) on absolute times (no drift divided out), variance pooled \
+                 over the groups (rows: over their group's rows); ratio = exp(mean)"
+            }
+            _ => "",
+        }
+    )
 }
 
 /// Every BASE row against its NEW row (Holm over the rows' `total_ms` tests), then the rows
@@ -381,6 +419,39 @@ struct RowTime<'a> {
     judged: bool,
 }
 
+/// One time `metric` of a matched row, BASE against NEW (`None` where neither has it): its
+/// rounds' test; `total_ms` is NEW divided by the drift, paired, Holm-adjusted over the rows and
+/// too noisy where time is not judged.
+fn row_time_test(
+    b: &Row,
+    n: &Row,
+    metric: &str,
+    time: &RowTime<'_>,
+    opt: &CompareOptions,
+) -> anyhow::Result<Option<TimeTest>> {
+    let rounds = time.rounds;
+    let (bs, mut ns) = (
+        round_values(b, metric, rounds.base, opt.normalised)?,
+        round_values(n, metric, rounds.new, opt.normalised)?,
+    );
+    if bs.is_empty() && ns.is_empty() {
+        return Ok(None);
+    }
+    if metric != "total_ms" {
+        return Ok(Some(round_test(metric, &bs, &ns, opt, rounds)));
+    }
+    ns = scaled(ns, time.scale);
+    let mut t = round_test(metric, &bs, &ns, opt, rounds);
+    if let Some((ratio, p)) = time.paired {
+        t = t.with_paired(ratio, p, opt.threshold, opt.alpha);
+    }
+    t = t.with_family_p(time.p_adjusted, opt.threshold, opt.alpha);
+    if rounds.enough() && !time.judged {
+        t.verdict = Verdict::TooNoisy;
+    }
+    Ok(Some(t))
+}
+
 /// One matched row; `dirs`: BASE, NEW and where heatmaps go.
 fn compare_rows(
     b: &Row,
@@ -389,13 +460,6 @@ fn compare_rows(
     dirs: (&Path, &Path, &Path),
     opt: &CompareOptions,
 ) -> anyhow::Result<RowComparison> {
-    let RowTime {
-        p_adjusted: total_p_adjusted,
-        paired: paired_test,
-        scale,
-        rounds,
-        judged: time_judged,
-    } = time;
     let (base_dir, new_dir, heat_dir) = dirs;
     let mut out = only(b, RowStatus::NoChange);
     out.notes.clear();
@@ -403,7 +467,7 @@ fn compare_rows(
     match (b.ok(), n.ok()) {
         (true, false) => {
             d.worse = true;
-            out.notes.push(format!("failed now: {}", n.error));
+            out.notes.push(format!("failed now: {}", n.error_text()));
         }
         (false, true) => {
             d.better = true;
@@ -418,7 +482,7 @@ fn compare_rows(
         &crate::regress::compare_work::WorkJudge {
             threshold: opt.threshold,
             alpha: opt.alpha,
-            rounds,
+            rounds: time.rounds,
         },
     ) {
         match change.verdict {
@@ -430,38 +494,20 @@ fn compare_rows(
         out.work.push(change);
     }
     for metric in ["total_ms", "cpu_ms", "gpu_ms"] {
-        let (bs, mut ns) = (
-            round_values(b, metric, rounds.base, opt.normalised)?,
-            round_values(n, metric, rounds.new, opt.normalised)?,
-        );
-        if bs.is_empty() && ns.is_empty() {
-            continue;
-        }
-        if metric == "total_ms" {
-            ns = scaled(ns, scale);
-        }
-        let mut t = round_test(metric, &bs, &ns, opt, rounds);
-        if metric == "total_ms" {
-            if let Some((ratio, p)) = paired_test {
-                t = t.with_paired(ratio, p, opt.threshold, opt.alpha);
-            }
-            t = t.with_family_p(total_p_adjusted, opt.threshold, opt.alpha);
-            if rounds.enough() && !time_judged {
-                t.verdict = Verdict::TooNoisy;
-            }
-            match t.verdict {
-                Verdict::Slower => {
+        if let Some(t) = row_time_test(b, n, metric, &time, opt)? {
+            match (metric, t.verdict) {
+                ("total_ms", Verdict::Slower) => {
                     d.worse = true;
                     out.notes.push(format!("slower ×{:.3}", t.ratio));
                 }
-                Verdict::Faster => {
+                ("total_ms", Verdict::Faster) => {
                     d.better = true;
                     out.notes.push(format!("faster ×{:.3}", t.ratio));
                 }
                 _ => {}
             }
+            out.times.push(t);
         }
-        out.times.push(t);
     }
     let img = image_change(b, n, base_dir, new_dir, heat_dir, opt)?;
     match img.verdict {

@@ -10,7 +10,6 @@ use crate::regress::compare_image::ImageChange;
 use crate::regress::compare_rounds::{GroupComparison, Rounds};
 use crate::regress::compare_time::TimeTest;
 use crate::regress::compare_work::WorkChange;
-use crate::results::aggregate::GroupKey;
 use crate::results::description::as_text;
 
 /// The layout of `compare.json` (`docs/compare.schema.json`); bumped when a field changes
@@ -72,15 +71,6 @@ pub struct RowComparison {
     pub image: Option<ImageChange>,
     /// Every work counter and GPU byte figure that differs ([`crate::regress::compare_work`]).
     pub work: Vec<WorkChange>,
-}
-
-impl RowComparison {
-    /// Whether the row belongs to group `g` (a row comparison keeps no projection: matched on
-    /// the rest).
-    pub fn in_group(&self, g: &GroupKey) -> bool {
-        (&self.algorithm, &self.settings, &self.dataset) == (&g.algorithm, &g.settings, &g.dataset)
-            && (self.width, self.height) == (g.width, g.height)
-    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]

@@ -127,7 +127,8 @@ mod tests {
             psnr_db: Some(50.0),
             gpu_bytes: Some(4096),
             frames: 3,
-            error: error.into(),
+            error: (!error.is_empty())
+                .then(|| crate::results::Failure::new(crate::results::Stage::Render, error)),
             ..Default::default()
         };
         ResultsFile {

@@ -597,41 +597,11 @@ pub fn build(runs: Vec<RunSummary>, pairs: &[Option<PairFindings>], threshold: f
             else {
                 continue;
             };
-            let mut changes = vec![];
             // Only a pair of adjacent runs is judged: a group missing from a run starts afresh.
-            if let Some(pf) = pairs
-                .get(i)
-                .and_then(|p| p.as_ref())
-                .filter(|_| points.last().is_some_and(|p| p.run + 1 == i))
-            {
-                if let Some((_, t)) = pf.time.iter().find(|(k, _)| k == g) {
-                    changes.push(t.clone());
-                }
-                let mut psnr_moved = false;
-                let mut memory = false;
-                let mut work: Vec<&str> = vec![];
-                for f in pf.rows.iter().filter(|f| f.in_series(g)) {
-                    psnr_moved |= f.psnr_moved;
-                    memory |= f.memory;
-                    for w in &f.work {
-                        if !work.contains(&w.as_str()) {
-                            work.push(w);
-                        }
-                    }
-                }
-                let last = points.last().expect("checked above");
-                if psnr_moved {
-                    if let (Some(a), Some(b)) = (last.psnr_db, v.psnr_db) {
-                        changes.push(format!("psnr {:+.2} dB", b - a));
-                    }
-                }
-                if memory {
-                    changes.push("memory".into());
-                }
-                if !work.is_empty() {
-                    changes.push(format!("work: {}", work.join(", ")));
-                }
-            }
+            let changes = match (pairs.get(i).and_then(|p| p.as_ref()), points.last()) {
+                (Some(pf), Some(last)) if last.run + 1 == i => pair_changes(pf, g, last, v),
+                _ => vec![],
+            };
             points.push(Point {
                 run: i,
                 total_ms: v.total_ms,
@@ -643,23 +613,7 @@ pub fn build(runs: Vec<RunSummary>, pairs: &[Option<PairFindings>], threshold: f
                 step: None,
             });
         }
-        let values: Vec<f64> = points.iter().map(|p| p.total_ms).collect();
-        let same: Vec<bool> = points
-            .iter()
-            .enumerate()
-            .map(|(k, p)| {
-                k > 0
-                    && runs[points[k - 1].run].run.commit == runs[p.run].run.commit
-                    && runs[p.run].run.commit != "?"
-            })
-            .collect();
-        let penalty = step_penalty(&values, threshold);
-        let steps = detect_steps(&values, &same, penalty, threshold);
-        for (k, &s) in steps.iter().enumerate() {
-            let prev_start = if k == 0 { 0 } else { steps[k - 1] };
-            let end = steps.get(k + 1).copied().unwrap_or(values.len());
-            points[s].step = Some(median(&values[s..end]) / median(&values[prev_start..s]));
-        }
+        mark_steps(&mut points, &runs, threshold);
         series.push(Series {
             algorithm: g.algorithm.clone(),
             settings: g.settings.to_string(),
@@ -674,6 +628,61 @@ pub fn build(runs: Vec<RunSummary>, pairs: &[Option<PairFindings>], threshold: f
         adapter,
         runs: runs.into_iter().map(|r| r.run).collect(),
         series,
+    }
+}
+
+/// What compare found between the previous run and this one for group `g` (its point `v`
+/// after the point `last`): the time's finding, the PSNR's move, memory, the work counters.
+fn pair_changes(pf: &PairFindings, g: &SeriesKey, last: &Point, v: &GroupValues) -> Vec<String> {
+    let mut changes = vec![];
+    if let Some((_, t)) = pf.time.iter().find(|(k, _)| k == g) {
+        changes.push(t.clone());
+    }
+    let mut psnr_moved = false;
+    let mut memory = false;
+    let mut work: Vec<&str> = vec![];
+    for f in pf.rows.iter().filter(|f| f.in_series(g)) {
+        psnr_moved |= f.psnr_moved;
+        memory |= f.memory;
+        for w in &f.work {
+            if !work.contains(&w.as_str()) {
+                work.push(w);
+            }
+        }
+    }
+    if psnr_moved {
+        if let (Some(a), Some(b)) = (last.psnr_db, v.psnr_db) {
+            changes.push(format!("psnr {:+.2} dB", b - a));
+        }
+    }
+    if memory {
+        changes.push("memory".into());
+    }
+    if !work.is_empty() {
+        changes.push(format!("work: {}", work.join(", ")));
+    }
+    changes
+}
+
+/// Marks the steps of a series' times (a lasting change between runs of different commits)
+/// with the ratio of the medians after and before each.
+fn mark_steps(points: &mut [Point], runs: &[RunSummary], threshold: f64) {
+    let values: Vec<f64> = points.iter().map(|p| p.total_ms).collect();
+    let same: Vec<bool> = points
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            k > 0
+                && runs[points[k - 1].run].run.commit == runs[p.run].run.commit
+                && runs[p.run].run.commit != "?"
+        })
+        .collect();
+    let penalty = step_penalty(&values, threshold);
+    let steps = detect_steps(&values, &same, penalty, threshold);
+    for (k, &s) in steps.iter().enumerate() {
+        let prev_start = if k == 0 { 0 } else { steps[k - 1] };
+        let end = steps.get(k + 1).copied().unwrap_or(values.len());
+        points[s].step = Some(median(&values[s..end]) / median(&values[prev_start..s]));
     }
 }
 

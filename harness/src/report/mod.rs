@@ -347,7 +347,7 @@ fn summary_lines(aggs: &[Aggregate]) -> Vec<SummaryLine> {
 fn suspect_figures(file: &ResultsFile, images: &Images) -> Vec<SuspectFigure> {
     file.rows
         .iter()
-        .filter(|r| !r.suspect.is_empty())
+        .filter(|r| r.suspect.is_some())
         .map(|row| SuspectFigure {
             images: [
                 (&row.heatmap, "error heatmap"),
@@ -365,7 +365,11 @@ fn suspect_figures(file: &ResultsFile, images: &Images) -> Vec<SuspectFigure> {
             settings: row.settings.to_string(),
             dataset: row.dataset.clone(),
             viewpoint: row.viewpoint.clone(),
-            why: row.suspect.clone(),
+            why: row
+                .suspect
+                .as_ref()
+                .map(ToString::to_string)
+                .unwrap_or_default(),
         })
         .collect()
 }
@@ -438,10 +442,9 @@ fn row_lines(file: &ResultsFile, suspect: &[bool]) -> Vec<RowLine> {
                 opt(row.bad_pixel_share.map(|v| v * 100.0), 2),
             ],
             stages: row.stages.to_string(),
-            error: if row.suspect.is_empty() {
-                row.error.clone()
-            } else {
-                format!("SUSPECT: {}", row.suspect)
+            error: match &row.suspect {
+                Some(why) => format!("SUSPECT: {why}"),
+                None => row.error_text(),
             },
         })
         .collect()
@@ -561,7 +564,10 @@ mod tests {
             rows.push(r);
         }
         let mut failed = test_row(3);
-        failed.error = "out of memory <boom>".into();
+        failed.error = Some(crate::results::Failure::new(
+            crate::results::Stage::Render,
+            "out of memory <boom>",
+        ));
         failed.tets_per_sec = None;
         rows.push(failed);
         ResultsFile {
@@ -597,7 +603,10 @@ mod tests {
             r.settings = render_core::Settings::new().with("k", HOSTILE_NAME);
             r.image = format!("images/{HOSTILE_NAME}.png");
         }
-        f.rows[3].error = HOSTILE_NAME.into();
+        f.rows[3].error = Some(crate::results::Failure::new(
+            crate::results::Stage::Render,
+            HOSTILE_NAME,
+        ));
         f.errors.push(HOSTILE_NAME.into());
         f.run.command_line = vec!["tetbench".into(), HOSTILE_NAME.into()];
         let dir = tempfile::tempdir().unwrap();

@@ -154,14 +154,6 @@ impl Progress {
         }
     }
 
-    /// The total changed (bisect's steps are known as an upper bound).
-    pub fn set_total(&mut self, total: u64) {
-        self.total = total;
-        if let Some(b) = &self.bar {
-            b.set_length(total);
-        }
-    }
-
     pub fn finish(&self) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();

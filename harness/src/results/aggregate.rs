@@ -146,7 +146,7 @@ pub fn aggregate(rows: &[Row]) -> Vec<Aggregate> {
                 error: g
                     .iter()
                     .find(|r| !r.ok())
-                    .map(|r| r.error.clone())
+                    .map(|r| r.error_text())
                     .unwrap_or_default(),
                 suspect: m.iter().filter(|&&i| suspect[i]).count(),
                 total_ms: spread(g.iter().filter_map(|r| r.total_ms)),

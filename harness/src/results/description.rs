@@ -70,7 +70,7 @@ pub fn as_text<T: fmt::Display, S: Serializer>(value: &T, s: S) -> Result<S::Ok,
 }
 
 /// Reads `field`'s text through `parse`; a failure names the field and the text.
-fn from_text<'de, T, E, D>(
+pub(crate) fn from_text<'de, T, E, D>(
     d: D,
     field: &str,
     parse: impl FnOnce(&str) -> Result<T, E>,

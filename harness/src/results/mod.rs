@@ -18,18 +18,24 @@ use serde::{Deserialize, Serialize};
 
 use render_core::Settings;
 
+pub use crate::results::csv_row::CsvRow;
 pub use crate::results::description::{MergedRun, RunDescription, Shard, Viewpoints};
 use crate::results::machine::MachineInfo;
 pub use crate::results::named::NamedValues;
+use crate::results::outcome::{opt_as_text, opt_from_text};
+pub use crate::results::outcome::{Bound, Failure, Stage};
+pub use crate::results::suspect::Suspect;
 
 pub mod aggregate;
 pub mod control;
+pub mod csv_row;
 pub mod description;
 pub mod git_state;
 pub mod machine;
 pub mod metrics;
 pub mod named;
 pub mod names;
+pub mod outcome;
 pub mod samples;
 pub mod stats;
 pub mod suspect;
@@ -55,7 +61,6 @@ pub struct Row {
     pub algorithm: String,
     /// The variant's typed settings: a map in `results.json` (`{"k": 6, …}`; the text form
     /// of older files still loads), `key=value;…` text in `results.csv`.
-    #[serde(serialize_with = "settings_column")]
     #[schemars(with = "SettingsSchema")]
     pub settings: Settings,
     pub dataset: String,
@@ -119,8 +124,13 @@ pub struct Row {
     pub heatmap: String,
     /// Empty, or why the row's image error is out of line with the other algorithms on the
     /// same image ([`crate::results::suspect`]). Absent in files written before it existed.
-    #[serde(default)]
-    pub suspect: String,
+    #[serde(
+        default,
+        serialize_with = "opt_as_text",
+        deserialize_with = "opt_from_text"
+    )]
+    #[schemars(with = "String")]
+    pub suspect: Option<Suspect>,
     /// The exact rendering (premultiplied linear RGBA f32, compressed, see [`crate::results::samples`]),
     /// relative to the output directory, and the blake3 hash of its pixels.
     #[serde(default)]
@@ -134,8 +144,13 @@ pub struct Row {
     pub roofline_ms: Option<f64>,
     #[serde(default)]
     pub limit_fraction: Option<f64>,
-    #[serde(default)]
-    pub bound_by: String,
+    #[serde(
+        default,
+        serialize_with = "opt_as_text",
+        deserialize_with = "opt_from_text"
+    )]
+    #[schemars(with = "String")]
+    pub bound_by: Option<Bound>,
     #[serde(default)]
     pub normalized_time: Option<f64>,
     /// The machine's speed at this row's rounds against the whole run: the geometric mean over
@@ -162,7 +177,9 @@ pub struct Row {
     #[serde(default)]
     pub harness_ms: Option<f64>,
     /// Empty on success; otherwise what went wrong (the metrics are then empty).
-    pub error: String,
+    #[serde(serialize_with = "opt_as_text", deserialize_with = "opt_from_text")]
+    #[schemars(with = "String")]
+    pub error: Option<Failure>,
     /// Per-frame samples: in `results.json` only (`samples.csv` has them one per line).
     #[serde(default, skip_serializing_if = "FrameSamples::is_empty")]
     pub samples: FrameSamples,
@@ -190,24 +207,9 @@ enum SettingValueSchema {
     Text(String),
 }
 
-fn settings_column<S: serde::Serializer>(s: &Settings, ser: S) -> Result<S::Ok, S::Error> {
-    if named::AS_TEXT.get() {
-        ser.collect_str(s)
-    } else {
-        s.serialize(ser)
-    }
-}
-
-/// Writes one row to `results.csv`: flat (no samples), settings, stages and counters as text.
+/// Writes one row to `results.csv`: its flat view ([`CsvRow`]).
 fn serialize_csv_row<W: Write>(csv: &mut csv::Writer<W>, row: &Row) -> csv::Result<()> {
-    named::AS_TEXT.set(true);
-    let written = csv.serialize(Row {
-        samples: FrameSamples::default(),
-        round_control: vec![],
-        ..row.clone()
-    });
-    named::AS_TEXT.set(false);
-    written
+    csv.serialize(CsvRow(row))
 }
 
 impl Row {
@@ -234,7 +236,15 @@ impl Row {
     }
 
     pub fn ok(&self) -> bool {
-        self.error.is_empty()
+        self.error.is_none()
+    }
+
+    /// The failure's text (empty for a row that did not fail).
+    pub fn error_text(&self) -> String {
+        self.error
+            .as_ref()
+            .map(Failure::to_string)
+            .unwrap_or_default()
     }
 }
 

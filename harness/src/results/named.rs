@@ -113,16 +113,8 @@ impl fmt::Display for NamedValues {
     }
 }
 
-thread_local! {
-    /// Set while a row is written to `results.csv`, whose cells cannot hold a map.
-    pub(crate) static AS_TEXT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
 impl Serialize for NamedValues {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        if AS_TEXT.get() {
-            return s.collect_str(self);
-        }
         use serde::ser::SerializeMap;
         let mut map = s.serialize_map(Some(self.0.len()))?;
         for (n, v) in &self.0 {

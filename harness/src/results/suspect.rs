@@ -7,6 +7,12 @@
 //! the best PSNR of that image. Rows without a PSNR (failed, or `--no-reference`) are never suspect: failures are
 //! reported on their own.
 
+use std::fmt;
+use std::str::FromStr;
+
+use render_core::Settings;
+
+use crate::results::outcome::TextColumn;
 use crate::results::Row;
 
 /// How far below the best row of the same image a PSNR may fall before the row is suspect.
@@ -29,8 +35,90 @@ fn same_image(a: &Row, b: &Row) -> bool {
         && a.height == b.height
 }
 
+/// Why a row's image is suspect. The figures are kept at the tenth of a dB its text shows, so
+/// a row read back from a file equals the row written.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Suspect {
+    /// The PSNR is below `floor_db` ([`FLOOR_DB`] when it was judged).
+    BelowFloor { psnr_db: f64, floor_db: f64 },
+    /// The PSNR is `gap_db` below the best row of the same image, that of `best_algorithm`
+    /// with `best_settings` at `best_db`.
+    BelowBest {
+        psnr_db: f64,
+        gap_db: f64,
+        best_algorithm: String,
+        best_settings: Settings,
+        best_db: f64,
+    },
+}
+
+/// `x` as its text to one decimal shows it.
+fn tenth(x: f64) -> f64 {
+    format!("{x:.1}").parse().unwrap_or(x)
+}
+
+impl fmt::Display for Suspect {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Suspect::BelowFloor { psnr_db, floor_db } => {
+                write!(f, "PSNR {psnr_db:.1} dB is below {floor_db} dB")
+            }
+            Suspect::BelowBest {
+                psnr_db,
+                gap_db,
+                best_algorithm,
+                best_settings,
+                best_db,
+            } => write!(
+                f,
+                "PSNR {psnr_db:.1} dB is {gap_db:.1} dB below the best on this image \
+                 ({best_algorithm} {best_settings} {best_db:.1} dB)"
+            ),
+        }
+    }
+}
+
+impl FromStr for Suspect {
+    type Err = String;
+    /// The text [`Display`](fmt::Display) writes.
+    fn from_str(text: &str) -> Result<Suspect, String> {
+        let bad = || "not a suspect row's reason (PSNR … dB is … below …)".to_string();
+        let db = |t: &str| -> Result<f64, String> {
+            t.strip_suffix(" dB")
+                .and_then(|t| t.parse().ok())
+                .ok_or_else(bad)
+        };
+        let rest = text.strip_prefix("PSNR ").ok_or_else(bad)?;
+        let (psnr, rest) = rest.split_once(" dB is ").ok_or_else(bad)?;
+        let psnr_db: f64 = psnr.parse().map_err(|_| bad())?;
+        if let Some(floor) = rest.strip_prefix("below ") {
+            return Ok(Suspect::BelowFloor {
+                psnr_db,
+                floor_db: db(floor)?,
+            });
+        }
+        let (gap, best) = rest
+            .split_once(" below the best on this image (")
+            .ok_or_else(bad)?;
+        let best = best.strip_suffix(" dB)").ok_or_else(bad)?;
+        let (who, best_db) = best.rsplit_once(' ').ok_or_else(bad)?;
+        let (best_algorithm, best_settings) = who.split_once(' ').ok_or_else(bad)?;
+        Ok(Suspect::BelowBest {
+            psnr_db,
+            gap_db: db(gap)?,
+            best_algorithm: best_algorithm.to_string(),
+            best_settings: best_settings.parse().map_err(|e| format!("{e}"))?,
+            best_db: best_db.parse().map_err(|_| bad())?,
+        })
+    }
+}
+
+impl TextColumn for Suspect {
+    const FIELD: &'static str = "suspect";
+}
+
 /// Why `row` is suspect among `others` (which may include `row` itself), or `None`.
-pub fn reason(row: &Row, others: &[Row]) -> Option<String> {
+pub fn reason(row: &Row, others: &[Row]) -> Option<Suspect> {
     let psnr = row.psnr_db?;
     let best = others
         .iter()
@@ -41,15 +129,19 @@ pub fn reason(row: &Row, others: &[Row]) -> Option<String> {
             _ => Some((p, o)),
         });
     if psnr < FLOOR_DB {
-        return Some(format!("PSNR {psnr:.1} dB is below {FLOOR_DB} dB"));
+        return Some(Suspect::BelowFloor {
+            psnr_db: tenth(psnr),
+            floor_db: FLOOR_DB,
+        });
     }
     match best {
-        Some((bp, b)) if psnr < FINE_DB && bp - psnr > GAP_DB => Some(format!(
-            "PSNR {psnr:.1} dB is {:.1} dB below the best on this image ({} {} {bp:.1} dB)",
-            bp - psnr,
-            b.algorithm,
-            b.settings
-        )),
+        Some((bp, b)) if psnr < FINE_DB && bp - psnr > GAP_DB => Some(Suspect::BelowBest {
+            psnr_db: tenth(psnr),
+            gap_db: tenth(bp - psnr),
+            best_algorithm: b.algorithm.clone(),
+            best_settings: b.settings.clone(),
+            best_db: tenth(bp),
+        }),
         _ => None,
     }
 }
@@ -59,19 +151,15 @@ pub fn reason(row: &Row, others: &[Row]) -> Option<String> {
 /// per row.
 pub fn flags(rows: &[Row]) -> Vec<bool> {
     rows.iter()
-        .map(|r| !r.suspect.is_empty() || reason(r, rows).is_some())
+        .map(|r| r.suspect.is_some() || reason(r, rows).is_some())
         .collect()
 }
 
 /// Sets every row's `suspect` column from all rows of the run; returns how many are suspect.
 pub fn mark_all(rows: &mut [Row]) -> usize {
-    let reasons: Vec<String> = rows
-        .iter()
-        .map(|r| reason(r, rows).unwrap_or_default())
-        .collect();
-    let mut n = 0;
+    let reasons: Vec<Option<Suspect>> = rows.iter().map(|r| reason(r, rows)).collect();
+    let n = reasons.iter().flatten().count();
     for (row, why) in rows.iter_mut().zip(reasons) {
-        n += usize::from(!why.is_empty());
         row.suspect = why;
     }
     n
@@ -101,29 +189,47 @@ mod tests {
             row("broken", "+y", None),
         ];
         assert_eq!(mark_all(&mut rows), 1);
-        assert!(rows[0].suspect.is_empty() && rows[1].suspect.is_empty());
-        assert!(
-            rows[2].suspect.contains("below 20 dB"),
-            "{}",
-            rows[2].suspect
+        assert!(rows[0].suspect.is_none() && rows[1].suspect.is_none());
+        assert_eq!(
+            rows[2].suspect.as_ref().unwrap().to_string(),
+            "PSNR 13.7 dB is below 20 dB"
         );
         // 17 dB below the best of its own image: within the gap.
-        assert!(rows[3].suspect.is_empty());
-        assert!(rows[5].suspect.is_empty());
+        assert!(rows[3].suspect.is_none());
+        assert!(rows[5].suspect.is_none());
         // A 30 dB gap above the floor is flagged and names the best row.
         rows[3].psnr_db = Some(21.0);
         assert_eq!(mark_all(&mut rows), 2);
-        assert!(
-            rows[3].suspect.contains("31.0 dB below the best"),
-            "{}",
-            rows[3].suspect
+        let why = rows[3].suspect.as_ref().unwrap().to_string();
+        assert_eq!(
+            why,
+            "PSNR 21.0 dB is 31.0 dB below the best on this image \
+             (gator-pt variant=a;sort=radix 52.0 dB)"
         );
-        assert!(rows[3].suspect.contains("gator-pt"));
+        // The text reads back to the same reason.
+        assert_eq!(
+            why.parse::<Suspect>().as_ref(),
+            Ok(rows[3].suspect.as_ref().unwrap())
+        );
         // Next to a row at the 99 dB cap, 45 dB is still fine.
         rows[4].psnr_db = Some(99.0);
         rows[3].psnr_db = Some(45.0);
         assert_eq!(mark_all(&mut rows), 1);
-        assert!(rows[3].suspect.is_empty());
+        assert!(rows[3].suspect.is_none());
+    }
+
+    #[test]
+    fn a_reason_that_does_not_parse_is_an_error() {
+        let floor = "PSNR 13.7 dB is below 20 dB".parse::<Suspect>().unwrap();
+        assert_eq!(floor.to_string(), "PSNR 13.7 dB is below 20 dB");
+        for bad in [
+            "",
+            "too dark",
+            "PSNR x dB is below 20 dB",
+            "PSNR 1.0 dB is 3 dB",
+        ] {
+            assert!(bad.parse::<Suspect>().is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -3,10 +3,10 @@
 //! counters, host peak memory). The run loop in the parent module drives it.
 
 use super::*;
-use crate::results::NamedValues;
+use crate::results::{Failure, NamedValues, Stage};
 
 pub(super) struct DatasetContext<'a> {
-    config: &'a RunConfig,
+    pub(super) config: &'a RunConfig,
     gpu: &'a Gpu,
     /// A mesh, or voxels split into tets on first need (a variant that draws tets, the
     /// reference).
@@ -135,7 +135,7 @@ impl<'a> DatasetContext<'a> {
             r.image.save_png(&dir.join("reference.png"))?;
             Ok((r.image, format!("{rel}/reference.png"), r.lost_rays))
         })
-        .map_err(|e| format!("reference for {} {}: {e:#}", self.label, vp.name));
+        .map_err(|e| format!("{} {}: {e:#}", self.label, vp.name));
         self.references.insert(vp.name.clone(), r.clone());
         r
     }
@@ -158,57 +158,11 @@ impl<'a> DatasetContext<'a> {
     ) -> anyhow::Result<()> {
         let c = self.config;
         let rounds = c.rounds.max(1);
-        let views = c.viewpoints.len();
         // Per prepared variant: renderer, what prepare gave, frames so far and the first
         // failure per viewpoint.
         let mut live = vec![];
-        for mut renderer in renderers {
-            let what = self.describe(renderer.as_ref());
-            progress.activity(&format!("preparing {what}"));
-            // A voxel renderer takes a voxel volume as it is; any other renderer needs the
-            // tets, split on first need before the prepare's peak is reset, so that the split
-            // (like loading) is not counted as the prepare's memory.
-            let input = match self.data.voxels().filter(|_| renderer.draws_voxels()) {
-                Some(volume) => Ok(PrepareInput::Voxels(volume)),
-                None => guarded("splitting the volume into tets", || Ok(self.data.mesh()?))
-                    .map(PrepareInput::Tets),
-            };
-            // The first viewpoint's row carries the prepare's peak (host copies of the mesh).
-            let peak_reset = reset_host_peak();
-            let prepared = input.and_then(|input| {
-                guarded("prepare", || match input {
-                    PrepareInput::Voxels(volume) => {
-                        renderer.prepare_voxels(self.gpu, volume, self.optics)
-                    }
-                    PrepareInput::Tets(mesh) => renderer.prepare(self.gpu, mesh, self.optics),
-                })
-            });
-            let prepare_peak = host_peak_bytes(peak_reset);
-            match prepared {
-                Ok(prepared) => {
-                    let mut peaks = vec![None::<u64>; views];
-                    peaks[0] = prepare_peak;
-                    live.push(Variant {
-                        renderer,
-                        prepared,
-                        frames: vec![Vec::<FrameStats>::new(); views],
-                        failed: vec![None::<String>; views],
-                        peaks,
-                        harness_ms: vec![0.0; views],
-                    })
-                }
-                Err(e) => {
-                    // Every viewpoint of this variant gets a row that says why it is empty.
-                    for vp in &c.viewpoints {
-                        let mut row = base_row(self, renderer.as_ref(), vp);
-                        row.error = format!("prepare failed: {e:#}");
-                        row.host_peak_bytes = prepare_peak;
-                        progress.step(&format!("FAILED {what} {}: {}", vp.name, row.error));
-                        writer.push(row)?;
-                        outcome.failed_rows += 1;
-                    }
-                }
-            }
+        for renderer in renderers {
+            live.extend(self.prepare_variant(renderer, writer, progress, outcome)?);
         }
         // `scripts/profile.sh` samples only from here on: the frames and the rows, not the
         // loading and preparing.
@@ -270,6 +224,66 @@ impl<'a> DatasetContext<'a> {
         Ok(())
     }
 
+    /// Prepares one variant for the data set: the voxels to a voxel renderer, the tets (split
+    /// on first need) to any other, the host memory peak taken around it. A variant that does
+    /// not prepare gets a failed row per viewpoint, and `None`.
+    fn prepare_variant(
+        &mut self,
+        mut renderer: Box<dyn Renderer>,
+        writer: &mut ResultsWriter,
+        progress: &mut Progress,
+        outcome: &mut RunOutcome,
+    ) -> anyhow::Result<Option<Variant>> {
+        let views = self.config.viewpoints.len();
+        let what = self.describe(renderer.as_ref());
+        progress.activity(&format!("preparing {what}"));
+        // A voxel renderer takes a voxel volume as it is; any other renderer needs the
+        // tets, split on first need before the prepare's peak is reset, so that the split
+        // (like loading) is not counted as the prepare's memory.
+        let input = match self.data.voxels().filter(|_| renderer.draws_voxels()) {
+            Some(volume) => Ok(PrepareInput::Voxels(volume)),
+            None => guarded("splitting the volume into tets", || Ok(self.data.mesh()?))
+                .map(PrepareInput::Tets),
+        };
+        // The first viewpoint's row carries the prepare's peak (host copies of the mesh).
+        let peak_reset = reset_host_peak();
+        let prepared = input.and_then(|input| {
+            guarded("prepare", || match input {
+                PrepareInput::Voxels(volume) => {
+                    renderer.prepare_voxels(self.gpu, volume, self.optics)
+                }
+                PrepareInput::Tets(mesh) => renderer.prepare(self.gpu, mesh, self.optics),
+            })
+        });
+        let prepare_peak = host_peak_bytes(peak_reset);
+        match prepared {
+            Ok(prepared) => {
+                let mut peaks = vec![None::<u64>; views];
+                peaks[0] = prepare_peak;
+                Ok(Some(Variant {
+                    renderer,
+                    prepared,
+                    frames: vec![Vec::<FrameStats>::new(); views],
+                    failed: vec![None::<String>; views],
+                    peaks,
+                    harness_ms: vec![0.0; views],
+                }))
+            }
+            Err(e) => {
+                // Every viewpoint of this variant gets a row that says why it is empty.
+                for vp in &self.config.viewpoints {
+                    let mut row = base_row(self, renderer.as_ref(), vp);
+                    row.error = Some(Failure::new(Stage::Prepare, format!("{e:#}")));
+                    row.host_peak_bytes = prepare_peak;
+                    progress.step(&format!("FAILED {what} {}: {}", vp.name, row.error_text()));
+                    writer.push(row)?;
+                    outcome.failed_rows += 1;
+                }
+                Ok(None)
+            }
+        }
+    }
+
     fn describe(&self, renderer: &dyn Renderer) -> String {
         format!(
             "{} {} on {}",
@@ -323,21 +337,21 @@ impl<'a> DatasetContext<'a> {
             None => self.measure(renderer, prepared, vp, frames, &mut row, progress),
         };
         if let Err(e) = measured {
-            row.error = format!("{e:#}");
+            row.error = Some(Failure::new(Stage::Render, format!("{e:#}")));
             outcome.failed_rows += 1;
-            progress.step(&format!("FAILED {what} {}: {}", vp.name, row.error));
-        } else if !row.error.is_empty() {
+            progress.step(&format!("FAILED {what} {}: {}", vp.name, row.error_text()));
+        } else if let Some(failure) = &row.error {
             // Measured, but without error metrics (the reference failed).
             outcome.failed_rows += 1;
             progress.step(&format!(
                 "{what} {}: {:.2} ms, no reference: {}",
                 vp.name,
                 row.total_ms.unwrap_or(f64::NAN),
-                row.error
+                failure
             ));
         } else {
             // Against the rows so far; the final flags are set once every row is in.
-            row.suspect = crate::results::suspect::reason(&row, rows_so_far).unwrap_or_default();
+            row.suspect = crate::results::suspect::reason(&row, rows_so_far);
             progress.step(&format!(
                 "{what} {}: {:.2} ms, {:.3} M tets/s, PSNR {}{}",
                 vp.name,
@@ -346,11 +360,10 @@ impl<'a> DatasetContext<'a> {
                 row.psnr_db
                     .map(|p| format!("{p:.2} dB"))
                     .unwrap_or_else(|| "-".into()),
-                if row.suspect.is_empty() {
-                    String::new()
-                } else {
-                    format!("  SUSPECT: {}", row.suspect)
-                }
+                row.suspect
+                    .as_ref()
+                    .map(|why| format!("  SUSPECT: {why}"))
+                    .unwrap_or_default()
             ));
         }
         row
@@ -453,7 +466,7 @@ impl<'a> DatasetContext<'a> {
                 }
                 Err(msg) => {
                     // The timing is still valid; the row stays, without error metrics.
-                    row.error = msg;
+                    row.error = Some(Failure::new(Stage::Reference, msg));
                 }
             }
         }

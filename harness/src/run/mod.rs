@@ -310,39 +310,46 @@ pub fn run(config: &RunConfig, factory: VariantFactory) -> anyhow::Result<RunOut
         let optics =
             Optics::for_extent(config.tf.clone(), &dataset.bounds(), dataset.scalar_range());
         let mut ctx = DatasetContext::new(config, &gpu, &dataset, &optics, label);
-        if config.rounds <= 1 {
-            // One variant at a time: its GPU memory is freed before the next one prepares.
-            // The control before the first, between variants when it is due, after the last.
-            for (i, renderer) in renderers.into_iter().enumerate() {
-                if let Some(c) = control.as_mut().filter(|c| i == 0 || c.due()) {
-                    c.take(&ctx.label, 0, &mut writer, &progress);
-                }
-                let mut none = None;
-                ctx.run_variants(
-                    vec![renderer],
-                    &mut writer,
-                    &mut progress,
-                    &mut outcome,
-                    &mut none,
-                )?;
-            }
-            if let Some(c) = control.as_mut() {
-                c.take(&ctx.label, 1, &mut writer, &progress);
-            }
-        } else {
-            ctx.run_variants(
-                renderers,
-                &mut writer,
-                &mut progress,
-                &mut outcome,
-                &mut control,
-            )?;
-        }
+        measure_dataset(
+            &mut ctx,
+            renderers,
+            &mut control,
+            &mut writer,
+            &mut progress,
+            &mut outcome,
+        )?;
     }
     progress.finish();
     finish_run(config, &gpu, &mut writer, &mut outcome)?;
     outcome.seconds = started.elapsed().as_secs_f64();
     Ok(outcome)
+}
+
+/// Measures `renderers` on one data set. In one round, one variant at a time (its GPU memory
+/// freed before the next one prepares), the control taken before the first, between variants
+/// when it is due and after the last; in several, all variants round after round, the control
+/// taken with each round ([`DatasetContext::run_variants`]).
+fn measure_dataset(
+    ctx: &mut DatasetContext<'_>,
+    renderers: Vec<Box<dyn Renderer>>,
+    control: &mut Option<control::RunControl>,
+    writer: &mut ResultsWriter,
+    progress: &mut Progress,
+    outcome: &mut RunOutcome,
+) -> anyhow::Result<()> {
+    if ctx.config.rounds > 1 {
+        return ctx.run_variants(renderers, writer, progress, outcome, control);
+    }
+    for (i, renderer) in renderers.into_iter().enumerate() {
+        if let Some(c) = control.as_mut().filter(|c| i == 0 || c.due()) {
+            c.take(&ctx.label, 0, writer, progress);
+        }
+        ctx.run_variants(vec![renderer], writer, progress, outcome, &mut None)?;
+    }
+    if let Some(c) = control.as_mut() {
+        c.take(&ctx.label, 1, writer, progress);
+    }
+    Ok(())
 }
 
 /// The units of the matrix this invocation runs: its shard's (all without `--shard`), less
@@ -523,12 +530,12 @@ fn finish_run(
         .file
         .rows
         .iter()
-        .filter(|r| !r.suspect.is_empty())
-        .map(|r| {
-            format!(
-                "{} {} on {} {}: {}",
-                r.algorithm, r.settings, r.dataset, r.viewpoint, r.suspect
-            )
+        .filter_map(|r| {
+            let why = r.suspect.as_ref()?;
+            Some(format!(
+                "{} {} on {} {}: {why}",
+                r.algorithm, r.settings, r.dataset, r.viewpoint
+            ))
         })
         .collect();
     if let Some(cal) = writer.file.machine.calibration.clone() {
@@ -599,7 +606,7 @@ pub fn beaten_bounds(rows: &[Row]) -> Vec<String> {
                 r.settings,
                 r.dataset,
                 r.viewpoint,
-                r.bound_by,
+                r.bound_by.map_or("", crate::results::Bound::name),
                 r.roofline_ms.unwrap_or(f64::NAN),
                 r.total_ms_min.unwrap_or(f64::NAN),
                 r.limit_fraction.unwrap_or(f64::NAN)

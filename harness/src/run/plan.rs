@@ -7,6 +7,7 @@
 
 use std::path::PathBuf;
 
+use external_peer::ExternalSpec;
 use render_core::{Projection, TransferFunction};
 
 use crate::algorithms::{self, SettingsFilter};
@@ -74,11 +75,7 @@ impl RunPlan {
                 .map(|s| s.to_string())
                 .collect()
         } else {
-            m.datasets
-                .iter()
-                .map(|s| s.trim().to_string())
-                .filter(|s| !s.is_empty())
-                .collect()
+            named(&m.datasets)
         };
         if datasets.is_empty() {
             anyhow::bail!("--datasets is empty");
@@ -110,47 +107,8 @@ impl RunPlan {
             anyhow::bail!("--rounds must be at least 1");
         }
 
-        let known = algorithms::names();
         let externals = m.external.specs()?;
-        let mut algorithms: Vec<String> = if m.algorithms.is_empty() {
-            // "All" means tetbench's own; peers come with --peers or by name.
-            known
-                .iter()
-                .filter(|n| !algorithms::is_peer(n))
-                .map(|s| s.to_string())
-                .collect()
-        } else {
-            m.algorithms
-                .iter()
-                .map(|s| s.trim().to_string())
-                .filter(|s| !s.is_empty())
-                .collect()
-        };
-        for a in &algorithms {
-            if !known.contains(&a.as_str()) && !externals.iter().any(|s| s.name == *a) {
-                anyhow::bail!(
-                    "--algorithms: unknown algorithm {a:?}; known: {}",
-                    known.join(", ")
-                );
-            }
-        }
-        for group in m.peers.iter().map(|s| s.trim()).filter(|s| !s.is_empty()) {
-            for name in
-                algorithms::peer_group(group).map_err(|e| anyhow::anyhow!("--peers: {e}"))?
-            {
-                if !algorithms.iter().any(|a| a == name) {
-                    algorithms.push(name.to_string());
-                }
-            }
-        }
-        for spec in &externals {
-            if !algorithms.contains(&spec.name) {
-                algorithms.push(spec.name.clone());
-            }
-        }
-        if algorithms.is_empty() {
-            anyhow::bail!("--algorithms is empty; known: {}", known.join(", "));
-        }
+        let algorithms = algorithm_list(m, &externals)?;
 
         let tf_spec = m.tf.clone().unwrap_or_else(|| DEFAULT_TF.to_string());
         let tf = TransferFunction::load(&tf_spec)
@@ -194,6 +152,54 @@ impl RunPlan {
             externals,
         })
     }
+}
+
+/// The algorithms to run: those named (all of tetbench's own when none is), the peer groups'
+/// and the external renderers; an unknown name is an error listing the known ones.
+fn algorithm_list(m: &MatrixArgs, externals: &[ExternalSpec]) -> anyhow::Result<Vec<String>> {
+    let known = algorithms::names();
+    let mut algorithms: Vec<String> = if m.algorithms.is_empty() {
+        // "All" means tetbench's own; peers come with --peers or by name.
+        known
+            .iter()
+            .filter(|n| !algorithms::is_peer(n))
+            .map(|s| s.to_string())
+            .collect()
+    } else {
+        named(&m.algorithms)
+    };
+    for a in &algorithms {
+        if !known.contains(&a.as_str()) && !externals.iter().any(|s| s.name == *a) {
+            anyhow::bail!(
+                "--algorithms: unknown algorithm {a:?}; known: {}",
+                known.join(", ")
+            );
+        }
+    }
+    for group in m.peers.iter().map(|s| s.trim()).filter(|s| !s.is_empty()) {
+        for name in algorithms::peer_group(group).map_err(|e| anyhow::anyhow!("--peers: {e}"))? {
+            if !algorithms.iter().any(|a| a == name) {
+                algorithms.push(name.to_string());
+            }
+        }
+    }
+    for spec in externals {
+        if !algorithms.contains(&spec.name) {
+            algorithms.push(spec.name.clone());
+        }
+    }
+    if algorithms.is_empty() {
+        anyhow::bail!("--algorithms is empty; known: {}", known.join(", "));
+    }
+    Ok(algorithms)
+}
+
+/// The names a list flag gave, trimmed, the empty ones left out.
+fn named(list: &[String]) -> Vec<String> {
+    list.iter()
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .collect()
 }
 
 /// A flag's text (`given`, else `default`) parsed into its type; a failure names the flag

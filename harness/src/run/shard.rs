@@ -235,37 +235,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path, allow_missing: bool) -> anyhow::Resul
         );
     }
     let first = &files[0];
-    let mut matrix = matrix_of(&first.run);
-    for (f, d) in files.iter().zip(dirs).skip(1) {
-        if matrix_of(&f.run) == matrix {
-            continue;
-        }
-        if matrix_but_algorithms(&f.run) == matrix_but_algorithms(&matrix) {
-            // Complementary algorithms: only meaningful side by side on one adapter.
-            anyhow::ensure!(
-                adapter_of(f) == adapter_of(first),
-                "{} measured other algorithms than {} on another adapter ({:?} vs {:?}); runs of \
-                 different algorithms can be merged only from one machine",
-                d.display(),
-                dirs[0].display(),
-                adapter_of(f),
-                adapter_of(first)
-            );
-            for a in &f.run.algorithms {
-                if !matrix.algorithms.contains(a) {
-                    matrix.algorithms.push(a.clone());
-                }
-            }
-            continue;
-        }
-        anyhow::bail!(
-            "{} was run with a different matrix than {} (data sets, viewpoints, size, frames, \
-             transfer function or settings differ); only shards of one run, the same run on \
-             several machines, or runs of other algorithms on one machine can be merged",
-            d.display(),
-            dirs[0].display()
-        );
-    }
+    let matrix = merged_matrix(&files, dirs)?;
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut seen: HashMap<_, PathBuf> = HashMap::new();
     let mut rows: Vec<Row> = vec![];
@@ -330,6 +300,44 @@ pub fn merge(dirs: &[PathBuf], out: &Path, allow_missing: bool) -> anyhow::Resul
     results::write_json(out, &merged)?;
     crate::results::samples::write_samples_csv(out, &merged.rows)?;
     Ok(merged)
+}
+
+/// The matrix the merged runs share: one run's (shards, machines), or one machine's runs of
+/// other algorithms put together; any other difference is an error naming the two runs.
+fn merged_matrix(files: &[ResultsFile], dirs: &[PathBuf]) -> anyhow::Result<RunDescription> {
+    let first = &files[0];
+    let mut matrix = matrix_of(&first.run);
+    for (f, d) in files.iter().zip(dirs).skip(1) {
+        if matrix_of(&f.run) == matrix {
+            continue;
+        }
+        if matrix_but_algorithms(&f.run) == matrix_but_algorithms(&matrix) {
+            // Complementary algorithms: only meaningful side by side on one adapter.
+            anyhow::ensure!(
+                adapter_of(f) == adapter_of(first),
+                "{} measured other algorithms than {} on another adapter ({:?} vs {:?}); runs of \
+                 different algorithms can be merged only from one machine",
+                d.display(),
+                dirs[0].display(),
+                adapter_of(f),
+                adapter_of(first)
+            );
+            for a in &f.run.algorithms {
+                if !matrix.algorithms.contains(a) {
+                    matrix.algorithms.push(a.clone());
+                }
+            }
+            continue;
+        }
+        anyhow::bail!(
+            "{} was run with a different matrix than {} (data sets, viewpoints, size, frames, \
+             transfer function or settings differ); only shards of one run, the same run on \
+             several machines, or runs of other algorithms on one machine can be merged",
+            d.display(),
+            dirs[0].display()
+        );
+    }
+    Ok(matrix)
 }
 
 fn copy_file(from: &Path, to: &Path, rel: &str) -> anyhow::Result<()> {
