@@ -35,6 +35,11 @@ fn generated_blocks(page: &Path, text: &str) -> Vec<Generated> {
     let mut out = vec![];
     let mut from = 0;
     while let Some(at) = text[from..].find(OPEN).map(|i| i + from) {
+        // Only a comment that opens its line: a page may name the syntax in its prose.
+        if at > 0 && !text[..at].ends_with('\n') {
+            from = at + OPEN.len();
+            continue;
+        }
         let line = text[..at].lines().count() + 1;
         let end_of_comment = text[at..]
             .find("-->")
@@ -135,4 +140,6 @@ fn blocks_are_found_between_the_two_comments() {
     assert_eq!(found[0].args, ["analyze", "medians", "a=b"]);
     assert_eq!(&text[found[0].body.clone()], "| 1 |\n");
     assert_eq!(found[0].line, 2);
+    let prose = "between `<!-- tetbench analyze … -->` and its end\n";
+    assert!(generated_blocks(page, prose).is_empty());
 }
