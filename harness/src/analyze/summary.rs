@@ -1,12 +1,13 @@
-//! `tetbench analyze summary OUT`: the means over viewpoints of a finished run as Markdown and
-//! CSV (`OUT/summary.md`, `OUT/summary.csv`), printed too.
+//! `tetbench analyze summary INPUT [--out FILE.md]`: the means over viewpoints of a finished run
+//! (its directory, or a results CSV) as Markdown and CSV (`INPUT/summary.md`, `INPUT/summary.csv`),
+//! printed too; with `--out`, the Markdown only, to that file.
 
 use std::path::PathBuf;
 
 use anyhow::Context as _;
 
+use crate::plot::data::distinct;
 use crate::report::{aggregate, markdown_summary, Spread};
-use crate::results::ResultsFile;
 
 /// The papers' tets/s beside ours for the series a paper table covers (GATOR Table 3, HAVS
 /// Table 4, fragment PT Table 1); empty when none does.
@@ -43,31 +44,41 @@ pub fn paper_markdown(aggs: &[crate::report::Aggregate]) -> String {
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Output directory of a `tetbench run` (holds results.json).
-    pub out: PathBuf,
+    /// A `tetbench run` output directory (holds results.json), or a results CSV file.
+    pub input: PathBuf,
+    /// Write only the Markdown, to this file, instead of INPUT/summary.md and
+    /// INPUT/summary.csv (a CSV input needs it).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }
 
 pub fn run(args: Args, _ctx: &super::Context) -> anyhow::Result<()> {
-    let file = ResultsFile::read(&args.out)?;
-    let aggs = aggregate(&file.rows);
-    let adapter = file
-        .machine
-        .adapter
-        .as_ref()
-        .map(|a| format!("{} ({})", a.name, a.backend))
-        .unwrap_or_default();
+    let rows = super::peers::read_rows(&args.input)?;
+    let aggs = aggregate(&rows);
+    let sizes = distinct(rows.iter().map(|r| format!("{}×{}", r.width, r.height)));
     let md = format!(
-        "Means over viewpoints ({}), {}×{}, adapter {adapter}.\n\n{}{}",
-        file.run.viewpoints,
-        file.run.width,
-        file.run.height,
+        "Means over viewpoints ({} viewpoints), {}, adapter {}.\n\n{}{}",
+        distinct(rows.iter().map(|r| r.viewpoint.as_str())).len(),
+        sizes.join(", "),
+        distinct(rows.iter().map(|r| r.adapter.as_str())).join(", "),
         markdown_summary(&aggs),
         paper_markdown(&aggs)
     );
-    let md_path = args.out.join("summary.md");
+    if let Some(out) = &args.out {
+        std::fs::write(out, &md).with_context(|| format!("cannot write {}", out.display()))?;
+        print!("{md}");
+        return Ok(());
+    }
+    if !args.input.is_dir() {
+        anyhow::bail!(
+            "{}: a results CSV has no run directory to write summary.md into; name a file with --out",
+            args.input.display()
+        );
+    }
+    let md_path = args.input.join("summary.md");
     std::fs::write(&md_path, &md).with_context(|| format!("cannot write {}", md_path.display()))?;
 
-    let csv_path = args.out.join("summary.csv");
+    let csv_path = args.input.join("summary.csv");
     let mut w = csv::Writer::from_path(&csv_path)
         .with_context(|| format!("cannot create {}", csv_path.display()))?;
     w.write_record([

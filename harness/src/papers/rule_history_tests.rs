@@ -229,7 +229,10 @@ fn committed_versions(file: &str) -> Result<Vec<(String, String)>, String> {
             "the clone is shallow: {file}'s history is not here"
         ));
     }
-    let log = git(&["log", "--format=%H", "--", file])?;
+    // The first-parent chain: branches merged in parallel each changed the file from its own
+    // base, so the commits in date order would read one branch's change as undone by the
+    // other's. A merge carries its branch's changes as one step.
+    let log = git(&["log", "--first-parent", "--format=%H", "--", file])?;
     log.lines()
         .rev()
         .map(|c| Ok((c.to_string(), git(&["show", &format!("{c}:{file}")])?)))
@@ -270,7 +273,9 @@ fn walk(file: &str, versions: &[(String, String)], uncovered: Uncovered) -> (usi
             Some((c, t)) => (c.clone(), t.clone()),
             None => (head.clone(), working.clone()),
         };
-        let mut in_range = |h: &str| is_ancestor(p_commit, h) && is_ancestor(h, &c_commit);
+        // A commit that came in with this step: in the new version's history, not in the old's
+        // (on a merged branch it need not descend from the old version).
+        let mut in_range = |h: &str| is_ancestor(h, &c_commit) && !is_ancestor(h, p_commit);
         for m in uncovered(p_text, &c_text, &mut in_range) {
             let to = if i + 1 < versions.len() {
                 c_commit[..7].to_string()
