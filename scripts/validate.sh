@@ -8,8 +8,9 @@
 # +x+y+z, no reference): every combination of the settings that choose code paths (HAVS sort ×
 # tags × mode × early termination, ray casting mode × table × et, splatting buckets × sort ×
 # bricks × ese, fragment PT sort × shading, GATOR sort × cell model), the numeric knobs that
-# only change constants at their extremes (HAVS k 2 and 16, ray casting 1×1 and 2×2 tiles and
-# 4 and 32 peel layers, one splatting kernel and grid).
+# only change constants at their extremes (HAVS k 2 and 16, ray casting 1×1 and 2×2 tiles,
+# 4 and 32 peel layers and k 1 and 8, one splatting kernel and grid); HAVS in a pass of its own
+# ("variants-havs"), since its k and the ray caster's share a key.
 # Pass "chunked": the default variants (ray casting with its 2D table) on box:24k, the device
 # requested with 256 KiB storage bindings, no timestamp queries and render passes of 4,096
 # triangles (TETBENCH_MAX_STORAGE_BINDING, TETBENCH_TIMESTAMPS, TETBENCH_MAX_TRIANGLES_PER_PASS;
@@ -122,8 +123,12 @@ PY
     rows=$((rows + ${counts% *}))
     echo "tetbench validate: pass $name: ${counts% *} rows, ${counts#* } variants, $((SECONDS - t0)) s" >&2
 }
+# HAVS's k and the ray caster's k (passes between counts) share a key, so each gets its own pass.
 run_pass variants -- --all-variants --datasets box:1k,shell:1k \
-    --settings 'k=2|16;tiles=1x1|2x2;layers=4|32;radius=2;slab=1;grid=32'
+    --algorithms gator-pt,fragment-pt,raycast,splat \
+    --settings 'tiles=1x1|2x2;layers=4|32;radius=2;slab=1;grid=32'
+run_pass variants-havs -- --all-variants --datasets box:1k,shell:1k --algorithms havs \
+    --settings 'k=2|16'
 run_pass chunked TETBENCH_MAX_STORAGE_BINDING=262144 TETBENCH_TIMESTAMPS=off TETBENCH_MAX_TRIANGLES_PER_PASS=4096 -- \
     --datasets box:24k --settings table=2d
 
