@@ -481,6 +481,19 @@ impl Renderer for Raycast {
             ),
         )))
     }
+
+    fn tile_counts(&mut self, _gpu: &Gpu) -> anyhow::Result<Option<render_core::TileCounts>> {
+        let st = self.state()?;
+        let (Some(t), Some(last)) = (&st.target, &st.last) else {
+            bail!("raycast: render before tile_counts");
+        };
+        Ok(Some(crate::passmap::tile_counts(
+            [t.width, t.height],
+            self.settings.tiles,
+            last.tile_size,
+            &last.tile_passes,
+        )))
+    }
 }
 
 /// Label of the texture that holds the mesh.
