@@ -442,6 +442,10 @@ impl<'a> DatasetContext<'a> {
         if let Some((suffix, extra)) = guarded("extra_image", || renderer.extra_image(self.gpu))? {
             extra.save_png(&dir.join(format!("{stem}.{suffix}.png")))?;
         }
+        // Its counts per screen tile, as numbers, beside it too.
+        if let Some(counts) = guarded("tile_counts", || renderer.tile_counts(self.gpu))? {
+            row.tile_counts = crate::results::tile_counts::write(&dir, &rel, &stem, &counts)?;
+        }
 
         if c.reference {
             let referencing = Instant::now();
