@@ -16,6 +16,7 @@ use crate::papers::table::{Cell, CompRow, Comparison, Metric};
 use crate::papers::transcription;
 use crate::papers::{Paper, PaperModule};
 
+mod heatmap;
 mod passes;
 use passes::{PASSES_RUN, TILED_RUN, WALKS_RUN};
 
@@ -183,6 +184,8 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     report
         .comparisons
         .push(passes::table4(m, &load("raycast_table4")));
+    // Fig. 5: the passes per tile of the tiled passes run, beside the figure's description.
+    report.figures.push(heatmap::fig5(m));
 
     // Tables 5 and 6: ms per tiling, 2D and 3D tables.
     for (name, table) in [("raycast_table5", "2d"), ("raycast_table6", "3d")] {
