@@ -1,13 +1,9 @@
 //! The pass-count map (the paper's Fig. 5): every tile filled with a colour for the number of
 //! ray-casting passes it ran, brighter where a ray entered the mesh, with dark tile borders;
 //! the same counts as numbers ([`tile_counts`]); and the CPU twin of that count
-//! ([`passes_per_tile`], from a frame's peeling layers: [`twin_passes`]).
+//! ([`passes_per_tile`]; from a rendered frame's peeling layers, [`crate::twin::tile_passes`]).
 
 use render_core::{Image, TileCounts};
-
-use crate::layout::MeshLayout;
-use crate::render::PassData;
-use crate::step;
 
 /// A perceptually ordered ramp (dark blue → teal → yellow), sRGB stops.
 const RAMP: [[f32; 3]; 5] = [
@@ -116,21 +112,6 @@ pub fn tile_counts(size: [u32; 2], tiles: u32, tile_size: [u32; 2], passes: &[u3
         tile_size,
         counts: passes.to_vec(),
     }
-}
-
-/// The CPU twin's passes per tile of a frame: every pixel's ray walked on the host from the
-/// frame's own peeling layers ([`step::walk_segments`] over `layout`, the mesh as the GPU holds
-/// it), spent per layer in rounds of `k` ([`passes_per_tile`]).
-pub fn twin_passes(layout: &MeshLayout, d: &PassData, tiles: u32, k: u32) -> Vec<u32> {
-    let segments: Vec<Vec<u32>> = (0..d.width * d.height)
-        .map(|i| {
-            let (x, y) = (i % d.width, i / d.width);
-            let entries: Vec<_> = d.layers.iter().map(|l| l[i as usize]).collect();
-            let (o, dir) = d.ray_frame.ray(x as f32 + 0.5, y as f32 + 0.5);
-            step::walk_segments(layout, &entries, o, dir, d.bias, d.max_steps).1
-        })
-        .collect();
-    passes_per_tile(&segments, d.width, tiles, d.tile_size, k)
 }
 
 #[cfg(test)]

@@ -264,7 +264,10 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
     assert_eq!(numbers.problem(), None);
     assert_eq!((numbers.tiles, numbers.tile_size), ([n, n], d.tile_size));
     assert_eq!(numbers.counts, twin);
-    assert_eq!(passmap::twin_passes(&layout, &d, n, COUNT_EVERY), twin);
+    assert_eq!(
+        raycast::twin::tile_passes(&layout, &d, n, COUNT_EVERY),
+        twin
+    );
     assert_eq!(
         counter(&stats, "passes_max"),
         *twin.iter().max().unwrap() as f64

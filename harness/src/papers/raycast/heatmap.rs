@@ -144,7 +144,7 @@ mod tests {
             let camera = Camera::fit(&mesh.bounds(), vp, Projection::default(), size, size);
             let stats = r.render(&gpu, &camera).unwrap();
             let d = r.pass_data(&gpu).unwrap();
-            let twin = raycast::passmap::twin_passes(&layout, &d, s.tiles, s.k);
+            let twin = raycast::twin::tile_passes(&layout, &d, s.tiles, s.k);
             let numbers = r.tile_counts(&gpu).unwrap().unwrap();
             let rel = format!("images/v{v}");
             std::fs::create_dir_all(dir.join(&rel)).unwrap();

@@ -96,7 +96,10 @@ impl PaperModule for Raycast {
     }
 
     fn tables(&self, m: &Measured, x: &Extra) -> Report {
-        tables(m, x)
+        let mut report = tables(m, x);
+        // Fig. 5: the passes per tile of the tiled passes run, beside the figure's description.
+        report.figures.push(heatmap::fig5(m));
+        report
     }
 }
 
@@ -184,8 +187,6 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
     report
         .comparisons
         .push(passes::table4(m, &load("raycast_table4")));
-    // Fig. 5: the passes per tile of the tiled passes run, beside the figure's description.
-    report.figures.push(heatmap::fig5(m));
 
     // Tables 5 and 6: ms per tiling, 2D and 3D tables.
     for (name, table) in [("raycast_table5", "2d"), ("raycast_table6", "3d")] {
