@@ -216,6 +216,21 @@ impl Session {
             .unwrap_or_else(|| name.to_string())
     }
 
+    /// Loads the data set the plan calls `name` for a CPU analysis; a failure goes to
+    /// `measured.errors`, naming the data set.
+    pub fn load(&self, name: &str, measured: &mut Measured) -> Option<datasets::Dataset> {
+        let registry = datasets::registry::Registry::new(self.data_dir.clone());
+        match registry.resolve(&self.dataset(name), &datasets::LoadOptions::default()) {
+            Ok(ds) => Some(ds),
+            Err(e) => {
+                measured
+                    .errors
+                    .push(format!("data set \"{name}\" could not be loaded: {e}"));
+                None
+            }
+        }
+    }
+
     /// Rounds per row in this mode.
     pub fn rounds(&self) -> u32 {
         self.rounds
@@ -385,6 +400,14 @@ impl Extra {
     /// The paper's own analyses, if they are of type `T`.
     pub fn own<T: Any>(&self) -> Option<&T> {
         self.own.as_deref()?.downcast_ref::<T>()
+    }
+
+    /// The points and tets of data set `d`, where it was loaded.
+    pub fn size(&self, d: &str) -> Option<(u64, u64)> {
+        self.sizes
+            .iter()
+            .find(|(n, _, _)| n == d)
+            .map(|&(_, points, tets)| (points, tets))
     }
 
     /// Tets of zero volume the loader dropped from data set `d` (0 when none or not loaded).
