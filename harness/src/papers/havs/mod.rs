@@ -192,8 +192,14 @@ fn racy<'a>(aggs: &'a [Aggregate], d: &str, k: &str) -> Option<&'a Aggregate> {
     find(aggs, "havs", d, &pins)
 }
 
+/// Which of an aggregate's spreads a column reads.
+type SpreadOf = fn(&Aggregate) -> Option<Spread>;
+
+/// Which count of the k-buffer model a column of Table 2 reads.
+type KbufferValue = fn(&analysis::KbufferRow) -> f64;
+
 /// The mean of one of an aggregate's spreads.
-fn mean(a: Option<&Aggregate>, spread: fn(&Aggregate) -> Option<Spread>) -> Option<f64> {
+fn mean(a: Option<&Aggregate>, spread: SpreadOf) -> Option<f64> {
     a.and_then(spread).map(|s| s.mean)
 }
 
@@ -236,7 +242,7 @@ pub fn table1(x: &Extra) -> Comparison {
 /// `analyze kbuffer` alike.
 pub fn table2(m: &Measured, x: &Extra) -> Comparison {
     let t = transcription::embedded("havs_table2");
-    let cols: [(&str, &str, fn(&analysis::KbufferRow) -> f64); 5] = [
+    let cols: [(&str, &str, KbufferValue); 5] = [
         ("fragments_count", "fragments", |r| r.fragments as f64),
         ("max_abuffer_list_length", "max A", |r| r.max_list as f64),
         ("max_k", "max k", |r| r.max_k as f64),
@@ -331,7 +337,7 @@ fn table3(m: &Measured, aggs: &[Aggregate]) -> Comparison {
 /// Table 4: whole frames at k = 2.
 fn table4(m: &Measured, aggs: &[Aggregate]) -> Comparison {
     let t = transcription::embedded("havs_table4");
-    let cols: [(&str, &str, usize, fn(&Aggregate) -> Option<Spread>); 5] = [
+    let cols: [(&str, &str, usize, SpreadOf); 5] = [
         ("cpu_sort_ms", "CPU ms", 1, |a| a.cpu_ms),
         ("gpu_ms", "GPU ms", 1, |a| a.gpu_ms),
         ("total_ms", "total ms", 1, |a| a.total_ms),
@@ -364,7 +370,7 @@ fn table4(m: &Measured, aggs: &[Aggregate]) -> Comparison {
 /// Table 5: ms per frame of the other algorithms on three data sets.
 fn table5(m: &Measured, aggs: &[Aggregate]) -> Comparison {
     let t = transcription::embedded("havs_table5");
-    let parts: [(&str, &str, fn(&Aggregate) -> Option<Spread>); 3] = [
+    let parts: [(&str, &str, SpreadOf); 3] = [
         ("cpu_ms", "CPU ms", |a| a.cpu_ms),
         ("gpu_ms", "GPU ms", |a| a.gpu_ms),
         ("total_ms", "total ms", |a| a.total_ms),
