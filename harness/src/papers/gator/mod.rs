@@ -63,18 +63,24 @@ pub fn observed_truth_table_with(
     samples: usize,
     classify: &dyn Fn([[f64; 3]; 4]) -> gator_pt::Classification,
 ) -> Vec<ObservedCase> {
-    let mut x = 0x9e37_79b9_7f4a_7c15u64;
-    let mut rnd = || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
+    let mut rnd = random_coordinates();
     distinct((0..samples).map(|_| {
         let p: [[f64; 3]; 4] = std::array::from_fn(|_| [rnd(), rnd(), rnd()]);
         let c = classify(p);
         ObservedCase::of(c.case, c.class, c.tests)
     }))
+}
+
+/// The coordinates of the random tets both classifiers see: xorshift64 from a fixed seed,
+/// uniform in [-1, 1).
+fn random_coordinates() -> impl FnMut() -> f64 {
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
 }
 
 /// The distinct outcomes, sorted.
@@ -106,13 +112,8 @@ pub fn observed_truth_table_gpu(
     gpu: &render_core::Gpu,
     samples: usize,
 ) -> anyhow::Result<Vec<ObservedCase>> {
-    let mut x = 0x9e37_79b9_7f4a_7c15u64;
-    let mut rnd = || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        ((x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) as f32
-    };
+    let mut random = random_coordinates();
+    let mut rnd = || random() as f32;
     let points: Vec<[f32; 3]> = (0..4 * samples).map(|_| [rnd(), rnd(), rnd()]).collect();
     let tets: Vec<[u32; 4]> = (0..samples as u32)
         .map(|t| [4 * t, 4 * t + 1, 4 * t + 2, 4 * t + 3])
