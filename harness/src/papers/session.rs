@@ -65,7 +65,33 @@ pub struct RunSpec {
     pub full_views: bool,
 }
 
+/// The viewport of every paper's plan: 512², stated by the papers or, where one is silent, ours.
+pub const PAPER_VIEWPORT: u32 = 512;
+
 impl RunSpec {
+    /// A run of one algorithm with the same settings in both modes, at [`PAPER_VIEWPORT`] with
+    /// the suite's transfer function, the quick mode shrinking its viewport and views.
+    pub fn new(
+        name: impl Into<String>,
+        algorithm: &str,
+        datasets: &[&str],
+        viewpoints: &str,
+        settings: Option<&str>,
+    ) -> RunSpec {
+        RunSpec {
+            name: name.into(),
+            algorithms: vec![algorithm.into()],
+            datasets: datasets.iter().map(|d| d.to_string()).collect(),
+            viewpoints: viewpoints.into(),
+            resolution: PAPER_VIEWPORT,
+            tf: None,
+            settings: settings.map(String::from),
+            quick_settings: None,
+            full_viewport: false,
+            full_views: false,
+        }
+    }
+
     /// The settings of the run in this mode.
     pub fn settings_for(&self, quick: bool) -> Option<&String> {
         match (&self.quick_settings, quick) {

@@ -67,54 +67,37 @@ impl PaperModule for FragmentPt {
     }
 
     fn plan(&self) -> Vec<RunSpec> {
-        let table1 = |name: &str, datasets: Vec<String>, full_viewport: bool| RunSpec {
-            name: name.into(),
-            algorithms: vec!["fragment-pt".into()],
-            datasets,
-            viewpoints: "orbit:14".into(),
-            resolution: 512,
-            tf: None,
-            settings: Some(FRAGMENT_SETTINGS.into()),
-            quick_settings: None,
-            full_viewport,
-            full_views: false,
+        let run = |name: &str, datasets: &[&str], settings: &str| {
+            RunSpec::new(name, "fragment-pt", datasets, "orbit:14", Some(settings))
         };
-        let (brain, others): (Vec<String>, Vec<String>) = DATASETS
-            .map(|(_, d)| d.to_string())
+        let (brain, others): (Vec<&str>, Vec<&str>) = DATASETS
+            .map(|(_, d)| d)
             .into_iter()
-            .partition(|d| d == "brain");
+            .partition(|d| *d == "brain");
         // Claim F8: the merge sort the paper draws still frames with, on the data sets of F2,
         // at the main run's viewpoints and viewport so each image pairs with a bucket-sorted one.
-        let merge = RunSpec {
-            name: "fragment-pt-merge".into(),
-            settings: Some(MERGE_SETTINGS.into()),
-            ..table1(
-                "",
-                others.iter().filter(|d| *d != "fuel").cloned().collect(),
-                false,
-            )
-        };
+        let f2: Vec<&str> = others.iter().copied().filter(|d| *d != "fuel").collect();
         let mut plan = vec![
-            table1("fragment-pt", others, false),
-            merge,
+            run("fragment-pt", &others, FRAGMENT_SETTINGS),
+            run("fragment-pt-merge", &f2, MERGE_SETTINGS),
             // §5's 5.5 M tets on a 256 MB board (claim F7) is judged on the device bytes of
             // the Brain row, which depend on the viewport: 512² in every mode.
-            table1("fragment-pt-brain", brain, true),
+            RunSpec {
+                full_viewport: true,
+                ..run("fragment-pt-brain", &brain, FRAGMENT_SETTINGS)
+            },
         ];
         for (label, alg, settings) in TABLE2.iter().skip(1) {
             let Some(alg) = alg else { continue };
-            plan.push(RunSpec {
-                name: format!("table2-{}", crate::results::names::slug(label)),
-                algorithms: vec![alg.to_string()],
-                datasets: vec!["bluntfin".into(), "post".into()],
-                viewpoints: "orbit:14".into(),
-                resolution: 512,
-                tf: None,
-                settings: (!settings.is_empty()).then(|| settings.to_string()),
-                quick_settings: None,
-                full_viewport: false,
-                full_views: false,
-            });
+            let name = format!("table2-{}", crate::results::names::slug(label));
+            let settings = (!settings.is_empty()).then_some(*settings);
+            plan.push(RunSpec::new(
+                name,
+                alg,
+                &["bluntfin", "post"],
+                "orbit:14",
+                settings,
+            ));
         }
         plan
     }

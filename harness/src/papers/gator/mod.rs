@@ -372,18 +372,9 @@ impl PaperModule for Gator {
     }
 
     fn plan(&self) -> Vec<RunSpec> {
-        vec![RunSpec {
-            name: "gator".into(),
-            algorithms: vec!["gator-pt".into()],
-            datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
-            viewpoints: "14".into(),
-            resolution: 512,
-            tf: None,
-            settings: Some("variant=constant|linear".into()),
-            quick_settings: None,
-            full_viewport: false,
-            full_views: false,
-        }]
+        let datasets = DATASETS.map(|(_, d)| d);
+        let settings = Some("variant=constant|linear");
+        vec![RunSpec::new("gator", "gator-pt", &datasets, "14", settings)]
     }
 
     fn analyses(&self, s: &mut Session, m: &mut Measured) -> anyhow::Result<Extra> {

@@ -41,16 +41,15 @@ const PASSES_LAYERS: &str = "32";
 /// A run of Table 4's counts with `settings`: the paper's viewport and views in every mode.
 fn passes_run(name: &str, settings: &str) -> RunSpec {
     RunSpec {
-        name: name.into(),
-        algorithms: vec!["raycast".into()],
-        datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
-        viewpoints: "14".into(),
-        resolution: 512,
-        tf: None,
-        settings: Some(settings.into()),
-        quick_settings: None,
         full_viewport: true,
         full_views: true,
+        ..RunSpec::new(
+            name,
+            "raycast",
+            &DATASETS.map(|(_, d)| d),
+            "14",
+            Some(settings),
+        )
     }
 }
 
@@ -64,24 +63,19 @@ impl PaperModule for Raycast {
 
     fn plan(&self) -> Vec<RunSpec> {
         vec![
-            RunSpec {
-                name: "raycast".into(),
-                algorithms: vec!["raycast".into()],
-                datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
-                viewpoints: "14".into(),
-                resolution: 512,
-                // The paper's configuration only: one pass per ray step (§2.3) and early ray
-                // termination as in its code (opacity 0.95), k at its default. Our `mode=loop` is
-                // not in its tables.
-                tf: None,
-                settings: Some(format!(
+            // The paper's configuration only: one pass per ray step (§2.3) and early ray
+            // termination as in its code (opacity 0.95), k at its default. Our `mode=loop` is
+            // not in its tables.
+            RunSpec::new(
+                "raycast",
+                "raycast",
+                &DATASETS.map(|(_, d)| d),
+                "14",
+                Some(&format!(
                     "tiles={};table=2d|3d;mode=passes;et=on;k=8",
                     TILINGS.join("|")
                 )),
-                quick_settings: None,
-                full_viewport: false,
-                full_views: false,
-            },
+            ),
             // Table 4's passes are counts: at the paper's viewport and views in every mode,
             // up to 32 peeling layers so that no re-entry is dropped (the paper peels until no
             // face is left). The passes mode at k = 8 and k = 1 on one tile, at k = 8 on 6×6
