@@ -195,6 +195,19 @@ pub fn find<'a>(
     )
 }
 
+/// The one aggregate of `algorithm` on `dataset` whose settings include the variant a paper's
+/// table names as text (its own constant: a typo there is a bug, so it panics).
+pub fn find_variant<'a>(
+    aggs: &'a [Aggregate],
+    algorithm: &str,
+    dataset: &str,
+    settings: &str,
+) -> Option<&'a Aggregate> {
+    let want = crate::algorithms::parse_settings(algorithm, settings)
+        .expect("a table's own settings parse");
+    find_including(aggs, algorithm, dataset, &want)
+}
+
 /// The one aggregate of `algorithm` on `dataset` whose settings include `want` (`None` when
 /// none or several do).
 pub fn find_including<'a>(

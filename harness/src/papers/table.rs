@@ -104,6 +104,26 @@ pub struct CompRow {
 }
 
 impl CompRow {
+    /// A row of one method of a comparison: `label (algorithm settings)`, or the label alone
+    /// where no tetbench algorithm implements the method.
+    pub fn method(
+        label: &str,
+        algorithm: Option<&str>,
+        settings: Option<&str>,
+        cells: Vec<Cell>,
+    ) -> CompRow {
+        let label = match (algorithm, settings) {
+            (Some(a), Some(s)) => format!("{label} ({a} {s})"),
+            (Some(a), None) => format!("{label} ({a})"),
+            (None, _) => label.to_string(),
+        };
+        CompRow {
+            label,
+            standin: false,
+            cells,
+        }
+    }
+
     /// A row measured on `dataset`, marked where that is a generated stand-in.
     pub fn on(label: impl Into<String>, dataset: &str, cells: Vec<Cell>) -> CompRow {
         CompRow {

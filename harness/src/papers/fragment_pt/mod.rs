@@ -9,7 +9,7 @@
 //! algorithm). Fig. 8 (performance against viewport size) is `tetbench analyze resolution`
 //! ([`fig8`]).
 
-use crate::papers::session::{find_including, Extra, Measured, Report, RunSpec, Session};
+use crate::papers::session::{find_variant, Extra, Measured, Report, RunSpec, Session};
 use crate::papers::table::{Cell, CompRow, Comparison, Metric, PaperRow};
 use crate::papers::transcription;
 use crate::papers::{Paper, PaperModule};
@@ -118,10 +118,6 @@ impl PaperModule for FragmentPt {
     }
 }
 
-fn want(settings: &str) -> render_core::Settings {
-    crate::algorithms::parse_settings("fragment-pt", settings).expect("the table's own settings")
-}
-
 /// Tables 1–2, the bytes per tet of §4 and the paper's claims from what was measured.
 pub fn tables(m: &Measured, x: &Extra) -> Report {
     let aggs = m.aggregates();
@@ -143,7 +139,7 @@ fn table1(m: &Measured, x: &Extra, aggs: &[Aggregate]) -> Comparison {
     let rows = DATASETS
         .iter()
         .map(|&(paper, d)| {
-            let a = find_including(aggs, "fragment-pt", d, &want(FRAGMENT_SETTINGS));
+            let a = find_variant(aggs, "fragment-pt", d, FRAGMENT_SETTINGS);
             let size = x.size(d);
             let row = PaperRow::new(&t, paper, m.why("fragment-pt", d));
             let cells = vec![
@@ -212,21 +208,13 @@ fn table2(m: &Measured, aggs: &[Aggregate]) -> Comparison {
                         None => "no tetbench algorithm implements it".into(),
                     };
                     let ours = alg
-                        .and_then(|a| find_including(aggs, a, d, &want(settings)))
+                        .and_then(|a| find_variant(aggs, a, d, settings))
                         .and_then(|a| a.fps.map(|s| s.mean));
                     PaperRow::new(&t, label, why).cell(col, ours)
                 })
                 .to_vec();
-            let label = match alg {
-                Some(a) if settings.is_empty() => format!("{label} ({a})"),
-                Some(a) => format!("{label} ({a} {settings})"),
-                None => label.to_string(),
-            };
-            CompRow {
-                label,
-                standin: false,
-                cells,
-            }
+            let settings = Some(settings).filter(|s| !s.is_empty());
+            CompRow::method(label, alg, settings, cells)
         })
         .collect();
     Comparison {

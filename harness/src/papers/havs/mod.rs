@@ -15,7 +15,7 @@ mod memory;
 use crate::papers::claims::VariantSpec;
 use crate::papers::evidence::exact_side;
 use crate::papers::session::{
-    find, find_including, is_standin, Extra, Measured, Report, RunSpec, Session,
+    find, find_variant, is_standin, Extra, Measured, Report, RunSpec, Session,
 };
 use crate::papers::spec;
 use crate::papers::table::{CompRow, Comparison, Metric, PaperRow};
@@ -378,12 +378,9 @@ fn table5(m: &Measured, aggs: &[Aggregate]) -> Comparison {
     let rows = TABLE5_ALGORITHMS
         .iter()
         .map(|&(label, alg, settings)| {
-            let want = settings
-                .map(|s| crate::algorithms::parse_settings(alg, s).expect("Table 5's own settings"))
-                .unwrap_or_default();
             let mut cells = vec![];
             for d in TABLE5_DATASETS {
-                let a = find_including(aggs, alg, d, &want);
+                let a = find_variant(aggs, alg, d, settings.unwrap_or_default());
                 for (col, _, spread) in parts {
                     // A peer's frame is VTK's mapper timed whole: its CPU/GPU split is unknown,
                     // not zero (what remains of our CPU time is the harness's own overhead).
@@ -397,15 +394,7 @@ fn table5(m: &Measured, aggs: &[Aggregate]) -> Comparison {
                     cells.push(PaperRow::new(&t, label, why).cell(&format!("{d}_{col}"), ours));
                 }
             }
-            let label = match settings {
-                Some(s) => format!("{label} ({alg} {s})"),
-                None => format!("{label} ({alg})"),
-            };
-            CompRow {
-                label,
-                standin: false,
-                cells,
-            }
+            CompRow::method(label, Some(alg), settings, cells)
         })
         .collect();
     let metrics = TABLE5_DATASETS
