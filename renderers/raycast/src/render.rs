@@ -1,26 +1,26 @@
-//! The renderer: uploads (prepare) and the per-frame phases (render).
+//! The renderer: its state, what `prepare` builds (`render/prepare.rs`), and a frame as the
+//! paper's phases (`frame`).
 
 use anyhow::{anyhow, bail, Context};
 use datasets::TetMesh;
 use render_core::bind;
 use render_core::gpu::{Lifetime, MemoryLedger};
-use render_core::preintegration::{Table2d, Table3d};
 use render_core::table_texture::TableTexture;
 use render_core::{
     Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Settings,
 };
 
-use crate::layout::{MeshLayout, TetRef, MESH_TEXTURE_BYTES, MESH_TEXTURE_WIDTH};
+use crate::layout::{MeshLayout, TetRef};
 use crate::resources::{FrameParams, Pipelines, Target, TileRect};
-use crate::settings::{Mode, RaycastSettings, TableKind};
+use crate::settings::{RaycastSettings, TableKind};
 use crate::step::{LayerEntry, RayFrame};
 use crate::{ET_OPACITY, PEEL_BIAS, TABLE_LENGTH, TABLE_SCALAR};
-use render_core::texel_texture::TexelTexture;
 
 mod cast;
 mod counters;
 mod passes;
 mod peel;
+mod prepare;
 use cast::cast;
 use counters::counters;
 use peel::peel;
@@ -35,8 +35,8 @@ pub struct Raycast {
     /// Bytes per mesh texture layer when smaller than the adapter's storage-binding limit
     /// (tests split small meshes across layers this way).
     max_binding: Option<u64>,
-    /// Bytes per mesh texture when smaller than [`MESH_TEXTURE_BYTES`] (tests split small
-    /// meshes across textures this way).
+    /// Bytes per mesh texture when smaller than [`crate::layout::MESH_TEXTURE_BYTES`] (tests
+    /// split small meshes across textures this way).
     max_texture_bytes: Option<u64>,
     /// mode=passes as compute dispatches even where the device can draw it as tile rectangles
     /// (tests compare the two).
@@ -280,138 +280,13 @@ impl Renderer for Raycast {
     ) -> anyhow::Result<Prepared> {
         self.state = None;
         self.settings.validate()?;
-        // A layer is at most a storage binding's size (so its count and bytes are those of
-        // the storage layout it replaced) and at most the texture's largest rows.
-        let texture_bytes =
-            MESH_TEXTURE_WIDTH as u64 * gpu.limits.max_texture_dimension_2d as u64 * 16;
-        let max_binding = self
-            .max_binding
-            .map_or(gpu.max_storage_binding(), |b| {
-                b.min(gpu.max_storage_binding())
-            })
-            .min(texture_bytes);
-        let mut layout = MeshLayout::build(mesh, optics, max_binding)?;
-        let slots = layout.chunks.len();
-        anyhow::ensure!(
-            slots as u32 <= gpu.limits.max_texture_array_layers,
-            "raycast on {}: the mesh needs {slots} texture layers, the adapter allows {}",
-            gpu.adapter.name,
-            gpu.limits.max_texture_array_layers
-        );
-        bind::check_storage_bindings(
-            gpu,
-            &format!("raycast on {}", gpu.adapter.name),
-            // Group 0: the frame; group 1: the traversal's eight buffers.
-            1 + 8,
-        )?;
-        let mut ledger = MemoryLedger::default();
-        let max_texture_bytes = self.max_texture_bytes.unwrap_or(MESH_TEXTURE_BYTES);
-        let mesh_textures = MeshTextures::upload(gpu, &mut ledger, &mut layout, max_texture_bytes)?;
-        let (mesh_bytes, mesh_padding_bytes) = (mesh_textures.bytes, mesh_textures.padding_bytes);
-        // Boundary faces as geometry (phase 1): position (OCS) and the tet's (binding, index).
-        let o = layout.origin;
-        let mut verts: Vec<u32> = Vec::with_capacity(mesh.boundary_faces().len() * 15);
-        for bf in mesh.boundary_faces() {
-            let r = layout.tet_ref(bf.tet);
-            for v in bf.vertices(mesh) {
-                let p = mesh.points[v as usize];
-                for a in 0..3 {
-                    verts.push(((p[a] as f64 - o[a]) as f32).to_bits());
-                }
-                verts.push(r.chunk);
-                verts.push(r.local);
-            }
-        }
-        let face_vertices = (verts.len() / 5) as u32;
-        let faces = ledger.buffer_init(
-            gpu,
-            "raycast boundary faces",
-            Lifetime::Persistent,
-            bytemuck::cast_slice(&verts),
-            wgpu::BufferUsages::VERTEX,
-        )?;
-        // The table is a filtered 3D texture, one sample a step as the paper's fragment
-        // program looks it up (§2.2); the 2D table is one layer of it.
-        let (table, inv_table_length) = match self.settings.table {
-            TableKind::ThreeD => {
-                let t = Table3d::build(optics, TABLE_SCALAR, TABLE_LENGTH, layout.longest_edge);
-                let size = [
-                    TABLE_SCALAR as u32,
-                    TABLE_SCALAR as u32,
-                    TABLE_LENGTH as u32,
-                ];
-                (
-                    TableTexture::new(gpu, &mut ledger, "raycast 3D table", size, &t.data)?,
-                    (1.0 / layout.longest_edge.max(f64::MIN_POSITIVE)) as f32,
-                )
-            }
-            TableKind::TwoD => {
-                let t = Table2d::build(optics, TABLE_SCALAR, layout.mean_edge);
-                let size = [TABLE_SCALAR as u32, TABLE_SCALAR as u32, 1];
-                (
-                    TableTexture::new(gpu, &mut ledger, "raycast 2D table", size, &t.data)?,
-                    (1.0 / layout.mean_edge.max(f64::MIN_POSITIVE)) as f32,
-                )
-            }
+        let state = State::new(gpu, self, mesh, optics)?;
+        let prepared = Prepared {
+            persistent_bytes: state.ledger.persistent,
+            tets: state.tets,
         };
-        let frame_params = ledger.buffer(
-            gpu,
-            "raycast frame params",
-            Lifetime::PerFrame,
-            std::mem::size_of::<FrameParams>() as u64,
-            wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::UNIFORM
-                | wgpu::BufferUsages::COPY_DST,
-        )?;
-        let pipes = Pipelines::new(
-            gpu,
-            mesh_textures.textures.len(),
-            mesh_textures.layers_per_texture,
-            self.settings.mode == Mode::Passes && !self.compute_passes,
-        );
-        let mut entries = vec![bind::whole(0, &frame_params)];
-        let views = mesh_textures.textures.iter().map(|t| &t.view);
-        entries.extend((1..).zip(views).map(|(b, v)| bind::view_entry(b, v)));
-        let mesh_bind = gpu.bind_group("raycast frame + mesh", &pipes.layouts.mesh, &entries);
-        // Set once per peeling layer (a render pass), never per dispatch: lavapipe keeps memory
-        // for every dispatch that sets a group holding a uniform buffer (docs/profile.md).
-        let peel_frame_bind = gpu.bind_group(
-            "raycast peel frame",
-            &pipes.layouts.peel_frame,
-            &[bind::whole(0, &frame_params)],
-        );
-        let n = mesh.num_tets() as u64;
-        // A guard against rays that cycle between tets through round-off: far more steps than
-        // a straight ray crosses in any mesh we know (counted as stalled when reached).
-        let max_steps = (64.0 * (n as f64).cbrt()).ceil() as u32 + 1024;
-        let persistent = ledger.persistent;
-        self.state = Some(State {
-            origin: layout.origin,
-            mesh_bindings: slots,
-            mesh_bytes,
-            mesh_padding_bytes,
-            max_binding,
-            tets: n,
-            ledger,
-            pipes,
-            frame_params,
-            mesh_bind,
-            peel_frame_bind,
-            faces,
-            face_vertices,
-            table,
-            inv_table_length,
-            length_unit: optics.length_unit,
-            max_steps,
-            target: None,
-            target_bytes: 0,
-            timer: FrameTimer::new(gpu),
-            last: None,
-        });
-        Ok(Prepared {
-            persistent_bytes: persistent,
-            tets: n,
-        })
+        self.state = Some(state);
+        Ok(prepared)
     }
 
     fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
@@ -454,60 +329,6 @@ impl Renderer for Raycast {
                 &entered,
             ),
         )))
-    }
-}
-
-/// Label of the texture that holds the mesh.
-const MESH_TEXTURE_LABEL: &str = "raycast mesh texture";
-
-/// The mesh in textures of at most `max_texture_bytes` ([`MESH_TEXTURE_BYTES`]), whole layers
-/// each, every layer as many rows as the largest needs.
-struct MeshTextures {
-    textures: Vec<TexelTexture>,
-    layers_per_texture: u32,
-    /// The texels written (§3.1's 144 B/tet is a claim about the layout).
-    bytes: u64,
-    /// The padding of each layer's last row, read from the ledger's allocation.
-    padding_bytes: u64,
-}
-
-impl MeshTextures {
-    /// Uploads `layout`'s layers and drops their host texels: the GPU's copy is the only one
-    /// kept (`layout` keeps its addressing and origin).
-    fn upload(
-        gpu: &Gpu,
-        ledger: &mut MemoryLedger,
-        layout: &mut MeshLayout,
-        max_texture_bytes: u64,
-    ) -> anyhow::Result<MeshTextures> {
-        let layers = layout.chunks.len();
-        let rows = layout.texture_rows();
-        let layer_bytes = rows as u64 * MESH_TEXTURE_WIDTH as u64 * 16;
-        let per_texture = (max_texture_bytes / layer_bytes).clamp(1, layers as u64) as usize;
-        let textures = (0..layers.div_ceil(per_texture))
-            .map(|k| {
-                let layers = (layers - k * per_texture).min(per_texture);
-                TexelTexture::new(
-                    gpu,
-                    ledger,
-                    MESH_TEXTURE_LABEL,
-                    Lifetime::Persistent,
-                    rows,
-                    layers as u32,
-                )
-            })
-            .collect::<anyhow::Result<Vec<_>>>()?;
-        let mut bytes = 0;
-        for (c, data) in std::mem::take(&mut layout.chunks).into_iter().enumerate() {
-            let layer = (c % per_texture) as u32;
-            bytes += textures[c / per_texture].write_layer(gpu, layer, &data);
-        }
-        Ok(MeshTextures {
-            textures,
-            layers_per_texture: per_texture as u32,
-            bytes,
-            padding_bytes: ledger.bytes_labelled(MESH_TEXTURE_LABEL) - bytes,
-        })
     }
 }
 
