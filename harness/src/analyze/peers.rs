@@ -453,11 +453,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         md.push_str(&target_table(&file.source, &cells));
         md.push_str(&repeat_table(&cells));
     }
-    if let Some(out) = &args.out {
-        std::fs::write(out, &md).with_context(|| format!("cannot write {}", out.display()))?;
-    }
-    print!("{md}");
-    Ok(())
+    crate::analyze::emit(&md, args.out.as_deref())
 }
 
 #[cfg(test)]
