@@ -72,6 +72,7 @@ fn row(algorithm: &str, settings: &str, dataset: &str, viewpoint: &str, i: usize
         harness_ms: None,
         suspect: None,
         error: None,
+        tile_counts: String::new(),
         samples: Default::default(),
     }
 }

@@ -22,7 +22,7 @@ use super::claims::ClaimResult;
 use super::claims_report;
 pub use super::session::SourceState;
 use super::session::{
-    not_built_reason, Measured, Report, Session, FULL_FRAMES, FULL_WARMUP, QUICK_FRAMES,
+    not_built_reason, Figure, Measured, Report, Session, FULL_FRAMES, FULL_WARMUP, QUICK_FRAMES,
     QUICK_RESOLUTION_DIVISOR, QUICK_VIEWPOINTS, QUICK_WARMUP,
 };
 use super::{table, Paper, PaperModule, PAPERS};
@@ -451,6 +451,7 @@ pub(crate) fn write_report(
             let _ = writeln!(md, "![{} {f}](charts/{f})\n", j.comparison.key);
         }
     }
+    md.push_str(&figures_markdown(&charts, &report.figures)?);
     if !report.notes.is_empty() {
         let _ = writeln!(md, "## Notes\n");
         for n in &report.notes {
@@ -470,6 +471,31 @@ pub(crate) fn write_report(
         &dir.join("report.html"),
         &table::markdown_to_html(&md, paper.title)?,
     )
+}
+
+/// The paper's figures drawn from measured data: each one's heading and text, then per panel
+/// its heat map (written into `charts`) and caption, or why it has none.
+fn figures_markdown(charts: &Path, figures: &[Figure]) -> anyhow::Result<String> {
+    let mut md = String::new();
+    if !figures.is_empty() {
+        md.push_str("## Figures\n\n");
+    }
+    for f in figures {
+        let _ = writeln!(md, "### {}\n\n{}\n", f.title, f.text);
+        for p in &f.panels {
+            match &p.grid {
+                Ok(grid) => {
+                    let stem = format!("{}_{}", f.key, crate::results::names::slug(&p.label));
+                    let png = crate::plot::tile_map::save(charts, &stem, &p.title, grid)?;
+                    let _ = writeln!(md, "![{}](charts/{png})\n\n{}\n", p.title, p.caption);
+                }
+                Err(why) => {
+                    let _ = writeln!(md, "{}: no heat map: {why}\n", p.label);
+                }
+            }
+        }
+    }
+    Ok(md)
 }
 
 /// The cells outside their rule, each a finding with its explanation or "unexplained", and

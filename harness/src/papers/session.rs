@@ -24,6 +24,31 @@ pub struct Report {
     /// The paper's claims (`reports/papers/claims.csv`), one verdict per data set.
     pub claims: Vec<ClaimResult>,
     pub notes: Vec<String>,
+    /// The paper's figures drawn from what was measured.
+    pub figures: Vec<Figure>,
+}
+
+/// A figure of the paper drawn from what was measured: a heading, what the paper's figure
+/// shows and how ours differs (Markdown), and its panels.
+#[derive(Debug, Clone, Default)]
+pub struct Figure {
+    /// The stem of its charts' file names.
+    pub key: String,
+    pub title: String,
+    pub text: String,
+    pub panels: Vec<Panel>,
+}
+
+/// One panel of a [`Figure`]: counts per screen tile drawn as a heat map, or why there are
+/// none.
+#[derive(Debug, Clone)]
+pub struct Panel {
+    /// What it shows in a word or two (a data set): part of its file name.
+    pub label: String,
+    /// The heat map's title, and the sentence under it.
+    pub title: String,
+    pub caption: String,
+    pub grid: Result<render_core::TileCounts, String>,
 }
 
 /// Whether this build has an algorithm (from the algorithm table).

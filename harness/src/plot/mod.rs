@@ -25,6 +25,7 @@ pub mod resolution;
 pub mod scaling;
 pub mod speed_error;
 pub mod style;
+pub mod tile_map;
 
 use data::{Inputs, Point};
 use style::StyleBook;

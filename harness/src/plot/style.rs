@@ -90,6 +90,29 @@ pub const BASELINE_GREY: RGBColor = RGBColor(140, 140, 140);
 pub const PAPER_VALUE: RGBColor = CATEGORICAL[7];
 pub const OUR_VALUE: RGBColor = CATEGORICAL[0];
 
+/// Counts drawn as colour (the tile heat maps of a paper's figure): the error heatmaps' ramp
+/// (`results::metrics::ramp`), dark at `t` = 0, pale yellow at 1.
+pub fn sequential(t: f64) -> RGBColor {
+    let [r, g, b] = crate::results::metrics::ramp(t);
+    RGBColor(r, g, b)
+}
+
+/// A tile that counted nothing, drawn apart from the ramp.
+pub const EMPTY_TILE: RGBColor = RGBColor(225, 225, 225);
+/// The outline of the busiest tile of a heat map: a hue the ramp does not hold.
+pub const BUSIEST_TILE: RGBColor = CATEGORICAL[9];
+
+/// The text colour that reads on `c`: black on light colours, white on dark ones (relative
+/// luminance, Rec. 709 weights, on the sRGB values).
+pub fn ink_on(c: RGBColor) -> RGBColor {
+    let y = 0.2126 * c.0 as f64 + 0.7152 * c.1 as f64 + 0.0722 * c.2 as f64;
+    if y > 140.0 {
+        RGBColor(0, 0, 0)
+    } else {
+        RGBColor(255, 255, 255)
+    }
+}
+
 /// A colour family: four shades of one hue, dark to light, all readable on white.
 type Family = [RGBColor; SHADES];
 

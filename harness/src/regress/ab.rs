@@ -357,6 +357,7 @@ fn merge_key(
                 &mut m.image_f32,
                 &mut m.reference_image,
                 &mut m.heatmap,
+                &mut m.tile_counts,
             ] {
                 if !p.is_empty() {
                     *p = base.join(&*p).display().to_string();

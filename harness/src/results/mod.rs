@@ -39,6 +39,7 @@ pub mod outcome;
 pub mod samples;
 pub mod stats;
 pub mod suspect;
+pub mod tile_counts;
 
 /// Bumped whenever a field changes meaning or is removed (adding a field does not bump it).
 /// Version 2 adds per-frame `samples`, the exact f32 image (`image_f32`, `image_hash`), the
@@ -176,6 +177,11 @@ pub struct Row {
     /// cached across runs) is in it. Empty in files written before it existed.
     #[serde(default)]
     pub harness_ms: Option<f64>,
+    /// The renderer's counts per screen tile of the frame (`….NAME.json` beside the image,
+    /// [`crate::results::tile_counts`]), relative to the output directory; empty where the
+    /// renderer keeps none and in older files.
+    #[serde(default)]
+    pub tile_counts: String,
     /// Empty on success; otherwise what went wrong (the metrics are then empty).
     #[serde(serialize_with = "opt_as_text", deserialize_with = "opt_from_text")]
     #[schemars(with = "String")]

@@ -438,10 +438,7 @@ impl<'a> DatasetContext<'a> {
         crate::results::samples::write_f32_image(&dir.join(&exact), &image)?;
         row.image_f32 = format!("{rel}/{exact}");
         row.image_hash = crate::results::samples::image_hash(&image);
-        // A renderer's second picture (the ray caster's pass-count map) goes beside it.
-        if let Some((suffix, extra)) = guarded("extra_image", || renderer.extra_image(self.gpu))? {
-            extra.save_png(&dir.join(format!("{stem}.{suffix}.png")))?;
-        }
+        self.write_extras(renderer, &dir, &rel, &stem, row)?;
 
         if c.reference {
             let referencing = Instant::now();
@@ -469,6 +466,26 @@ impl<'a> DatasetContext<'a> {
                     row.error = Some(Failure::new(Stage::Reference, msg));
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// What a renderer keeps of its last frame besides the image, written beside it as
+    /// `STEM.…` in `dir` (the folder `rel` names): its second picture (the ray caster's
+    /// pass-count map) and its counts per screen tile, as numbers the row names.
+    fn write_extras(
+        &self,
+        renderer: &mut dyn Renderer,
+        dir: &std::path::Path,
+        rel: &str,
+        stem: &str,
+        row: &mut Row,
+    ) -> anyhow::Result<()> {
+        if let Some((suffix, extra)) = guarded("extra_image", || renderer.extra_image(self.gpu))? {
+            extra.save_png(&dir.join(format!("{stem}.{suffix}.png")))?;
+        }
+        if let Some(counts) = guarded("tile_counts", || renderer.tile_counts(self.gpu))? {
+            row.tile_counts = crate::results::tile_counts::write(dir, rel, stem, &counts)?;
         }
         Ok(())
     }

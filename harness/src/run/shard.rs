@@ -253,7 +253,13 @@ pub fn merge(dirs: &[PathBuf], out: &Path, allow_missing: bool) -> anyhow::Resul
                     d.display()
                 );
             }
-            for rel in [&r.image, &r.reference_image, &r.heatmap, &r.image_f32] {
+            for rel in [
+                &r.image,
+                &r.reference_image,
+                &r.heatmap,
+                &r.image_f32,
+                &r.tile_counts,
+            ] {
                 copy_file(d, out, rel)?;
             }
             rows.push(r.clone());

@@ -18,6 +18,7 @@ pub mod silhouette;
 pub mod sort;
 pub mod table_texture;
 pub mod texel_texture;
+pub mod tile_counts;
 pub mod transfer;
 pub mod visibility;
 
@@ -31,4 +32,5 @@ pub use image::Image;
 pub use renderer::{DeclaredAccuracy, FrameStats, Prepared, Renderer};
 pub use scene::{fixed_viewpoints, orbit_viewpoints, Camera, Projection, Ray, Viewpoint};
 pub use settings::{Setting, SettingValue, Settings, SettingsError, SettingsFilter, ValueKind};
+pub use tile_counts::TileCounts;
 pub use transfer::{Optics, TransferFunction};

@@ -12,6 +12,7 @@ use crate::gpu::Gpu;
 use crate::image::Image;
 use crate::scene::Camera;
 use crate::settings::Settings;
+use crate::tile_counts::TileCounts;
 use crate::transfer::Optics;
 
 /// What [`Renderer::prepare`] uploaded.
@@ -87,6 +88,13 @@ pub trait Renderer {
     /// An optional second picture of the last frame that the harness saves beside the
     /// rendering as `….SUFFIX.png` (e.g. the ray caster's pass-count map, `passes`).
     fn extra_image(&mut self, _gpu: &Gpu) -> anyhow::Result<Option<(&'static str, Image)>> {
+        Ok(None)
+    }
+
+    /// The last frame's counts per screen tile, for a renderer that spends its work tile by
+    /// tile (the ray caster's passes); the harness writes them beside the rendering as
+    /// `….NAME.json` and names that file in the row. Default none.
+    fn tile_counts(&mut self, _gpu: &Gpu) -> anyhow::Result<Option<TileCounts>> {
         Ok(None)
     }
 

@@ -36,6 +36,7 @@ mod render;
 pub mod resources;
 pub mod settings;
 pub mod step;
+pub mod twin;
 
 pub use description::DESCRIPTION;
 pub use render::{PassData, Raycast};

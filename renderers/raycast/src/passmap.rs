@@ -1,8 +1,9 @@
 //! The pass-count map (the paper's Fig. 5): every tile filled with a colour for the number of
 //! ray-casting passes it ran, brighter where a ray entered the mesh, with dark tile borders;
-//! and the CPU twin of that count ([`passes_per_tile`]).
+//! the same counts as numbers ([`tile_counts`]); and the CPU twin of that count
+//! ([`passes_per_tile`]; from a rendered frame's peeling layers, [`crate::twin::tile_passes`]).
 
-use render_core::Image;
+use render_core::{Image, TileCounts};
 
 /// A perceptually ordered ramp (dark blue → teal → yellow), sRGB stops.
 const RAMP: [[f32; 3]; 5] = [
@@ -98,6 +99,19 @@ pub fn passes_per_tile(
         .iter()
         .map(|l| l.iter().map(|&s| s.div_ceil(k) * k).sum())
         .collect()
+}
+
+/// The passes each of the `tiles`×`tiles` tiles of a `size` viewport ran, as the numbers the
+/// harness writes beside the pass map (named `passes`).
+pub fn tile_counts(size: [u32; 2], tiles: u32, tile_size: [u32; 2], passes: &[u32]) -> TileCounts {
+    TileCounts {
+        name: "passes".into(),
+        width: size[0],
+        height: size[1],
+        tiles: [tiles; 2],
+        tile_size,
+        counts: passes.to_vec(),
+    }
 }
 
 #[cfg(test)]

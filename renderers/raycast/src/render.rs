@@ -330,6 +330,19 @@ impl Renderer for Raycast {
             ),
         )))
     }
+
+    fn tile_counts(&mut self, _gpu: &Gpu) -> anyhow::Result<Option<render_core::TileCounts>> {
+        let st = self.state()?;
+        let (Some(t), Some(last)) = (&st.target, &st.last) else {
+            bail!("raycast: render before tile_counts");
+        };
+        Ok(Some(crate::passmap::tile_counts(
+            [t.width, t.height],
+            self.settings.tiles,
+            last.tile_size,
+            &last.tile_passes,
+        )))
+    }
 }
 
 /// One frame, phase by phase as §3.2 of Bernardon et al. (2005) orders them (its Fig. 4): the

@@ -255,6 +255,19 @@ fn pass_counts_equal_the_twins_steps_and_empty_tiles_do_no_passes() {
     // The paper's scheme (per layer, rounds of k passes until the tile's rays have all left).
     let twin = passmap::passes_per_tile(&segments, d.width, n, d.tile_size, COUNT_EVERY);
     assert_eq!(d.tile_passes, twin);
+    // The numbers the harness writes beside the pass map are these counts, on this grid, and
+    // the twin walked from the frame's own layers in one call gives them too.
+    let numbers = r
+        .tile_counts(&gpu)
+        .unwrap()
+        .expect("the ray caster's counts");
+    assert_eq!(numbers.problem(), None);
+    assert_eq!((numbers.tiles, numbers.tile_size), ([n, n], d.tile_size));
+    assert_eq!(numbers.counts, twin);
+    assert_eq!(
+        raycast::twin::tile_passes(&layout, &d, n, COUNT_EVERY),
+        twin
+    );
     assert_eq!(
         counter(&stats, "passes_max"),
         *twin.iter().max().unwrap() as f64

@@ -130,6 +130,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
             &crate::papers::evidence::no_analyses,
         ),
         notes: vec![],
+        figures: vec![],
     }
 }
 

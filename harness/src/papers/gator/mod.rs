@@ -429,6 +429,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
             claim_side(x, metric, spec, d)
         }),
         notes: vec![],
+        figures: vec![],
     }
 }
 

@@ -178,6 +178,7 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
             claim_side(x, metric, spec, d)
         }),
         notes,
+        figures: vec![],
     }
 }
 

@@ -16,6 +16,7 @@ use crate::papers::table::{Cell, CompRow, Comparison, Metric, PaperRow};
 use crate::papers::transcription::{self, PaperTable};
 use crate::papers::{Paper, PaperModule};
 
+mod heatmap;
 mod passes;
 use passes::{PASSES_RUN, TILED_RUN, WALKS_RUN};
 
@@ -117,7 +118,7 @@ fn min_max(v: impl Iterator<Item = f64>) -> (Option<f64>, Option<f64>) {
     )
 }
 
-/// Tables 3–6, the bytes per tet of §3.1 and the paper's claims from what was measured.
+/// Tables 3–6, the bytes per tet of §3.1, Fig. 5 and the paper's claims from what was measured.
 pub fn tables(m: &Measured, x: &Extra) -> Report {
     let t3 = transcription::embedded("raycast_table3");
     // The paper's GPUs, in Table 3's order: its tables of times have a row per GPU and data set.
@@ -144,6 +145,8 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
             &crate::papers::evidence::no_analyses,
         ),
         notes: vec![],
+        // Fig. 5: the passes per tile of the tiled passes run, beside the figure's description.
+        figures: vec![heatmap::fig5(m)],
     }
 }
 
