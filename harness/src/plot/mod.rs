@@ -227,6 +227,20 @@ mod tests {
         }
     }
 
+    /// The columns of a line chart's CSV line (scaling, resolution) that these tests check.
+    #[derive(Debug, serde::Deserialize)]
+    struct LineRecord {
+        dataset: String,
+        width: u32,
+        label: String,
+        algorithm: String,
+        settings: String,
+        rows: usize,
+        failed: usize,
+        tets_per_sec_mean: Option<f64>,
+        error: String,
+    }
+
     fn read_csv<T: serde::de::DeserializeOwned>(path: &Path) -> Vec<T> {
         csv::Reader::from_path(path)
             .unwrap()
@@ -352,7 +366,7 @@ mod tests {
             assert_eq!(b.label, label_of(&b.algorithm, &b.settings));
         }
 
-        let scal: Vec<scaling::Record> = read_csv(&dir.path().join("scaling_box_tets_per_sec.csv"));
+        let scal: Vec<LineRecord> = read_csv(&dir.path().join("scaling_box_tets_per_sec.csv"));
         assert_eq!(scal.len(), 4);
         for s in &scal {
             let t = direct(&rows, &s.algorithm, &s.settings, &s.dataset, |r| {
@@ -408,7 +422,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let charts = write_charts(dir.path(), &inputs(rows), Kind::Resolution).unwrap();
         assert_eq!(charts.files.len(), 1);
-        let recs: Vec<resolution::Record> = read_csv(&dir.path().join("resolution_box_10k.csv"));
+        let recs: Vec<LineRecord> = read_csv(&dir.path().join("resolution_box_10k.csv"));
         assert_eq!(recs.len(), 4);
         let failed = recs
             .iter()
