@@ -220,11 +220,6 @@ impl Row {
         self.settings = crate::algorithms::retype(&self.algorithm, settings);
     }
 
-    /// A setting of the row's variant, as written (`cpu-radix`, `6`).
-    pub fn setting(&self, key: &str) -> Option<String> {
-        self.settings.text(key)
-    }
-
     /// A counter of the row, if present.
     pub fn counter(&self, name: &str) -> Option<f64> {
         self.counters.get(name)
