@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context as _};
 
 use crate::results::stats::median;
-use crate::results::{ResultsFile, Row};
+use crate::results::{write_file, ResultsFile, Row};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -227,7 +227,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let md = markdown(&runs);
     if let Some(out) = &args.out {
-        std::fs::write(out, &md).with_context(|| format!("cannot write {}", out.display()))?;
+        write_file(out, &md)?;
     }
     print!("{md}");
     Ok(())

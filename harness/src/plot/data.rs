@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use crate::results::aggregate::{aggregate, Aggregate};
 use crate::results::stats::Spread;
-use crate::results::{ResultsFile, Row, JSON_FILE};
+use crate::results::{read_text, write_file, ResultsFile, Row, JSON_FILE};
 
 /// Rows of every input, with what the charts need from the runs' headers.
 #[derive(Debug, Clone, Default)]
@@ -75,8 +75,7 @@ impl Inputs {
             for path in result_files(arg)? {
                 let dir = path.parent().unwrap_or(Path::new("."));
                 let file = ResultsFile::read(dir)?;
-                let text = std::fs::read_to_string(&path)
-                    .with_context(|| format!("cannot read {}", path.display()))?;
+                let text = read_text(&path)?;
                 let raw: serde_json::Value = serde_json::from_str(&text)
                     .with_context(|| format!("{} is not JSON", path.display()))?;
                 inputs.add(&file, Some(&raw));
@@ -295,8 +294,7 @@ pub fn csv_text<T: Serialize>(records: &[T]) -> anyhow::Result<String> {
 /// Writes `records` as `dir/stem.csv`.
 pub fn write_csv<T: Serialize>(dir: &Path, stem: &str, records: &[T]) -> anyhow::Result<()> {
     let path = dir.join(format!("{stem}.csv"));
-    std::fs::write(&path, csv_text(records)?)
-        .with_context(|| format!("cannot write {}", path.display()))
+    write_file(&path, csv_text(records)?)
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@
 
 use std::path::Path;
 
+use crate::results::write_file;
 use anyhow::Context;
 use serde::Serialize;
 
@@ -141,8 +142,7 @@ pub fn write_charts(dir: &Path, inputs: &Inputs, kind: Kind) -> anyhow::Result<C
         charts.files.extend(bars::write(dir, &points, &book)?);
     }
     let key = dir.join("key.csv");
-    std::fs::write(&key, book.key_csv())
-        .with_context(|| format!("cannot write {}", key.display()))?;
+    write_file(&key, book.key_csv())?;
     charts.book = book;
     Ok(charts)
 }

@@ -265,8 +265,7 @@ pub struct ResultsFile {
 impl ResultsFile {
     pub fn read(dir: &Path) -> anyhow::Result<ResultsFile> {
         let path = dir.join(JSON_FILE);
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
+        let text = read_text(&path)?;
         // The version alone first (every other field skipped, not built into a value: a
         // history reads a thousand of these files).
         #[derive(Deserialize)]
@@ -406,6 +405,21 @@ pub fn write_csv(dir: &Path, rows: &[Row]) -> anyhow::Result<()> {
     }
     csv.flush()
         .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes `contents` to `path`; the error names the file.
+pub fn write_file(path: &Path, contents: impl AsRef<[u8]>) -> anyhow::Result<()> {
+    std::fs::write(path, contents).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Reads `path` as text; the error names the file.
+pub fn read_text(path: &Path) -> anyhow::Result<String> {
+    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// Reads `path`'s bytes; the error names the file.
+pub fn read_bytes(path: &Path) -> anyhow::Result<Vec<u8>> {
+    std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))
 }
 
 /// Writes `results.json` atomically.
