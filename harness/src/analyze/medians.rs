@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context as _};
 
 use crate::results::stats::median;
-use crate::results::{write_file, ResultsFile, Row};
+use crate::results::{ResultsFile, Row};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -33,6 +33,8 @@ pub enum Field {
     TetsPerSec,
     BytesPerTet,
     TotalMs,
+    /// The time the row's bounding resource alone needs at the row's own control.
+    RooflineMs,
     PsnrDb,
 }
 
@@ -43,6 +45,7 @@ impl Field {
             Field::TetsPerSec => row.tets_per_sec,
             Field::BytesPerTet => row.bytes_per_tet,
             Field::TotalMs => row.total_ms,
+            Field::RooflineMs => row.roofline_ms,
             Field::PsnrDb => row.psnr_db,
         }
     }
@@ -192,7 +195,7 @@ pub fn markdown(runs: &[RunMedians]) -> String {
     md
 }
 
-fn parse_run(arg: &str) -> anyhow::Result<(String, PathBuf)> {
+pub fn parse_run(arg: &str) -> anyhow::Result<(String, PathBuf)> {
     let (label, dir) = match arg.split_once('=') {
         Some((label, dir)) if !label.is_empty() => (label.to_string(), PathBuf::from(dir)),
         Some(_) => bail!("{arg}: an empty label before '='"),
@@ -226,11 +229,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         runs.push(medians);
     }
     let md = markdown(&runs);
-    if let Some(out) = &args.out {
-        write_file(out, &md)?;
-    }
-    print!("{md}");
-    Ok(())
+    crate::analyze::emit(&md, args.out.as_deref())
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@ use clap::Subcommand;
 use crate::papers::fragment_pt::fig8;
 use crate::papers::havs::analysis;
 
+pub mod control;
 pub mod medians;
 pub mod peers;
 pub mod summary;
@@ -44,6 +45,18 @@ pub enum AnalyzeCommand {
     /// Each algorithm's median of one row field (limit fraction by default) in each of
     /// several runs, side by side, and each run's over the first's.
     Medians(medians::Args),
+    /// Each control figure's median over a run's samples, in several runs side by side, and
+    /// each run's speed over the first's: which of the machine's resources moved.
+    Control(control::Args),
+}
+
+/// Prints an analysis's Markdown, and with `--out` also writes it to that file.
+pub fn emit(md: &str, out: Option<&std::path::Path>) -> anyhow::Result<()> {
+    if let Some(out) = out {
+        crate::results::write_file(out, md)?;
+    }
+    print!("{md}");
+    Ok(())
 }
 
 pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
@@ -54,5 +67,6 @@ pub fn run(cmd: AnalyzeCommand, ctx: &Context) -> anyhow::Result<()> {
         AnalyzeCommand::Kbuffer(args) => analysis::run_kbuffer(args, ctx.data_dir.clone()),
         AnalyzeCommand::Peers(args) => peers::run(args),
         AnalyzeCommand::Medians(args) => medians::run(args),
+        AnalyzeCommand::Control(args) => control::run(args),
     }
 }

@@ -18,7 +18,7 @@ use serde::Deserialize;
 
 use crate::plot::data::distinct;
 use crate::results::aggregate::{aggregate, Aggregate};
-use crate::results::{read_text, write_file, ResultsFile, Row};
+use crate::results::{read_text, ResultsFile, Row};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -452,11 +452,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         md.push_str(&target_table(&file.source, &cells));
         md.push_str(&repeat_table(&cells));
     }
-    if let Some(out) = &args.out {
-        write_file(out, &md)?;
-    }
-    print!("{md}");
-    Ok(())
+    crate::analyze::emit(&md, args.out.as_deref())
 }
 
 #[cfg(test)]

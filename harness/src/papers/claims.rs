@@ -428,9 +428,11 @@ fn judge(
         NotCheckable => "not run, so the rule's sensitivity is not shown here",
         _ => "the rule does not reject it: the rule is insensitive here",
     };
+    // The control's own figures, so that a reader sees how far from failing it is.
     e.numbers.push_str(&format!(
-        "; positive control (side a = `{perturbed}`): {}, {outcome}",
-        control.verdict.label()
+        "; positive control (side a = `{perturbed}`): {}, {outcome} ({})",
+        control.verdict.label(),
+        control.numbers
     ));
     if e.verdict == Holds && !matches!(control.verdict, DoesNotHold | NotCheckable) {
         e.verdict = Insensitive;

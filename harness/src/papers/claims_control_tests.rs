@@ -10,7 +10,7 @@ use crate::papers::claims::{self, Claim, ClaimResult, Metric, VariantSpec};
 use crate::papers::claims_report;
 use crate::papers::evidence::{evaluate_claims, exact_side};
 use crate::papers::session::{Extra, Measured};
-use crate::papers::sides_tests::{disc, row_with_image};
+use crate::papers::sides_tests::{dim_disc, disc, row_with_image};
 use crate::papers::verdict::{Side, Verdict};
 
 fn h12() -> Claim {
@@ -181,4 +181,106 @@ fn discriminates_parses_and_refuses_with_why() {
             "{bad}: {e}"
         );
     }
+}
+
+/// S5's verdict on engine with the bricked image equal to the one-brick image, and its
+/// misaligned control's image `control`: a small dim volume (8 px radius in 64², brightest
+/// channel 0.1), as the splatting stand-ins draw a small share of the viewport in dim light.
+fn s5_with_control(control: &Image) -> ClaimResult {
+    let c = claims::all()
+        .unwrap()
+        .into_iter()
+        .find(|c| c.paper == "splat" && c.id == "S5")
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let volume = dim_disc(64, 8.0, 0.1);
+    let rows = vec![
+        row_with_image(dir.path(), &c.a, "engine", "+x", &volume),
+        row_with_image(dir.path(), c.b.as_ref().unwrap(), "engine", "+x", &volume),
+        row_with_image(
+            dir.path(),
+            c.control.as_ref().unwrap(),
+            "engine",
+            "+x",
+            control,
+        ),
+    ];
+    let mut m = Measured::default();
+    m.push_run(dir.path(), rows);
+    let none = |_: &Metric, _: &VariantSpec, _: Option<&str>| None;
+    evaluate_claims("splat", &m, &Extra::default(), &none)
+        .into_iter()
+        .find(|r| r.claim.id == "S5" && r.dataset.as_deref() == Some("engine"))
+        .unwrap()
+}
+
+/// The dim volume with every covered pixel's colour raised by `by`.
+fn dim_shifted(by: f32) -> Image {
+    let mut img = dim_disc(64, 8.0, 0.1);
+    for p in img.pixels.iter_mut().filter(|p| p[3] > 0.0) {
+        for c in &mut p[..3] {
+            *c += by;
+        }
+    }
+    img
+}
+
+#[test]
+fn the_covered_psnr_rejects_a_control_that_the_whole_image_psnr_let_pass() {
+    // A control 0.01 off at every covered pixel: 20 dB over the covered pixels at the image's
+    // peak (rejected, so the claim's hold counts), above 50 dB over the whole image at peak 1
+    // (passed, so by the rule before the claim read insensitive).
+    let r = s5_with_control(&dim_shifted(0.01));
+    assert_eq!(r.claim.metric, Metric::PairPsnrCoveredDb);
+    let control = r.control.as_ref().unwrap();
+    assert_eq!(control.verdict, Verdict::DoesNotHold, "{}", control.numbers);
+    assert_eq!(
+        r.evaluation.verdict,
+        Verdict::Holds,
+        "{}",
+        r.evaluation.numbers
+    );
+    // The control's own figures are in the verdict text.
+    assert!(
+        r.evaluation.numbers.contains("positive control")
+            && r.evaluation
+                .numbers
+                .contains("over the 208 covered pixels at peak 0.096")
+            && r.evaluation.numbers.contains("dB over the image at peak 1"),
+        "{}",
+        r.evaluation.numbers
+    );
+    let (change, before) = r
+        .earlier
+        .iter()
+        .find(|(h, _)| {
+            h.old
+                .as_ref()
+                .is_some_and(|o| o.metric == Metric::PairPsnrDb && o.control.is_some())
+        })
+        .expect("S5's history keeps the whole-image rule with its control");
+    assert_eq!(before.verdict, Verdict::Insensitive, "{}", before.numbers);
+    let md = claims_report::markdown(std::slice::from_ref(&r));
+    assert!(
+        md.contains("holds (positive control: does not hold)")
+            && md.contains(&format!(
+                "by the rule before {}: insensitive",
+                change.commit
+            )),
+        "{md}"
+    );
+    // A control 0.0005 off (below one 8-bit step): about 46 dB even over the covered pixels,
+    // so the new rule passes it too and the claim reads insensitive by both rules.
+    let r = s5_with_control(&dim_shifted(0.0005));
+    assert_eq!(
+        r.control.as_ref().unwrap().verdict,
+        Verdict::Holds,
+        "{}",
+        r.evaluation.numbers
+    );
+    assert_eq!(r.evaluation.verdict, Verdict::Insensitive);
+    assert!(r
+        .earlier
+        .iter()
+        .any(|(h, e)| h.commit == change.commit && e.verdict == Verdict::Insensitive));
 }

@@ -65,7 +65,33 @@ pub struct RunSpec {
     pub full_views: bool,
 }
 
+/// The viewport of every paper's plan: 512², stated by the papers or, where one is silent, ours.
+pub const PAPER_VIEWPORT: u32 = 512;
+
 impl RunSpec {
+    /// A run of one algorithm with the same settings in both modes, at [`PAPER_VIEWPORT`] with
+    /// the suite's transfer function, the quick mode shrinking its viewport and views.
+    pub fn new(
+        name: impl Into<String>,
+        algorithm: &str,
+        datasets: &[&str],
+        viewpoints: &str,
+        settings: Option<&str>,
+    ) -> RunSpec {
+        RunSpec {
+            name: name.into(),
+            algorithms: vec![algorithm.into()],
+            datasets: datasets.iter().map(|d| d.to_string()).collect(),
+            viewpoints: viewpoints.into(),
+            resolution: PAPER_VIEWPORT,
+            tf: None,
+            settings: settings.map(String::from),
+            quick_settings: None,
+            full_viewport: false,
+            full_views: false,
+        }
+    }
+
     /// The settings of the run in this mode.
     pub fn settings_for(&self, quick: bool) -> Option<&String> {
         match (&self.quick_settings, quick) {
@@ -169,6 +195,19 @@ pub fn find<'a>(
     )
 }
 
+/// The one aggregate of `algorithm` on `dataset` whose settings include the variant a paper's
+/// table names as text (its own constant: a typo there is a bug, so it panics).
+pub fn find_variant<'a>(
+    aggs: &'a [Aggregate],
+    algorithm: &str,
+    dataset: &str,
+    settings: &str,
+) -> Option<&'a Aggregate> {
+    let want = crate::algorithms::parse_settings(algorithm, settings)
+        .expect("a table's own settings parse");
+    find_including(aggs, algorithm, dataset, &want)
+}
+
 /// The one aggregate of `algorithm` on `dataset` whose settings include `want` (`None` when
 /// none or several do).
 pub fn find_including<'a>(
@@ -214,6 +253,21 @@ impl Session {
             .find(|(n, _)| n == name)
             .map(|(_, s)| s.clone())
             .unwrap_or_else(|| name.to_string())
+    }
+
+    /// Loads the data set the plan calls `name` for a CPU analysis; a failure goes to
+    /// `measured.errors`, naming the data set.
+    pub fn load(&self, name: &str, measured: &mut Measured) -> Option<datasets::Dataset> {
+        let registry = datasets::registry::Registry::new(self.data_dir.clone());
+        match registry.resolve(&self.dataset(name), &datasets::LoadOptions::default()) {
+            Ok(ds) => Some(ds),
+            Err(e) => {
+                measured
+                    .errors
+                    .push(format!("data set \"{name}\" could not be loaded: {e}"));
+                None
+            }
+        }
     }
 
     /// Rounds per row in this mode.
@@ -385,6 +439,14 @@ impl Extra {
     /// The paper's own analyses, if they are of type `T`.
     pub fn own<T: Any>(&self) -> Option<&T> {
         self.own.as_deref()?.downcast_ref::<T>()
+    }
+
+    /// The points and tets of data set `d`, where it was loaded.
+    pub fn size(&self, d: &str) -> Option<(u64, u64)> {
+        self.sizes
+            .iter()
+            .find(|(n, _, _)| n == d)
+            .map(|&(_, points, tets)| (points, tets))
     }
 
     /// Tets of zero volume the loader dropped from data set `d` (0 when none or not loaded).

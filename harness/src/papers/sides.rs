@@ -112,9 +112,92 @@ fn row_image(inputs: &Inputs, i: usize, row: &Row) -> Result<render_core::Image,
     crate::results::samples::read_f32_image(&path).map_err(|e| format!("{}: {e:#}", path.display()))
 }
 
-/// A side from two variants' images (`metric` is [`Metric::PairPsnrDb`] or
-/// [`Metric::PairBadPixelShare`]): for every viewpoint `a` was rendered at, its image against `b`'s
-/// at the same viewpoint and viewport; the worst viewpoint is the side's one value (lowest PSNR,
+/// Image error over the pixels that show the volume, against the picture's own range: PSNR of
+/// `a` against `b` over the covered pixels (either image's α above one 8-bit step, as
+/// [`compare`] counts them), the peak at `b`'s brightest clamped colour channel (never below
+/// one 8-bit step). [`compare`]'s PSNR takes every pixel and peak 1, so the black background
+/// and a dim transfer function dilute its error; this one is the same RGB error read as a
+/// viewer reads the picture, at the volume's pixels and the image's range
+/// (docs/reproduction.md, "Image-quality words").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoveredError {
+    pub psnr_db: f64,
+    pub rmse: f64,
+    /// `b`'s brightest colour channel (clamped to [0, 1], at least one 8-bit step).
+    pub peak: f64,
+    pub covered_pixels: u64,
+}
+
+/// [`CoveredError`] of `a` against `b` (same size, as [`compare`] requires).
+pub fn covered_error(a: &render_core::Image, b: &render_core::Image) -> CoveredError {
+    use render_core::image_error::{channel_error, ONE_STEP, PSNR_CAP_DB};
+    // Clamped as `compare` clamps; a NaN counts as full scale (covered, maximal), never as
+    // agreement.
+    let unit = |v: f32| {
+        if v.is_nan() {
+            1.0
+        } else {
+            (v as f64).clamp(0.0, 1.0)
+        }
+    };
+    let mut sum_sq = 0.0f64;
+    let mut covered = 0u64;
+    let mut peak = ONE_STEP;
+    for (p, r) in a.pixels.iter().zip(&b.pixels) {
+        for c in &r[..3] {
+            peak = peak.max(unit(*c));
+        }
+        if unit(p[3]) > ONE_STEP || unit(r[3]) > ONE_STEP {
+            covered += 1;
+            sum_sq += (0..3)
+                .map(|c| channel_error(p[c], r[c]).powi(2))
+                .sum::<f64>();
+        }
+    }
+    let rmse = (sum_sq / (3 * covered.max(1)) as f64).sqrt();
+    let psnr_db = if rmse > 0.0 {
+        (20.0 * (peak / rmse).log10()).min(PSNR_CAP_DB)
+    } else {
+        PSNR_CAP_DB
+    };
+    CoveredError {
+        psnr_db,
+        rmse,
+        peak,
+        covered_pixels: covered,
+    }
+}
+
+/// One viewpoint of an image pair: [`compare`]'s figures and the covered ones.
+#[derive(Debug, Clone, Copy)]
+struct PairView {
+    whole: ImageError,
+    covered: CoveredError,
+}
+
+impl PairView {
+    fn value(&self, metric: &Metric) -> f64 {
+        match metric {
+            Metric::PairPsnrDb => self.whole.psnr_db,
+            Metric::PairPsnrCoveredDb => self.covered.psnr_db,
+            _ => self.whole.bad_pixel_share,
+        }
+    }
+
+    /// Every figure of the viewpoint, whichever the metric: a reader sees how far from the
+    /// rule each reading is.
+    fn describe(&self) -> String {
+        let (w, c) = (&self.whole, &self.covered);
+        format!(
+            "{:.2} dB over the {} covered pixels at peak {:.3}, {:.2} dB over the image at peak 1, {} of {} covered pixels off by more than 1/255, largest change {:.3}",
+            c.psnr_db, c.covered_pixels, c.peak, w.psnr_db, w.bad_pixels, w.covered_pixels, w.max_abs_error
+        )
+    }
+}
+
+/// A side from two variants' images (`metric` is one of the pair metrics,
+/// [`Metric::is_pair`]): for every viewpoint `a` was rendered at, its image against `b`'s at
+/// the same viewpoint and viewport; the worst viewpoint is the side's one value (lowest PSNR,
 /// largest bad-pixel share), every viewpoint's figures are in the label.
 pub fn pair_side(
     metric: &Metric,
@@ -125,7 +208,7 @@ pub fn pair_side(
 ) -> Result<Side, String> {
     let (a_label, a_rows) = one_variant(a, dataset, inputs)?;
     let (b_label, b_rows) = one_variant(b, dataset, inputs)?;
-    let mut views: Vec<(String, ImageError)> = vec![];
+    let mut views: Vec<(String, PairView)> = vec![];
     for (ia, ra) in &a_rows {
         // Every image of `a` is judged: one without its pair is a missing measurement.
         let Some((ib, rb)) = b_rows.iter().find(|(_, rb)| {
@@ -136,24 +219,19 @@ pub fn pair_side(
                 ra.viewpoint, ra.width, ra.height
             ));
         };
-        let e = compare(&row_image(inputs, *ia, ra)?, &row_image(inputs, *ib, rb)?)
+        let (ima, imb) = (row_image(inputs, *ia, ra)?, row_image(inputs, *ib, rb)?);
+        let whole = compare(&ima, &imb)
             .map_err(|e| format!("{a_label} against {b_label} at {}: {e:#}", ra.viewpoint))?;
-        views.push((ra.viewpoint.clone(), e));
+        let covered = covered_error(&ima, &imb);
+        views.push((ra.viewpoint.clone(), PairView { whole, covered }));
     }
-    let worst_psnr = *metric == Metric::PairPsnrDb;
-    let value = |e: &ImageError| {
-        if worst_psnr {
-            e.psnr_db
-        } else {
-            e.bad_pixel_share
-        }
-    };
+    let worst_is_lowest = *metric != Metric::PairBadPixelShare;
     // The first of the worst viewpoints: the lowest PSNR, or the largest share of bad pixels.
     let (view, worst) = views
         .iter()
         .min_by(|a, b| {
-            let (a, b) = (value(&a.1), value(&b.1));
-            if worst_psnr {
+            let (a, b) = (a.1.value(metric), b.1.value(metric));
+            if worst_is_lowest {
                 a.total_cmp(&b)
             } else {
                 b.total_cmp(&a)
@@ -162,21 +240,16 @@ pub fn pair_side(
         .expect("one_variant returns at least one row");
     let each: Vec<String> = views
         .iter()
-        .map(|(v, e)| {
-            format!(
-                "{v}: {:.2} dB, {} of {} covered pixels off by more than 1/255",
-                e.psnr_db, e.bad_pixels, e.covered_pixels
-            )
-        })
+        .map(|(v, e)| format!("{v}: {}", e.describe()))
         .collect();
     Ok(Side::new(
         format!(
             "{a_label} against {b_label}, {metric} {} over {} viewpoint(s) (at {view}; {})",
-            if worst_psnr { "lowest" } else { "largest" },
+            if worst_is_lowest { "lowest" } else { "largest" },
             views.len(),
             each.join("; ")
         ),
-        vec![Sample::exact(view.clone(), value(worst))],
+        vec![Sample::exact(view.clone(), worst.value(metric))],
     ))
 }
 

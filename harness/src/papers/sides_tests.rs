@@ -195,3 +195,66 @@ fn an_image_pair_refuses_an_expectation_of_two_values() {
     let e = claims::parse(&format!("{header}\n{line}\n"), "test.csv").unwrap_err();
     assert!(format!("{e:#}").contains("needs a second side"), "{e:#}");
 }
+
+/// A dim disc of radius `radius` pixels in a `size`² image, its brightest channel `peak`.
+pub(crate) fn dim_disc(size: u32, radius: f32, peak: f32) -> Image {
+    let mut img = Image::new(size, size);
+    let c = size as f32 / 2.0;
+    for y in 0..size {
+        for x in 0..size {
+            let r = ((x as f32 + 0.5 - c).powi(2) + (y as f32 + 0.5 - c).powi(2)).sqrt() / radius;
+            if r < 1.0 {
+                let a = 0.5 + 0.5 * (1.0 - r);
+                img.pixels[(y * size + x) as usize] = [peak * a, peak * a * 0.6, peak * a * 0.3, a];
+            }
+        }
+    }
+    img
+}
+
+#[test]
+fn the_covered_psnr_reads_the_error_at_the_volume_s_pixels_and_the_image_s_range() {
+    use crate::papers::sides::covered_error;
+    use crate::results::metrics::compare;
+    // A small, dim volume: 8 px radius in 64², brightest channel 0.1 at the centre.
+    let b = dim_disc(64, 8.0, 0.1);
+    let covered = b.pixels.iter().filter(|p| p[3] > 1.0 / 255.0).count() as u64;
+    let mut a = b.clone();
+    for p in &mut a.pixels {
+        if p[3] > 0.0 {
+            p[0] += 0.01;
+            p[1] += 0.01;
+            p[2] += 0.01;
+        }
+    }
+    let e = covered_error(&a, &b);
+    assert_eq!(e.covered_pixels, covered);
+    assert!(e.peak > 0.09 && e.peak <= 0.1, "{}", e.peak);
+    // RMSE 0.01 over the covered pixels against a peak near 0.1: about 20 dB.
+    assert!((e.rmse - 0.01).abs() < 1e-6, "{}", e.rmse);
+    assert!((e.psnr_db - 20.0 * (e.peak / e.rmse).log10()).abs() < 1e-9);
+    assert!(e.psnr_db < 21.0, "{}", e.psnr_db);
+    // The same error over the whole image at peak 1 reads above 40 dB: the background and
+    // the dim light dilute it.
+    assert!(compare(&a, &b).unwrap().psnr_db > 45.0);
+    // The same image, or a background change below one 8-bit step, reads the cap.
+    assert_eq!(covered_error(&b, &b).psnr_db, 99.0);
+    let mut haze = b.clone();
+    for p in &mut haze.pixels {
+        if p[3] == 0.0 {
+            p[0] = 0.5 / 255.0;
+            p[3] = 0.5 / 255.0;
+        }
+    }
+    assert_eq!(covered_error(&haze, &b).psnr_db, 99.0);
+    // A NaN pixel counts as covered and maximally wrong.
+    let mut nan = b.clone();
+    nan.pixels[0] = [f32::NAN, 0.0, 0.0, f32::NAN];
+    let n = covered_error(&nan, &b);
+    assert_eq!(n.covered_pixels, covered + 1);
+    assert!(n.psnr_db < 20.0, "{}", n.psnr_db);
+    // Both images empty: nothing to see, nothing wrong.
+    let empty = Image::new(8, 8);
+    let z = covered_error(&empty, &empty);
+    assert_eq!((z.covered_pixels, z.psnr_db), (0, 99.0));
+}

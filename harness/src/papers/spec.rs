@@ -29,8 +29,8 @@ pub const ANALYSIS_METRICS: &[&str] = &[
 /// A claim's metric. Read from a run's rows: the row figures, `counter:NAME`,
 /// `counter_per_tet:NAME`, `stage:NAME`, `stage_share:NAME` (the stage over the most expensive
 /// other stage), `view_range:METRIC` (range over the viewpoints divided by their mean) and
-/// `view_max:METRIC` / `view_min:METRIC`; from two sides' images, `pair_psnr_db` and
-/// `pair_bad_pixel_share`; from the papers' CPU analyses, one of [`ANALYSIS_METRICS`].
+/// `view_max:METRIC` / `view_min:METRIC`; from two sides' images, `pair_psnr_db`,
+/// `pair_psnr_covered_db` and `pair_bad_pixel_share`; from the papers' CPU analyses, one of [`ANALYSIS_METRICS`].
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Metric {
     TotalMs,
@@ -52,6 +52,11 @@ pub enum Metric {
     ViewMin(Box<Metric>),
     /// PSNR (dB) of side `a`'s image against side `b`'s, the lowest over the viewpoints.
     PairPsnrDb,
+    /// PSNR (dB) of side `a`'s image against side `b`'s over the covered pixels only (either
+    /// image's α above one 8-bit step), with the peak at `b`'s brightest colour channel: the
+    /// error against the picture's own range, not diluted by the background or by a dim
+    /// transfer function. The lowest over the viewpoints.
+    PairPsnrCoveredDb,
     /// Share of covered pixels of `a` off by more than one 8-bit step from `b`, the largest
     /// over the viewpoints.
     PairBadPixelShare,
@@ -70,6 +75,7 @@ const PLAIN: &[(&str, Metric)] = &[
     ("gpu_bytes", Metric::GpuBytes),
     ("psnr_db", Metric::PsnrDb),
     ("pair_psnr_db", Metric::PairPsnrDb),
+    ("pair_psnr_covered_db", Metric::PairPsnrCoveredDb),
     ("pair_bad_pixel_share", Metric::PairBadPixelShare),
 ];
 
@@ -140,7 +146,10 @@ impl Metric {
     /// Whether it compares the images of the claim's two sides (its `b` is then the image
     /// compared with, not a second value).
     pub fn is_pair(&self) -> bool {
-        matches!(self, Metric::PairPsnrDb | Metric::PairBadPixelShare)
+        matches!(
+            self,
+            Metric::PairPsnrDb | Metric::PairPsnrCoveredDb | Metric::PairBadPixelShare
+        )
     }
 
     /// Whether one row gives it (not a reduction over viewpoints, an image pair or an
@@ -152,6 +161,7 @@ impl Metric {
                 | Metric::ViewMax(_)
                 | Metric::ViewMin(_)
                 | Metric::PairPsnrDb
+                | Metric::PairPsnrCoveredDb
                 | Metric::PairBadPixelShare
                 | Metric::Analysis(_)
         )
@@ -464,6 +474,7 @@ mod tests {
             "view_range:gpu_ms",
             "stage_share:sort",
             "pair_psnr_db",
+            "pair_psnr_covered_db",
             "kbuffer_share_k_gt6",
         ] {
             assert_eq!(Metric::parse(t).unwrap().to_string(), t);

@@ -8,6 +8,7 @@ use std::path::Path;
 use anyhow::Context;
 
 use super::cells::{self, CellCounts, CellRule, CellVerdict, NotCompared};
+use super::transcription::PaperTable;
 
 /// One metric (column group) of a comparison table. How its cells are judged is its rule in
 /// `reports/papers/cell_rules.csv` ([`super::cells`]), found by the paper, the table's key and
@@ -59,11 +60,37 @@ impl Cell {
         self.uncertain = why;
         self
     }
+    /// Keeps `why` as the reason where ours is missing.
+    pub fn missing_because(mut self, why: &str) -> Cell {
+        self.why_no_ours = self.ours.is_none().then(|| why.to_string());
+        self
+    }
     pub fn ratio(&self) -> Option<f64> {
         match (self.paper, self.ours) {
             (Some(p), Some(o)) if p != 0.0 && p.is_finite() && o.is_finite() => Some(o / p),
             _ => None,
         }
+    }
+}
+
+/// One row of a paper's transcribed table and why ours may be missing on it: each of its cells
+/// pairs the paper's value in a column (with the transcription's doubt about it) with ours.
+pub struct PaperRow<'t> {
+    pub table: &'t PaperTable,
+    pub key: &'t str,
+    pub why: String,
+}
+
+impl<'t> PaperRow<'t> {
+    pub fn new(table: &'t PaperTable, key: &'t str, why: String) -> PaperRow<'t> {
+        PaperRow { table, key, why }
+    }
+
+    /// The paper's value in `column` beside `ours`.
+    pub fn cell(&self, column: &str, ours: Option<f64>) -> Cell {
+        Cell::new(self.table.value(self.key, column), ours)
+            .missing_because(&self.why)
+            .uncertain(self.table.uncertain(self.key, column))
     }
 }
 
@@ -74,6 +101,37 @@ pub struct CompRow {
     pub label: String,
     pub standin: bool,
     pub cells: Vec<Cell>,
+}
+
+impl CompRow {
+    /// A row of one method of a comparison: `label (algorithm settings)`, or the label alone
+    /// where no tetbench algorithm implements the method.
+    pub fn method(
+        label: &str,
+        algorithm: Option<&str>,
+        settings: Option<&str>,
+        cells: Vec<Cell>,
+    ) -> CompRow {
+        let label = match (algorithm, settings) {
+            (Some(a), Some(s)) => format!("{label} ({a} {s})"),
+            (Some(a), None) => format!("{label} ({a})"),
+            (None, _) => label.to_string(),
+        };
+        CompRow {
+            label,
+            standin: false,
+            cells,
+        }
+    }
+
+    /// A row measured on `dataset`, marked where that is a generated stand-in.
+    pub fn on(label: impl Into<String>, dataset: &str, cells: Vec<Cell>) -> CompRow {
+        CompRow {
+            label: label.into(),
+            standin: datasets::standins::is_generated(dataset),
+            cells,
+        }
+    }
 }
 
 /// A table in the paper's shape with our values beside the paper's.

@@ -259,6 +259,11 @@ pub fn is_key_column(name: &str) -> bool {
     )
 }
 
+/// One of the embedded tables, which all parse (`every_paper_csv_parses_with_its_rows`).
+pub fn embedded(name: &str) -> PaperTable {
+    table(name).expect("embedded paper CSV parses (tested)")
+}
+
 /// Parses one embedded CSV; every row must have the header's number of cells, and every cell
 /// other than the key columns must be empty or a number.
 pub fn table(name: &str) -> anyhow::Result<PaperTable> {

@@ -35,7 +35,7 @@ use crate::regress::history_page::StepLine;
 use crate::regress::publish_runs::{copy_file, link_pages_to_front, PageKind, PairRecord, SiteRun};
 use crate::results::control::Pricing;
 use crate::results::names::slug;
-use crate::results::{read_text, ResultsFile, JSON_FILE};
+use crate::results::{read_text, write_file, ResultsFile, JSON_FILE};
 
 /// The file marking a directory as a site `publish` wrote (and may therefore replace).
 pub const SITE_MARKER: &str = ".tetbench-site";
@@ -550,7 +550,7 @@ pub fn publish(args: &PublishArgs) -> anyhow::Result<(PathBuf, Published)> {
     page.runs = runs.iter().map(run_line).collect();
     let html = crate::report::html::render("site.html", &page)?;
     let index = site.join("index.html");
-    std::fs::write(&index, html).with_context(|| format!("cannot write {}", index.display()))?;
+    write_file(&index, html)?;
     Ok((index, done))
 }
 

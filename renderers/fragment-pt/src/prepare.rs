@@ -412,16 +412,5 @@ fn timestamp_queries(gpu: &Gpu) -> Option<(wgpu::QuerySet, wgpu::Buffer)> {
     if !gpu.features.contains(wgpu::Features::TIMESTAMP_QUERY) {
         return None;
     }
-    let qs = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-        label: Some("fragment-pt timestamps"),
-        ty: wgpu::QueryType::Timestamp,
-        count: 4,
-    });
-    let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("fragment-pt timestamp resolve"),
-        size: 32,
-        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    Some((qs, buf))
+    Some(gpu.query_set("fragment-pt timestamps", wgpu::QueryType::Timestamp, 4, 32))
 }

@@ -1,39 +1,33 @@
-//! The renderer: uploads (prepare) and the per-frame phases (render).
-
-use std::time::Instant;
+//! The renderer: its state, what `prepare` builds (`render/prepare.rs`), and a frame as the
+//! paper's phases (`frame`).
 
 use anyhow::{anyhow, bail, Context};
 use datasets::TetMesh;
+use render_core::bind;
 use render_core::gpu::{Lifetime, MemoryLedger};
-use render_core::preintegration::{Table2d, Table3d};
 use render_core::table_texture::TableTexture;
 use render_core::{
     Camera, FrameClock, FrameStats, FrameTimer, Gpu, Image, Optics, Prepared, Renderer, Settings,
 };
 
-use crate::layout::{MeshLayout, TetRef, MESH_TEXTURE_BYTES, MESH_TEXTURE_WIDTH};
-use crate::resources::{FrameParams, Pipelines, Target, TileRect, MAX_TILES, STAT_SLOTS};
-use crate::settings::{Mode, RaycastSettings, TableKind};
+use crate::layout::{MeshLayout, TetRef};
+use crate::resources::{FrameParams, Pipelines, Target, TileRect};
+use crate::settings::{RaycastSettings, TableKind};
 use crate::step::{LayerEntry, RayFrame};
 use crate::{ET_OPACITY, PEEL_BIAS, TABLE_LENGTH, TABLE_SCALAR};
-use render_core::texel_texture::TexelTexture;
 
+mod cast;
+mod counters;
 mod passes;
 mod peel;
-use passes::run_passes;
-use peel::{peel, Peeled};
+mod prepare;
+use cast::cast;
+use counters::counters;
+use peel::peel;
 
 const FLAG_ET: u32 = 1;
 const FLAG_TABLE3D: u32 = 2;
 const FLAG_COUNT_DROPPED: u32 = 4;
-const STAT_ENTERED: usize = 0;
-const STAT_TERMINATED: usize = 1;
-const STAT_STALLED: usize = 2;
-const STAT_DROPPED: usize = 3;
-const STAT_SKIPPED: usize = 4;
-const STAT_STEPS: usize = 5;
-const STAT_MAX_STEPS: usize = 6;
-const STAT_STEPS_HIGH: usize = 7;
 
 /// Tiled ray caster (`raycast`).
 pub struct Raycast {
@@ -41,8 +35,8 @@ pub struct Raycast {
     /// Bytes per mesh texture layer when smaller than the adapter's storage-binding limit
     /// (tests split small meshes across layers this way).
     max_binding: Option<u64>,
-    /// Bytes per mesh texture when smaller than [`MESH_TEXTURE_BYTES`] (tests split small
-    /// meshes across textures this way).
+    /// Bytes per mesh texture when smaller than [`crate::layout::MESH_TEXTURE_BYTES`] (tests
+    /// split small meshes across textures this way).
     max_texture_bytes: Option<u64>,
     /// mode=passes as compute dispatches even where the device can draw it as tile rectangles
     /// (tests compare the two).
@@ -182,20 +176,8 @@ impl Raycast {
             rays.len() as u64 * 32,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         )?;
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("raycast probe"),
-            layout: &st.pipes.probe_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: inbuf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: out.as_entire_binding(),
-                },
-            ],
-        });
+        let entries = bind::whole_from(0, &[&inbuf, &out]);
+        let bind = gpu.bind_group("raycast probe", &st.pipes.layouts.probe, &entries);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -298,146 +280,13 @@ impl Renderer for Raycast {
     ) -> anyhow::Result<Prepared> {
         self.state = None;
         self.settings.validate()?;
-        // A layer is at most a storage binding's size (so its count and bytes are those of
-        // the storage layout it replaced) and at most the texture's largest rows.
-        let texture_bytes =
-            MESH_TEXTURE_WIDTH as u64 * gpu.limits.max_texture_dimension_2d as u64 * 16;
-        let max_binding = self
-            .max_binding
-            .map_or(gpu.max_storage_binding(), |b| {
-                b.min(gpu.max_storage_binding())
-            })
-            .min(texture_bytes);
-        let mut layout = MeshLayout::build(mesh, optics, max_binding)?;
-        let slots = layout.chunks.len();
-        anyhow::ensure!(
-            slots as u32 <= gpu.limits.max_texture_array_layers,
-            "raycast on {}: the mesh needs {slots} texture layers, the adapter allows {}",
-            gpu.adapter.name,
-            gpu.limits.max_texture_array_layers
-        );
-        render_core::bind::check_storage_bindings(
-            gpu,
-            &format!("raycast on {}", gpu.adapter.name),
-            // Group 0: the frame; group 1: the traversal's eight buffers.
-            1 + 8,
-        )?;
-        let mut ledger = MemoryLedger::default();
-        let max_texture_bytes = self.max_texture_bytes.unwrap_or(MESH_TEXTURE_BYTES);
-        let mesh_textures = MeshTextures::upload(gpu, &mut ledger, &mut layout, max_texture_bytes)?;
-        let (mesh_bytes, mesh_padding_bytes) = (mesh_textures.bytes, mesh_textures.padding_bytes);
-        // Boundary faces as geometry (phase 1): position (OCS) and the tet's (binding, index).
-        let o = layout.origin;
-        let mut verts: Vec<u32> = Vec::with_capacity(mesh.boundary_faces().len() * 15);
-        for bf in mesh.boundary_faces() {
-            let r = layout.tet_ref(bf.tet);
-            for v in bf.vertices(mesh) {
-                let p = mesh.points[v as usize];
-                for a in 0..3 {
-                    verts.push(((p[a] as f64 - o[a]) as f32).to_bits());
-                }
-                verts.push(r.chunk);
-                verts.push(r.local);
-            }
-        }
-        let face_vertices = (verts.len() / 5) as u32;
-        let faces = ledger.buffer_init(
-            gpu,
-            "raycast boundary faces",
-            Lifetime::Persistent,
-            bytemuck::cast_slice(&verts),
-            wgpu::BufferUsages::VERTEX,
-        )?;
-        // The table is a filtered 3D texture, one sample a step as the paper's fragment
-        // program looks it up (§2.2); the 2D table is one layer of it.
-        let (table, inv_table_length) = match self.settings.table {
-            TableKind::ThreeD => {
-                let t = Table3d::build(optics, TABLE_SCALAR, TABLE_LENGTH, layout.longest_edge);
-                let size = [
-                    TABLE_SCALAR as u32,
-                    TABLE_SCALAR as u32,
-                    TABLE_LENGTH as u32,
-                ];
-                (
-                    TableTexture::new(gpu, &mut ledger, "raycast 3D table", size, &t.data)?,
-                    (1.0 / layout.longest_edge.max(f64::MIN_POSITIVE)) as f32,
-                )
-            }
-            TableKind::TwoD => {
-                let t = Table2d::build(optics, TABLE_SCALAR, layout.mean_edge);
-                let size = [TABLE_SCALAR as u32, TABLE_SCALAR as u32, 1];
-                (
-                    TableTexture::new(gpu, &mut ledger, "raycast 2D table", size, &t.data)?,
-                    (1.0 / layout.mean_edge.max(f64::MIN_POSITIVE)) as f32,
-                )
-            }
+        let state = State::new(gpu, self, mesh, optics)?;
+        let prepared = Prepared {
+            persistent_bytes: state.ledger.persistent,
+            tets: state.tets,
         };
-        let frame_params = ledger.buffer(
-            gpu,
-            "raycast frame params",
-            Lifetime::PerFrame,
-            std::mem::size_of::<FrameParams>() as u64,
-            wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::UNIFORM
-                | wgpu::BufferUsages::COPY_DST,
-        )?;
-        let pipes = Pipelines::new(
-            gpu,
-            mesh_textures.textures.len(),
-            mesh_textures.layers_per_texture,
-            self.settings.mode == Mode::Passes && !self.compute_passes,
-        );
-        let mut entries = vec![render_core::bind::whole(0, &frame_params)];
-        entries.extend(mesh_textures.textures.iter().zip(1..).map(|(t, binding)| {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: wgpu::BindingResource::TextureView(&t.view),
-            }
-        }));
-        let mesh_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("raycast frame + mesh"),
-            layout: &pipes.mesh_layout,
-            entries: &entries,
-        });
-        // Set once per peeling layer (a render pass), never per dispatch: lavapipe keeps memory
-        // for every dispatch that sets a group holding a uniform buffer (docs/profile.md).
-        let peel_frame_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("raycast peel frame"),
-            layout: &pipes.peel_frame_layout,
-            entries: &[render_core::bind::whole(0, &frame_params)],
-        });
-        let n = mesh.num_tets() as u64;
-        // A guard against rays that cycle between tets through round-off: far more steps than
-        // a straight ray crosses in any mesh we know (counted as stalled when reached).
-        let max_steps = (64.0 * (n as f64).cbrt()).ceil() as u32 + 1024;
-        let persistent = ledger.persistent;
-        self.state = Some(State {
-            origin: layout.origin,
-            mesh_bindings: slots,
-            mesh_bytes,
-            mesh_padding_bytes,
-            max_binding,
-            tets: n,
-            ledger,
-            pipes,
-            frame_params,
-            mesh_bind,
-            peel_frame_bind,
-            faces,
-            face_vertices,
-            table,
-            inv_table_length,
-            length_unit: optics.length_unit,
-            max_steps,
-            target: None,
-            target_bytes: 0,
-            timer: FrameTimer::new(gpu),
-            last: None,
-        });
-        Ok(Prepared {
-            persistent_bytes: persistent,
-            tets: n,
-        })
+        self.state = Some(state);
+        Ok(prepared)
     }
 
     fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
@@ -483,99 +332,76 @@ impl Renderer for Raycast {
     }
 }
 
-/// Label of the texture that holds the mesh.
-const MESH_TEXTURE_LABEL: &str = "raycast mesh texture";
-
-/// The mesh in textures of at most `max_texture_bytes` ([`MESH_TEXTURE_BYTES`]), whole layers
-/// each, every layer as many rows as the largest needs.
-struct MeshTextures {
-    textures: Vec<TexelTexture>,
-    layers_per_texture: u32,
-    /// The texels written (§3.1's 144 B/tet is a claim about the layout).
-    bytes: u64,
-    /// The padding of each layer's last row, read from the ledger's allocation.
-    padding_bytes: u64,
-}
-
-impl MeshTextures {
-    /// Uploads `layout`'s layers and drops their host texels: the GPU's copy is the only one
-    /// kept (`layout` keeps its addressing and origin).
-    fn upload(
-        gpu: &Gpu,
-        ledger: &mut MemoryLedger,
-        layout: &mut MeshLayout,
-        max_texture_bytes: u64,
-    ) -> anyhow::Result<MeshTextures> {
-        let layers = layout.chunks.len();
-        let rows = layout.texture_rows();
-        let layer_bytes = rows as u64 * MESH_TEXTURE_WIDTH as u64 * 16;
-        let per_texture = (max_texture_bytes / layer_bytes).clamp(1, layers as u64) as usize;
-        let textures = (0..layers.div_ceil(per_texture))
-            .map(|k| {
-                let layers = (layers - k * per_texture).min(per_texture);
-                TexelTexture::new(
-                    gpu,
-                    ledger,
-                    MESH_TEXTURE_LABEL,
-                    Lifetime::Persistent,
-                    rows,
-                    layers as u32,
-                )
-            })
-            .collect::<anyhow::Result<Vec<_>>>()?;
-        let mut bytes = 0;
-        for (c, data) in std::mem::take(&mut layout.chunks).into_iter().enumerate() {
-            let layer = (c % per_texture) as u32;
-            bytes += textures[c / per_texture].write_layer(gpu, layer, &data);
-        }
-        Ok(MeshTextures {
-            textures,
-            layers_per_texture: per_texture as u32,
-            bytes,
-            padding_bytes: ledger.bytes_labelled(MESH_TEXTURE_LABEL) - bytes,
-        })
-    }
-}
-
+/// One frame, phase by phase as §3.2 of Bernardon et al. (2005) orders them (its Fig. 4): the
+/// viewport's buffers and the frame's parameters, phases 1–2 (the first hit and the peeling
+/// layers, [`peel`]), phase 3 (the ray-casting passes and their counts per tile, [`cast`]), and
+/// the counters. Phase 4, the colour, is [`Renderer::read_image`]'s readback.
 fn frame(
     gpu: &Gpu,
     st: &mut State,
     s: &RaycastSettings,
     camera: &Camera,
 ) -> anyhow::Result<FrameStats> {
-    let (w, h) = (camera.width, camera.height);
     let slots = s.max_layers + 1;
-    if st
-        .target
-        .as_ref()
-        .is_none_or(|t| t.width != w || t.height != h)
-    {
-        st.target = None;
-        let mut target_ledger = MemoryLedger::default();
-        st.target = Some(Target::new(
-            gpu,
-            &st.pipes,
-            &mut target_ledger,
-            &st.table,
-            w,
-            h,
-            slots,
-        )?);
-        st.target_bytes = target_ledger.per_frame;
-    }
-    let t = st.target.as_ref().expect("target created above");
-    let (tile_size, rects) = tile_rects(w, h, s.tiles);
-    let ntiles = rects.len();
+    fit_target(gpu, st, camera, slots)?;
+    let t = st.target.as_ref().expect("target fitted above");
+    let (tile_size, rects) = tile_rects(camera.width, camera.height, s.tiles);
     let mut clock = FrameClock::start();
     gpu.queue
         .write_buffer(&t.tile_rects, 0, bytemuck::cast_slice(&rects));
+    let mut params = frame_params(st, s, camera, tile_size);
+    gpu.queue
+        .write_buffer(&st.frame_params, 0, bytemuck::bytes_of(&params));
+    let peeled = peel(gpu, st, t, s, slots, &mut clock)?;
+    // Rays start at their first entry; active rays are counted per tile.
+    params.counts[1] = peeled.layers;
+    params.counts[3] = cast_flags(s, peeled.dropped_check);
+    let cast = cast(gpu, st, t, s, &params, &mut clock)?;
+    let times = clock.finish();
+    let gpu_ms = st.timer.gpu_ms(gpu)?;
+    let counters = counters(st, s, &peeled, &cast);
+    st.last = Some(LastFrame {
+        camera: camera.clone(),
+        layers_used: peeled.layers,
+        tile_passes: cast.tile_passes,
+        tile_size,
+    });
+    Ok(times.stats(gpu_ms, st.ledger.per_frame + st.target_bytes, counters))
+}
+
+/// Makes `st.target` the buffers of `camera`'s viewport with `slots` layer slots, if it is not.
+fn fit_target(gpu: &Gpu, st: &mut State, camera: &Camera, slots: u32) -> anyhow::Result<()> {
+    let (w, h) = (camera.width, camera.height);
+    if st
+        .target
+        .as_ref()
+        .is_some_and(|t| t.width == w && t.height == h)
+    {
+        return Ok(());
+    }
+    st.target = None;
+    let mut target_ledger = MemoryLedger::default();
+    let target = Target::new(gpu, &st.pipes, &mut target_ledger, &st.table, w, h, slots)?;
+    st.target = Some(target);
+    st.target_bytes = target_ledger.per_frame;
+    Ok(())
+}
+
+/// The frame's parameters for the peel: the rays in object coordinates, the projection, the
+/// viewport and tiles, the bias and the table. The cast's layer count and flags are 0 here.
+fn frame_params(
+    st: &State,
+    s: &RaycastSettings,
+    camera: &Camera,
+    tile_size: [u32; 2],
+) -> FrameParams {
     let rf = RayFrame::new(camera, st.origin);
     let p4 = |v: [f32; 3]| [v[0], v[1], v[2], 0.0];
     let model = glam::DMat4::from_translation(glam::DVec3::from(st.origin));
     let vp: glam::Mat4 = (camera.view_proj() * model).as_mat4();
     // λ of the farthest point any ray can reach inside the fitted frustum (slightly beyond far).
     let lambda_far = camera.far * 2.0;
-    let mut params = FrameParams {
+    FrameParams {
         o0: p4(rf.o0),
         ox: p4(rf.ox),
         oy: p4(rf.oy),
@@ -583,7 +409,7 @@ fn frame(
         dx: p4(rf.dx),
         dy: p4(rf.dy),
         view_proj: vp.to_cols_array_2d(),
-        size: [w, h, tile_size[0], tile_size[1]],
+        size: [camera.width, camera.height, tile_size[0], tile_size[1]],
         counts: [s.tiles, 0, st.max_steps, 0],
         misc: [
             (1.0 / lambda_far) as f32,
@@ -592,146 +418,36 @@ fn frame(
             st.inv_table_length,
         ],
         table: [TABLE_SCALAR as u32, TABLE_LENGTH as u32, s.max_layers, 0],
-    };
-    gpu.queue
-        .write_buffer(&st.frame_params, 0, bytemuck::bytes_of(&params));
+    }
+}
 
-    let Peeled {
-        layers: layers_used,
-        draws: peel_draws,
-        dropped_check,
-    } = peel(gpu, st, t, s, slots, &mut clock)?;
+/// The cast's flags: early termination, the 3D table, and counting the dropped re-entries
+/// where the peel drew the spare slot.
+fn cast_flags(s: &RaycastSettings, dropped_check: bool) -> u32 {
+    let flag = |on: bool, bit: u32| if on { bit } else { 0 };
+    flag(s.early_termination, FLAG_ET)
+        | flag(s.table == TableKind::ThreeD, FLAG_TABLE3D)
+        | flag(dropped_check, FLAG_COUNT_DROPPED)
+}
 
-    // Rays start at their first entry; active rays are counted per tile.
-    params.counts[1] = layers_used;
-    params.counts[3] = if s.early_termination { FLAG_ET } else { 0 }
-        | if s.table == TableKind::ThreeD {
-            FLAG_TABLE3D
-        } else {
-            0
-        }
-        | if dropped_check { FLAG_COUNT_DROPPED } else { 0 };
-    gpu.queue
-        .write_buffer(&st.frame_params, 0, bytemuck::bytes_of(&params));
-    gpu.queue.write_buffer(&t.stats, 0, &[0u8; STAT_SLOTS * 4]);
-    gpu.queue
-        .write_buffer(&t.tile_counts, 0, &[0u8; MAX_TILES * 4]);
-    let t_cast = Instant::now();
+/// Submits one dispatch of `pipeline` over the mesh and the traversal (a plain pass's flag).
+fn dispatch(
+    gpu: &Gpu,
+    st: &State,
+    t: &Target,
+    pipeline: &wgpu::ComputePipeline,
+    [x, y, z]: [u32; 3],
+    clock: &mut FrameClock,
+) {
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     {
         let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&st.pipes.init);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &st.mesh_bind, &[]);
         pass.set_bind_group(1, &t.cast_binds[0], &[]);
-        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        pass.dispatch_workgroups(x, y, z);
     }
     clock.submit(gpu, [enc.finish()]);
-    let counts = read_counts(gpu, &mut clock, &t.tile_counts, ntiles)?;
-    let mut tile_passes = vec![0u32; ntiles];
-    let mut rounds = passes::Rounds::default();
-    // One dispatch per pass covers every listed tile (workgroup z = slot in the list).
-    let grid = passes::Grid::new(tile_size, s.k);
-    match s.mode {
-        Mode::Passes => {
-            rounds = run_passes(gpu, st, t, grid, counts, &mut tile_passes, &mut clock)?;
-        }
-        Mode::Loop => {
-            let active = active_tiles(&counts);
-            if !active.is_empty() {
-                gpu.queue
-                    .write_buffer(&t.active_tiles, 0, bytemuck::cast_slice(&active));
-                let mut enc = gpu.device.create_command_encoder(&Default::default());
-                {
-                    let mut pass = enc.begin_compute_pass(&Default::default());
-                    pass.set_pipeline(&st.pipes.run_loop);
-                    pass.set_bind_group(0, &st.mesh_bind, &[]);
-                    pass.set_bind_group(1, &t.cast_binds[0], &[]);
-                    pass.dispatch_workgroups(grid.groups[0], grid.groups[1], active.len() as u32);
-                }
-                clock.submit(gpu, [enc.finish()]);
-                for &tile in &active {
-                    tile_passes[tile as usize] = 1;
-                }
-            }
-        }
-    }
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    st.timer.end(&mut enc);
-    clock.submit(gpu, [enc.finish()]);
-    let stats_bytes = clock.read_buffer(gpu, &t.stats, 0, STAT_SLOTS as u64 * 4)?;
-    clock.stage("cast", t_cast);
-    let times = clock.finish();
-    let gpu_ms = st.timer.gpu_ms(gpu)?;
-    let stats: &[u32] = bytemuck::cast_slice(&stats_bytes);
-    let entered = stats[STAT_ENTERED] as f64;
-    // Tets crossed by all rays together (one step = one ray-tet exit computation and one
-    // composited segment), the work the roofline's ray-step rate measures.
-    let ray_steps = ((stats[STAT_STEPS_HIGH] as u64) << 32 | stats[STAT_STEPS] as u64) as f64;
-    let max_passes = tile_passes.iter().copied().max().unwrap_or(0);
-    let mean_passes = tile_passes.iter().map(|&p| p as f64).sum::<f64>() / ntiles as f64;
-    let mut counters = vec![
-        ("passes_max".to_string(), max_passes as f64),
-        ("passes_mean".to_string(), mean_passes),
-        (
-            "tiles_empty".to_string(),
-            tile_passes.iter().filter(|&&p| p == 0).count() as f64,
-        ),
-        ("count_rounds".to_string(), rounds.rounds as f64),
-        ("peel_layers".to_string(), layers_used as f64),
-        ("rays".to_string(), entered),
-        (
-            "steps_mean".to_string(),
-            if entered > 0.0 {
-                ray_steps / entered
-            } else {
-                0.0
-            },
-        ),
-        ("steps_max".to_string(), stats[STAT_MAX_STEPS] as f64),
-        ("ray_steps".to_string(), ray_steps),
-        // Every peeling layer draws all boundary faces (the last draw finds its layer empty or
-        // fills the spare slot that counts dropped re-entries); passes drawn as tile rectangles
-        // add two triangles a rectangle.
-        (
-            "triangles".to_string(),
-            (st.face_vertices / 3) as f64 * peel_draws as f64 + 2.0 * rounds.rectangles as f64,
-        ),
-        (
-            "early_terminated_rays".to_string(),
-            stats[STAT_TERMINATED] as f64,
-        ),
-        ("stalled_rays".to_string(), stats[STAT_STALLED] as f64),
-        ("dropped_reentries".to_string(), stats[STAT_DROPPED] as f64),
-        ("skipped_entries".to_string(), stats[STAT_SKIPPED] as f64),
-        (
-            "mesh_bytes_per_tet".to_string(),
-            st.mesh_bytes as f64 / st.tets.max(1) as f64,
-        ),
-        (
-            "mesh_padding_bytes".to_string(),
-            st.mesh_padding_bytes as f64,
-        ),
-        ("table_bytes".to_string(), st.table.bytes as f64),
-        // An adapter that cannot filter Rgba32Float samples the table nearest (counted).
-        (
-            "table_filter_nearest".to_string(),
-            !st.table.filterable as u8 as f64,
-        ),
-        ("mesh_bindings".to_string(), st.mesh_bindings as f64),
-    ];
-    if s.mode == Mode::Passes {
-        // The passes' and depth updates' rectangles (0 where the passes are compute dispatches).
-        counters.push(("tile_rectangles".to_string(), rounds.rectangles as f64));
-        // Times a tile restarted its passes from its next peeling layer (§3.2 phase 3a).
-        counters.push(("layer_loads".to_string(), rounds.layer_loads as f64));
-    }
-    st.last = Some(LastFrame {
-        camera: camera.clone(),
-        layers_used,
-        tile_passes,
-        tile_size,
-    });
-    Ok(times.stats(gpu_ms, st.ledger.per_frame + st.target_bytes, counters))
 }
 
 /// The tiles that still have active rays, from their counts.
@@ -741,6 +457,7 @@ fn active_tiles(counts: &[u32]) -> Vec<u32> {
         .collect()
 }
 
+/// The first `n` per-tile counts of `buf`.
 fn read_counts(
     gpu: &Gpu,
     clock: &mut FrameClock,

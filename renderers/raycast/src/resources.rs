@@ -2,7 +2,7 @@
 //! mesh), and the per-viewport traversal buffers, peeling layers and tile parameters.
 
 use render_core::bind;
-use render_core::gpu::{Lifetime, MemoryLedger};
+use render_core::gpu::{LayoutEntries, Lifetime, MemoryLedger, RasterState};
 use render_core::Gpu;
 
 use render_core::table_texture::TableTexture;
@@ -68,31 +68,9 @@ pub fn gpu_layouts() -> render_core::gpu_layout::GpuLayouts {
 /// Every stage the ray caster's bind groups are visible to.
 const STAGES: wgpu::ShaderStages =
     wgpu::ShaderStages::VERTEX_FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
-
-fn buffer_entry(
-    binding: u32,
-    ty: wgpu::BufferBindingType,
-    dynamic: bool,
-) -> wgpu::BindGroupLayoutEntry {
-    let e = bind::buffer_entry(binding, STAGES, ty);
-    if dynamic {
-        bind::with_dynamic_offset(e)
-    } else {
-        e
-    }
-}
-
-fn uint_texture_entry(binding: u32, dim: wgpu::TextureViewDimension) -> wgpu::BindGroupLayoutEntry {
-    bind::sampled_texture_entry(
-        binding,
-        wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        wgpu::TextureSampleType::Uint,
-        dim,
-    )
-}
-
-const RO: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: true };
-const RW: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: false };
+/// The stages that read the ray caster's `Rgba32Uint` textures (the mesh, the peeled layers).
+const TEXTURE_STAGES: wgpu::ShaderStages =
+    wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
 
 pub const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -143,15 +121,61 @@ pub struct TilePipelines {
 /// The depth format of the tile passes' early depth test (depth only).
 pub const ZCULL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
+/// The bind-group layouts: group 0 (`mesh`) for every pipeline, then what each pass adds.
+pub struct Layouts {
+    /// The frame's parameters and the mesh textures ([`mesh_wgsl`]).
+    pub mesh: wgpu::BindGroupLayout,
+    /// The previous peeling layer (group 1 of `peel.wgsl`).
+    pub peel: wgpu::BindGroupLayout,
+    /// The traversal's buffers, the layers, the table and the pass flag (group 1 of `cast.wgsl`).
+    pub cast: wgpu::BindGroupLayout,
+    /// The probe's input and output (group 1 of `probe.wgsl`).
+    pub probe: wgpu::BindGroupLayout,
+    /// The frame's parameters as a uniform block for the peel and the tile passes (group 2).
+    pub peel_frame: wgpu::BindGroupLayout,
+}
+
+impl Layouts {
+    /// The layouts for a mesh in `textures` textures. The frame's and the pass's parameters are
+    /// bound with [`bind::params_entry`] (set again every pass).
+    fn new(gpu: &Gpu, textures: u32) -> Layouts {
+        use wgpu::TextureViewDimension::{D2Array, D2};
+        let table = TableTexture::layout_entries(TableTexture::filterable_on(gpu), 4, 10, STAGES);
+        Layouts {
+            mesh: LayoutEntries::new(STAGES)
+                .params(0)
+                .visible(TEXTURE_STAGES)
+                .uint_texture(1..=textures, D2Array)
+                .build(gpu, "raycast frame + mesh"),
+            peel: LayoutEntries::new(TEXTURE_STAGES)
+                .uint_texture(0, D2)
+                .build(gpu, "raycast previous layer"),
+            cast: LayoutEntries::new(STAGES)
+                .read_write(0..=2)
+                .read_write(5..=6)
+                .read(7..=8)
+                .params(9)
+                .with(table)
+                .visible(TEXTURE_STAGES)
+                .uint_texture(3, D2Array)
+                .build(gpu, "raycast traversal"),
+            probe: LayoutEntries::new(STAGES)
+                .read(0)
+                .read_write(1)
+                .build(gpu, "raycast probe"),
+            peel_frame: LayoutEntries::new(wgpu::ShaderStages::VERTEX_FRAGMENT)
+                .uniform(0)
+                .build(gpu, "raycast peel frame"),
+        }
+    }
+}
+
 /// Layouts and pipelines, independent of the viewport.
 pub struct Pipelines {
-    pub mesh_layout: wgpu::BindGroupLayout,
-    pub peel_layout: wgpu::BindGroupLayout,
-    pub cast_layout: wgpu::BindGroupLayout,
-    pub probe_layout: wgpu::BindGroupLayout,
-    /// The frame's parameters as a uniform block for the peel (group 2; `peel.wgsl`).
-    pub peel_frame_layout: wgpu::BindGroupLayout,
+    pub layouts: Layouts,
+    /// Phase 1 (§3.2): the first boundary entry per pixel.
     pub first: wgpu::RenderPipeline,
+    /// Phase 2: the next boundary entry behind the previous layer's.
     pub peel: wgpu::RenderPipeline,
     /// With a stencil: a full-screen triangle that passes where a peeling pass left two
     /// candidates or more in a pixel. Drawn under an occlusion query after each layer, it
@@ -170,214 +194,154 @@ pub struct Pipelines {
     pub probe: wgpu::ComputePipeline,
 }
 
-impl Pipelines {
-    /// Layouts and pipelines. The frame's and the pass's parameters are bound with
-    /// [`bind::params_entry`] (set again every pass); the mesh is `textures` array textures of
-    /// `layers_per_texture` layers ([`mesh_wgsl`]).
-    /// `tile_passes` (mode=passes): build [`TilePipelines`] where the device can force early
-    /// depth tests.
-    pub fn new(
-        gpu: &Gpu,
-        textures: usize,
-        layers_per_texture: u32,
-        tile_passes: bool,
-    ) -> Pipelines {
-        let dev = &gpu.device;
-        let mut mesh_entries = vec![bind::params_entry(0, STAGES)];
-        mesh_entries.extend(
-            (1..=textures as u32)
-                .map(|b| uint_texture_entry(b, wgpu::TextureViewDimension::D2Array)),
-        );
-        let mesh_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("raycast frame + mesh"),
-            entries: &mesh_entries,
-        });
-        let peel_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("raycast previous layer"),
-            entries: &[uint_texture_entry(0, wgpu::TextureViewDimension::D2)],
-        });
-        let table_entries =
-            TableTexture::layout_entries(TableTexture::filterable_on(gpu), 4, 10, STAGES);
-        let cast_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("raycast traversal"),
-            entries: &[
-                buffer_entry(0, RW, false),
-                buffer_entry(1, RW, false),
-                buffer_entry(2, RW, false),
-                uint_texture_entry(3, wgpu::TextureViewDimension::D2Array),
-                table_entries[0],
-                buffer_entry(5, RW, false),
-                buffer_entry(6, RW, false),
-                buffer_entry(7, RO, false),
-                buffer_entry(8, RO, false),
-                bind::params_entry(9, STAGES),
-                table_entries[1],
-            ],
-        });
-        let peel_frame_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("raycast peel frame"),
-            entries: &[bind::uniform_entry(
-                0,
-                wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
-            )],
-        });
-        let probe_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("raycast probe"),
-            entries: &[buffer_entry(0, RO, false), buffer_entry(1, RW, false)],
-        });
+/// The WGSL of the ray caster's modules, each after the shared prelude (texel records,
+/// `common.wgsl`, the mesh's textures).
+struct Sources {
+    peel: String,
+    cast: String,
+    probe: String,
+}
+
+impl Sources {
+    fn new(textures: usize, layers_per_texture: u32) -> Sources {
         let common = format!(
             "{}\n{}\n{}",
             render_core::texel_texture::TEXEL_WGSL,
             include_str!("common.wgsl"),
             mesh_wgsl(textures, layers_per_texture)
         );
-        let peel_src = format!(
-            "{common}\n{}\n{}",
-            include_str!("peel.wgsl"),
-            render_core::bind::FULLSCREEN_WGSL
-        );
-        let cast_src = format!(
-            "{common}\n{}\n{}",
-            render_core::table_texture::TABLE_WGSL,
-            include_str!("cast.wgsl")
-        );
-        let probe_src = format!("{common}\n{}", include_str!("probe.wgsl"));
-        let peel_module = gpu.shader("raycast peel", &peel_src);
-        let cast_module = gpu.shader("raycast cast", &cast_src);
-        let probe_module = gpu.shader("raycast probe", &probe_src);
-        let layout = |label: &str, groups: &[Option<&wgpu::BindGroupLayout>]| {
-            render_core::bind::pipeline_layout(gpu, label, groups)
-        };
-        let first_layout = layout(
-            "raycast first hit",
-            &[Some(&mesh_layout), None, Some(&peel_frame_layout)],
-        );
-        let peel_pl = layout(
-            "raycast peel",
-            &[
-                Some(&mesh_layout),
-                Some(&peel_layout),
-                Some(&peel_frame_layout),
-            ],
-        );
-        let cast_pl = layout("raycast cast", &[Some(&mesh_layout), Some(&cast_layout)]);
-        let probe_pl = layout("raycast probe", &[Some(&mesh_layout), Some(&probe_layout)]);
+        Sources {
+            peel: format!(
+                "{common}\n{}\n{}",
+                include_str!("peel.wgsl"),
+                bind::FULLSCREEN_WGSL
+            ),
+            cast: format!(
+                "{common}\n{}\n{}",
+                render_core::table_texture::TABLE_WGSL,
+                include_str!("cast.wgsl")
+            ),
+            probe: format!("{common}\n{}", include_str!("probe.wgsl")),
+        }
+    }
+}
+
+/// The peel's pipelines (phases 1–2, §2.4 and §3.2): `first`, `peel` and `more`.
+struct PeelPipelines {
+    first: wgpu::RenderPipeline,
+    peel: wgpu::RenderPipeline,
+    more: Option<wgpu::RenderPipeline>,
+}
+
+impl PeelPipelines {
+    fn new(gpu: &Gpu, layouts: &Layouts, source: &str) -> PeelPipelines {
+        let module = gpu.shader("raycast peel", source);
         let (depth, stencil) = depth_format(gpu);
-        let raster = |label: &str, pl: &wgpu::PipelineLayout, fs: &str| {
-            dev.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(pl),
-                vertex: wgpu::VertexState {
-                    module: &peel_module,
-                    entry_point: Some("vs_face"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: 20,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32x2],
-                    })],
-                },
-                // §2.4: only front-facing boundary faces (back faces culled); boundary faces are
-                // wound counter-clockwise seen from outside the mesh.
+        let faces = [Some(wgpu::VertexBufferLayout {
+            array_stride: 20,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32x2],
+        })];
+        let layer = [Some(wgpu::ColorTargetState::from(LAYER_FORMAT))];
+        let faces_state = |fragment_entry| {
+            let state = RasterState {
+                vertex_buffers: &faces,
+                // §2.4: only front-facing boundary faces (back faces culled); boundary faces
+                // are wound counter-clockwise seen from outside the mesh.
                 primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
                     front_face: wgpu::FrontFace::Ccw,
                     cull_mode: Some(wgpu::Face::Back),
                     ..Default::default()
                 },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: depth,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: if stencil {
-                        wgpu::StencilState {
-                            front: COUNT_CANDIDATES,
-                            back: COUNT_CANDIDATES,
-                            read_mask: 0xff,
-                            write_mask: 0xff,
-                        }
-                    } else {
-                        Default::default()
-                    },
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &peel_module,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: LAYER_FORMAT,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+                targets: &layer,
+                ..RasterState::new("vs_face", fragment_entry)
+            }
+            .depth_test(depth, wgpu::CompareFunction::Less, true);
+            if stencil {
+                state.stencil(both_faces(COUNT_CANDIDATES, 0xff))
+            } else {
+                state
+            }
         };
-        let first = raster("raycast first hit", &first_layout, "fs_first");
-        let peel = raster("raycast peel", &peel_pl, "fs_peel");
+        let (mesh, peel, frame) = (&layouts.mesh, &layouts.peel, &layouts.peel_frame);
+        // Group 1 (the previous layer) is unused by the first hit.
+        let first_layout =
+            bind::pipeline_layout(gpu, "raycast first hit", &[Some(mesh), None, Some(frame)]);
+        let peel_layout = gpu.pipeline_layout("raycast peel", &[mesh, peel, frame]);
+        let first = gpu.render_pipeline(
+            "raycast first hit",
+            &first_layout,
+            &module,
+            faces_state("fs_first"),
+        );
+        let peel = gpu.render_pipeline(
+            "raycast peel",
+            &peel_layout,
+            &module,
+            faces_state("fs_peel"),
+        );
         let more = stencil.then(|| {
-            dev.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("raycast more candidates"),
-                layout: Some(&layout("raycast more candidates", &[])),
-                vertex: wgpu::VertexState {
-                    module: &peel_module,
-                    entry_point: Some("fullscreen_vs"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: depth,
-                    depth_write_enabled: Some(false),
-                    depth_compare: Some(wgpu::CompareFunction::Always),
-                    stencil: wgpu::StencilState {
-                        front: MORE_THAN_REFERENCE,
-                        back: MORE_THAN_REFERENCE,
-                        read_mask: 0xff,
-                        write_mask: 0,
-                    },
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &peel_module,
-                    entry_point: Some("fs_nothing"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: LAYER_FORMAT,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::empty(),
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            let nothing = [Some(wgpu::ColorTargetState {
+                write_mask: wgpu::ColorWrites::empty(),
+                ..LAYER_FORMAT.into()
+            })];
+            let state = RasterState {
+                targets: &nothing,
+                ..RasterState::new("fullscreen_vs", "fs_nothing")
+            }
+            .depth_test(depth, wgpu::CompareFunction::Always, false)
+            .stencil(both_faces(MORE_THAN_REFERENCE, 0));
+            let layout = gpu.pipeline_layout("raycast more candidates", &[]);
+            gpu.render_pipeline("raycast more candidates", &layout, &module, state)
         });
-        let cast = |label, entry| gpu.compute_pipeline(label, Some(&cast_pl), &cast_module, entry);
-        let (init, step) = (cast("raycast init", "init"), cast("raycast step", "step"));
-        let run_loop = cast("raycast loop", "run_loop");
-        let load_layer = cast("raycast load layer", "load_layer");
-        let probe = gpu.compute_pipeline("raycast probe", Some(&probe_pl), &probe_module, "probe");
+        PeelPipelines { first, peel, more }
+    }
+}
+
+/// `face` on both sides, every stencil bit read, `write_mask`'s written.
+fn both_faces(face: wgpu::StencilFaceState, write_mask: u32) -> wgpu::StencilState {
+    wgpu::StencilState {
+        front: face,
+        back: face,
+        read_mask: 0xff,
+        write_mask,
+    }
+}
+
+impl Pipelines {
+    /// Layouts and pipelines for a mesh in `textures` array textures of `layers_per_texture`
+    /// layers ([`mesh_wgsl`]). `tile_passes` (mode=passes): build [`TilePipelines`] where the
+    /// device can force early depth tests.
+    pub fn new(
+        gpu: &Gpu,
+        textures: usize,
+        layers_per_texture: u32,
+        tile_passes: bool,
+    ) -> Pipelines {
+        let layouts = Layouts::new(gpu, textures as u32);
+        let sources = Sources::new(textures, layers_per_texture);
+        let PeelPipelines { first, peel, more } = PeelPipelines::new(gpu, &layouts, &sources.peel);
+        let (mesh, cast) = (&layouts.mesh, &layouts.cast);
+        let cast_module = gpu.shader("raycast cast", &sources.cast);
+        let [init, step, run_loop, load_layer] = gpu.compute_pipelines(
+            "raycast",
+            &[mesh, cast],
+            &cast_module,
+            ["init", "step", "run_loop", "load_layer"],
+        );
+        let probe_module = gpu.shader("raycast probe", &sources.probe);
+        let [probe] =
+            gpu.compute_pipelines("raycast", &[mesh, &layouts.probe], &probe_module, ["probe"]);
         let early_depth = gpu
             .features
             .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
         let tile_passes = (tile_passes && early_depth).then(|| {
-            let groups = [&mesh_layout, &cast_layout, &peel_frame_layout];
-            TilePipelines::build(
-                gpu,
-                &layout("raycast tile passes", &groups.map(Some)),
-                &cast_src,
-            )
+            let layout =
+                gpu.pipeline_layout("raycast tile passes", &[mesh, cast, &layouts.peel_frame]);
+            TilePipelines::build(gpu, &layout, &sources.cast)
         });
         Pipelines {
-            mesh_layout,
-            peel_layout,
-            cast_layout,
-            probe_layout,
-            peel_frame_layout,
+            layouts,
             first,
             peel,
             more,
@@ -400,34 +364,8 @@ impl TilePipelines {
 
     fn new(gpu: &Gpu, layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule) -> Self {
         let pipeline = |label: &str, fs: &str, compare, write| {
-            gpu.device
-                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(label),
-                    layout: Some(layout),
-                    vertex: wgpu::VertexState {
-                        module,
-                        entry_point: Some("vs_tile"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: Default::default(),
-                    depth_stencil: Some(wgpu::DepthStencilState {
-                        format: ZCULL_FORMAT,
-                        depth_write_enabled: Some(write),
-                        depth_compare: Some(compare),
-                        stencil: Default::default(),
-                        bias: Default::default(),
-                    }),
-                    multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module,
-                        entry_point: Some(fs),
-                        compilation_options: Default::default(),
-                        targets: &[],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
+            let state = RasterState::new("vs_tile", fs).depth_test(ZCULL_FORMAT, compare, write);
+            gpu.render_pipeline(label, layout, module, state)
         };
         TilePipelines {
             // The rectangles lie at depth 0.5: in front of the clear (1), behind an ended ray (0).
@@ -488,77 +426,119 @@ impl Target {
         layer_slots: u32,
     ) -> anyhow::Result<Target> {
         let pixels = width as u64 * height as u64;
-        let storage = wgpu::BufferUsages::STORAGE
-            | wgpu::BufferUsages::COPY_SRC
-            | wgpu::BufferUsages::COPY_DST;
-        let rays = ledger.buffer(
+        let mut storage = |label: &str, bytes: u64| {
+            let usage = wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST;
+            ledger.buffer(gpu, label, Lifetime::PerFrame, bytes, usage)
+        };
+        // The traversal (Table 2), then the tiles' rectangles and counts and the statistics.
+        let rays = storage("raycast current cell", pixels * 16)?;
+        let colours = storage("raycast colour", pixels * 16)?;
+        let aux = storage("raycast layer + steps", pixels * 8)?;
+        let tile_counts = storage("raycast tile counts", MAX_TILES as u64 * 4)?;
+        let stats = storage("raycast stats", STAT_SLOTS as u64 * 4)?;
+        let tile_rects = storage("raycast tile rectangles", MAX_TILES as u64 * 16)?;
+        let active_tiles = storage("raycast active tiles", MAX_TILES as u64 * 4)?;
+        let plain = pass_flag(gpu, ledger, 0)?;
+        let counting = pass_flag(gpu, ledger, 1)?;
+        let peeled = PeelLayers::new(gpu, ledger, (width, height), layer_slots)?;
+        let (_, depth_view) = bind::render_target(
             gpu,
-            "raycast current cell",
-            Lifetime::PerFrame,
-            pixels * 16,
-            storage,
+            ledger,
+            "raycast depth",
+            (width, height),
+            depth_format(gpu).0,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
         )?;
-        let colours = ledger.buffer(
-            gpu,
-            "raycast colour",
-            Lifetime::PerFrame,
-            pixels * 16,
-            storage,
-        )?;
-        let aux = ledger.buffer(
-            gpu,
-            "raycast layer + steps",
-            Lifetime::PerFrame,
-            pixels * 8,
-            storage,
-        )?;
-        let tile_counts = ledger.buffer(
-            gpu,
-            "raycast tile counts",
-            Lifetime::PerFrame,
-            MAX_TILES as u64 * 4,
-            storage,
-        )?;
-        let stats = ledger.buffer(
-            gpu,
-            "raycast stats",
-            Lifetime::PerFrame,
-            STAT_SLOTS as u64 * 4,
-            storage,
-        )?;
-        let tile_rects = ledger.buffer(
-            gpu,
-            "raycast tile rectangles",
-            Lifetime::PerFrame,
-            MAX_TILES as u64 * 16,
-            storage,
-        )?;
-        let active_tiles = ledger.buffer(
-            gpu,
-            "raycast active tiles",
-            Lifetime::PerFrame,
-            MAX_TILES as u64 * 4,
-            storage,
-        )?;
-        let params = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
-        let pass_flags: Vec<wgpu::Buffer> = (0..2u32)
-            .map(|c| {
-                let mut bytes = [0u8; 16];
-                bytes[..4].copy_from_slice(&c.to_le_bytes());
-                ledger.buffer_init(gpu, "raycast pass flag", Lifetime::PerFrame, &bytes, params)
+        let [table_view, table_sampler] = table.bind_entries(4, 10);
+        let cast_bind = |flag: &wgpu::Buffer| {
+            let tiles = [&tile_counts, &stats, &tile_rects, &active_tiles, flag];
+            let mut entries = bind::whole_from(0, &[&rays, &colours, &aux]);
+            entries.push(bind::view_entry(3, &peeled.array));
+            entries.push(table_view.clone());
+            entries.extend(bind::whole_from(5, &tiles));
+            entries.push(table_sampler.clone());
+            gpu.bind_group("raycast traversal", &pipes.layouts.cast, &entries)
+        };
+        let cast_binds = [cast_bind(&plain), cast_bind(&counting)];
+        let peel_binds = peeled
+            .views
+            .iter()
+            .map(|v| {
+                let entries = [bind::view_entry(0, v)];
+                gpu.bind_group("raycast previous layer", &pipes.layouts.peel, &entries)
             })
-            .collect::<anyhow::Result<_>>()?;
-        let size = wgpu::Extent3d {
+            .collect();
+        // Per layer l: queries 2l (the layer's samples) and 2l + 1 (pixels with more candidates,
+        // `Pipelines::more`), resolved together at l × the alignment.
+        let (occlusion, occlusion_resolve) = gpu.query_set(
+            "raycast peel occlusion",
+            wgpu::QueryType::Occlusion,
+            2 * layer_slots,
+            layer_slots as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
+        );
+        let zcull = pipes.tile_passes.is_some().then(|| {
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+            let size = (width, height);
+            bind::render_target(gpu, ledger, "raycast tile depth", size, ZCULL_FORMAT, usage)
+                .map(|(_, view)| view)
+        });
+        Ok(Target {
             width,
             height,
-            depth_or_array_layers: layer_slots,
-        };
-        let layers = ledger.texture(
+            rays,
+            colours,
+            aux,
+            layers: peeled.texture,
+            layer_views: peeled.views,
+            depth_view,
+            tile_rects,
+            active_tiles,
+            tile_counts,
+            stats,
+            cast_binds,
+            peel_binds,
+            occlusion,
+            occlusion_resolve,
+            zcull: zcull.transpose()?,
+        })
+    }
+}
+
+/// The pass's parameter block: its count flag `c` (0: a plain pass, 1: the pass that ends a
+/// round and counts active rays).
+fn pass_flag(gpu: &Gpu, ledger: &mut MemoryLedger, c: u32) -> anyhow::Result<wgpu::Buffer> {
+    let mut bytes = [0u8; 16];
+    bytes[..4].copy_from_slice(&c.to_le_bytes());
+    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+    ledger.buffer_init(gpu, "raycast pass flag", Lifetime::PerFrame, &bytes, usage)
+}
+
+/// The peeling layers' texture (one slot a layer), a view of each slot and one of them all.
+struct PeelLayers {
+    texture: wgpu::Texture,
+    views: Vec<wgpu::TextureView>,
+    array: wgpu::TextureView,
+}
+
+impl PeelLayers {
+    fn new(
+        gpu: &Gpu,
+        ledger: &mut MemoryLedger,
+        (width, height): (u32, u32),
+        slots: u32,
+    ) -> anyhow::Result<PeelLayers> {
+        let texture = ledger.texture(
             gpu,
             Lifetime::PerFrame,
             &wgpu::TextureDescriptor {
                 label: Some("raycast peeling layers"),
-                size,
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: slots,
+                },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -569,17 +549,9 @@ impl Target {
                 view_formats: &[],
             },
         )?;
-        let (_, depth_view) = bind::render_target(
-            gpu,
-            ledger,
-            "raycast depth",
-            (width, height),
-            depth_format(gpu).0,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-        )?;
-        let layer_views: Vec<wgpu::TextureView> = (0..layer_slots)
+        let views = (0..slots)
             .map(|l| {
-                layers.create_view(&wgpu::TextureViewDescriptor {
+                texture.create_view(&wgpu::TextureViewDescriptor {
                     label: Some("raycast layer"),
                     dimension: Some(wgpu::TextureViewDimension::D2),
                     base_array_layer: l,
@@ -588,98 +560,15 @@ impl Target {
                 })
             })
             .collect();
-        let array_view = layers.create_view(&wgpu::TextureViewDescriptor {
+        let array = texture.create_view(&wgpu::TextureViewDescriptor {
             label: Some("raycast layers"),
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        fn buf(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: b.as_entire_binding(),
-            }
-        }
-        let [table_view, table_sampler] = table.bind_entries(4, 10);
-        let cast_bind = |flag: &wgpu::Buffer| {
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("raycast traversal"),
-                layout: &pipes.cast_layout,
-                entries: &[
-                    buf(0, &rays),
-                    buf(1, &colours),
-                    buf(2, &aux),
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::TextureView(&array_view),
-                    },
-                    table_view.clone(),
-                    buf(5, &tile_counts),
-                    buf(6, &stats),
-                    buf(7, &tile_rects),
-                    buf(8, &active_tiles),
-                    buf(9, flag),
-                    table_sampler.clone(),
-                ],
-            })
-        };
-        let cast_binds = [cast_bind(&pass_flags[0]), cast_bind(&pass_flags[1])];
-        let peel_binds = layer_views
-            .iter()
-            .map(|v| {
-                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("raycast previous layer"),
-                    layout: &pipes.peel_layout,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(v),
-                    }],
-                })
-            })
-            .collect();
-        let occlusion = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("raycast peel occlusion"),
-            ty: wgpu::QueryType::Occlusion,
-            count: 2 * layer_slots,
-        });
-        // Per layer l: queries 2l (the layer's samples) and 2l + 1 (pixels with more candidates,
-        // `Pipelines::more`), resolved together at l × the alignment.
-        let occlusion_resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("raycast occlusion resolve"),
-            size: layer_slots as u64 * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
-            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let zcull = if pipes.tile_passes.is_some() {
-            let (_, view) = bind::render_target(
-                gpu,
-                ledger,
-                "raycast tile depth",
-                (width, height),
-                ZCULL_FORMAT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-            )?;
-            Some(view)
-        } else {
-            None
-        };
-        Ok(Target {
-            width,
-            height,
-            rays,
-            colours,
-            aux,
-            layers,
-            layer_views,
-            depth_view,
-            tile_rects,
-            active_tiles,
-            tile_counts,
-            stats,
-            cast_binds,
-            peel_binds,
-            occlusion,
-            occlusion_resolve,
-            zcull,
+        Ok(PeelLayers {
+            texture,
+            views,
+            array,
         })
     }
 }

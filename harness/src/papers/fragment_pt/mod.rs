@@ -9,12 +9,11 @@
 //! algorithm). Fig. 8 (performance against viewport size) is `tetbench analyze resolution`
 //! ([`fig8`]).
 
-use crate::papers::session::{
-    find_including, is_standin, Extra, Measured, Report, RunSpec, Session,
-};
-use crate::papers::table::{Cell, CompRow, Comparison, Metric};
+use crate::papers::session::{find_variant, Extra, Measured, Report, RunSpec, Session};
+use crate::papers::table::{Cell, CompRow, Comparison, Metric, PaperRow};
 use crate::papers::transcription;
 use crate::papers::{Paper, PaperModule};
+use crate::report::Aggregate;
 
 pub mod fig8;
 
@@ -68,71 +67,47 @@ impl PaperModule for FragmentPt {
     }
 
     fn plan(&self) -> Vec<RunSpec> {
-        let table1 = |name: &str, datasets: Vec<String>, full_viewport: bool| RunSpec {
-            name: name.into(),
-            algorithms: vec!["fragment-pt".into()],
-            datasets,
-            viewpoints: "orbit:14".into(),
-            resolution: 512,
-            tf: None,
-            settings: Some(FRAGMENT_SETTINGS.into()),
-            quick_settings: None,
-            full_viewport,
-            full_views: false,
+        let run = |name: &str, datasets: &[&str], settings: &str| {
+            RunSpec::new(name, "fragment-pt", datasets, "orbit:14", Some(settings))
         };
-        let (brain, others): (Vec<String>, Vec<String>) = DATASETS
-            .map(|(_, d)| d.to_string())
+        let (brain, others): (Vec<&str>, Vec<&str>) = DATASETS
+            .map(|(_, d)| d)
             .into_iter()
-            .partition(|d| d == "brain");
+            .partition(|d| *d == "brain");
         // Claim F8: the merge sort the paper draws still frames with, on the data sets of F2,
         // at the main run's viewpoints and viewport so each image pairs with a bucket-sorted one.
-        let merge = RunSpec {
-            name: "fragment-pt-merge".into(),
-            settings: Some(MERGE_SETTINGS.into()),
-            ..table1(
-                "",
-                others.iter().filter(|d| *d != "fuel").cloned().collect(),
-                false,
-            )
-        };
+        let f2: Vec<&str> = others.iter().copied().filter(|d| *d != "fuel").collect();
         let mut plan = vec![
-            table1("fragment-pt", others, false),
-            merge,
+            run("fragment-pt", &others, FRAGMENT_SETTINGS),
+            run("fragment-pt-merge", &f2, MERGE_SETTINGS),
             // §5's 5.5 M tets on a 256 MB board (claim F7) is judged on the device bytes of
             // the Brain row, which depend on the viewport: 512² in every mode.
-            table1("fragment-pt-brain", brain, true),
+            RunSpec {
+                full_viewport: true,
+                ..run("fragment-pt-brain", &brain, FRAGMENT_SETTINGS)
+            },
         ];
         for (label, alg, settings) in TABLE2.iter().skip(1) {
             let Some(alg) = alg else { continue };
-            plan.push(RunSpec {
-                name: format!("table2-{}", crate::results::names::slug(label)),
-                algorithms: vec![alg.to_string()],
-                datasets: vec!["bluntfin".into(), "post".into()],
-                viewpoints: "orbit:14".into(),
-                resolution: 512,
-                tf: None,
-                settings: (!settings.is_empty()).then(|| settings.to_string()),
-                quick_settings: None,
-                full_viewport: false,
-                full_views: false,
-            });
+            let name = format!("table2-{}", crate::results::names::slug(label));
+            let settings = (!settings.is_empty()).then_some(*settings);
+            plan.push(RunSpec::new(
+                name,
+                alg,
+                &["bluntfin", "post"],
+                "orbit:14",
+                settings,
+            ));
         }
         plan
     }
 
     fn analyses(&self, s: &mut Session, m: &mut Measured) -> anyhow::Result<Extra> {
         let mut x = Extra::default();
-        let registry = datasets::registry::Registry::new(s.data_dir.clone());
         for (_, d) in DATASETS {
-            match registry.resolve(&s.dataset(d), &datasets::LoadOptions::default()) {
-                Ok(ds) => x.sizes.push((
-                    d.to_string(),
-                    ds.mesh.num_points() as u64,
-                    ds.mesh.num_tets() as u64,
-                )),
-                Err(e) => m
-                    .errors
-                    .push(format!("data set \"{d}\" could not be loaded: {e}")),
+            if let Some(ds) = s.load(d, m) {
+                let (points, tets) = (ds.mesh.num_points(), ds.mesh.num_tets());
+                x.sizes.push((d.to_string(), points as u64, tets as u64));
             }
         }
         Ok(x)
@@ -143,54 +118,43 @@ impl PaperModule for FragmentPt {
     }
 }
 
-fn want(settings: &str) -> render_core::Settings {
-    crate::algorithms::parse_settings("fragment-pt", settings).expect("the table's own settings")
+/// Tables 1–2, the bytes per tet of §4 and the paper's claims from what was measured.
+pub fn tables(m: &Measured, x: &Extra) -> Report {
+    let aggs = m.aggregates();
+    Report {
+        comparisons: vec![table1(m, x, &aggs), memory(m), table2(m, &aggs)],
+        claims: crate::papers::evidence::evaluate_claims(
+            PAPER.id,
+            m,
+            x,
+            &crate::papers::evidence::no_analyses,
+        ),
+        notes: vec![],
+    }
 }
 
-pub fn tables(m: &Measured, x: &Extra) -> Report {
-    let mut report = Report::default();
-    let aggs = m.aggregates();
-    let load = |n: &str| transcription::table(n).expect("embedded paper CSV parses (tested)");
-
-    // Table 1.
-    let t = load("fragment-pt_table1");
-    let mut rows = vec![];
-    let mut bytes_rows = vec![];
-    for (paper, d) in DATASETS {
-        let a = find_including(&aggs, "fragment-pt", d, &want(FRAGMENT_SETTINGS));
-        let size = x.sizes.iter().find(|(n, _, _)| n == d);
-        let why = m.why("fragment-pt", d);
-        let fps = a.and_then(|a| a.fps.map(|s| s.mean));
-        let tps = a.and_then(|a| a.tets_per_sec.map(|s| s.mean));
-        let cell = |col: &str, ours: Option<f64>| Cell {
-            paper: t.value(paper, col),
-            ours,
-            why_no_ours: ours.is_none().then(|| why.clone()),
-            uncertain: t.uncertain(paper, col),
-        };
-        rows.push(CompRow {
-            label: format!("{paper} ({d})"),
-            standin: is_standin(d),
-            cells: vec![
-                cell("vertices", size.map(|s| s.1 as f64)),
-                cell("tets", size.map(|s| s.2 as f64)),
-                cell("fps", fps),
-                cell("tets_per_sec", tps),
-            ],
-        });
-        let model = m.counter("fragment-pt", d, "model_bytes_per_tet");
-        bytes_rows.push(CompRow {
-            label: format!("{paper} ({d})"),
-            standin: is_standin(d),
-            cells: vec![Cell {
-                paper: Some(PAPER_BYTES_PER_TET),
-                ours: model,
-                why_no_ours: model.is_none().then(|| why.clone()),
-                uncertain: Some("the paper's 20 assumes about 4 tets per vertex".into()),
-            }],
-        });
-    }
-    report.comparisons.push(Comparison {
+/// Table 1: the data sets' sizes and the method's rates while the model rotates.
+fn table1(m: &Measured, x: &Extra, aggs: &[Aggregate]) -> Comparison {
+    let t = transcription::embedded("fragment-pt_table1");
+    let rows = DATASETS
+        .iter()
+        .map(|&(paper, d)| {
+            let a = find_variant(aggs, "fragment-pt", d, FRAGMENT_SETTINGS);
+            let size = x.size(d);
+            let row = PaperRow::new(&t, paper, m.why("fragment-pt", d));
+            let cells = vec![
+                row.cell("vertices", size.map(|s| s.0 as f64)),
+                row.cell("tets", size.map(|s| s.1 as f64)),
+                row.cell("fps", a.and_then(|a| a.fps.map(|s| s.mean))),
+                row.cell(
+                    "tets_per_sec",
+                    a.and_then(|a| a.tets_per_sec.map(|s| s.mean)),
+                ),
+            ];
+            CompRow::on(format!("{paper} ({d})"), d, cells)
+        })
+        .collect();
+    Comparison {
         key: "table1".into(),
         title: "Table 1 — data sets and average rates while rotating".into(),
         conditions: format!(
@@ -204,61 +168,63 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         ],
         rows,
         notes: vec!["Fuel and Brain are stand-ins at the paper's sizes: a synthetic 64³ volume and HeadMRVolume resampled to 98³, 6 tets per cube.".into()],
-    });
-    report.comparisons.push(Comparison {
+    }
+}
+
+/// §4: the model's bytes per tet against the paper's 20.
+fn memory(m: &Measured) -> Comparison {
+    let rows = DATASETS
+        .iter()
+        .map(|&(paper, d)| {
+            let model = m.counter("fragment-pt", d, "model_bytes_per_tet");
+            let cell = Cell::new(Some(PAPER_BYTES_PER_TET), model)
+                .missing_because(&m.why("fragment-pt", d))
+                .uncertain(Some(
+                    "the paper's 20 assumes about 4 tets per vertex".into(),
+                ));
+            CompRow::on(format!("{paper} ({d})"), d, vec![cell])
+        })
+        .collect();
+    Comparison {
         key: "memory".into(),
         title: "§4 — GPU bytes per tet of the model (vertex and tet textures)".into(),
         conditions: "Paper (§4): 16 B per tet texel + 16 B per vertex texel, about 20 B/tet at about four tets per vertex. Ours: the renderer's `model_bytes_per_tet` counter (tet indices + vertices), which does not depend on the GPU. Claims F2 (about 20) and F3 (under the ray casters' 96 and 144) give the verdicts.".into(),
         metrics: vec![Metric::new("B/tet", 1)],
-        rows: bytes_rows,
+        rows,
         notes: brain_bytes_note(m).into_iter().collect(),
-    });
-
-    // Table 2.
-    let t = load("fragment-pt_table2");
-    let mut rows = vec![];
-    for (label, alg, settings) in TABLE2 {
-        let mut cells = vec![];
-        for (col, d) in [("blunt_fps", "bluntfin"), ("post_fps", "post")] {
-            let ours = alg
-                .and_then(|a| find_including(&aggs, a, d, &want(settings)))
-                .and_then(|a| a.fps.map(|s| s.mean));
-            let why = match alg {
-                Some(a) => m.why(a, d),
-                None => "no tetbench algorithm implements it".into(),
-            };
-            cells.push(Cell {
-                paper: t.value(label, col),
-                ours,
-                why_no_ours: ours.is_none().then_some(why),
-                uncertain: t.uncertain(label, col),
-            });
-        }
-        rows.push(CompRow {
-            label: match alg {
-                Some(a) if settings.is_empty() => format!("{label} ({a})"),
-                Some(a) => format!("{label} ({a} {settings})"),
-                None => label.to_string(),
-            },
-            standin: false,
-            cells,
-        });
     }
-    report.comparisons.push(Comparison {
+}
+
+/// Table 2: fps on Blunt and Post beside the other methods.
+fn table2(m: &Measured, aggs: &[Aggregate]) -> Comparison {
+    let t = transcription::embedded("fragment-pt_table2");
+    let rows = TABLE2
+        .iter()
+        .map(|&(label, alg, settings)| {
+            let cells = [("blunt_fps", "bluntfin"), ("post_fps", "post")]
+                .map(|(col, d)| {
+                    let why = match alg {
+                        Some(a) => m.why(a, d),
+                        None => "no tetbench algorithm implements it".into(),
+                    };
+                    let ours = alg
+                        .and_then(|a| find_variant(aggs, a, d, settings))
+                        .and_then(|a| a.fps.map(|s| s.mean));
+                    PaperRow::new(&t, label, why).cell(col, ours)
+                })
+                .to_vec();
+            let settings = Some(settings).filter(|s| !s.is_empty());
+            CompRow::method(label, alg, settings, cells)
+        })
+        .collect();
+    Comparison {
         key: "table2".into(),
         title: "Table 2 — fps against other methods".into(),
         conditions: "Paper: 512², model rotating; competitors' code from their authors (HARC PPI) or reimplemented. Ours: the same orbit and viewport for every algorithm; GATOR with linear cells and the centroid radix sort. The paper's HARC is Weiler et al.'s ray caster; tetbench's `raycast` is the tiled one (Bernardon et al.), the closest we have.".into(),
         metrics: vec![Metric::new("Blunt fps", 2), Metric::new("Post fps", 2)],
         rows,
         notes: vec![],
-    });
-    report.claims = crate::papers::evidence::evaluate_claims(
-        PAPER.id,
-        m,
-        x,
-        &crate::papers::evidence::no_analyses,
-    );
-    report
+    }
 }
 
 /// The bytes of a 256 MB board (claim F7).

@@ -11,9 +11,9 @@
 //! the paper does). Table 4's difference from the paper is split into measured parts
 //! ([`passes_parts`]): the restart per layer, k and the tiling, each from a run of its own.
 
-use crate::papers::session::{is_standin, Extra, Measured, Report, RunSpec};
-use crate::papers::table::{Cell, CompRow, Comparison, Metric};
-use crate::papers::transcription;
+use crate::papers::session::{Extra, Measured, Report, RunSpec};
+use crate::papers::table::{Cell, CompRow, Comparison, Metric, PaperRow};
+use crate::papers::transcription::{self, PaperTable};
 use crate::papers::{Paper, PaperModule};
 
 mod passes;
@@ -41,16 +41,15 @@ const PASSES_LAYERS: &str = "32";
 /// A run of Table 4's counts with `settings`: the paper's viewport and views in every mode.
 fn passes_run(name: &str, settings: &str) -> RunSpec {
     RunSpec {
-        name: name.into(),
-        algorithms: vec!["raycast".into()],
-        datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
-        viewpoints: "14".into(),
-        resolution: 512,
-        tf: None,
-        settings: Some(settings.into()),
-        quick_settings: None,
         full_viewport: true,
         full_views: true,
+        ..RunSpec::new(
+            name,
+            "raycast",
+            &DATASETS.map(|(_, d)| d),
+            "14",
+            Some(settings),
+        )
     }
 }
 
@@ -64,24 +63,19 @@ impl PaperModule for Raycast {
 
     fn plan(&self) -> Vec<RunSpec> {
         vec![
-            RunSpec {
-                name: "raycast".into(),
-                algorithms: vec!["raycast".into()],
-                datasets: DATASETS.map(|(_, d)| d.to_string()).to_vec(),
-                viewpoints: "14".into(),
-                resolution: 512,
-                // The paper's configuration only: one pass per ray step (§2.3) and early ray
-                // termination as in its code (opacity 0.95), k at its default. Our `mode=loop` is
-                // not in its tables.
-                tf: None,
-                settings: Some(format!(
+            // The paper's configuration only: one pass per ray step (§2.3) and early ray
+            // termination as in its code (opacity 0.95), k at its default. Our `mode=loop` is
+            // not in its tables.
+            RunSpec::new(
+                "raycast",
+                "raycast",
+                &DATASETS.map(|(_, d)| d),
+                "14",
+                Some(&format!(
                     "tiles={};table=2d|3d;mode=passes;et=on;k=8",
                     TILINGS.join("|")
                 )),
-                quick_settings: None,
-                full_viewport: false,
-                full_views: false,
-            },
+            ),
             // Table 4's passes are counts: at the paper's viewport and views in every mode,
             // up to 32 peeling layers so that no re-entry is dropped (the paper peels until no
             // face is left). The passes mode at k = 8 and k = 1 on one tile, at k = 8 on 6×6
@@ -123,48 +117,63 @@ fn min_max(v: impl Iterator<Item = f64>) -> (Option<f64>, Option<f64>) {
     )
 }
 
+/// Tables 3–6, the bytes per tet of §3.1 and the paper's claims from what was measured.
 pub fn tables(m: &Measured, x: &Extra) -> Report {
-    let mut report = Report::default();
-    let load = |n: &str| transcription::table(n).expect("embedded paper CSV parses (tested)");
-    let t3 = load("raycast_table3");
-    let gpus: Vec<String> = {
-        let mut g: Vec<String> = t3
-            .keys()
-            .iter()
-            .filter_map(|k| k.split(" / ").next().map(String::from))
-            .collect();
-        g.dedup();
-        g
-    };
+    let t3 = transcription::embedded("raycast_table3");
+    // The paper's GPUs, in Table 3's order: its tables of times have a row per GPU and data set.
+    let mut gpus: Vec<String> = t3
+        .keys()
+        .iter()
+        .filter_map(|k| k.split(" / ").next().map(String::from))
+        .collect();
+    gpus.dedup();
+    Report {
+        comparisons: vec![
+            table3(m, &t3, &gpus),
+            // Table 4: passes from the passes runs (the paper's viewport and views in every
+            // mode), with the parts of the difference.
+            passes::table4(m, &transcription::embedded("raycast_table4")),
+            table_ms(m, &gpus, 5, "2d"),
+            table_ms(m, &gpus, 6, "3d"),
+            memory(m),
+        ],
+        claims: crate::papers::evidence::evaluate_claims(
+            PAPER.id,
+            m,
+            x,
+            &crate::papers::evidence::no_analyses,
+        ),
+        notes: vec![],
+    }
+}
 
-    // Table 3: min/max fps and tets/s over views and tilings (2D table).
-    let mut rows = vec![];
-    for gpu in &gpus {
-        for (paper, d) in DATASETS {
-            let key = format!("{gpu} / {paper}");
+/// Every (paper's row key, data set) of a table per GPU: `GPU / paper name`.
+fn gpu_rows<'a>(gpus: &'a [String]) -> impl Iterator<Item = (String, &'static str)> + 'a {
+    gpus.iter().flat_map(|gpu| {
+        DATASETS
+            .iter()
+            .map(move |(paper, d)| (format!("{gpu} / {paper}"), *d))
+    })
+}
+
+/// Table 3: min/max fps and tets/s over views and tilings (2D table).
+fn table3(m: &Measured, t3: &PaperTable, gpus: &[String]) -> Comparison {
+    let rows = gpu_rows(gpus)
+        .map(|(key, d)| {
             let r = rows_of(m, d, None, Some("2d"));
             let (fmin, fmax) = min_max(r.iter().filter_map(|r| r.fps));
             let (tmin, tmax) = min_max(r.iter().filter_map(|r| r.tets_per_sec));
-            let why = m.why("raycast", d);
-            let cell = |col: &str, ours: Option<f64>| Cell {
-                paper: t3.value(&key, col),
-                ours,
-                why_no_ours: ours.is_none().then(|| why.clone()),
-                uncertain: t3.uncertain(&key, col),
-            };
-            rows.push(CompRow {
-                label: format!("{key} ({d})"),
-                standin: is_standin(d),
-                cells: vec![
-                    cell("min_fps", fmin),
-                    cell("max_fps", fmax),
-                    cell("min_tets_per_sec", tmin),
-                    cell("max_tets_per_sec", tmax),
-                ],
-            });
-        }
-    }
-    report.comparisons.push(Comparison {
+            let row = PaperRow::new(t3, &key, m.why("raycast", d));
+            let cells = vec![
+                row.cell("min_fps", fmin),
+                row.cell("max_fps", fmax),
+                row.cell("min_tets_per_sec", tmin),
+                row.cell("max_tets_per_sec", tmax),
+            ];
+            CompRow::on(format!("{key} ({d})"), d, cells)
+        })
+        .collect();
+    Comparison {
         key: "table3".into(),
         title: "Table 3 — min/max fps and tets/s over camera positions and tilings (2D table)".into(),
         conditions: "Paper: per GPU, 512², min/max over camera positions and all tilings 1×1…6×6. Ours: min/max over our viewpoints and tilings on this adapter (the same values are compared with each of the paper's GPUs).".into(),
@@ -176,94 +185,63 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
         ],
         rows,
         notes: vec![],
-    });
-
-    // Table 4: ray-casting passes, from the passes runs (the paper's viewport and views in
-    // every mode), with the parts of the difference.
-    report
-        .comparisons
-        .push(passes::table4(m, &load("raycast_table4")));
-
-    // Tables 5 and 6: ms per tiling, 2D and 3D tables.
-    for (name, table) in [("raycast_table5", "2d"), ("raycast_table6", "3d")] {
-        let t = load(name);
-        let mut rows = vec![];
-        for gpu in &gpus {
-            for (paper, d) in DATASETS {
-                let key = format!("{gpu} / {paper}");
-                let why = m.why("raycast", d);
-                let mut cells = vec![];
-                for tiles in TILINGS {
-                    let (lo, hi) = min_max(
-                        rows_of(m, d, Some(tiles), Some(table))
-                            .iter()
-                            .filter_map(|r| r.total_ms),
-                    );
-                    for (suffix, ours) in [("min_ms", lo), ("max_ms", hi)] {
-                        let col = format!("tiles_{tiles}_{suffix}");
-                        cells.push(Cell {
-                            paper: t.value(&key, &col),
-                            ours,
-                            why_no_ours: ours.is_none().then(|| why.clone()),
-                            uncertain: t.uncertain(&key, &col),
-                        });
-                    }
-                }
-                rows.push(CompRow {
-                    label: format!("{key} ({d})"),
-                    standin: is_standin(d),
-                    cells,
-                });
-            }
-        }
-        report.comparisons.push(Comparison {
-            key: if table == "2d" { "table5" } else { "table6" }.into(),
-            title: format!(
-                "Table {} — min/max ms per frame per tiling, {} pre-integration table",
-                if table == "2d" { 5 } else { 6 },
-                table.to_uppercase()
-            ),
-            conditions: "Paper: min–max over camera positions, per GPU. Ours: min/max of the median frame time over our viewpoints, per tiling.".into(),
-            metrics: TILINGS
-                .iter()
-                .flat_map(|t| [Metric::new(format!("{t} min ms"), 0), Metric::new(format!("{t} max ms"), 0)])
-                .collect(),
-            rows,
-            notes: vec![],
-        });
     }
+}
 
-    // Bytes per tet (§3.1), independent of the GPU.
-    let rows = DATASETS
-        .iter()
-        .map(|(paper, d)| {
-            // The mesh layout alone (§3.1 counts the mesh textures, not the tables).
-            let b = m.counter("raycast", d, "mesh_bytes_per_tet");
-            CompRow {
-                label: format!("{paper} ({d})"),
-                standin: is_standin(d),
-                cells: vec![Cell {
-                    paper: Some(PAPER_BYTES_PER_TET),
-                    ours: b,
-                    why_no_ours: b.is_none().then(|| m.why("raycast", d)),
-                    uncertain: None,
-                }],
-            }
+/// Tables 5 (`table` 2d) and 6 (3d): min/max ms per frame per tiling.
+fn table_ms(m: &Measured, gpus: &[String], number: u32, table: &str) -> Comparison {
+    let t = transcription::embedded(&format!("raycast_table{number}"));
+    let rows = gpu_rows(gpus)
+        .map(|(key, d)| {
+            let row = PaperRow::new(&t, &key, m.why("raycast", d));
+            let cells = TILINGS
+                .iter()
+                .flat_map(|tiles| {
+                    let ms = rows_of(m, d, Some(tiles), Some(table));
+                    let (lo, hi) = min_max(ms.iter().filter_map(|r| r.total_ms));
+                    [
+                        row.cell(&format!("tiles_{tiles}_min_ms"), lo),
+                        row.cell(&format!("tiles_{tiles}_max_ms"), hi),
+                    ]
+                })
+                .collect();
+            CompRow::on(format!("{key} ({d})"), d, cells)
         })
         .collect();
-    report.comparisons.push(Comparison {
+    Comparison {
+        key: format!("table{number}"),
+        title: format!(
+            "Table {number} — min/max ms per frame per tiling, {} pre-integration table",
+            table.to_uppercase()
+        ),
+        conditions: "Paper: min–max over camera positions, per GPU. Ours: min/max of the median frame time over our viewpoints, per tiling.".into(),
+        metrics: TILINGS
+            .iter()
+            .flat_map(|t| [Metric::new(format!("{t} min ms"), 0), Metric::new(format!("{t} max ms"), 0)])
+            .collect(),
+        rows,
+        notes: vec![],
+    }
+}
+
+/// Bytes per tet (§3.1), independent of the GPU.
+fn memory(m: &Measured) -> Comparison {
+    let rows = DATASETS
+        .iter()
+        .map(|&(paper, d)| {
+            // The mesh layout alone (§3.1 counts the mesh textures, not the tables).
+            let b = m.counter("raycast", d, "mesh_bytes_per_tet");
+            let cell =
+                Cell::new(Some(PAPER_BYTES_PER_TET), b).missing_because(&m.why("raycast", d));
+            CompRow::on(format!("{paper} ({d})"), d, vec![cell])
+        })
+        .collect();
+    Comparison {
         key: "memory".into(),
         title: "§3.1 — persistent GPU bytes per tet".into(),
         conditions: "Paper: 9 RGBA32F texels per tet = 144 B (Weiler et al.: 160 B). Ours: the `mesh_bytes_per_tet` counter (the mesh layout; the pre-integration tables are counted apart, as in the paper). Does not depend on the GPU.".into(),
         metrics: vec![Metric::new("B/tet", 1)],
         rows,
         notes: vec![],
-    });
-    report.claims = crate::papers::evidence::evaluate_claims(
-        PAPER.id,
-        m,
-        x,
-        &crate::papers::evidence::no_analyses,
-    );
-    report
+    }
 }

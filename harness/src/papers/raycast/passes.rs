@@ -3,8 +3,8 @@
 //! (§2.3, §3.2: per peeling layer, rounds of k passes until a count finds no ray of the tile
 //! still inside); each part is the same count with one input changed, on the same viewpoint.
 
-use crate::papers::session::{is_standin, Measured};
-use crate::papers::table::{Cell, CompRow, Comparison, Metric};
+use crate::papers::session::Measured;
+use crate::papers::table::{CompRow, Comparison, Metric, PaperRow};
 use crate::papers::transcription::PaperTable;
 use crate::results::Row;
 
@@ -142,22 +142,12 @@ pub(super) fn table4(m: &Measured, t4: &PaperTable) -> Comparison {
                     }
                 }
             }
-            let ours = [ext.map(|e| e.0.count), ext.map(|e| e.1.count)];
-            let why = m.why("raycast", d);
-            CompRow {
-                label: format!("{paper} ({d})"),
-                standin: is_standin(d),
-                cells: columns
-                    .iter()
-                    .zip(ours)
-                    .map(|(c, ours)| Cell {
-                        paper: t4.value(paper, c),
-                        ours,
-                        why_no_ours: ours.is_none().then(|| why.clone()),
-                        uncertain: t4.uncertain(paper, c),
-                    })
-                    .collect(),
-            }
+            let row = PaperRow::new(t4, paper, m.why("raycast", d));
+            let cells = vec![
+                row.cell(columns[0], ext.map(|e| e.0.count)),
+                row.cell(columns[1], ext.map(|e| e.1.count)),
+            ];
+            CompRow::on(format!("{paper} ({d})"), d, cells)
         })
         .collect();
     Comparison {

@@ -10,7 +10,7 @@
 use datasets::standins::{self, Recipe};
 
 use crate::papers::session::{find, Extra, Measured, Report, RunSpec};
-use crate::papers::table::{Cell, CompRow, Comparison, Metric};
+use crate::papers::table::{Cell, CompRow, Comparison, Metric, PaperRow};
 use crate::papers::transcription;
 use crate::papers::{Paper, PaperModule};
 
@@ -98,7 +98,7 @@ impl PaperModule for Splat {
 
 pub fn tables(m: &Measured, x: &Extra) -> Report {
     let mut report = Report::default();
-    let t = transcription::table("splat_table1").expect("embedded paper CSV parses (tested)");
+    let t = transcription::embedded("splat_table1");
     let aggs = m.aggregates();
     let mut rows = vec![];
     let mut radix_notes = vec![];
@@ -156,15 +156,9 @@ pub fn tables(m: &Measured, x: &Extra) -> Report {
             }),
             uncertain: t.uncertain(paper, "effective_voxels"),
         });
-        for (b, col) in [("cpu", "cpu_buckets_fps"), ("gpu", "gpu_buckets_fps")] {
-            let ours = fps(b);
-            cells.push(Cell {
-                paper: t.value(paper, col),
-                ours,
-                why_no_ours: ours.is_none().then(|| why.clone()),
-                uncertain: t.uncertain(paper, col),
-            });
-        }
+        let row = PaperRow::new(&t, paper, why);
+        cells.push(row.cell("cpu_buckets_fps", fps("cpu")));
+        cells.push(row.cell("gpu_buckets_fps", fps("gpu")));
         rows.push(CompRow {
             label: format!("{paper} ({d})"),
             standin: true,

@@ -108,6 +108,18 @@ impl LayoutEntries {
         self.each(bindings, |b, v| bind::texture_entry(b, v, false, dimension))
     }
 
+    /// An unsigned-integer texture of `dimension` (records of texels read with `textureLoad`:
+    /// [`crate::texel_texture`], a renderer's own `Rgba32Uint` targets).
+    pub fn uint_texture(
+        self,
+        bindings: impl BindingNumbers,
+        dimension: wgpu::TextureViewDimension,
+    ) -> Self {
+        self.each(bindings, |b, v| {
+            bind::sampled_texture_entry(b, v, wgpu::TextureSampleType::Uint, dimension)
+        })
+    }
+
     /// Entries built elsewhere (a table texture and its sampler, a chunked array's buffers),
     /// with their own visibility.
     pub fn with(mut self, entries: impl IntoIterator<Item = wgpu::BindGroupLayoutEntry>) -> Self {
@@ -187,6 +199,7 @@ mod tests {
             .uniform(4)
             .params_at_offset(5)
             .texture(6..7, wgpu::TextureViewDimension::D1)
+            .uint_texture(8, wgpu::TextureViewDimension::D2Array)
             .with([bind::storage_entry(9, S::VERTEX, true)]);
         let expected = [
             bind::params_entry(0, S::COMPUTE),
@@ -196,6 +209,12 @@ mod tests {
             bind::uniform_entry(4, S::FRAGMENT),
             bind::with_dynamic_offset(bind::params_entry(5, S::FRAGMENT)),
             bind::texture_entry(6, S::FRAGMENT, false, wgpu::TextureViewDimension::D1),
+            bind::sampled_texture_entry(
+                8,
+                S::FRAGMENT,
+                wgpu::TextureSampleType::Uint,
+                wgpu::TextureViewDimension::D2Array,
+            ),
             bind::storage_entry(9, S::VERTEX, true),
         ];
         assert_eq!(built.entries(), &expected[..]);

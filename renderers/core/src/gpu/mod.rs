@@ -21,6 +21,7 @@ use serde::{Deserialize, Serialize};
 
 pub use layouts::{BindingNumbers, LayoutEntries};
 pub use memory::{chunk_ranges, Lifetime, MemoryLedger, UPLOAD_CHUNK};
+pub use pipelines::RasterState;
 pub use request::{
     DeviceRequest, ENV_MAX_STORAGE_BINDING, ENV_MAX_TRIANGLES_PER_PASS, ENV_TIMESTAMPS,
 };

@@ -18,6 +18,31 @@ pub struct FrameTimer {
     count: u32,
 }
 
+impl Gpu {
+    /// `count` queries of type `ty` and the buffer of `resolve_bytes` they are resolved into,
+    /// to be copied on from there (timestamps, occlusion counts).
+    pub fn query_set(
+        &self,
+        label: &str,
+        ty: wgpu::QueryType,
+        count: u32,
+        resolve_bytes: u64,
+    ) -> (wgpu::QuerySet, wgpu::Buffer) {
+        let set = self.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some(label),
+            ty,
+            count,
+        });
+        let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(&format!("{label} resolve")),
+            size: resolve_bytes,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        (set, resolve)
+    }
+}
+
 impl FrameTimer {
     pub fn new(gpu: &Gpu) -> FrameTimer {
         FrameTimer::with_marks(gpu, 0)
@@ -29,17 +54,8 @@ impl FrameTimer {
         let count = marks + 2;
         let bytes = count as u64 * 8;
         let (query_set, resolve, readback) = if gpu.has_timestamps() {
-            let qs = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("frame timestamps"),
-                ty: wgpu::QueryType::Timestamp,
-                count,
-            });
-            let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamp resolve"),
-                size: bytes,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
+            let (qs, buf) =
+                gpu.query_set("frame timestamps", wgpu::QueryType::Timestamp, count, bytes);
             let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("timestamp readback"),
                 size: bytes,

@@ -7,7 +7,7 @@
 
 use render_core::{FrameClock, Gpu};
 
-use super::{active_tiles, read_counts, State};
+use super::{active_tiles, dispatch, read_counts, State};
 use crate::resources::{Target, TilePipelines};
 
 /// The dispatch of one pass over the listed tiles (workgroups per tile), and k.
@@ -128,15 +128,15 @@ fn load_layers(
         .write_buffer(&t.active_tiles, 0, bytemuck::cast_slice(tiles));
     gpu.queue
         .write_buffer(&t.tile_counts, 0, &[0u8; crate::resources::MAX_TILES * 4]);
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&st.pipes.load_layer);
-        pass.set_bind_group(0, &st.mesh_bind, &[]);
-        pass.set_bind_group(1, &t.cast_binds[0], &[]);
-        pass.dispatch_workgroups(groups[0], groups[1], tiles.len() as u32);
-    }
-    clock.submit(gpu, [enc.finish()]);
+    let [x, y] = groups;
+    dispatch(
+        gpu,
+        st,
+        t,
+        &st.pipes.load_layer,
+        [x, y, tiles.len() as u32],
+        clock,
+    );
     read_counts(gpu, clock, &t.tile_counts, ntiles)
 }
 
