@@ -12,8 +12,6 @@ pub mod cli;
 pub mod papers;
 pub mod plot;
 pub mod regress;
-// The regression wing's modules keep their crate-level paths (`crate::regress::compare`, …).
-pub use regress::{compare, compare_report, compare_time, export, history};
 pub mod report;
 pub mod results;
 pub mod run;

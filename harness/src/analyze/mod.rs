@@ -53,8 +53,7 @@ pub enum AnalyzeCommand {
 /// Prints an analysis's Markdown, and with `--out` also writes it to that file.
 pub fn emit(md: &str, out: Option<&std::path::Path>) -> anyhow::Result<()> {
     if let Some(out) = out {
-        use anyhow::Context as _;
-        std::fs::write(out, md).with_context(|| format!("cannot write {}", out.display()))?;
+        crate::results::write_file(out, md)?;
     }
     print!("{md}");
     Ok(())

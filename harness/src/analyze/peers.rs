@@ -18,7 +18,7 @@ use serde::Deserialize;
 
 use crate::plot::data::distinct;
 use crate::results::aggregate::{aggregate, Aggregate};
-use crate::results::{ResultsFile, Row};
+use crate::results::{read_text, ResultsFile, Row};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -71,8 +71,7 @@ pub struct Side {
 
 impl TargetFile {
     pub fn read(path: &Path) -> anyhow::Result<TargetFile> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
+        let text = read_text(path)?;
         let file: TargetFile = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a target file", path.display()))?;
         for t in &file.targets {

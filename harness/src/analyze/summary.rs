@@ -8,6 +8,7 @@ use anyhow::Context as _;
 
 use crate::plot::data::distinct;
 use crate::report::{aggregate, markdown_summary, Spread};
+use crate::results::write_file;
 
 /// The papers' tets/s beside ours for the series a paper table covers (GATOR Table 3, HAVS
 /// Table 4, fragment PT Table 1); empty when none does.
@@ -65,7 +66,7 @@ pub fn run(args: Args, _ctx: &super::Context) -> anyhow::Result<()> {
         paper_markdown(&aggs)
     );
     if let Some(out) = &args.out {
-        std::fs::write(out, &md).with_context(|| format!("cannot write {}", out.display()))?;
+        write_file(out, &md)?;
         print!("{md}");
         return Ok(());
     }
@@ -76,7 +77,7 @@ pub fn run(args: Args, _ctx: &super::Context) -> anyhow::Result<()> {
         );
     }
     let md_path = args.input.join("summary.md");
-    std::fs::write(&md_path, &md).with_context(|| format!("cannot write {}", md_path.display()))?;
+    write_file(&md_path, &md)?;
 
     let csv_path = args.input.join("summary.csv");
     let mut w = csv::Writer::from_path(&csv_path)

@@ -8,6 +8,7 @@ use anyhow::Context;
 
 use crate::plot::data::Inputs;
 use crate::plot::Kind;
+use crate::results::write_file;
 use crate::run::matrix::MatrixArgs;
 use crate::run::plan::RunPlan;
 
@@ -197,7 +198,7 @@ pub fn run(
     if !charts.fits.is_empty() {
         let md = crate::plot::scaling::fits_markdown(&charts.fits);
         let path = args.out.join("scaling_fits.md");
-        std::fs::write(&path, &md).with_context(|| format!("cannot write {}", path.display()))?;
+        write_file(&path, &md)?;
         print!("{md}");
     }
     print_files(&args.out, &charts.files);

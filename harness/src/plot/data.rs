@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use crate::results::aggregate::{aggregate, Aggregate};
 use crate::results::stats::Spread;
-use crate::results::{ResultsFile, Row, JSON_FILE};
+use crate::results::{read_text, write_file, ResultsFile, Row, JSON_FILE};
 
 /// Rows of every input, with what the charts need from the runs' headers.
 #[derive(Debug, Clone, Default)]
@@ -75,8 +75,7 @@ impl Inputs {
             for path in result_files(arg)? {
                 let dir = path.parent().unwrap_or(Path::new("."));
                 let file = ResultsFile::read(dir)?;
-                let text = std::fs::read_to_string(&path)
-                    .with_context(|| format!("cannot read {}", path.display()))?;
+                let text = read_text(&path)?;
                 let raw: serde_json::Value = serde_json::from_str(&text)
                     .with_context(|| format!("{} is not JSON", path.display()))?;
                 inputs.add(&file, Some(&raw));
@@ -194,7 +193,7 @@ pub struct Point {
     /// Largest GPU bytes over the viewpoints.
     pub gpu_bytes: Option<u64>,
     pub bytes_per_tet: Option<f64>,
-    /// Any of its rows is suspect (see [`suspect_flags`]).
+    /// Any of its rows is suspect (see [`crate::results::suspect::flags`]).
     pub suspect: bool,
 }
 
@@ -203,9 +202,6 @@ impl Point {
         super::style::is_peer(&self.algorithm)
     }
 }
-
-/// Suspect rows, one flag per row: [`crate::results::suspect::flags`].
-pub use crate::results::suspect::flags as suspect_flags;
 
 impl From<&Aggregate> for Point {
     fn from(a: &Aggregate) -> Point {
@@ -224,6 +220,45 @@ impl From<&Aggregate> for Point {
             gpu_bytes: a.gpu_bytes,
             bytes_per_tet: a.bytes_per_tet,
             suspect: a.suspect > 0,
+        }
+    }
+}
+
+/// The CSV columns a per-variant chart's line opens with: the variant, its data set and
+/// viewport, its rows and its throughput. A chart writes its line as the tuple
+/// `(PointColumns, Own)`, `Own` its own columns (the csv crate writes a tuple of structs as
+/// one flat line under one header).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PointColumns {
+    pub dataset: String,
+    pub tets: u64,
+    pub width: u32,
+    pub height: u32,
+    pub label: String,
+    pub algorithm: String,
+    pub settings: String,
+    pub rows: usize,
+    pub failed: usize,
+    pub tets_per_sec_mean: Option<f64>,
+    pub tets_per_sec_min: Option<f64>,
+    pub tets_per_sec_max: Option<f64>,
+}
+
+impl PointColumns {
+    pub fn new(p: &Point, book: &super::style::StyleBook) -> PointColumns {
+        PointColumns {
+            dataset: p.dataset.clone(),
+            tets: p.tets,
+            width: p.width,
+            height: p.height,
+            label: book.get(&p.algorithm, &p.settings).label,
+            algorithm: p.algorithm.clone(),
+            settings: p.settings.clone(),
+            rows: p.rows,
+            failed: p.failed,
+            tets_per_sec_mean: p.tets_per_sec.map(|s| s.mean),
+            tets_per_sec_min: p.tets_per_sec.map(|s| s.min),
+            tets_per_sec_max: p.tets_per_sec.map(|s| s.max),
         }
     }
 }
@@ -259,8 +294,7 @@ pub fn csv_text<T: Serialize>(records: &[T]) -> anyhow::Result<String> {
 /// Writes `records` as `dir/stem.csv`.
 pub fn write_csv<T: Serialize>(dir: &Path, stem: &str, records: &[T]) -> anyhow::Result<()> {
     let path = dir.join(format!("{stem}.csv"));
-    std::fs::write(&path, csv_text(records)?)
-        .with_context(|| format!("cannot write {}", path.display()))
+    write_file(&path, csv_text(records)?)
 }
 
 #[cfg(test)]
@@ -320,24 +354,6 @@ pub(crate) mod tests {
         // HAVS's 15–16 dB is below 20 dB: suspect; GATOR's 50 dB is not.
         assert!(h.suspect);
         assert!(!p[3].suspect);
-    }
-
-    #[test]
-    fn suspect_rule() {
-        let mut r = rows();
-        for x in &mut r {
-            if x.algorithm == "havs" {
-                x.psnr_db = Some(35.0);
-            }
-        }
-        // 35 dB is above 20 but 15 dB below GATOR's 50: not suspect; 29 dB would be.
-        assert!(suspect_flags(&r).iter().all(|s| !s));
-        r[0].psnr_db = Some(29.0);
-        assert!(suspect_flags(&r)[0]);
-        // Next to a capped 99 dB row, 45 dB is still fine.
-        r[0].psnr_db = Some(45.0);
-        r[4].psnr_db = Some(99.0);
-        assert!(!suspect_flags(&r)[0]);
     }
 
     #[test]

@@ -15,6 +15,7 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 
 use super::style::{Marker, Style};
+use crate::results::write_file;
 
 pub const FONT: &str = "DejaVu Sans";
 
@@ -48,8 +49,7 @@ pub fn save(chart: &impl Chart, dir: &Path, stem: &str) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let font = dir.join("DejaVuSans.ttf");
     if !font.exists() {
-        std::fs::write(&font, dejavu::sans::regular())
-            .with_context(|| format!("cannot write {}", font.display()))?;
+        write_file(&font, dejavu::sans::regular())?;
     }
     let size = chart.size();
     let png = dir.join(format!("{stem}.png"));
@@ -75,7 +75,7 @@ pub fn save(chart: &impl Chart, dir: &Path, stem: &str) -> anyhow::Result<()> {
         svg.insert_str(end, &style);
     }
     let path = dir.join(format!("{stem}.svg"));
-    std::fs::write(&path, svg).with_context(|| format!("cannot write {}", path.display()))
+    write_file(&path, svg)
 }
 
 /// Draws a marker of `style` centred at pixel `(x, y)` with radius `r`.

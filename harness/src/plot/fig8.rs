@@ -113,5 +113,5 @@ pub fn write_fig8(dir: &Path, points: &[SweepPoint], adapter: &str) -> anyhow::R
     }
     std::fs::write(dir.join("DejaVuSans.ttf"), dejavu::sans::regular())?;
     let path = dir.join("fig8.svg");
-    std::fs::write(&path, svg).with_context(|| format!("cannot write {}", path.display()))
+    crate::results::write_file(&path, svg)
 }

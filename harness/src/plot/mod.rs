@@ -9,6 +9,7 @@
 
 use std::path::Path;
 
+use crate::results::write_file;
 use anyhow::Context;
 use serde::Serialize;
 
@@ -142,8 +143,7 @@ pub fn write_charts(dir: &Path, inputs: &Inputs, kind: Kind) -> anyhow::Result<C
         charts.files.extend(bars::write(dir, &points, &book)?);
     }
     let key = dir.join("key.csv");
-    std::fs::write(&key, book.key_csv())
-        .with_context(|| format!("cannot write {}", key.display()))?;
+    write_file(&key, book.key_csv())?;
     charts.book = book;
     Ok(charts)
 }
@@ -226,6 +226,20 @@ mod tests {
             rows,
             ..Default::default()
         }
+    }
+
+    /// The columns of a line chart's CSV line (scaling, resolution) that these tests check.
+    #[derive(Debug, serde::Deserialize)]
+    struct LineRecord {
+        dataset: String,
+        width: u32,
+        label: String,
+        algorithm: String,
+        settings: String,
+        rows: usize,
+        failed: usize,
+        tets_per_sec_mean: Option<f64>,
+        error: String,
     }
 
     fn read_csv<T: serde::de::DeserializeOwned>(path: &Path) -> Vec<T> {
@@ -353,7 +367,7 @@ mod tests {
             assert_eq!(b.label, label_of(&b.algorithm, &b.settings));
         }
 
-        let scal: Vec<scaling::Record> = read_csv(&dir.path().join("scaling_box_tets_per_sec.csv"));
+        let scal: Vec<LineRecord> = read_csv(&dir.path().join("scaling_box_tets_per_sec.csv"));
         assert_eq!(scal.len(), 4);
         for s in &scal {
             let t = direct(&rows, &s.algorithm, &s.settings, &s.dataset, |r| {
@@ -409,7 +423,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let charts = write_charts(dir.path(), &inputs(rows), Kind::Resolution).unwrap();
         assert_eq!(charts.files.len(), 1);
-        let recs: Vec<resolution::Record> = read_csv(&dir.path().join("resolution_box_10k.csv"));
+        let recs: Vec<LineRecord> = read_csv(&dir.path().join("resolution_box_10k.csv"));
         assert_eq!(recs.len(), 4);
         let failed = recs
             .iter()

@@ -10,6 +10,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::plot::draw::{register_font, FONT};
 use crate::plot::style::{BASELINE_GREY, FASTER, NO_CHANGE, SLOWER};
+use crate::results::write_file;
 
 /// Which way a strip's verdict went, for its colour (the verdicts themselves are compare's).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -139,5 +140,5 @@ pub fn ratio_plot(
         draw(&root, title, strips, threshold)?;
     }
     let path = dir.join(format!("{stem}.svg"));
-    std::fs::write(&path, svg).with_context(|| format!("cannot write {}", path.display()))
+    write_file(&path, svg)
 }

@@ -6,28 +6,16 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::data::{distinct, Inputs, Point};
+use super::data::{distinct, Inputs, Point, PointColumns};
 use super::draw;
 use super::lines::{save_parts, variants, Line, LineChart, LinePoint};
 use super::speed_error::sort_by_style;
 use super::style::StyleBook;
 use super::{ChartFile, Kind};
 
-/// One CSV line: a variant on one data set at one viewport size.
-#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
-pub struct Record {
-    pub dataset: String,
-    pub tets: u64,
-    pub width: u32,
-    pub height: u32,
-    pub label: String,
-    pub algorithm: String,
-    pub settings: String,
-    pub rows: usize,
-    pub failed: usize,
-    pub tets_per_sec_mean: Option<f64>,
-    pub tets_per_sec_min: Option<f64>,
-    pub tets_per_sec_max: Option<f64>,
+/// A resolution chart's own CSV column, after the [`PointColumns`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Own {
     pub error: String,
 }
 
@@ -50,22 +38,13 @@ pub fn write(
         sort_by_style(&mut pts, book);
         pts.sort_by_key(|p| (p.width, p.height));
         let square = pts.iter().all(|p| p.width == p.height);
-        let records: Vec<Record> = pts
+        let records: Vec<(PointColumns, Own)> = pts
             .iter()
-            .map(|p| Record {
-                dataset: p.dataset.clone(),
-                tets: p.tets,
-                width: p.width,
-                height: p.height,
-                label: book.get(&p.algorithm, &p.settings).label,
-                algorithm: p.algorithm.clone(),
-                settings: p.settings.clone(),
-                rows: p.rows,
-                failed: p.failed,
-                tets_per_sec_mean: p.tets_per_sec.map(|s| s.mean),
-                tets_per_sec_min: p.tets_per_sec.map(|s| s.min),
-                tets_per_sec_max: p.tets_per_sec.map(|s| s.max),
-                error: p.error.clone(),
+            .map(|p| {
+                let own = Own {
+                    error: p.error.clone(),
+                };
+                (PointColumns::new(p, book), own)
             })
             .collect();
         let lines: Vec<Line> = variants(&pts, book)

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::data::{distinct, write_csv, Inputs, Point};
+use super::data::{distinct, write_csv, Inputs, Point, PointColumns};
 use super::draw;
 use super::lines::{save_parts, variants, Line, LineChart, LinePoint};
 use super::speed_error::sort_by_style;
@@ -27,20 +27,12 @@ pub fn family(dataset: &str) -> String {
 /// Slope of the least-squares line through (ln x, ln y): the exponent of y ∝ x^b. `None` with
 /// fewer than two distinct x.
 pub fn power_law_exponent(xy: &[(f64, f64)]) -> Option<f64> {
-    let pts: Vec<(f64, f64)> = xy
+    let logs: Vec<(f64, f64)> = xy
         .iter()
         .filter(|(x, y)| *x > 0.0 && *y > 0.0)
         .map(|(x, y)| (x.ln(), y.ln()))
         .collect();
-    let n = pts.len() as f64;
-    if pts.len() < 2 {
-        return None;
-    }
-    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
+    linear_slope(&logs)
 }
 
 /// Slope of the least-squares line through (x, y): e.g. GPU bytes per extra tet, which the
@@ -58,26 +50,22 @@ pub fn linear_slope(xy: &[(f64, f64)]) -> Option<f64> {
     (sxx > 0.0).then(|| sxy / sxx)
 }
 
-/// One CSV line: a variant at one mesh size.
-#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
-pub struct Record {
+/// The family column a scaling chart's CSV line opens with, before the [`PointColumns`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Family {
     pub family: String,
-    pub dataset: String,
-    pub tets: u64,
-    pub width: u32,
-    pub height: u32,
-    pub label: String,
-    pub algorithm: String,
-    pub settings: String,
-    pub rows: usize,
-    pub failed: usize,
-    pub tets_per_sec_mean: Option<f64>,
-    pub tets_per_sec_min: Option<f64>,
-    pub tets_per_sec_max: Option<f64>,
+}
+
+/// A scaling chart's own CSV columns, after the [`PointColumns`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Own {
     pub gpu_bytes: Option<u64>,
     pub bytes_per_tet: Option<f64>,
     pub error: String,
 }
+
+/// One CSV line: a variant at one mesh size.
+pub type Record = (Family, PointColumns, Own);
 
 /// One CSV line of the fits: a variant's exponents over the sizes it was measured at.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
@@ -203,23 +191,16 @@ pub fn write(
 /// The CSV lines of one family's points.
 fn records(fam: &str, pts: &[&Point], book: &StyleBook) -> Vec<Record> {
     pts.iter()
-        .map(|p| Record {
-            family: fam.to_string(),
-            dataset: p.dataset.clone(),
-            tets: p.tets,
-            width: p.width,
-            height: p.height,
-            label: book.get(&p.algorithm, &p.settings).label,
-            algorithm: p.algorithm.clone(),
-            settings: p.settings.clone(),
-            rows: p.rows,
-            failed: p.failed,
-            tets_per_sec_mean: p.tets_per_sec.map(|s| s.mean),
-            tets_per_sec_min: p.tets_per_sec.map(|s| s.min),
-            tets_per_sec_max: p.tets_per_sec.map(|s| s.max),
-            gpu_bytes: p.gpu_bytes,
-            bytes_per_tet: p.bytes_per_tet,
-            error: p.error.clone(),
+        .map(|p| {
+            let family = Family {
+                family: fam.to_string(),
+            };
+            let own = Own {
+                gpu_bytes: p.gpu_bytes,
+                bytes_per_tet: p.bytes_per_tet,
+                error: p.error.clone(),
+            };
+            (family, PointColumns::new(p, book), own)
         })
         .collect()
 }

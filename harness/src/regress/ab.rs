@@ -30,7 +30,7 @@ use crate::regress::compare::{adapter_of, CompareOptions, Comparison, Finding};
 use crate::report::progress::Progress;
 use crate::results::metrics::summarize;
 use crate::results::stats::median;
-use crate::results::{MergedRun, ResultsFile, Row};
+use crate::results::{write_file, MergedRun, ResultsFile, Row};
 
 /// Which build an invocation ran.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -512,8 +512,7 @@ pub fn run_ab(base: &Binary, new: &Binary, opt: &AbOptions) -> anyhow::Result<Ab
         seconds: started.elapsed().as_secs_f64(),
     };
     let path = opt.out.join("ab.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    write_file(&path, serde_json::to_string_pretty(&report)? + "\n")?;
     let fail = crate::regress::compare_report::gate(&comparison, opt.compare.fail_on)?;
     Ok(AbOutcome {
         comparison,

@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 use super::ab::{self, AbOptions};
 use super::build::{self, BuildArgs};
 use crate::report::progress::Progress;
+use crate::results::write_file;
 
 /// The first-parent commits after `good` up to and including `bad`, oldest first.
 pub fn candidates(repo: &std::path::Path, good: &str, bad: &str) -> anyhow::Result<Vec<String>> {
@@ -208,8 +209,7 @@ pub fn run_command(opt: &BisectOptions) -> anyhow::Result<BisectReport> {
     std::fs::create_dir_all(&opt.ab.out)
         .with_context(|| format!("cannot create {}", opt.ab.out.display()))?;
     let path: PathBuf = opt.ab.out.join("bisect.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    write_file(&path, serde_json::to_string_pretty(&report)? + "\n")?;
     println!("wrote {}", path.display());
     Ok(report)
 }

@@ -9,6 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use crate::results::write_file;
 use anyhow::Context;
 
 /// How revisions are built (`--build-*` of `ab` and `bisect`).
@@ -229,7 +230,6 @@ pub fn build_commit(commit: &str, args: &BuildArgs) -> anyhow::Result<PathBuf> {
         .with_context(|| format!("cannot create {}", bin_dir.display()))?;
     std::fs::copy(&output, &bin)
         .with_context(|| format!("cannot copy {} to {}", output.display(), bin.display()))?;
-    std::fs::write(&recipe_file, recipe)
-        .with_context(|| format!("cannot write {}", recipe_file.display()))?;
+    write_file(&recipe_file, recipe)?;
     Ok(bin)
 }

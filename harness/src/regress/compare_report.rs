@@ -11,6 +11,7 @@ use crate::plot::ratio::{ratio_plot, Direction, Strip};
 use crate::regress::compare::{
     CompareOptions, Comparison, FailOn, Finding, RowComparison, RowStatus, TimeTest, Verdict,
 };
+use crate::results::write_file;
 
 fn header(c: &Comparison) -> Vec<String> {
     let commit = |c: &Option<String>| {
@@ -118,6 +119,14 @@ fn groups_basis(c: &Comparison) -> &'static str {
     }
 }
 
+/// The rows with something to say: a status other than no change.
+fn notable(c: &Comparison) -> Vec<&RowComparison> {
+    c.rows
+        .iter()
+        .filter(|r| r.status != RowStatus::NoChange)
+        .collect()
+}
+
 /// The terminal summary: header, group table, then only the rows with something to say.
 pub fn terminal(c: &Comparison) -> String {
     let mut s = header(c).join("\n");
@@ -138,11 +147,7 @@ pub fn terminal(c: &Comparison) -> String {
             let _ = writeln!(s, "  {l}");
         }
     }
-    let notable: Vec<&RowComparison> = c
-        .rows
-        .iter()
-        .filter(|r| r.status != RowStatus::NoChange)
-        .collect();
+    let notable = notable(c);
     let _ = writeln!(
         s,
         "\nrows with a change ({} of {}):",
@@ -211,11 +216,7 @@ fn markdown(c: &Comparison) -> String {
         );
     }
     // Only the rows with something to say: the page is meant for a pull-request comment.
-    let notable: Vec<&RowComparison> = c
-        .rows
-        .iter()
-        .filter(|r| r.status != RowStatus::NoChange)
-        .collect();
+    let notable = notable(c);
     let _ = write!(
         s,
         "\n## Rows with a change ({} of {})\n\n",
@@ -360,7 +361,7 @@ fn html(c: &Comparison) -> anyhow::Result<String> {
 pub fn write_outputs(c: &Comparison, out: &Path) -> anyhow::Result<()> {
     let write = |name: &str, text: String| {
         let p = out.join(name);
-        std::fs::write(&p, text).with_context(|| format!("cannot write {}", p.display()))
+        write_file(&p, text)
     };
     write("compare.md", markdown(c))?;
     write("compare.json", serde_json::to_string_pretty(c)? + "\n")?;

@@ -33,14 +33,6 @@ pub struct GroupComparison {
     pub total: TimeTest,
 }
 
-impl GroupComparison {
-    /// Whether this is the comparison of the reports' group `g`.
-    pub fn is(&self, g: &GroupKey) -> bool {
-        (&self.algorithm, &self.settings, &self.dataset) == (&g.algorithm, &g.settings, &g.dataset)
-            && (self.width, self.height, &self.projection) == (g.width, g.height, &g.projection)
-    }
-}
-
 /// Fewer rounds than this on either side and time is not judged: 2 vs 2 values cannot reach
 /// p < 0.05 even pooled over a few viewpoints, and one round is one moment of the machine.
 pub const MIN_ROUNDS: u32 = 3;

@@ -55,17 +55,6 @@ pub enum WorkVerdict {
     Removed,
 }
 
-impl WorkVerdict {
-    pub fn label(self) -> &'static str {
-        match self {
-            WorkVerdict::More => "more",
-            WorkVerdict::Less => "less",
-            WorkVerdict::Added => "added",
-            WorkVerdict::Removed => "removed",
-        }
-    }
-}
-
 /// One work counter or byte figure of a row that NEW changed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]

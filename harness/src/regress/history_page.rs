@@ -21,6 +21,7 @@ use serde::Serialize;
 use crate::plot::history::{Change, Line, LinePoint, RunTick};
 use crate::regress::history::{History, Series};
 use crate::results::names::slug;
+use crate::results::write_file;
 
 /// One step of a series, as the pages list it.
 #[derive(Debug, Clone, Serialize)]
@@ -174,8 +175,7 @@ fn write_charts(out: &Path, h: &History) -> anyhow::Result<Vec<ChartFile>> {
         let file = format!("charts/{id}.svg");
         let svg =
             crate::report::html::render("history_chart.svg", serde_json::json!({ "c": chart }))?;
-        std::fs::write(out.join(&file), svg)
-            .with_context(|| format!("cannot write {}", out.join(&file).display()))?;
+        write_file(&out.join(&file), svg)?;
         charts.push(ChartFile {
             id,
             title,

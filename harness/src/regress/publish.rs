@@ -35,7 +35,7 @@ use crate::regress::history_page::StepLine;
 use crate::regress::publish_runs::{copy_file, link_pages_to_front, PageKind, PairRecord, SiteRun};
 use crate::results::control::Pricing;
 use crate::results::names::slug;
-use crate::results::{ResultsFile, JSON_FILE};
+use crate::results::{read_text, write_file, ResultsFile, JSON_FILE};
 
 /// The file marking a directory as a site `publish` wrote (and may therefore replace).
 pub const SITE_MARKER: &str = ".tetbench-site";
@@ -125,8 +125,7 @@ impl Inputs {
 
     fn add_paper(&mut self, dir: &Path, source: &str) -> anyhow::Result<()> {
         let path = dir.join(SUMMARY_FILE);
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
+        let text = read_text(&path)?;
         let summary: PaperSummary = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a paper summary", path.display()))?;
         anyhow::ensure!(
@@ -551,7 +550,7 @@ pub fn publish(args: &PublishArgs) -> anyhow::Result<(PathBuf, Published)> {
     page.runs = runs.iter().map(run_line).collect();
     let html = crate::report::html::render("site.html", &page)?;
     let index = site.join("index.html");
-    std::fs::write(&index, html).with_context(|| format!("cannot write {}", index.display()))?;
+    write_file(&index, html)?;
     Ok((index, done))
 }
 

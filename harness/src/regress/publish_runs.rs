@@ -24,7 +24,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::regress::history::{PairFindings, RunSummary};
-use crate::results::{ResultsFile, JSON_FILE};
+use crate::results::{read_bytes, read_text, write_file, ResultsFile, JSON_FILE};
 
 /// The record beside each run's page.
 pub const RECORD: &str = ".tetbench-run.json";
@@ -106,8 +106,7 @@ fn input_hash(dir: &Path) -> anyhow::Result<String> {
     for f in RUN_FILES {
         let path = dir.join(f);
         if path.is_file() {
-            let bytes =
-                std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
+            let bytes = read_bytes(&path)?;
             h.update(f.as_bytes());
             h.update(&(bytes.len() as u64).to_le_bytes());
             h.update(&bytes);
@@ -289,8 +288,7 @@ pub fn write_run(
         pair,
     };
     let path = out.join(RECORD);
-    std::fs::write(&path, serde_json::to_string(&record)?)
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    write_file(&path, serde_json::to_string(&record)?)?;
     Ok(!unchanged)
 }
 
@@ -370,13 +368,11 @@ fn write_brief(
     else {
         unreachable!("write_brief draws brief pages");
     };
-    let json = std::fs::read(run.dir.join(JSON_FILE))
-        .with_context(|| format!("cannot read {}", run.dir.join(JSON_FILE).display()))?;
+    let json = read_bytes(&run.dir.join(JSON_FILE))?;
     gzip(&json, &out.join("results.json.gz"))?;
     crate::results::write_csv(out, &file.rows)?;
     let csv_path = out.join(crate::results::CSV_FILE);
-    let csv =
-        std::fs::read(&csv_path).with_context(|| format!("cannot read {}", csv_path.display()))?;
+    let csv = read_bytes(&csv_path)?;
     gzip(&csv, &out.join("results.csv.gz"))?;
     std::fs::remove_file(&csv_path)
         .with_context(|| format!("cannot remove {}", csv_path.display()))?;
@@ -421,7 +417,7 @@ fn write_brief(
         },
     )?;
     let path = out.join("index.html");
-    std::fs::write(&path, html).with_context(|| format!("cannot write {}", path.display()))
+    write_file(&path, html)
 }
 
 /// The line every page below the front page gets after its `<body>`: a link back to
@@ -451,15 +447,13 @@ pub fn link_pages_to_front(site: &Path, dir: &Path) -> anyhow::Result<()> {
         if path.extension().is_none_or(|x| x != "html") || rel == Path::new("index.html") {
             continue;
         }
-        let html = std::fs::read_to_string(&path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
+        let html = read_text(&path)?;
         let Some(at) = html.find("<body>").map(|i| i + "<body>".len()) else {
             continue;
         };
         let depth = rel.components().count() - 1;
         let linked = format!("{}\n{}{}", &html[..at], front_link(depth), &html[at..]);
-        std::fs::write(&path, linked)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        write_file(&path, linked)?;
     }
     Ok(())
 }

@@ -7,12 +7,11 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::Context;
 use serde::Serialize;
 
 use crate::algorithms::is_peer;
 use crate::results::metrics::{HEATMAP_MAX_ERROR, ONE_STEP, PSNR_CAP_DB};
-use crate::results::{ResultsFile, Row};
+use crate::results::{write_file, ResultsFile, Row};
 
 pub mod control;
 pub mod html;
@@ -37,7 +36,7 @@ pub fn write(out: &Path, file: &ResultsFile) -> anyhow::Result<()> {
         &Images::in_dir(out),
     )?;
     let path = out.join("index.html");
-    std::fs::write(&path, html).with_context(|| format!("cannot write {}", path.display()))
+    write_file(&path, html)
 }
 
 /// Re-renders the report of an earlier run (`tetbench report OUT`).

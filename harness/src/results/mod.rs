@@ -226,11 +226,6 @@ impl Row {
         self.settings = crate::algorithms::retype(&self.algorithm, settings);
     }
 
-    /// A setting of the row's variant, as written (`cpu-radix`, `6`).
-    pub fn setting(&self, key: &str) -> Option<String> {
-        self.settings.text(key)
-    }
-
     /// A counter of the row, if present.
     pub fn counter(&self, name: &str) -> Option<f64> {
         self.counters.get(name)
@@ -276,8 +271,7 @@ pub struct ResultsFile {
 impl ResultsFile {
     pub fn read(dir: &Path) -> anyhow::Result<ResultsFile> {
         let path = dir.join(JSON_FILE);
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
+        let text = read_text(&path)?;
         // The version alone first (every other field skipped, not built into a value: a
         // history reads a thousand of these files).
         #[derive(Deserialize)]
@@ -417,6 +411,21 @@ pub fn write_csv(dir: &Path, rows: &[Row]) -> anyhow::Result<()> {
     }
     csv.flush()
         .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes `contents` to `path`; the error names the file.
+pub fn write_file(path: &Path, contents: impl AsRef<[u8]>) -> anyhow::Result<()> {
+    std::fs::write(path, contents).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Reads `path` as text; the error names the file.
+pub fn read_text(path: &Path) -> anyhow::Result<String> {
+    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// Reads `path`'s bytes; the error names the file.
+pub fn read_bytes(path: &Path) -> anyhow::Result<Vec<u8>> {
+    std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))
 }
 
 /// Writes `results.json` atomically.

@@ -41,14 +41,6 @@ impl NamedValues {
         self.0.iter().map(|(n, _)| n.as_str())
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.0.is_empty()
-    }
-
-    pub fn len(&self) -> usize {
-        self.0.len()
-    }
-
     /// Parses the text form `name=value;name=value` (empty text: no values). A value that is
     /// not a number is an error naming it.
     pub fn parse(text: &str) -> Result<NamedValues, String> {

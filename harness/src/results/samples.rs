@@ -13,10 +13,10 @@
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, Context};
+use anyhow::anyhow;
 use render_core::Image;
 
-use crate::results::Row;
+use crate::results::{read_bytes, write_file, Row};
 
 pub use crate::results::{
     sample_lines, write_samples_csv, FrameSamples, SampleLine, SamplesWriter, SAMPLES_CSV,
@@ -63,13 +63,13 @@ pub fn write_f32_image(path: &Path, img: &Image) -> anyhow::Result<u64> {
     let mut enc = flate2::write::ZlibEncoder::new(bytes, flate2::Compression::default());
     enc.write_all(&planes)?;
     let bytes = enc.finish()?;
-    std::fs::write(path, &bytes).with_context(|| format!("cannot write {}", path.display()))?;
+    write_file(path, &bytes)?;
     Ok(bytes.len() as u64)
 }
 
 /// Reads an image written by [`write_f32_image`]; a damaged file is an error naming it.
 pub fn read_f32_image(path: &Path) -> anyhow::Result<Image> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let bytes = read_bytes(path)?;
     let bad = |what: &str| anyhow!("{}: not a tetbench f32 image ({what})", path.display());
     if bytes.len() < 16 || &bytes[..8] != IMAGE_MAGIC {
         return Err(bad("wrong magic"));
