@@ -13,7 +13,6 @@ use anyhow::bail;
 use crate::analyze::medians::parse_run;
 use crate::results::control::Control;
 use crate::results::machine::Figure;
-use crate::results::stats::median;
 use crate::results::ResultsFile;
 
 #[derive(Debug, clap::Args)]
@@ -45,30 +44,25 @@ pub struct RunControl {
 }
 
 impl RunControl {
+    /// The medians are [`Control::median`]'s, the one every row's control factor is taken
+    /// against.
     pub fn of(label: &str, control: &Control) -> RunControl {
-        let figures = Figure::ALL
-            .iter()
-            .filter_map(|&f| {
-                let v: Vec<f64> = control
+        let figures = control
+            .median()
+            .into_iter()
+            .map(|(f, m)| {
+                let (lo, hi) = control
                     .samples
                     .iter()
                     .filter_map(|s| s.figures.get(&f).copied())
                     .filter(|v| *v > 0.0)
-                    .collect();
-                let m = median(&v);
-                (m > 0.0).then(|| {
-                    let (lo, hi) = v
-                        .iter()
-                        .fold((f64::MAX, 0.0_f64), |(lo, hi), x| (lo.min(*x), hi.max(*x)));
-                    (
-                        f,
-                        FigureSpread {
-                            median: m,
-                            low: lo / m,
-                            high: hi / m,
-                        },
-                    )
-                })
+                    .fold((f64::MAX, 0.0_f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
+                let spread = FigureSpread {
+                    median: m,
+                    low: lo / m,
+                    high: hi / m,
+                };
+                (f, spread)
             })
             .collect();
         RunControl {
