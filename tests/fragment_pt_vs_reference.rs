@@ -19,7 +19,11 @@ fn render(
     sort: SortMode,
     camera: &Camera,
 ) -> Image {
-    let mut r = FragmentPt::new(FragmentPtSettings { shading, sort });
+    let mut r = FragmentPt::new(FragmentPtSettings {
+        shading,
+        sort,
+        slabs: None,
+    });
     let prepared = r.prepare(gpu, mesh, optics).unwrap();
     assert_eq!(prepared.tets, mesh.num_tets() as u64);
     // The model is a tet-index array and a vertex array only (the paper's ≈ 20 B/tet).

@@ -60,6 +60,17 @@ pub fn parse_settings(algorithm: &str, text: &str) -> anyhow::Result<Settings> {
     })?)
 }
 
+/// Whether `settings` of `algorithm` carry a perturbation (a positive control's key,
+/// `AlgorithmDescription::perturbations`) that `named` does not name: such a row is only the
+/// control's, never a configuration's that the tables look up by its other settings.
+pub fn perturbed_beyond(algorithm: &str, settings: &Settings, named: &Settings) -> bool {
+    describe(algorithm).is_some_and(|d| {
+        d.perturbations
+            .iter()
+            .any(|k| settings.get(k).is_some() && named.get(k).is_none())
+    })
+}
+
 /// `settings` with each value retyped as `algorithm` declares it (results loaded from JSON
 /// written before a parameter's type was declared).
 pub fn retype(algorithm: &str, settings: Settings) -> Settings {
@@ -218,6 +229,30 @@ mod tests {
         assert!(settings_of("splat", "buckets=gpu|cpu")
             .iter()
             .all(|s| !s.contains("misalign")));
+        // Fragment PT's slabs and the ray caster's unscaled table likewise.
+        let control = settings_of("fragment-pt", "shading=average;sort=bucket;slabs=2");
+        assert_eq!(control, ["shading=average;sort=bucket;slabs=2"]);
+        let bucket = settings_of("fragment-pt", "sort=bucket");
+        assert!(bucket.len() == 2 && bucket.iter().all(|s| !s.contains("slabs")));
+        let control = settings_of("raycast", "tiles=5x5;table=2d;unscaled=1");
+        assert_eq!(
+            control,
+            ["tiles=5x5;table=2d;mode=passes;et=on;layers=8;k=8;unscaled=1"]
+        );
+        let tables = settings_of("raycast", "tiles=5x5;table=2d|3d;mode=passes;et=on;k=8");
+        assert!(tables.len() == 2 && tables.iter().all(|s| !s.contains("unscaled")));
+        for name in ["splat", "fragment-pt", "raycast"] {
+            let d = description(name).unwrap();
+            for s in (d.default_grid)() {
+                assert!(d.perturbations.iter().all(|k| s.get(k).is_none()), "{s}");
+            }
+            // The full grid holds each perturbation once: the control's variant.
+            let perturbed = (d.full_grid)()
+                .into_iter()
+                .filter(|s| d.perturbations.iter().any(|k| s.get(k).is_some()))
+                .count();
+            assert_eq!(perturbed, 1, "{name}");
+        }
     }
 
     /// Every grid point builds a renderer that reports exactly the settings it was built

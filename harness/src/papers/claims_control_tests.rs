@@ -2,7 +2,8 @@
 //! discriminating* (our own analysis of the data set says the sides cannot differ there) and
 //! *insensitive* (the claim's positive control passes its rule too). HAVS H12 is the claim: k =
 //! 6 against k = 16, which can only differ where some pixel needs more than 6 entries, with k =
-//! 1 on spx2 as the perturbation its 40 dB rule must reject.
+//! 1 on spx2 as the perturbation its rule must reject. HAVS H13 (the racy pass, a GPU claim)
+//! shows a control judged beside a verdict withheld on the software rasteriser.
 
 use render_core::Image;
 
@@ -12,6 +13,7 @@ use crate::papers::evidence::{evaluate_claims, exact_side};
 use crate::papers::session::{Extra, Measured};
 use crate::papers::sides_tests::{dim_disc, disc, row_with_image};
 use crate::papers::verdict::{Side, Verdict};
+use crate::results::Row;
 
 fn h12() -> Claim {
     claims::all()
@@ -285,4 +287,76 @@ fn the_changed_pixel_share_rejects_a_control_that_both_psnrs_let_pass() {
         .as_ref()
         .is_some_and(|o| o.metric == Metric::PairPsnrCoveredDb)
         && e.verdict == Verdict::Holds));
+}
+
+/// H13's verdict on spx2 on an adapter of `device_type`: the racy and the race-free pass at
+/// k = 6 drawing the same image, and the racy pass at k = 1 (its positive control) drawing
+/// `control`.
+fn h13_with_control(device_type: &str, control: &Image) -> ClaimResult {
+    let c = claims::all()
+        .unwrap()
+        .into_iter()
+        .find(|c| c.paper == "havs" && c.id == "H13")
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let perturbed = c.control.as_ref().expect("H13 has a positive control");
+    let rows: Vec<Row> = [
+        (&c.a, &disc(32)),
+        (c.b.as_ref().unwrap(), &disc(32)),
+        (perturbed, control),
+    ]
+    .into_iter()
+    .map(|(spec, img)| Row {
+        device_type: device_type.into(),
+        ..row_with_image(dir.path(), spec, "spx2", "+x", img)
+    })
+    .collect();
+    let mut m = Measured::default();
+    m.push_run(dir.path(), rows);
+    let none = |_: &Metric, _: &VariantSpec, _: Option<&str>| None;
+    evaluate_claims("havs", &m, &Extra::default(), &none)
+        .into_iter()
+        .find(|r| r.claim.id == "H13" && r.dataset.as_deref() == Some("spx2"))
+        .unwrap()
+}
+
+#[test]
+fn a_gpu_claims_image_control_is_judged_beside_its_withheld_verdict() {
+    // On the software rasteriser the race cannot happen, so H13's own verdict is withheld;
+    // its control is still judged, since whether the rule sees k = 1's image does not depend
+    // on the adapter. A visibly changed control: rejected, and printed beside the verdict.
+    let r = h13_with_control("Cpu", &brighter(0.05));
+    assert_eq!(r.evaluation.verdict, Verdict::NotTestableOnThisAdapter);
+    let control = r.control.as_ref().expect("judged on the software adapter");
+    assert_eq!(control.verdict, Verdict::DoesNotHold, "{}", control.numbers);
+    assert!(
+        r.evaluation
+            .numbers
+            .contains("the rule rejects it, as it must"),
+        "{}",
+        r.evaluation.numbers
+    );
+    let md = claims_report::markdown(std::slice::from_ref(&r));
+    assert!(
+        md.contains("not testable on this adapter (positive control: does not hold)"),
+        "{md}"
+    );
+    // A control that draws the claim's image passes the rule: the text says the rule is
+    // insensitive, while the claim's own verdict stays withheld (it is not a hold that the
+    // control could undo).
+    let r = h13_with_control("Cpu", &brighter(0.0));
+    assert_eq!(r.evaluation.verdict, Verdict::NotTestableOnThisAdapter);
+    assert_eq!(r.control.as_ref().unwrap().verdict, Verdict::Holds);
+    assert!(
+        r.evaluation.numbers.contains("the rule is insensitive"),
+        "{}",
+        r.evaluation.numbers
+    );
+    // On a GPU the claim is judged: the same images hold, and the passing control makes the
+    // hold insensitive; the rejected one lets it stand.
+    let r = h13_with_control("DiscreteGpu", &brighter(0.0));
+    assert_eq!(r.evaluation.verdict, Verdict::Insensitive);
+    let r = h13_with_control("DiscreteGpu", &brighter(0.05));
+    assert_eq!(r.evaluation.verdict, Verdict::Holds);
+    assert_eq!(r.control.as_ref().unwrap().verdict, Verdict::DoesNotHold);
 }

@@ -234,16 +234,19 @@ pub fn find_variant<'a>(
 }
 
 /// The one aggregate of `algorithm` on `dataset` whose settings include `want` (`None` when
-/// none or several do).
+/// none or several do); a positive control's perturbed variant only where `want` names its key.
 pub fn find_including<'a>(
     aggs: &'a [Aggregate],
     algorithm: &str,
     dataset: &str,
     want: &render_core::Settings,
 ) -> Option<&'a Aggregate> {
-    let mut hits = aggs
-        .iter()
-        .filter(|a| a.algorithm == algorithm && a.dataset == dataset && a.settings.includes(want));
+    let mut hits = aggs.iter().filter(|a| {
+        a.algorithm == algorithm
+            && a.dataset == dataset
+            && a.settings.includes(want)
+            && !crate::algorithms::perturbed_beyond(algorithm, &a.settings, want)
+    });
     let first = hits.next()?;
     hits.next().is_none().then_some(first)
 }

@@ -303,16 +303,12 @@ impl VariantSpec {
 
     /// [`Self::matches`] on a variant's algorithm and settings.
     pub(crate) fn matches_variant(&self, algorithm: &str, settings: &Settings) -> bool {
-        let perturbations =
-            crate::algorithms::describe(&self.algorithm).map_or(&[][..], |d| d.perturbations);
         algorithm == self.algorithm
             && self
                 .settings
                 .iter()
                 .all(|(k, v)| settings.get(k) == Some(v))
-            && perturbations
-                .iter()
-                .all(|k| settings.get(k).is_none() || self.settings.get(k).is_some())
+            && !crate::algorithms::perturbed_beyond(algorithm, settings, &self.settings)
     }
 }
 

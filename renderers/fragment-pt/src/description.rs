@@ -24,11 +24,17 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
             meaning: "bucket (moving camera) or merge (still) as the paper; radix, mpvonc, or gpu (no readback)",
             section: "§4",
         },
+        Param {
+            key: "slabs",
+            kind: ValueKind::Int,
+            meaning: "a perturbation, not a configuration: the bucket sort's depth slabs where not the paper's 20 (sort=bucket only; the positive control of the bucket sort's image claim)",
+            section: "ours (positive control of §3.2's and §5's claim)",
+        },
     ],
     // Both shadings × the paper's orders (bucket while moving, merge when still) and the
     // GPU-resident variant.
     default_grid: || grid(&[SortMode::Bucket, SortMode::Merge, SortMode::Gpu]),
-    full_grid: || grid(&SortMode::ALL),
+    full_grid,
     build: |s| Ok(Box::new(FragmentPt::new(from_settings(s)?)) as Box<dyn Renderer>),
     hue: Hue::Greens,
     tolerance,
@@ -45,24 +51,49 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     gpu_layouts: crate::gpu_layouts,
     // The model's bytes per tet are the texel layout's size over the tets (§4).
     counter_evidence: &[("model_bytes_per_tet", CounterEvidence::Layout)],
-    perturbations: &[],
+    perturbations: &["slabs"],
 };
+
+/// The slabs of the bucket sort's positive control: a tenth of the paper's about 20 (§4), so
+/// that cells far apart in depth share a slab and are drawn in their input order.
+pub const CONTROL_SLABS: usize = 2;
 
 fn grid(sorts: &[SortMode]) -> Vec<Settings> {
     [Shading::Average, Shading::Psi]
         .iter()
         .flat_map(|&shading| {
-            sorts
-                .iter()
-                .map(move |&sort| settings_of(&FragmentPtSettings { shading, sort }))
+            sorts.iter().map(move |&sort| {
+                settings_of(&FragmentPtSettings {
+                    shading,
+                    sort,
+                    slabs: None,
+                })
+            })
         })
         .collect()
 }
 
+fn full_grid() -> Vec<Settings> {
+    let mut out = grid(&SortMode::ALL);
+    // The positive control of the bucket sort's image claim (F8): average shading, as the
+    // claim's sides, with a tenth of the paper's slabs.
+    out.push(settings_of(&FragmentPtSettings {
+        shading: Shading::Average,
+        sort: SortMode::Bucket,
+        slabs: Some(CONTROL_SLABS),
+    }));
+    out
+}
+
 pub(crate) fn settings_of(s: &FragmentPtSettings) -> Settings {
-    Settings::new()
+    let settings = Settings::new()
         .with("shading", s.shading.name())
-        .with("sort", s.sort.name())
+        .with("sort", s.sort.name());
+    // A perturbation is written only where set: every other variant keeps its settings.
+    match s.slabs {
+        Some(n) => settings.with("slabs", n as i64),
+        None => settings,
+    }
 }
 
 /// The typed settings of a variant.
@@ -72,9 +103,27 @@ pub fn from_settings(s: &Settings) -> anyhow::Result<FragmentPtSettings> {
         "psi" => Shading::Psi,
         v => anyhow::bail!("fragment-pt: shading={v} is neither average nor psi"),
     };
+    let sort = SortMode::parse(&s.require_text("sort")?)?;
+    let slabs = match s.get("slabs") {
+        None => None,
+        Some(_) => {
+            let n = s.require_int("slabs")?;
+            if sort != SortMode::Bucket {
+                anyhow::bail!(
+                    "fragment-pt: slabs={n} perturbs the bucket sort only, not sort={}",
+                    sort.name()
+                );
+            }
+            match usize::try_from(n) {
+                Ok(n) if n >= 1 => Some(n),
+                _ => anyhow::bail!("fragment-pt: slabs={n} is not a positive count"),
+            }
+        }
+    };
     Ok(FragmentPtSettings {
         shading,
-        sort: SortMode::parse(&s.require_text("sort")?)?,
+        sort,
+        slabs,
     })
 }
 

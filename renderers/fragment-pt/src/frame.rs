@@ -11,8 +11,8 @@ use render_core::{Camera, FrameClock, FrameStats, Gpu};
 
 use crate::classify::ZERO_AREA_REL;
 use crate::{
-    project_params, Pass1Params, Pass2Params, SortMode, State, EXP_ENTRIES, EXP_MAX_TAU, PSI_SIDE,
-    TF_ENTRIES, WORKGROUP,
+    project_params, FragmentPtSettings, Pass1Params, Pass2Params, SortMode, State, EXP_ENTRIES,
+    EXP_MAX_TAU, PSI_SIDE, TF_ENTRIES, WORKGROUP,
 };
 
 pub(crate) fn write_params(gpu: &Gpu, st: &State, camera: &Camera) {
@@ -68,8 +68,9 @@ pub(crate) fn render(
     gpu: &Gpu,
     st: &mut State,
     camera: &Camera,
-    sort_mode: SortMode,
+    settings: &FragmentPtSettings,
 ) -> anyhow::Result<FrameStats> {
+    let sort_mode = settings.sort;
     let mut clock = FrameClock::start();
     write_params(gpu, st, camera);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -87,7 +88,7 @@ pub(crate) fn render(
         _ => {
             clock.submit(gpu, [enc.finish()]);
             enc = gpu.device.create_command_encoder(&Default::default());
-            host_order(gpu, st, camera, sort_mode, &mut clock)?;
+            host_order(gpu, st, camera, settings, &mut clock)?;
         }
     }
     encode_pass2(gpu, &mut enc, st);
@@ -112,9 +113,10 @@ fn host_order(
     gpu: &Gpu,
     st: &mut State,
     camera: &Camera,
-    sort_mode: SortMode,
+    settings: &FragmentPtSettings,
     clock: &mut FrameClock,
 ) -> anyhow::Result<()> {
+    let sort_mode = settings.sort;
     let t0 = Instant::now();
     let keys: Vec<f32> = if sort_mode == SortMode::Mpvonc {
         Vec::new()
@@ -128,7 +130,9 @@ fn host_order(
     let t1 = Instant::now();
     match sort_mode {
         SortMode::Bucket => {
-            sort::bucket_sort_indices(&keys, sort::DEFAULT_SLABS, true, &mut st.indices);
+            // The paper's about 20 slabs (§4), unless a positive control perturbs them.
+            let slabs = settings.bucket_slabs();
+            sort::bucket_sort_indices(&keys, slabs, true, &mut st.indices);
         }
         SortMode::Merge => sort::merge_sort_indices(&keys, true, &mut st.indices, &mut st.merge),
         SortMode::Radix => {

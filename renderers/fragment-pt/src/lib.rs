@@ -102,6 +102,10 @@ impl SortMode {
 pub struct FragmentPtSettings {
     pub shading: Shading,
     pub sort: SortMode,
+    /// A perturbation, not a configuration (the positive control of the bucket sort's image
+    /// claim): the bucket sort's depth slabs where they are not the paper's
+    /// [`sort::DEFAULT_SLABS`] (`None`: the paper's, §4). Only with [`SortMode::Bucket`].
+    pub slabs: Option<usize>,
 }
 
 impl Default for FragmentPtSettings {
@@ -109,7 +113,15 @@ impl Default for FragmentPtSettings {
         FragmentPtSettings {
             shading: Shading::Psi,
             sort: SortMode::Merge,
+            slabs: None,
         }
+    }
+}
+
+impl FragmentPtSettings {
+    /// The depth slabs of the bucket sort: the paper's about 20 unless perturbed.
+    pub fn bucket_slabs(&self) -> usize {
+        self.slabs.unwrap_or(sort::DEFAULT_SLABS)
     }
 }
 
@@ -330,7 +342,7 @@ impl Renderer for FragmentPt {
     }
 
     fn render(&mut self, gpu: &Gpu, camera: &Camera) -> anyhow::Result<FrameStats> {
-        let sort_mode = self.settings.sort;
+        let settings = self.settings;
         let st = self
             .state
             .as_mut()
@@ -350,7 +362,7 @@ impl Renderer for FragmentPt {
                 wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             )?);
         }
-        frame::render(gpu, st, camera, sort_mode)
+        frame::render(gpu, st, camera, &settings)
     }
 
     fn read_image(&mut self, gpu: &Gpu) -> anyhow::Result<Image> {

@@ -99,6 +99,7 @@ fn gpu_pass1_matches_cpu_twin() {
         let mut r = FragmentPt::new(FragmentPtSettings {
             shading: Shading::Average,
             sort: SortMode::Radix,
+            slabs: None,
         });
         r.prepare(&gpu, &mesh, &optics).unwrap();
         let params = r.project_params(&camera).unwrap();
@@ -203,6 +204,7 @@ fn split_bindings_draw_the_same_image() {
         let s = FragmentPtSettings {
             shading: Shading::Psi,
             sort,
+            slabs: None,
         };
         let mut images = Vec::new();
         for r in [

@@ -28,6 +28,7 @@ fn main() -> anyhow::Result<()> {
             early_termination: false,
             max_layers: 32,
             k: raycast::COUNT_EVERY,
+            unscaled: false,
         });
         r.prepare(&gpu, &mesh, &optics)?;
         let layout = r.layout(&mesh, &optics)?;

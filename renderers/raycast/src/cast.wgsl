@@ -86,8 +86,11 @@ fn lookup(s_f: f32, s_b: f32, len: f32, sp: StepParams) -> vec4<f32> {
     let is_3d = (sp.flags & FLAG_TABLE3D) != 0u;
     let w = select(0.5, table_coord(len * sp.inv_table_length, f32(sp.table_lengths)), is_3d);
     let c = textureSampleLevel(table, table_sampler, vec3<f32>(u, v, w), 0.0);
-    // The 2D table holds a segment of the fixed length; the paper's code scales by length.
-    return select(min(c * (len * sp.inv_table_length), vec4<f32>(1.0)), c, is_3d);
+    // The 2D table holds a segment of the fixed length; the paper's code scales by length
+    // (§2.2). The positive control (FLAG_UNSCALED) takes the entry as it stands, as the 3D
+    // table's.
+    let as_is = is_3d || (sp.flags & FLAG_UNSCALED) != 0u;
+    return select(min(c * (len * sp.inv_table_length), vec4<f32>(1.0)), c, as_is);
 }
 
 struct State {

@@ -9,6 +9,8 @@ const TEXELS: u32 = 9u;
 const FLAG_ET: u32 = 1u;
 const FLAG_TABLE3D: u32 = 2u;
 const FLAG_COUNT_DROPPED: u32 = 4u;
+// The 2D table's entry composited without the scaling by length (a positive control only).
+const FLAG_UNSCALED: u32 = 8u;
 
 struct Frame {
     // Pixel ray: origin = o0 + ndc.x·ox + ndc.y·oy, direction = normalize(d0 + ndc.x·dx + ndc.y·dy),

@@ -49,6 +49,12 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
             meaning: "mode=passes: passes between counts of a tile's active rays (the occlusion query)",
             section: "§3.2 (phase 3b); the paper does not give k",
         },
+        Param {
+            key: "unscaled",
+            kind: ValueKind::Int,
+            meaning: "a perturbation, not a configuration: unscaled=1 composites the 2D table's entry without scaling it by the segment's length (table=2d only; the positive control of the 2D table's image claim)",
+            section: "ours (positive control of §2.2's and §4's claim)",
+        },
     ],
     default_grid: || default_settings().iter().map(RaycastSettings::to_settings).collect(),
     full_grid: || all_settings().iter().map(RaycastSettings::to_settings).collect(),
@@ -63,7 +69,7 @@ pub static DESCRIPTION: AlgorithmDescription = AlgorithmDescription {
     gpu_layouts: crate::resources::gpu_layouts,
     // The mesh's bytes per tet are the texel layout's size over the tets (§3.1, its Table 1).
     counter_evidence: &[("mesh_bytes_per_tet", CounterEvidence::Layout)],
-    perturbations: &[],
+    perturbations: &["unscaled"],
 };
 
 /// Measured on the check scene (`tests/vs_reference.rs`, lavapipe): the 3D table 96.5 dB, the

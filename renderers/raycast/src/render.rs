@@ -28,6 +28,9 @@ use peel::peel;
 const FLAG_ET: u32 = 1;
 const FLAG_TABLE3D: u32 = 2;
 const FLAG_COUNT_DROPPED: u32 = 4;
+/// The 2D table's entry composited without the scaling by length (`unscaled=1`, a positive
+/// control; `cast.wgsl`'s `lookup`).
+const FLAG_UNSCALED: u32 = 8;
 
 /// Tiled ray caster (`raycast`).
 pub struct Raycast {
@@ -434,13 +437,14 @@ fn frame_params(
     }
 }
 
-/// The cast's flags: early termination, the 3D table, and counting the dropped re-entries
-/// where the peel drew the spare slot.
+/// The cast's flags: early termination, the 3D table, counting the dropped re-entries where
+/// the peel drew the spare slot, and the unscaled 2D table of the positive control.
 fn cast_flags(s: &RaycastSettings, dropped_check: bool) -> u32 {
     let flag = |on: bool, bit: u32| if on { bit } else { 0 };
     flag(s.early_termination, FLAG_ET)
         | flag(s.table == TableKind::ThreeD, FLAG_TABLE3D)
         | flag(dropped_check, FLAG_COUNT_DROPPED)
+        | flag(s.unscaled, FLAG_UNSCALED)
 }
 
 /// Submits one dispatch of `pipeline` over the mesh and the traversal (a plain pass's flag).

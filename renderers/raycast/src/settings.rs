@@ -56,6 +56,11 @@ pub struct RaycastSettings {
     /// mode=passes: a tile's active rays are counted after every `k` passes (§3.2 phase 3b,
     /// the paper's occlusion query; it does not give k). Default [`crate::COUNT_EVERY`].
     pub k: u32,
+    /// A perturbation, not a configuration (the positive control of the 2D table's image
+    /// claim): the 2D table's entry composited as it stands, without the scaling by the
+    /// segment's length that the paper's code applies (§2.2), so every segment counts as one of
+    /// the table's length. Only with [`TableKind::TwoD`].
+    pub unscaled: bool,
 }
 
 impl Default for RaycastSettings {
@@ -67,19 +72,26 @@ impl Default for RaycastSettings {
             early_termination: true,
             max_layers: 8,
             k: crate::COUNT_EVERY,
+            unscaled: false,
         }
     }
 }
 
 impl RaycastSettings {
     pub fn to_settings(&self) -> Settings {
-        Settings::new()
+        let settings = Settings::new()
             .with("tiles", format!("{0}x{0}", self.tiles))
             .with("table", self.table.name())
             .with("mode", self.mode.name())
             .with("et", self.early_termination)
             .with("layers", self.max_layers)
-            .with("k", self.k)
+            .with("k", self.k);
+        // A perturbation is written only where set: every other variant keeps its settings.
+        if self.unscaled {
+            settings.with("unscaled", 1)
+        } else {
+            settings
+        }
     }
 
     /// The typed settings of a variant, checked by [`RaycastSettings::validate`].
@@ -103,6 +115,13 @@ impl RaycastSettings {
         let layers = s.require_int("layers")?;
         // Rows written before k was a setting ran it at the default.
         let k = s.int("k").unwrap_or(crate::COUNT_EVERY as i64);
+        let unscaled = match s.get("unscaled") {
+            None => false,
+            Some(_) => match s.require_int("unscaled")? {
+                1 => true,
+                v => return Err(anyhow!("raycast: unscaled={v} is not 1 (absent: scaled)")),
+            },
+        };
         let settings = RaycastSettings {
             tiles,
             table,
@@ -111,13 +130,21 @@ impl RaycastSettings {
             max_layers: u32::try_from(layers)
                 .map_err(|_| anyhow!("raycast: layers={layers} is negative"))?,
             k: u32::try_from(k).map_err(|_| anyhow!("raycast: k={k} is negative"))?,
+            unscaled,
         };
         settings.validate()?;
         Ok(settings)
     }
 
-    /// Checks the ranges (tiles 1…6, 1 … 64 layers, k 1 … 64).
+    /// Checks the ranges (tiles 1…6, 1 … 64 layers, k 1 … 64) and that `unscaled` perturbs
+    /// the 2D table only.
     pub fn validate(&self) -> anyhow::Result<()> {
+        if self.unscaled && self.table != TableKind::TwoD {
+            return Err(anyhow!(
+                "raycast: unscaled=1 perturbs the 2D table only, not table={}",
+                self.table.name()
+            ));
+        }
         if !(1..=6).contains(&self.tiles) {
             return Err(anyhow!(
                 "raycast: tiles must be 1x1 … 6x6, got {}",
@@ -183,6 +210,7 @@ pub fn all_settings() -> Vec<RaycastSettings> {
                                 early_termination,
                                 max_layers,
                                 k,
+                                unscaled: false,
                             });
                         }
                     }
@@ -190,5 +218,11 @@ pub fn all_settings() -> Vec<RaycastSettings> {
             }
         }
     }
+    // The positive control of the 2D table's image claim (R8): its variant (5×5 tiles, one pass
+    // per step, early termination, 8 layers) with the entry unscaled.
+    v.push(RaycastSettings {
+        unscaled: true,
+        ..RaycastSettings::default()
+    });
     v
 }

@@ -29,6 +29,7 @@ fn exact() -> RaycastSettings {
         early_termination: false,
         max_layers: 8,
         k: COUNT_EVERY,
+        unscaled: false,
     }
 }
 

@@ -41,6 +41,9 @@ const DATASETS: [(&str, &str); 7] = [
 const FRAGMENT_SETTINGS: &str = "shading=average;sort=bucket";
 /// The order of still frames (§3.2), against which F8 judges the bucket sort's image.
 const MERGE_SETTINGS: &str = "shading=average;sort=merge";
+/// F8's positive control: the bucket sort with a tenth of the paper's about 20 slabs (§4), which
+/// F8's rule must reject against the merge-sorted image.
+const CONTROL_SETTINGS: &str = "shading=average;sort=bucket;slabs=2";
 /// Table 2 rows → tetbench algorithm and settings (None: no tetbench algorithm).
 const TABLE2: [(&str, Option<&str>, &str); 5] = [
     ("GPU CP for Int. VR", Some("fragment-pt"), FRAGMENT_SETTINGS),
@@ -74,12 +77,14 @@ impl PaperModule for FragmentPt {
             .map(|(_, d)| d)
             .into_iter()
             .partition(|d| *d == "brain");
-        // Claim F8: the merge sort the paper draws still frames with, on the data sets of F2,
-        // at the main run's viewpoints and viewport so each image pairs with a bucket-sorted one.
+        // Claim F8: the merge sort the paper draws still frames with, and its positive control,
+        // on the data sets of F2, at the main run's viewpoints and viewport so each image pairs
+        // with a bucket-sorted one.
         let f2: Vec<&str> = others.iter().copied().filter(|d| *d != "fuel").collect();
         let mut plan = vec![
             run("fragment-pt", &others, FRAGMENT_SETTINGS),
             run("fragment-pt-merge", &f2, MERGE_SETTINGS),
+            run("fragment-pt-control", &f2, CONTROL_SETTINGS),
             // §5's 5.5 M tets on a 256 MB board (claim F7) is judged on the device bytes of
             // the Brain row, which depend on the viewport: 512² in every mode.
             RunSpec {

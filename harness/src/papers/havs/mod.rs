@@ -61,9 +61,10 @@ const HAVS_SETTINGS: &str = "k=2|6;sort=cpu-radix;et=off";
 /// Claims H12 and H13 (image quality): the race-free pass at the hardware's k and at k = 16,
 /// rendered at the main run's viewpoints and viewport so that each image pairs with one of it.
 const RACE_FREE_SETTINGS: &str = "k=6|16;sort=cpu-radix;et=off;mode=race-free";
-/// H12's positive control: the race-free pass at k = 1 on spx2 (the paper's own mesh, where
-/// pixels need up to 15 entries), which H12's rule must reject against k = 16.
-const CONTROL_SETTINGS: &str = "k=1;sort=cpu-radix;et=off;mode=race-free";
+/// The positive controls of H12 and H13 on spx2 (the paper's own mesh, where pixels need up
+/// to 15 entries): the race-free pass at k = 1, which H12's rule must reject against k = 16,
+/// and the racy pass at k = 1, which H13's must reject against the race-free pass at k = 6.
+const CONTROL_SETTINGS: &str = "k=1;sort=cpu-radix;et=off;mode=race-free|fragment-race";
 const CONTROL_DATASET: &str = "spx2";
 
 /// The HAVS paper.

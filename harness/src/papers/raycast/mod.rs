@@ -39,6 +39,11 @@ const PAPER_BYTES_PER_TET: f64 = 144.0;
 /// The peeling layers of Table 4's runs, which keep them out of the timing tables.
 const PASSES_LAYERS: &str = "32";
 
+/// R8's positive control: R8's 2D-table variant (5×5 tiles, one pass per step, the main run's
+/// k) with the table's entry unscaled by the segment's length (§2.2), which R8's rule must
+/// reject against the 3D table's image.
+const CONTROL_SETTINGS: &str = "tiles=5x5;table=2d;mode=passes;et=on;k=8;unscaled=1";
+
 /// A run of Table 4's counts with `settings`: the paper's viewport and views in every mode.
 fn passes_run(name: &str, settings: &str) -> RunSpec {
     RunSpec {
@@ -86,6 +91,15 @@ impl PaperModule for Raycast {
             passes_run("passes", PASSES_RUN),
             passes_run("passes-tiled", TILED_RUN),
             passes_run("walks", WALKS_RUN),
+            // R8's positive control, at the main run's viewpoints and viewport so that each of
+            // its images pairs with a 3D-table image.
+            RunSpec::new(
+                "raycast-control",
+                "raycast",
+                &DATASETS.map(|(_, d)| d),
+                "14",
+                Some(CONTROL_SETTINGS),
+            ),
         ]
     }
 
@@ -103,8 +117,12 @@ fn rows_of<'a>(
     m.rows
         .iter()
         .filter(|r| r.algorithm == "raycast" && r.dataset == dataset && r.ok())
-        // The passes run (Table 4) is not part of the timing tables.
+        // The passes run (Table 4) is not part of the timing tables, nor is R8's positive
+        // control (the unscaled 2D table).
         .filter(|r| !r.settings.is("layers", PASSES_LAYERS))
+        .filter(|r| {
+            !crate::algorithms::perturbed_beyond("raycast", &r.settings, &Default::default())
+        })
         .filter(|r| tiles.is_none_or(|t| r.settings.is("tiles", t)))
         .filter(|r| table.is_none_or(|t| r.settings.is("table", t)))
         .collect()
